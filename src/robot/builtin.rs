@@ -1,0 +1,63 @@
+//! The built-in robots, embedded as URDF text and parsed once on first use.
+//! `tools/gen_builtin_urdf.py` writes the URDFs from the published data.
+
+use std::sync::{Arc, OnceLock};
+
+use super::{Chain, ChainSpec, RobotError, UrdfLimits, parse_chain};
+
+macro_rules! builtins {
+    ($($name:literal),* $(,)?) => {
+        /// Names of the built-in robots.
+        pub const BUILTIN_NAMES: &[&str] = &[$($name),*];
+        const BUILTIN_URDFS: &[&str] = &[$(include_str!(concat!("builtin/", $name, ".urdf"))),*];
+    };
+}
+
+builtins!(
+    "kuka_kr210_r2700_extra",
+    "kuka_kr120_r2500_pro",
+    "abb_irb4600_60_205",
+    "ur5",
+    "franka_panda",
+    "kuka_lbr_iiwa14_r820",
+    "planar_2",
+    "planar_3",
+    "planar_4",
+    "planar_5",
+    "planar_6",
+    "planar_7",
+    "planar_8",
+    "planar_9",
+    "planar_10",
+);
+
+/// The URDF text of a built-in robot.
+pub fn builtin_urdf(name: &str) -> Result<&'static str, RobotError> {
+    BUILTIN_NAMES
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| BUILTIN_URDFS[i])
+        .ok_or_else(|| RobotError::UnknownRobot {
+            name: name.into(),
+            known: BUILTIN_NAMES.join(", "),
+        })
+}
+
+/// The default chain (base_link → tool tip) of a built-in robot, parsed once.
+pub fn builtin_chain(name: &str) -> Result<Arc<Chain>, RobotError> {
+    static CHAINS: OnceLock<Vec<OnceLock<Arc<Chain>>>> = OnceLock::new();
+    let index = BUILTIN_NAMES
+        .iter()
+        .position(|n| *n == name)
+        .ok_or_else(|| RobotError::UnknownRobot {
+            name: name.into(),
+            known: BUILTIN_NAMES.join(", "),
+        })?;
+    let cells = CHAINS.get_or_init(|| BUILTIN_NAMES.iter().map(|_| OnceLock::new()).collect());
+    let chain = cells[index].get_or_init(|| {
+        let chain = parse_chain(BUILTIN_URDFS[index], &ChainSpec::default(), UrdfLimits::default())
+            .expect("built-in URDFs are valid (checked by tests)");
+        Arc::new(chain)
+    });
+    Ok(chain.clone())
+}

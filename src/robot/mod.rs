@@ -1,0 +1,17 @@
+//! Robot models: URDF text turned into immutable serial chains with forward
+//! kinematics, geometric Jacobians and collision primitives.
+
+mod builtin;
+mod chain;
+mod error;
+mod geometry;
+mod urdf;
+
+pub use builtin::{BUILTIN_NAMES, builtin_chain, builtin_urdf};
+pub use chain::{Chain, Joint, JointKind, LinkFrame};
+pub use error::RobotError;
+pub use geometry::{CollisionShape, LinkCollision, Shape};
+pub use urdf::{ChainSpec, UrdfLimits, parse_chain};
+
+#[cfg(test)]
+mod tests;

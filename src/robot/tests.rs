@@ -1,0 +1,284 @@
+//! Built-in models checked against kinematics written independently from the
+//! published tables: Denavit–Hartenberg products and hand-derived poses.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use nalgebra::{Isometry3, Matrix4, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::*;
+
+/// Standard DH link transform Rz(θ) Tz(d) Tx(a) Rx(α) as a 4×4 matrix.
+fn dh(theta: f64, d: f64, a: f64, alpha: f64) -> Matrix4<f64> {
+    let (st, ct) = theta.sin_cos();
+    let (sa, ca) = alpha.sin_cos();
+    Matrix4::new(
+        ct, -st * ca, st * sa, a * ct, //
+        st, ct * ca, -ct * sa, a * st, //
+        0.0, sa, ca, d, //
+        0.0, 0.0, 0.0, 1.0,
+    )
+}
+
+/// Modified (Craig) DH link transform Rx(α) Tx(a) Rz(θ) Tz(d).
+fn craig(alpha: f64, a: f64, theta: f64, d: f64) -> Matrix4<f64> {
+    let (st, ct) = theta.sin_cos();
+    let (sa, ca) = alpha.sin_cos();
+    Matrix4::new(
+        ct, -st, 0.0, a, //
+        st * ca, ct * ca, -sa, -sa * d, //
+        st * sa, ct * sa, ca, ca * d, //
+        0.0, 0.0, 0.0, 1.0,
+    )
+}
+
+fn rot_z(angle: f64) -> Matrix4<f64> {
+    dh(angle, 0.0, 0.0, 0.0)
+}
+
+/// Tool pose from a DH table: rows (θ offset, θ sign, d, a, α), then `tool`.
+fn dh_chain(rows: &[(f64, f64, f64, f64, f64)], q: &[f64], tool: Matrix4<f64>) -> Matrix4<f64> {
+    rows.iter()
+        .zip(q)
+        .fold(Matrix4::<f64>::identity(), |t, (&(off, sign, d, a, alpha), &qi)| {
+            t * dh(off + sign * qi, d, a, alpha)
+        })
+        * tool
+}
+
+/// KUKA KR 210 / KR 120: standard DH derived by hand from the table, with the
+/// controller's signs (A1 about −z, A4 and A6 about −x) as θ = −q.
+fn kuka_dh(d4: f64, q: &[f64]) -> Matrix4<f64> {
+    let rows = [
+        (0.0, -1.0, 0.675, 0.35, -FRAC_PI_2),
+        (0.0, 1.0, 0.0, 1.15, 0.0),
+        (FRAC_PI_2, 1.0, 0.0, 0.041, FRAC_PI_2),
+        (0.0, -1.0, d4, 0.0, -FRAC_PI_2),
+        (0.0, 1.0, 0.0, 0.0, FRAC_PI_2),
+        (0.0, -1.0, 0.215, 0.0, 0.0),
+    ];
+    dh_chain(&rows, q, Matrix4::identity())
+}
+
+/// ABB IRB 4600-60/2.05: standard DH derived by hand (θ2 offset −90°); the
+/// ROS-Industrial tool0 has x opposite to DH x6, hence Rz(π).
+fn abb_dh(q: &[f64]) -> Matrix4<f64> {
+    let rows = [
+        (0.0, 1.0, 0.495, 0.175, -FRAC_PI_2),
+        (-FRAC_PI_2, 1.0, 0.0, 0.9, 0.0),
+        (0.0, 1.0, 0.0, 0.175, -FRAC_PI_2),
+        (0.0, 1.0, 0.96, 0.0, FRAC_PI_2),
+        (0.0, 1.0, 0.0, 0.0, -FRAC_PI_2),
+        (0.0, 1.0, 0.135, 0.0, 0.0),
+    ];
+    dh_chain(&rows, q, rot_z(PI))
+}
+
+fn ur5_dh(q: &[f64]) -> Matrix4<f64> {
+    let d = [0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823];
+    let a = [0.0, -0.425, -0.39225, 0.0, 0.0, 0.0];
+    let alpha = [FRAC_PI_2, 0.0, 0.0, FRAC_PI_2, -FRAC_PI_2, 0.0];
+    let rows: Vec<_> = (0..6).map(|i| (0.0, 1.0, d[i], a[i], alpha[i])).collect();
+    dh_chain(&rows, q, Matrix4::identity())
+}
+
+fn iiwa_dh(q: &[f64]) -> Matrix4<f64> {
+    let d = [0.36, 0.0, 0.42, 0.0, 0.4, 0.0, 0.081];
+    let alpha = [-FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, -FRAC_PI_2, -FRAC_PI_2, FRAC_PI_2, 0.0];
+    let rows: Vec<_> = (0..7).map(|i| (0.0, 1.0, d[i], 0.0, alpha[i])).collect();
+    dh_chain(&rows, q, Matrix4::identity())
+}
+
+fn panda_craig(q: &[f64]) -> Matrix4<f64> {
+    let a = [0.0, 0.0, 0.0, 0.0825, -0.0825, 0.0, 0.088];
+    let d = [0.333, 0.0, 0.316, 0.0, 0.384, 0.0, 0.0];
+    let alpha = [0.0, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2];
+    (0..7).fold(Matrix4::<f64>::identity(), |t, i| t * craig(alpha[i], a[i], q[i], d[i]))
+        * craig(0.0, 0.0, 0.0, 0.107)
+}
+
+fn planar(n: usize, q: &[f64]) -> Matrix4<f64> {
+    let rows: Vec<_> = (0..n).map(|_| (0.0, 1.0, 0.0, 1.0 / n as f64, 0.0)).collect();
+    dh_chain(&rows, q, Matrix4::identity())
+}
+
+fn reference(name: &str, q: &[f64]) -> Matrix4<f64> {
+    match name {
+        "kuka_kr210_r2700_extra" => kuka_dh(1.2, q),
+        "kuka_kr120_r2500_pro" => kuka_dh(1.0, q),
+        "abb_irb4600_60_205" => abb_dh(q),
+        "ur5" => ur5_dh(q),
+        "franka_panda" => panda_craig(q),
+        "kuka_lbr_iiwa14_r820" => iiwa_dh(q),
+        planar_n => planar(planar_n["planar_".len()..].parse().unwrap(), q),
+    }
+}
+
+fn random_q(chain: &Chain, rng: &mut ChaCha8Rng) -> Vec<f64> {
+    chain
+        .limits()
+        .map(|(lo, hi)| rng.random_range(lo.max(-PI)..=hi.min(PI)))
+        .collect()
+}
+
+#[test]
+fn every_builtin_matches_its_published_kinematics() {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    for name in BUILTIN_NAMES {
+        let chain = builtin_chain(name).unwrap();
+        for _ in 0..200 {
+            let q = random_q(&chain, &mut rng);
+            let ours = chain.fk(&q).to_homogeneous();
+            let theirs = reference(name, &q);
+            let dp = (ours.fixed_view::<3, 1>(0, 3) - theirs.fixed_view::<3, 1>(0, 3)).norm();
+            let dr = (ours.fixed_view::<3, 3>(0, 0) - theirs.fixed_view::<3, 3>(0, 0)).norm();
+            assert!(dp < 1e-9, "{name}: position differs by {dp} m at {q:?}");
+            assert!(dr < 1e-9, "{name}: orientation differs by {dr} at {q:?}");
+        }
+    }
+}
+
+#[test]
+fn zero_poses_match_hand_derived_positions() {
+    let cases: [(&str, Vector3<f64>); 6] = [
+        // Arm stretched forward: 350 + 1150 + 1200 + 215 mm, height 675 − 41 mm.
+        ("kuka_kr210_r2700_extra", Vector3::new(2.915, 0.0, 0.634)),
+        ("kuka_kr120_r2500_pro", Vector3::new(2.715, 0.0, 0.634)),
+        // Arm 2 vertical: x = 175 + 960 + 135, z = 495 + 900 + 175 mm.
+        ("abb_irb4600_60_205", Vector3::new(1.27, 0.0, 1.57)),
+        // UR5 zero: x = a2 + a3, y = −(d4 + d6)... in the DH base frame.
+        ("ur5", Vector3::new(-0.81725, -0.19145, -0.005491)),
+        ("kuka_lbr_iiwa14_r820", Vector3::new(0.0, 0.0, 1.261)),
+        ("planar_4", Vector3::new(1.0, 0.0, 0.0)),
+    ];
+    for (name, expected) in cases {
+        let chain = builtin_chain(name).unwrap();
+        let p = chain.fk(&vec![0.0; chain.dof()]).translation.vector;
+        assert!((p - expected).norm() < 1e-9, "{name}: {p:?} vs {expected:?}");
+    }
+}
+
+#[test]
+fn jacobian_matches_finite_differences() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let h = 1e-6;
+    for name in BUILTIN_NAMES {
+        let chain = builtin_chain(name).unwrap();
+        for _ in 0..20 {
+            let q = random_q(&chain, &mut rng);
+            let jac = chain.jacobian(&q);
+            let t0 = chain.fk(&q);
+            for i in 0..chain.dof() {
+                let mut qp = q.clone();
+                let mut qm = q.clone();
+                qp[i] += h;
+                qm[i] -= h;
+                let (tp, tm) = (chain.fk(&qp), chain.fk(&qm));
+                let v = (tp.translation.vector - tm.translation.vector) / (2.0 * h);
+                // Angular velocity from the rotation difference R(q+h) R(q−h)ᵀ.
+                let w = (tp.rotation * tm.rotation.inverse()).scaled_axis() / (2.0 * h);
+                let col = jac.column(i);
+                let err_v = (col.fixed_rows::<3>(0) - v).norm();
+                let err_w = (col.fixed_rows::<3>(3) - w).norm();
+                assert!(err_v < 1e-6 && err_w < 1e-6, "{name} joint {i}: {err_v} {err_w}");
+            }
+            let _ = t0;
+        }
+    }
+}
+
+#[test]
+fn link_frames_end_at_the_tip() {
+    let chain = builtin_chain("franka_panda").unwrap();
+    let q = [0.1, -0.4, 0.3, -2.0, 0.2, 1.5, 0.7];
+    let mut frames = Vec::new();
+    chain.link_frames_into(&q, &mut frames);
+    assert_eq!(frames.len(), chain.links().len());
+    let tip: Isometry3<f64> = *frames.last().unwrap();
+    assert!((tip.to_homogeneous() - chain.fk(&q).to_homogeneous()).norm() < 1e-12);
+    assert_eq!(chain.links()[0].name, "base_link");
+}
+
+#[test]
+fn prismatic_and_fixed_joints_compose() {
+    let urdf = r#"<robot name="slide">
+      <link name="a"/><link name="b"/><link name="c"/><link name="d"/>
+      <joint name="j1" type="prismatic"><parent link="a"/><child link="b"/>
+        <origin xyz="0 0 1" rpy="0 0 0"/><axis xyz="1 0 0"/>
+        <limit lower="0" upper="2" effort="1" velocity="0.5"/></joint>
+      <joint name="f" type="fixed"><parent link="b"/><child link="c"/>
+        <origin xyz="0 1 0" rpy="0 0 1.5707963267948966"/></joint>
+      <joint name="j2" type="continuous"><parent link="c"/><child link="d"/>
+        <origin xyz="0.5 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/></joint>
+    </robot>"#;
+    let chain = parse_chain(urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap();
+    assert_eq!(chain.dof(), 2);
+    assert_eq!(chain.joints()[0].max_velocity, Some(0.5));
+    assert!(chain.joints()[1].upper.is_infinite());
+    // Slide 0.7 along x, then (0,1,0), then the yawed frame puts (0.5,0,0) along +y.
+    let p = chain.fk(&[0.7, 0.3]).translation.vector;
+    assert!((p - Vector3::new(0.7, 1.5, 1.0)).norm() < 1e-12, "{p:?}");
+    let jac = chain.jacobian(&[0.7, 0.3]);
+    assert!((jac.column(0) - nalgebra::Vector6::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0)).norm() < 1e-12);
+}
+
+#[test]
+fn bad_urdfs_are_rejected_with_reasons() {
+    let spec = ChainSpec::default();
+    let limits = UrdfLimits::default();
+    let err = |text: &str| parse_chain(text, &spec, limits).unwrap_err();
+    assert!(matches!(err(""), RobotError::MalformedUrdf(_)));
+    assert!(matches!(err("<robot"), RobotError::MalformedUrdf(_)));
+    assert!(matches!(err("not xml at all"), RobotError::MalformedUrdf(_)));
+    let two_tips = r#"<robot name="y"><link name="a"/><link name="b"/><link name="c"/>
+      <joint name="j1" type="fixed"><parent link="a"/><child link="b"/></joint>
+      <joint name="j2" type="fixed"><parent link="a"/><child link="c"/></joint></robot>"#;
+    assert!(matches!(err(two_tips), RobotError::AmbiguousTip { .. }));
+    let spec_bc = ChainSpec {
+        base_link: Some("b".into()),
+        tip_link: Some("c".into()),
+    };
+    assert!(matches!(
+        parse_chain(two_tips, &spec_bc, limits).unwrap_err(),
+        RobotError::NotSerialChain { .. }
+    ));
+    let spec_x = ChainSpec {
+        base_link: None,
+        tip_link: Some("x".into()),
+    };
+    assert!(matches!(
+        parse_chain(two_tips, &spec_x, limits).unwrap_err(),
+        RobotError::UnknownLink { .. }
+    ));
+    let nan = r#"<robot name="n"><link name="a"/><link name="b"/>
+      <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+      <origin xyz="0 NaN 0" rpy="0 0 0"/><axis xyz="0 0 1"/>
+      <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>"#;
+    assert!(matches!(err(nan), RobotError::NonFiniteValue { .. }));
+    let floating = r#"<robot name="f"><link name="a"/><link name="b"/>
+      <joint name="j" type="floating"><parent link="a"/><child link="b"/></joint></robot>"#;
+    assert!(matches!(err(floating), RobotError::UnsupportedJoint { .. }));
+    let small = UrdfLimits {
+        max_bytes: 10,
+        max_elements: 5,
+    };
+    assert!(matches!(
+        parse_chain(nan, &spec, small).unwrap_err(),
+        RobotError::UrdfTooLarge { .. }
+    ));
+}
+
+#[test]
+fn mesh_files_are_reported_not_read() {
+    let urdf = r#"<robot name="m"><link name="a"><collision><geometry>
+      <mesh filename="/etc/passwd"/></geometry></collision></link></robot>"#;
+    let chain = parse_chain(urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap();
+    assert_eq!(chain.dof(), 0);
+    assert_eq!(
+        chain.collision()[0].shapes[0].shape,
+        Shape::MeshReference {
+            filename: "/etc/passwd".into()
+        }
+    );
+}
