@@ -8,7 +8,11 @@ pub enum RobotError {
     #[error("URDF is {size} bytes, more than the limit of {limit} bytes")]
     UrdfTooLarge { size: usize, limit: usize },
     #[error("URDF has {count} {what}, more than the limit of {limit}")]
-    TooManyElements { what: &'static str, count: usize, limit: usize },
+    TooManyElements {
+        what: &'static str,
+        count: usize,
+        limit: usize,
+    },
     #[error("URDF value {field} is not finite")]
     NonFiniteValue { field: String },
     #[error("unknown link `{link}`")]

@@ -8,14 +8,26 @@ use nalgebra::{Isometry3, Vector3};
 #[derive(Debug, Clone, PartialEq)]
 pub enum Shape {
     /// Half extents along x, y, z.
-    Box { half_extents: Vector3<f64> },
+    Box {
+        half_extents: Vector3<f64>,
+    },
     /// Radius and full length along z.
-    Cylinder { radius: f64, length: f64 },
+    Cylinder {
+        radius: f64,
+        length: f64,
+    },
     /// Radius and the distance between the two cap centres, along z.
-    Capsule { radius: f64, length: f64 },
-    Sphere { radius: f64 },
+    Capsule {
+        radius: f64,
+        length: f64,
+    },
+    Sphere {
+        radius: f64,
+    },
     /// A mesh named by file: never read from disk, only reported.
-    MeshReference { filename: String },
+    MeshReference {
+        filename: String,
+    },
 }
 
 /// One shape placed in a link frame.

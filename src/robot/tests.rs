@@ -14,10 +14,22 @@ fn dh(theta: f64, d: f64, a: f64, alpha: f64) -> Matrix4<f64> {
     let (st, ct) = theta.sin_cos();
     let (sa, ca) = alpha.sin_cos();
     Matrix4::new(
-        ct, -st * ca, st * sa, a * ct, //
-        st, ct * ca, -ct * sa, a * st, //
-        0.0, sa, ca, d, //
-        0.0, 0.0, 0.0, 1.0,
+        ct,
+        -st * ca,
+        st * sa,
+        a * ct, //
+        st,
+        ct * ca,
+        -ct * sa,
+        a * st, //
+        0.0,
+        sa,
+        ca,
+        d, //
+        0.0,
+        0.0,
+        0.0,
+        1.0,
     )
 }
 
@@ -26,10 +38,22 @@ fn craig(alpha: f64, a: f64, theta: f64, d: f64) -> Matrix4<f64> {
     let (st, ct) = theta.sin_cos();
     let (sa, ca) = alpha.sin_cos();
     Matrix4::new(
-        ct, -st, 0.0, a, //
-        st * ca, ct * ca, -sa, -sa * d, //
-        st * sa, ct * sa, ca, ca * d, //
-        0.0, 0.0, 0.0, 1.0,
+        ct,
+        -st,
+        0.0,
+        a, //
+        st * ca,
+        ct * ca,
+        -sa,
+        -sa * d, //
+        st * sa,
+        ct * sa,
+        ca,
+        ca * d, //
+        0.0,
+        0.0,
+        0.0,
+        1.0,
     )
 }
 
@@ -39,12 +63,10 @@ fn rot_z(angle: f64) -> Matrix4<f64> {
 
 /// Tool pose from a DH table: rows (θ offset, θ sign, d, a, α), then `tool`.
 fn dh_chain(rows: &[(f64, f64, f64, f64, f64)], q: &[f64], tool: Matrix4<f64>) -> Matrix4<f64> {
-    rows.iter()
-        .zip(q)
-        .fold(Matrix4::<f64>::identity(), |t, (&(off, sign, d, a, alpha), &qi)| {
-            t * dh(off + sign * qi, d, a, alpha)
-        })
-        * tool
+    rows.iter().zip(q).fold(
+        Matrix4::<f64>::identity(),
+        |t, (&(off, sign, d, a, alpha), &qi)| t * dh(off + sign * qi, d, a, alpha),
+    ) * tool
 }
 
 /// KUKA KR 210 / KR 120: standard DH derived by hand from the table, with the
@@ -85,7 +107,9 @@ fn ur5_dh(q: &[f64]) -> Matrix4<f64> {
 
 fn iiwa_dh(q: &[f64]) -> Matrix4<f64> {
     let d = [0.36, 0.0, 0.42, 0.0, 0.4, 0.0, 0.081];
-    let alpha = [-FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, -FRAC_PI_2, -FRAC_PI_2, FRAC_PI_2, 0.0];
+    let alpha = [
+        -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, -FRAC_PI_2, -FRAC_PI_2, FRAC_PI_2, 0.0,
+    ];
     let rows: Vec<_> = (0..7).map(|i| (0.0, 1.0, d[i], 0.0, alpha[i])).collect();
     dh_chain(&rows, q, Matrix4::identity())
 }
@@ -93,9 +117,12 @@ fn iiwa_dh(q: &[f64]) -> Matrix4<f64> {
 fn panda_craig(q: &[f64]) -> Matrix4<f64> {
     let a = [0.0, 0.0, 0.0, 0.0825, -0.0825, 0.0, 0.088];
     let d = [0.333, 0.0, 0.316, 0.0, 0.384, 0.0, 0.0];
-    let alpha = [0.0, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2];
-    (0..7).fold(Matrix4::<f64>::identity(), |t, i| t * craig(alpha[i], a[i], q[i], d[i]))
-        * craig(0.0, 0.0, 0.0, 0.107)
+    let alpha = [
+        0.0, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2,
+    ];
+    (0..7).fold(Matrix4::<f64>::identity(), |t, i| {
+        t * craig(alpha[i], a[i], q[i], d[i])
+    }) * craig(0.0, 0.0, 0.0, 0.107)
 }
 
 fn planar(n: usize, q: &[f64]) -> Matrix4<f64> {

@@ -119,12 +119,7 @@ impl<'a> Tree<'a> {
     }
 
     fn leaf(&self) -> Result<&'a str, RobotError> {
-        let parents: HashSet<&str> = self
-            .robot
-            .joints
-            .iter()
-            .map(|j| j.parent.link.as_str())
-            .collect();
+        let parents: HashSet<&str> = self.robot.joints.iter().map(|j| j.parent.link.as_str()).collect();
         let leaves: Vec<&str> = self
             .robot
             .links
@@ -263,9 +258,7 @@ fn moving_joint(
     let name = &joint.name;
     finite(&joint.axis.xyz[..], || format!("{name}.axis"))?;
     let axis = Vector3::new(joint.axis.xyz[0], joint.axis.xyz[1], joint.axis.xyz[2]);
-    let axis = Unit::try_new(axis, 1e-12).ok_or_else(|| RobotError::ZeroAxis {
-        joint: name.clone(),
-    })?;
+    let axis = Unit::try_new(axis, 1e-12).ok_or_else(|| RobotError::ZeroAxis { joint: name.clone() })?;
     let limit = &joint.limit;
     let (lower, upper) = match kind {
         JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),

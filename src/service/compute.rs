@@ -1,0 +1,190 @@
+//! Admission control and the CPU pool. Every request takes an admission
+//! permit (or is shed with RESOURCE_EXHAUSTED); long computations run on a
+//! dedicated rayon pool, never on the async runtime, and see the request's
+//! deadline and cancellation through a [`Budget`].
+
+use std::panic::AssertUnwindSafe;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use tokio::sync::{OwnedSemaphorePermit, Semaphore, oneshot};
+use tonic::Status;
+
+/// What a running computation may spend: a deadline and a cancellation flag
+/// raised when the caller goes away.
+#[derive(Debug, Clone)]
+pub struct Budget {
+    deadline: Option<Instant>,
+    cancelled: Arc<AtomicBool>,
+}
+
+impl Budget {
+    pub fn new(deadline: Option<Instant>) -> Self {
+        Self {
+            deadline,
+            cancelled: Arc::new(AtomicBool::new(false)),
+        }
+    }
+
+    pub fn deadline(&self) -> Option<Instant> {
+        self.deadline
+    }
+
+    /// True once the deadline has passed or the caller has gone.
+    pub fn should_stop(&self) -> bool {
+        self.cancelled.load(Ordering::Relaxed) || self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+}
+
+/// Raises the cancellation flag when the request's future is dropped.
+struct CancelOnDrop(Arc<AtomicBool>);
+
+impl Drop for CancelOnDrop {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+}
+
+/// The server's CPU pool and admission limit.
+pub struct Compute {
+    pool: rayon::ThreadPool,
+    admitted: Arc<Semaphore>,
+    limit: usize,
+    default_timeout: Option<Duration>,
+}
+
+impl Compute {
+    /// `threads` workers (0: one per core), at most `concurrency` requests in
+    /// the server at once, `default_timeout` for requests without a deadline.
+    pub fn new(threads: usize, concurrency: usize, default_timeout: Option<Duration>) -> Self {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(|i| format!("kinplan-cpu-{i}"))
+            .build()
+            .expect("the CPU pool starts");
+        let limit = concurrency.max(1);
+        Self {
+            pool,
+            admitted: Arc::new(Semaphore::new(limit)),
+            limit,
+            default_timeout,
+        }
+    }
+
+    /// Admits a request or sheds it; the permit is held until the reply.
+    pub fn admit<T>(&self, request: &tonic::Request<T>) -> Result<(OwnedSemaphorePermit, Budget), Status> {
+        let permit = self.admitted.clone().try_acquire_owned().map_err(|_| {
+            metrics::counter!("kinplan_requests_shed_total").increment(1);
+            Status::resource_exhausted(format!(
+                "server busy: {} requests in flight; retry with backoff",
+                self.limit
+            ))
+        })?;
+        let timeout = match (grpc_timeout(request.metadata()), self.default_timeout) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        Ok((permit, Budget::new(timeout.map(|t| Instant::now() + t))))
+    }
+
+    /// Runs `work` on the CPU pool. Answers DEADLINE_EXCEEDED when the
+    /// deadline passes first (the work sees `should_stop()` and ends early)
+    /// and INTERNAL if the work panics.
+    pub async fn run<T, F>(&self, budget: &Budget, work: F) -> Result<T, Status>
+    where
+        T: Send + 'static,
+        F: FnOnce(&Budget) -> T + Send + 'static,
+    {
+        if budget.should_stop() {
+            return Err(deadline_exceeded());
+        }
+        let _cancel_on_drop = CancelOnDrop(budget.cancelled.clone());
+        let (tx, rx) = oneshot::channel();
+        let inner = budget.clone();
+        self.pool.spawn(move || {
+            if inner.should_stop() {
+                return;
+            }
+            let out = std::panic::catch_unwind(AssertUnwindSafe(|| work(&inner)));
+            let _ = tx.send(out);
+        });
+        let received = match budget.deadline {
+            Some(deadline) => tokio::time::timeout_at(deadline.into(), rx)
+                .await
+                .map_err(|_| deadline_exceeded())?,
+            None => rx.await,
+        };
+        match received {
+            Ok(Ok(value)) => Ok(value),
+            Ok(Err(_panic)) => {
+                tracing::error!("a computation panicked");
+                Err(Status::internal("the computation failed unexpectedly"))
+            }
+            Err(_dropped) => Err(deadline_exceeded()),
+        }
+    }
+}
+
+fn deadline_exceeded() -> Status {
+    Status::deadline_exceeded("the request's deadline passed before the work finished")
+}
+
+/// Parses the `grpc-timeout` header: up to 8 digits and a unit (H M S m u n).
+fn grpc_timeout(metadata: &tonic::metadata::MetadataMap) -> Option<Duration> {
+    let value = metadata.get("grpc-timeout")?.to_str().ok()?;
+    let (digits, unit) = value.split_at(value.len().checked_sub(1)?);
+    let n: u64 = digits.parse().ok()?;
+    Some(match unit {
+        "H" => Duration::from_secs(n.saturating_mul(3600)),
+        "M" => Duration::from_secs(n.saturating_mul(60)),
+        "S" => Duration::from_secs(n),
+        "m" => Duration::from_millis(n),
+        "u" => Duration::from_micros(n),
+        "n" => Duration::from_nanos(n),
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grpc_timeout_units() {
+        let mut md = tonic::metadata::MetadataMap::new();
+        md.insert("grpc-timeout", "250m".parse().unwrap());
+        assert_eq!(grpc_timeout(&md), Some(Duration::from_millis(250)));
+        md.insert("grpc-timeout", "3S".parse().unwrap());
+        assert_eq!(grpc_timeout(&md), Some(Duration::from_secs(3)));
+        md.insert("grpc-timeout", "x".parse().unwrap());
+        assert_eq!(grpc_timeout(&md), None);
+    }
+
+    #[tokio::test]
+    async fn shed_when_full_and_deadline_stops_work() {
+        let compute = Compute::new(1, 1, None);
+        let req = tonic::Request::new(());
+        let (permit, _) = compute.admit(&req).unwrap();
+        let err = compute.admit(&req).unwrap_err();
+        assert_eq!(err.code(), tonic::Code::ResourceExhausted);
+        drop(permit);
+        let budget = Budget::new(Some(Instant::now() + Duration::from_millis(50)));
+        let started = Instant::now();
+        let result = compute
+            .run(&budget, |b| {
+                while !b.should_stop() {
+                    std::hint::spin_loop();
+                }
+                1
+            })
+            .await;
+        // Either the work saw the deadline and returned, or the timer fired.
+        assert!(result.is_ok() || result.unwrap_err().code() == tonic::Code::DeadlineExceeded);
+        assert!(started.elapsed() < Duration::from_secs(2));
+        let panicking = compute
+            .run(&Budget::new(None), |_| -> i32 { panic!("boom") })
+            .await;
+        assert_eq!(panicking.unwrap_err().code(), tonic::Code::Internal);
+    }
+}

@@ -1,0 +1,18 @@
+//! The gRPC edge: one thin adapter per service that validates and converts
+//! proto messages into domain values, runs the work and maps errors to
+//! `tonic::Status`. Only this layer (and `main.rs`) knows about tonic.
+
+pub mod pb;
+
+mod compute;
+#[allow(dead_code)] // helpers for the request types of services still to come
+mod convert;
+mod metrics;
+mod models;
+mod robot;
+mod server;
+mod status;
+
+pub use compute::{Budget, Compute};
+pub use models::ModelStore;
+pub use server::{HANDLING_BUCKETS, ServerConfig, serve};

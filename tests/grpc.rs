@@ -1,0 +1,299 @@
+//! End-to-end: starts the real server on a free loopback port and calls it
+//! over gRPC, as clients do.
+
+use std::time::Duration;
+
+use kinplan::service::pb::{self, robot_ref::Source, robot_service_client::RobotServiceClient};
+use kinplan::service::{ServerConfig, serve};
+use tonic::Code;
+use tonic::transport::Channel;
+use tonic_health::pb::{
+    HealthCheckRequest, health_check_response::ServingStatus, health_client::HealthClient,
+};
+use tonic_types::StatusExt;
+
+struct TestServer {
+    channel: Channel,
+    stop: Option<tokio::sync::oneshot::Sender<()>>,
+    handle: tokio::task::JoinHandle<()>,
+}
+
+async fn start(config: ServerConfig) -> TestServer {
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let addr = listener.local_addr().unwrap();
+    let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+    let handle = tokio::spawn(async move {
+        serve(config, listener, async {
+            let _ = stopped.await;
+        })
+        .await
+        .unwrap();
+    });
+    let channel = Channel::from_shared(format!("http://{addr}"))
+        .unwrap()
+        .connect()
+        .await
+        .unwrap();
+    TestServer {
+        channel,
+        stop: Some(stop),
+        handle,
+    }
+}
+
+fn named(name: &str) -> Option<pb::RobotRef> {
+    Some(pb::RobotRef {
+        source: Some(Source::Name(name.into())),
+        ..Default::default()
+    })
+}
+
+fn fk_request(robot: Option<pb::RobotRef>, q: Vec<f64>) -> pb::ForwardKinematicsRequest {
+    pb::ForwardKinematicsRequest {
+        robot,
+        joint_positions: q,
+        include_links: false,
+    }
+}
+
+fn position(pose: &pb::Pose) -> [f64; 3] {
+    let p = pose.position.as_ref().unwrap();
+    [p.x, p.y, p.z]
+}
+
+const TWO_LINK_URDF: &str = r#"<robot name="two_link">
+  <link name="base"/><link name="upper"/><link name="tool"/>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+    <origin xyz="0 0 0.5" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="2"/></joint>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="tool"/>
+    <origin xyz="0.4 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="2"/></joint>
+</robot>"#;
+
+#[tokio::test]
+async fn health_reflection_and_listing() {
+    let server = start(ServerConfig::default()).await;
+    let mut health = HealthClient::new(server.channel.clone());
+    for service in ["", "kinplan.v1.RobotService"] {
+        let reply = health
+            .check(HealthCheckRequest {
+                service: service.into(),
+            })
+            .await
+            .unwrap()
+            .into_inner();
+        assert_eq!(reply.status(), ServingStatus::Serving, "service `{service}`");
+    }
+
+    let mut reflection = tonic_reflection::pb::v1::server_reflection_client::ServerReflectionClient::new(
+        server.channel.clone(),
+    );
+    let request = tonic_reflection::pb::v1::ServerReflectionRequest {
+        host: String::new(),
+        message_request: Some(
+            tonic_reflection::pb::v1::server_reflection_request::MessageRequest::ListServices(String::new()),
+        ),
+    };
+    let mut replies = reflection
+        .server_reflection_info(tokio_stream::iter([request]))
+        .await
+        .unwrap()
+        .into_inner();
+    let reply = replies.message().await.unwrap().unwrap();
+    let Some(tonic_reflection::pb::v1::server_reflection_response::MessageResponse::ListServicesResponse(
+        list,
+    )) = reply.message_response
+    else {
+        panic!("unexpected reflection reply");
+    };
+    let names: Vec<String> = list.service.into_iter().map(|s| s.name).collect();
+    for expected in ["kinplan.v1.RobotService", "grpc.health.v1.Health"] {
+        assert!(names.contains(&expected.to_string()), "{names:?}");
+    }
+
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let list = robots
+        .list_robots(pb::ListRobotsRequest {})
+        .await
+        .unwrap()
+        .into_inner();
+    let dof = |name: &str| list.robots.iter().find(|r| r.name == name).map(|r| r.dof);
+    assert_eq!(dof("kuka_kr210_r2700_extra"), Some(6));
+    assert_eq!(dof("franka_panda"), Some(7));
+    assert_eq!(dof("planar_10"), Some(10));
+    assert_eq!(list.robots.len(), 15);
+}
+
+#[tokio::test]
+async fn fk_and_jacobian_over_grpc() {
+    let server = start(ServerConfig::default()).await;
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    // KR 210 stretched: 350 + 1150 + 1200 + 215 mm forward, 675 − 41 mm up.
+    let reply = robots
+        .forward_kinematics(fk_request(named("kuka_kr210_r2700_extra"), vec![0.0; 6]))
+        .await
+        .unwrap()
+        .into_inner();
+    let p = position(reply.tool_pose.as_ref().unwrap());
+    assert!(
+        (p[0] - 2.915).abs() < 1e-9 && p[1].abs() < 1e-9 && (p[2] - 0.634).abs() < 1e-9,
+        "{p:?}"
+    );
+
+    // Inline URDF: planar two-link, hand-computed pose and Jacobian.
+    let inline = Some(pb::RobotRef {
+        source: Some(Source::Urdf(TWO_LINK_URDF.into())),
+        ..Default::default()
+    });
+    let (a, b) = (0.3_f64, 0.9_f64);
+    let reply = robots
+        .forward_kinematics(pb::ForwardKinematicsRequest {
+            robot: inline.clone(),
+            joint_positions: vec![a, b],
+            include_links: true,
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    let p = position(reply.tool_pose.as_ref().unwrap());
+    assert!((p[0] - 0.4 * a.cos()).abs() < 1e-12 && (p[1] - 0.4 * a.sin()).abs() < 1e-12);
+    assert!((p[2] - 0.5).abs() < 1e-12);
+    assert_eq!(reply.links.len(), 3);
+    assert_eq!(reply.model_id.len(), 32);
+
+    let jac = robots
+        .jacobian(pb::JacobianRequest {
+            robot: inline.clone(),
+            joint_positions: vec![a, b],
+        })
+        .await
+        .unwrap()
+        .into_inner()
+        .jacobian
+        .unwrap();
+    assert_eq!((jac.rows, jac.cols), (6, 2));
+    // Tool at the elbow joint: d/dq1 = 0.4·(−sin a, cos a, 0), ω = z; d/dq2 = 0.
+    let expect = [
+        -0.4 * a.sin(),
+        0.0,
+        0.4 * a.cos(),
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        1.0,
+    ];
+    for (got, want) in jac.data.iter().zip(expect) {
+        assert!((got - want).abs() < 1e-12, "{:?}", jac.data);
+    }
+
+    // The model id now stands in for the URDF.
+    let by_id = Some(pb::RobotRef {
+        source: Some(Source::ModelId(reply.model_id.clone())),
+        ..Default::default()
+    });
+    let again = robots
+        .forward_kinematics(fk_request(by_id, vec![a, b]))
+        .await
+        .unwrap()
+        .into_inner();
+    assert_eq!(position(again.tool_pose.as_ref().unwrap()), p);
+
+    let described = robots
+        .describe_robot(pb::DescribeRobotRequest { robot: inline })
+        .await
+        .unwrap()
+        .into_inner();
+    assert_eq!(described.joints.len(), 2);
+    assert_eq!(described.joints[1].name, "elbow");
+    assert_eq!(described.joints[0].max_velocity, 2.0);
+    assert_eq!(described.tip_link, "tool");
+}
+
+/// Each bad request gets the right code and a message naming the field, and
+/// the server keeps serving afterwards.
+#[tokio::test]
+async fn bad_inputs_are_rejected_and_the_server_keeps_serving() {
+    let server = start(ServerConfig {
+        max_urdf_bytes: 64 * 1024,
+        ..ServerConfig::default()
+    })
+    .await;
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let urdf = |text: String, tip: &str| {
+        Some(pb::RobotRef {
+            source: Some(Source::Urdf(text)),
+            tip_link: tip.into(),
+            ..Default::default()
+        })
+    };
+    let cases: Vec<(&str, pb::ForwardKinematicsRequest, Code, &str)> = vec![
+        ("NaN joint", fk_request(named("ur5"), vec![0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0]), Code::InvalidArgument, "joint_positions[1]"),
+        ("infinite joint", fk_request(named("ur5"), vec![0.0, 0.0, 0.0, 0.0, 0.0, f64::INFINITY]), Code::InvalidArgument, "joint_positions[5]"),
+        ("wrong joint count", fk_request(named("ur5"), vec![0.0; 5]), Code::InvalidArgument, "joint_positions"),
+        ("unknown robot", fk_request(named("r2d2"), vec![]), Code::NotFound, "robot.name"),
+        ("missing robot", fk_request(None, vec![]), Code::InvalidArgument, "robot"),
+        ("empty robot ref", fk_request(Some(pb::RobotRef::default()), vec![]), Code::InvalidArgument, "robot"),
+        ("unknown link", fk_request(urdf(TWO_LINK_URDF.into(), "hand"), vec![0.0, 0.0]), Code::NotFound, "robot.base_link/tip_link"),
+        ("malformed URDF", fk_request(urdf("<robot name='x'><link".into(), ""), vec![]), Code::InvalidArgument, "robot.urdf"),
+        ("not XML", fk_request(urdf("{\"robot\": 1}".into(), ""), vec![]), Code::InvalidArgument, "robot.urdf"),
+        ("oversized URDF", fk_request(urdf(format!("{TWO_LINK_URDF}<!--{}-->", "x".repeat(70_000)), ""), vec![]), Code::InvalidArgument, "robot.urdf"),
+        ("NaN in URDF", fk_request(urdf(TWO_LINK_URDF.replace("0.4 0 0", "0.4 nan 0"), ""), vec![0.0, 0.0]), Code::InvalidArgument, "robot.urdf"),
+        ("not a serial chain", fk_request(urdf(TWO_LINK_URDF.replace("</robot>", "<link name='side'/><joint name='s' type='fixed'><parent link='base'/><child link='side'/></joint></robot>"), ""), vec![0.0, 0.0]), Code::InvalidArgument, "robot.tip_link"),
+        ("bad model id", fk_request(Some(pb::RobotRef { source: Some(Source::ModelId(vec![1, 2, 3])), ..Default::default() }), vec![]), Code::InvalidArgument, "robot.model_id"),
+        ("unseen model id", fk_request(Some(pb::RobotRef { source: Some(Source::ModelId(vec![7; 32])), ..Default::default() }), vec![]), Code::NotFound, "robot.model_id"),
+    ];
+    for (what, request, code, field) in cases {
+        let status = robots.forward_kinematics(request).await.unwrap_err();
+        assert_eq!(status.code(), code, "{what}: {status:?}");
+        assert!(
+            status.message().starts_with(field),
+            "{what}: {}",
+            status.message()
+        );
+        let details = status.get_details_bad_request().expect("BadRequest details");
+        assert_eq!(details.field_violations[0].field, field, "{what}");
+        // Still serving.
+        robots
+            .forward_kinematics(fk_request(named("ur5"), vec![0.1; 6]))
+            .await
+            .unwrap_or_else(|e| panic!("after {what}: {e:?}"));
+    }
+    let status = robots
+        .jacobian(pb::JacobianRequest {
+            robot: named("franka_panda"),
+            joint_positions: vec![0.0; 6],
+        })
+        .await
+        .unwrap_err();
+    assert_eq!(status.code(), Code::InvalidArgument);
+}
+
+#[tokio::test]
+async fn shutdown_reports_not_serving_then_stops() {
+    let mut server = start(ServerConfig {
+        drain_delay: Duration::from_millis(400),
+        ..ServerConfig::default()
+    })
+    .await;
+    let mut health = HealthClient::new(server.channel.clone());
+    server.stop.take().unwrap().send(()).unwrap();
+    tokio::time::sleep(Duration::from_millis(100)).await;
+    let reply = health
+        .check(HealthCheckRequest {
+            service: "kinplan.v1.RobotService".into(),
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert_eq!(reply.status(), ServingStatus::NotServing);
+    tokio::time::timeout(Duration::from_secs(5), server.handle)
+        .await
+        .expect("server stops after draining")
+        .unwrap();
+}
