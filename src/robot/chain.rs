@@ -197,7 +197,7 @@ impl Chain {
         // First pass: store p_i in rows 0–2 and z_i in rows 3–5.
         let mut t = Isometry3::identity();
         for (i, (joint, &qi)) in self.joints.iter().zip(q).enumerate() {
-            t = t * joint.origin;
+            t *= joint.origin;
             let z = t.rotation * joint.axis.into_inner();
             out.fixed_view_mut::<3, 1>(0, i).copy_from(&t.translation.vector);
             out.fixed_view_mut::<3, 1>(3, i).copy_from(&z);

@@ -113,7 +113,7 @@ pub fn matrix_in(field: &str, m: Option<&pb::Matrix>, max_entries: usize) -> Res
     if rows == 0 || cols == 0 {
         return Err(invalid(field, format!("shape {rows}x{cols} is empty")));
     }
-    let entries = rows.checked_mul(cols).unwrap_or(usize::MAX);
+    let entries = rows.saturating_mul(cols);
     if entries > max_entries {
         return Err(invalid(
             field,
