@@ -1,0 +1,19 @@
+"""kinplan: Python client for the kinplan motion-planning service.
+
+>>> import kinplan
+>>> with kinplan.Client("127.0.0.1:50051") as c:          # doctest: +SKIP
+...     T = c.robot("ur5").fk([0, -1.57, 1.57, 0, 0, 0])
+"""
+from ._convert import matrix_to_pose, pose_to_matrix
+from .client import Client, Robot, RobotDescription
+from .errors import KinplanError
+
+__all__ = [
+    "Client",
+    "KinplanError",
+    "Robot",
+    "RobotDescription",
+    "matrix_to_pose",
+    "pose_to_matrix",
+]
+__version__ = "0.1.0"

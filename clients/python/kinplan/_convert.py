@@ -1,0 +1,75 @@
+"""numpy <-> proto conversions. Quaternion arrays use the order (x, y, z, w)."""
+from __future__ import annotations
+
+from typing import Iterable
+
+import numpy as np
+
+from .v1 import common_pb2
+
+
+def joints(q: Iterable[float], name: str = "q") -> list:
+    """A 1-D float list from any array-like; the server validates the values."""
+    arr = np.asarray(q, dtype=float)
+    if arr.ndim != 1:
+        raise ValueError(f"{name} must be one-dimensional, got shape {arr.shape}")
+    return arr.tolist()
+
+
+def quat_to_matrix(x: float, y: float, z: float, w: float) -> np.ndarray:
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def matrix_to_quat(r: np.ndarray) -> np.ndarray:
+    """Unit quaternion (x, y, z, w) of a rotation matrix (Shepperd's method)."""
+    m = np.asarray(r, dtype=float)
+    t = np.trace(m)
+    if t > 0:
+        s = 2.0 * np.sqrt(t + 1.0)
+        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
+    else:
+        i = int(np.argmax(np.diag(m)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * np.sqrt(1.0 + m[i, i] - m[j, j] - m[k, k])
+        q = [0.0, 0.0, 0.0, (m[k, j] - m[j, k]) / s]
+        q[i] = 0.25 * s
+        q[j] = (m[j, i] + m[i, j]) / s
+        q[k] = (m[k, i] + m[i, k]) / s
+    q = np.asarray(q)
+    return q / np.linalg.norm(q)
+
+
+def pose_to_matrix(pose: common_pb2.Pose) -> np.ndarray:
+    """4x4 homogeneous matrix of a proto Pose (metres)."""
+    t = np.eye(4)
+    o = pose.orientation
+    if (o.x, o.y, o.z, o.w) != (0.0, 0.0, 0.0, 0.0):
+        t[:3, :3] = quat_to_matrix(o.x, o.y, o.z, o.w)
+    t[:3, 3] = (pose.position.x, pose.position.y, pose.position.z)
+    return t
+
+
+def matrix_to_pose(t: np.ndarray) -> common_pb2.Pose:
+    """Proto Pose of a 4x4 homogeneous matrix (or of a (position, quaternion
+    x-y-z-w) pair)."""
+    if isinstance(t, tuple) and len(t) == 2:
+        p, q = (np.asarray(v, dtype=float) for v in t)
+    else:
+        m = np.asarray(t, dtype=float)
+        if m.shape != (4, 4):
+            raise ValueError(f"a pose must be a 4x4 matrix, got shape {m.shape}")
+        p, q = m[:3, 3], matrix_to_quat(m[:3, :3])
+    return common_pb2.Pose(
+        position=common_pb2.Vec3(x=p[0], y=p[1], z=p[2]),
+        orientation=common_pb2.Quaternion(x=q[0], y=q[1], z=q[2], w=q[3]),
+    )
+
+
+def matrix_from_proto(m: common_pb2.Matrix) -> np.ndarray:
+    return np.asarray(m.data, dtype=float).reshape(m.rows, m.cols)

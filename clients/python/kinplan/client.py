@@ -1,0 +1,188 @@
+"""The kinplan client: a channel, robots, and numpy conversions."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, List, Optional, Sequence
+
+import grpc
+import numpy as np
+
+from ._convert import joints, matrix_from_proto, pose_to_matrix
+from .errors import KinplanError
+from .v1 import common_pb2, robot_pb2, robot_pb2_grpc
+
+DEFAULT_TIMEOUT = 30.0
+
+
+class Client:
+    """A connection to a kinplan server.
+
+    `timeout` (seconds) is the default deadline of every call; each method
+    also takes its own `timeout=`. Use as a context manager, or call close().
+    """
+
+    def __init__(
+        self,
+        target: str = "127.0.0.1:50051",
+        *,
+        timeout: Optional[float] = DEFAULT_TIMEOUT,
+        max_message_bytes: int = 16 * 1024 * 1024,
+        channel: Optional[grpc.Channel] = None,
+    ):
+        self.target = target
+        self.timeout = timeout
+        self._channel = channel or grpc.insecure_channel(
+            target,
+            options=[
+                ("grpc.max_send_message_length", max_message_bytes),
+                ("grpc.max_receive_message_length", max_message_bytes),
+            ],
+        )
+        self._robots = robot_pb2_grpc.RobotServiceStub(self._channel)
+
+    def __enter__(self) -> "Client":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self._channel.close()
+
+    def _call(self, method: Callable, request: Any, timeout: Optional[float]) -> Any:
+        try:
+            return method(request, timeout=self.timeout if timeout is None else timeout)
+        except grpc.RpcError as err:
+            raise KinplanError.from_rpc_error(err) from None
+
+    def list_robots(self, *, timeout: Optional[float] = None) -> List[Dict[str, Any]]:
+        """The built-in robots: name, dof, description, base and tip links."""
+        reply = self._call(self._robots.ListRobots, robot_pb2.ListRobotsRequest(), timeout)
+        return [
+            {
+                "name": r.name,
+                "dof": r.dof,
+                "description": r.description,
+                "base_link": r.base_link,
+                "tip_link": r.tip_link,
+            }
+            for r in reply.robots
+        ]
+
+    def robot(
+        self,
+        name: Optional[str] = None,
+        *,
+        urdf: Optional[str] = None,
+        base_link: str = "",
+        tip_link: str = "",
+    ) -> "Robot":
+        """A built-in robot by `name`, or a model sent as `urdf` text."""
+        if (name is None) == (urdf is None):
+            raise ValueError("give exactly one of name or urdf=")
+        return Robot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link)
+
+
+@dataclass
+class RobotDescription:
+    """A robot's chain as the server sees it. Limits in rad (m for prismatic
+    joints); infinite for unlimited joints; max_velocity 0 when unknown."""
+
+    name: str
+    base_link: str
+    tip_link: str
+    joint_names: List[str]
+    joint_types: List[str]
+    lower: np.ndarray
+    upper: np.ndarray
+    max_velocity: np.ndarray
+    link_names: List[str]
+    model_id: bytes = b""
+    raw: Any = field(default=None, repr=False)
+
+    @property
+    def dof(self) -> int:
+        return len(self.joint_names)
+
+
+class Robot:
+    """A robot on a server. Inline URDFs are sent once, then referred to by
+    the content hash the server returns; if a replica does not hold it
+    (NOT_FOUND), the URDF is sent again by itself."""
+
+    def __init__(self, client: Client, *, name: Optional[str], urdf: Optional[str], base_link: str, tip_link: str):
+        self.client = client
+        self.name = name
+        self.urdf = urdf
+        self.base_link = base_link
+        self.tip_link = tip_link
+        self.model_id: bytes = b""
+
+    def _ref(self, inline: bool = False) -> common_pb2.RobotRef:
+        ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link)
+        if self.name is not None:
+            ref.name = self.name
+        elif self.model_id and not inline:
+            ref.model_id = self.model_id
+        else:
+            ref.urdf = self.urdf or ""
+        return ref
+
+    def _call(self, method: Callable, build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
+        try:
+            reply = self.client._call(method, build(self._ref()), timeout)
+        except KinplanError as err:
+            if not (err.code == grpc.StatusCode.NOT_FOUND and self.model_id and self.urdf):
+                raise
+            self.model_id = b""
+            reply = self.client._call(method, build(self._ref(inline=True)), timeout)
+        model_id = getattr(reply, "model_id", b"")
+        if model_id and self.urdf is not None:
+            self.model_id = model_id
+        return reply
+
+    def describe(self, *, timeout: Optional[float] = None) -> RobotDescription:
+        r = self._call(
+            self.client._robots.DescribeRobot,
+            lambda ref: robot_pb2.DescribeRobotRequest(robot=ref),
+            timeout,
+        )
+        return RobotDescription(
+            name=r.name,
+            base_link=r.base_link,
+            tip_link=r.tip_link,
+            joint_names=[j.name for j in r.joints],
+            joint_types=[robot_pb2.JointType.Name(j.type).removeprefix("JOINT_TYPE_").lower() for j in r.joints],
+            lower=np.array([j.lower for j in r.joints]),
+            upper=np.array([j.upper for j in r.joints]),
+            max_velocity=np.array([j.max_velocity for j in r.joints]),
+            link_names=[link.name for link in r.links],
+            model_id=r.model_id,
+            raw=r,
+        )
+
+    def fk(self, q: Sequence[float], *, links: bool = False, timeout: Optional[float] = None):
+        """Tool pose (4x4, base frame, metres) for joint vector `q`; with
+        `links=True`, also a dict of every link's 4x4 pose."""
+        positions = joints(q)
+        r = self._call(
+            self.client._robots.ForwardKinematics,
+            lambda ref: robot_pb2.ForwardKinematicsRequest(
+                robot=ref, joint_positions=positions, include_links=links
+            ),
+            timeout,
+        )
+        tool = pose_to_matrix(r.tool_pose)
+        if links:
+            return tool, {link.name: pose_to_matrix(link.pose) for link in r.links}
+        return tool
+
+    def jacobian(self, q: Sequence[float], *, timeout: Optional[float] = None) -> np.ndarray:
+        """6 x n geometric Jacobian in the base frame (rows: vx, vy, vz, wx, wy, wz)."""
+        positions = joints(q)
+        r = self._call(
+            self.client._robots.Jacobian,
+            lambda ref: robot_pb2.JacobianRequest(robot=ref, joint_positions=positions),
+            timeout,
+        )
+        return matrix_from_proto(r.jacobian)
