@@ -5,4 +5,5 @@
 //! only layer that does.
 
 pub mod robot;
+pub mod score;
 pub mod service;

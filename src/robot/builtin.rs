@@ -1,5 +1,5 @@
 //! The built-in robots, embedded as URDF text and parsed once on first use.
-//! `tools/gen_builtin_urdf.py` writes the URDFs from the published data.
+//! `builtin/generate.py` writes the URDFs from the published data.
 
 use std::sync::{Arc, OnceLock};
 

@@ -10,12 +10,22 @@ use tonic::{Request, Response, Status};
 use super::convert::{matrix_out, pose_out, vec3_out};
 use super::pb::{self, robot_service_server::RobotService};
 use super::status::robot_error;
+use super::server::Shared;
 use super::{Compute, ModelStore};
 use crate::robot::{BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf};
 
 pub struct RobotApi {
-    pub models: Arc<ModelStore>,
-    pub compute: Arc<Compute>,
+    models: Arc<ModelStore>,
+    compute: Arc<Compute>,
+}
+
+impl RobotApi {
+    pub fn new(shared: Shared) -> Self {
+        Self {
+            models: shared.models,
+            compute: shared.compute,
+        }
+    }
 }
 
 #[tonic::async_trait]

@@ -72,16 +72,20 @@ pub async fn serve(
         },
         config.model_cache_entries,
     ));
+    let shared = Shared { models, compute };
     let limit = config.max_message_bytes;
-    let robot = RobotServiceServer::new(RobotApi {
-        models: models.clone(),
-        compute: compute.clone(),
-    })
-    .max_decoding_message_size(limit)
-    .max_encoding_message_size(limit);
+    // Each kinplan service: its adapter, with the message size limits.
+    macro_rules! service {
+        ($server:ident, $api:expr) => {
+            $server::new($api)
+                .max_decoding_message_size(limit)
+                .max_encoding_message_size(limit)
+        };
+    }
+    let robot = service!(RobotServiceServer, RobotApi::new(shared.clone()));
 
+    let services = [name_of(&robot)];
     let (health, health_service) = tonic_health::server::health_reporter();
-    let services = [robot_service_name()];
     for name in services {
         health.set_service_status(name, ServingStatus::Serving).await;
     }
@@ -116,8 +120,15 @@ pub async fn serve(
     Ok(())
 }
 
-fn robot_service_name() -> &'static str {
-    <RobotServiceServer<RobotApi> as tonic::server::NamedService>::NAME
+/// What every service adapter shares: the model cache and the CPU pool.
+#[derive(Clone)]
+pub struct Shared {
+    pub models: Arc<ModelStore>,
+    pub compute: Arc<Compute>,
+}
+
+fn name_of<S: tonic::server::NamedService>(_: &S) -> &'static str {
+    S::NAME
 }
 
 pub use super::metrics::HANDLING_BUCKETS;

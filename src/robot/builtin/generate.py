@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """Writes the built-in robots' URDF files (src/robot/builtin/*.urdf) from their
 published kinematic data (mm, degrees), with one capsule per link as collision
-geometry. Run from the repository root: python3 tools/gen_builtin_urdf.py
+geometry. Run: python3 src/robot/builtin/generate.py
 
 The URDFs are committed; this script documents where every number comes from.
 """
 import math
 import os
 
-OUT = os.path.join(os.path.dirname(__file__), "..", "src", "robot", "builtin")
+OUT = os.path.dirname(os.path.abspath(__file__))
 
 
 def fmt(v):

@@ -1,52 +1,16 @@
-//! End-to-end: starts the real server on a free loopback port and calls it
-//! over gRPC, as clients do.
+//! RobotService, health, reflection and shutdown.
 
 use std::time::Duration;
 
+use kinplan::service::ServerConfig;
 use kinplan::service::pb::{self, robot_ref::Source, robot_service_client::RobotServiceClient};
-use kinplan::service::{ServerConfig, serve};
 use tonic::Code;
-use tonic::transport::Channel;
 use tonic_health::pb::{
     HealthCheckRequest, health_check_response::ServingStatus, health_client::HealthClient,
 };
 use tonic_types::StatusExt;
 
-struct TestServer {
-    channel: Channel,
-    stop: Option<tokio::sync::oneshot::Sender<()>>,
-    handle: tokio::task::JoinHandle<()>,
-}
-
-async fn start(config: ServerConfig) -> TestServer {
-    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
-    let addr = listener.local_addr().unwrap();
-    let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
-    let handle = tokio::spawn(async move {
-        serve(config, listener, async {
-            let _ = stopped.await;
-        })
-        .await
-        .unwrap();
-    });
-    let channel = Channel::from_shared(format!("http://{addr}"))
-        .unwrap()
-        .connect()
-        .await
-        .unwrap();
-    TestServer {
-        channel,
-        stop: Some(stop),
-        handle,
-    }
-}
-
-fn named(name: &str) -> Option<pb::RobotRef> {
-    Some(pb::RobotRef {
-        source: Some(Source::Name(name.into())),
-        ..Default::default()
-    })
-}
+use crate::{named, start};
 
 fn fk_request(robot: Option<pb::RobotRef>, q: Vec<f64>) -> pb::ForwardKinematicsRequest {
     pb::ForwardKinematicsRequest {

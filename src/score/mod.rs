@@ -1,0 +1,55 @@
+//! Trajectory quality: the S0 criteria (CD, JD, OC, CPC, RDM, pseudo-jerk and
+//! its peaks), the S2 PTP cycle time with time potentials, and set comparison.
+//!
+//! Pure functions over already computed data (joints, tool poses, robot
+//! points); no robot model and no transport types. Spec: ALGORITHMS.md §3.
+
+mod compare;
+mod criteria;
+mod cycle_time;
+mod error;
+mod input;
+mod jerk;
+mod scoring;
+
+pub use compare::{Comparison, LabelledSet, SetSummary, Stat, compare, summarize};
+pub use criteria::{
+    Criterion, Scores, TimeScaledJerk, max_point_displacement, orientation_geodesic_angle,
+    orientation_half_angle,
+};
+pub use cycle_time::{
+    CycleTime, CycleTimeParams, SegmentTime, TimePotential, cycle_time, ptp_joint_time,
+    ptp_segment_time,
+};
+pub use error::ScoreError;
+pub use input::{JointLimits, QUATERNION_NORM_TOLERANCE, Rows, ScoreInput, Shape, TrajectoryData};
+pub use jerk::{
+    JerkPeakParams, Peak, cartesian_slowdown, find_peaks, joint_slowdown, third_derivative,
+    third_derivative_weights, third_difference,
+};
+pub use scoring::{ScoreParams, ScoreReport, Series, score};
+
+#[cfg(test)]
+mod tests {
+    /// House rule 1: the domain core never names the transport crates.
+    #[test]
+    fn no_transport_types_in_the_domain() {
+        let banned = [concat!("ton", "ic"), concat!("pro", "st::")];
+        let sources = [
+            include_str!("mod.rs"),
+            include_str!("compare.rs"),
+            include_str!("criteria.rs"),
+            include_str!("cycle_time.rs"),
+            include_str!("error.rs"),
+            include_str!("input.rs"),
+            include_str!("jerk.rs"),
+            include_str!("scoring.rs"),
+            include_str!("scoring/tests.rs"),
+        ];
+        for src in sources {
+            for b in banned {
+                assert!(!src.contains(b), "found {b:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,45 @@
+//! End-to-end tests, one binary: each module starts the real server on a free
+//! loopback port and calls it over gRPC, as clients do.
+
+mod robot;
+
+use kinplan::service::pb::{self, robot_ref::Source};
+use kinplan::service::{ServerConfig, serve};
+use tonic::transport::Channel;
+
+pub struct TestServer {
+    pub channel: Channel,
+    pub stop: Option<tokio::sync::oneshot::Sender<()>>,
+    pub handle: tokio::task::JoinHandle<()>,
+}
+
+pub async fn start(config: ServerConfig) -> TestServer {
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let addr = listener.local_addr().unwrap();
+    let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+    let handle = tokio::spawn(async move {
+        serve(config, listener, async {
+            let _ = stopped.await;
+        })
+        .await
+        .unwrap();
+    });
+    let channel = Channel::from_shared(format!("http://{addr}"))
+        .unwrap()
+        .connect()
+        .await
+        .unwrap();
+    TestServer {
+        channel,
+        stop: Some(stop),
+        handle,
+    }
+}
+
+/// A reference to a built-in robot.
+pub fn named(name: &str) -> Option<pb::RobotRef> {
+    Some(pb::RobotRef {
+        source: Some(Source::Name(name.into())),
+        ..Default::default()
+    })
+}
