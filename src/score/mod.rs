@@ -2,7 +2,8 @@
 //! its peaks), the S2 PTP cycle time with time potentials, and set comparison.
 //!
 //! Pure functions over already computed data (joints, tool poses, robot
-//! points); no robot model and no transport types. Spec: ALGORITHMS.md §3.
+//! points); `robot_points` alone turns a robot model into those data. No
+//! transport types. Spec: ALGORITHMS.md §3.
 
 mod compare;
 mod criteria;
@@ -10,6 +11,7 @@ mod cycle_time;
 mod error;
 mod input;
 mod jerk;
+mod robot_points;
 mod scoring;
 
 pub use compare::{Comparison, LabelledSet, SetSummary, Stat, compare, summarize};
@@ -27,6 +29,9 @@ pub use jerk::{
     JerkPeakParams, Peak, cartesian_slowdown, find_peaks, joint_slowdown, third_derivative,
     third_derivative_weights, third_difference,
 };
+pub use robot_points::{
+    ChainSamples, PointSet, robot_link_points, sample_chain, shape_extreme_points,
+};
 pub use scoring::{ScoreParams, ScoreReport, Series, score};
 
 #[cfg(test)]
@@ -43,6 +48,7 @@ mod tests {
             include_str!("error.rs"),
             include_str!("input.rs"),
             include_str!("jerk.rs"),
+            include_str!("robot_points.rs"),
             include_str!("scoring.rs"),
             include_str!("scoring/tests.rs"),
         ];
