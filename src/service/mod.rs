@@ -10,6 +10,7 @@ mod convert;
 mod metrics;
 mod models;
 mod robot;
+mod scoring;
 mod server;
 mod status;
 

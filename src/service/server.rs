@@ -11,8 +11,11 @@ use tonic::transport::Server;
 use tonic_health::ServingStatus;
 
 use super::metrics::MetricsLayer;
-use super::pb::{self, robot_service_server::RobotServiceServer};
+use super::pb::{
+    self, robot_service_server::RobotServiceServer, scoring_service_server::ScoringServiceServer,
+};
 use super::robot::RobotApi;
+use super::scoring::ScoringApi;
 use super::{Compute, ModelStore};
 use crate::robot::UrdfLimits;
 
@@ -83,8 +86,9 @@ pub async fn serve(
         };
     }
     let robot = service!(RobotServiceServer, RobotApi::new(shared.clone()));
+    let scoring = service!(ScoringServiceServer, ScoringApi::new(shared.clone()));
 
-    let services = [name_of(&robot)];
+    let services = [name_of(&robot), name_of(&scoring)];
     let (health, health_service) = tonic_health::server::health_reporter();
     for name in services {
         health.set_service_status(name, ServingStatus::Serving).await;
@@ -115,6 +119,7 @@ pub async fn serve(
         .add_service(reflection_v1)
         .add_service(reflection_v1alpha)
         .add_service(robot)
+        .add_service(scoring)
         .serve_with_incoming_shutdown(TcpListenerStream::new(listener), drain)
         .await?;
     Ok(())
