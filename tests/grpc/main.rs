@@ -2,6 +2,7 @@
 //! loopback port and calls it over gRPC, as clients do.
 
 mod robot;
+mod scoring;
 
 use kinplan::service::pb::{self, robot_ref::Source};
 use kinplan::service::{ServerConfig, serve};
