@@ -7,8 +7,10 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use kinplan::robot::builtin_chain;
 use kinplan::score::{
-    JointLimits, LabelledSet, Rows, ScoreInput, ScoreParams, TrajectoryData, compare, score,
+    JointLimits, LabelledSet, PointSet, Rows, ScoreInput, ScoreParams, TrajectoryData, compare, sample_chain,
+    score,
 };
 use nalgebra::{Isometry3, Point3, Vector3};
 use rand::{Rng, SeedableRng};
@@ -138,5 +140,58 @@ fn bench(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, bench);
+/// KR 210 R2700 extra, 10,000 waypoints of a smooth six-axis move with seeded
+/// noise: real FK (tool poses, link frames) then every criterion, as the
+/// service does for one ScoreTrajectory request.
+fn bench_kr210(c: &mut Criterion) {
+    let chain = builtin_chain("kuka_kr210_r2700_extra").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let q: Vec<f64> = (0..N)
+        .flat_map(|i| {
+            let s = i as f64 / N as f64;
+            [
+                0.9 * s,
+                -1.5 + 0.4 * s,
+                1.4 - 0.5 * s,
+                0.3 * (6.0 * s).sin(),
+                0.5 + 0.2 * s,
+                -0.4 * s,
+            ]
+        })
+        .map(|v| v + 1e-5 * rng.random_range(-1.0..1.0))
+        .collect();
+    let joints = Rows::Flat { values: &q, width: M };
+    let v_max: Vec<f64> = chain.joints().iter().map(|j| j.max_velocity.unwrap()).collect();
+    let run = |points: Option<PointSet>| {
+        let samples = sample_chain(&chain, joints, points).unwrap();
+        let input = ScoreInput {
+            trajectory: TrajectoryData {
+                joints,
+                poses: &samples.poses,
+                robot_points: samples.point_rows(),
+                timestamps: None,
+            },
+            dof: Some(M),
+            joint_weights: None,
+            limits: Some(JointLimits {
+                v_max: &v_max,
+                a_max: None,
+            }),
+        };
+        score(&input, &ScoreParams::default()).unwrap().scores
+    };
+    let mut g = c.benchmark_group("kr210_10k");
+    g.bench_function("fk_only", |b| {
+        b.iter(|| sample_chain(&chain, black_box(joints), None).unwrap())
+    });
+    g.bench_function("fk+score (link origins)", |b| {
+        b.iter(|| run(black_box(Some(PointSet::LinkOrigins))))
+    });
+    g.bench_function("fk+score (collision vertices)", |b| {
+        b.iter(|| run(black_box(Some(PointSet::CollisionVertices))))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_kr210);
 criterion_main!(benches);
