@@ -92,11 +92,7 @@ impl Criterion {
     pub fn unit(self) -> &'static str {
         match self {
             Criterion::Cd | Criterion::Rdm | Criterion::Cj | Criterion::Cmj => "m",
-            Criterion::Jd
-            | Criterion::Oc
-            | Criterion::OcGeodesic
-            | Criterion::Jj
-            | Criterion::Jmj => "rad",
+            Criterion::Jd | Criterion::Oc | Criterion::OcGeodesic | Criterion::Jj | Criterion::Jmj => "rad",
             Criterion::Cpc => "weight·rad",
             Criterion::Jjp | Criterion::Cjp => "1",
             Criterion::CycleTime => "s",

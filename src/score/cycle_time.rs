@@ -216,10 +216,7 @@ mod tests {
     use super::*;
 
     fn flat(q: &[f64], m: usize) -> Rows<'_, f64> {
-        Rows::Flat {
-            values: q,
-            width: m,
-        }
+        Rows::Flat { values: q, width: m }
     }
 
     #[test]
@@ -355,10 +352,7 @@ mod tests {
         };
         let p = CycleTimeParams::default();
         let ct = cycle_time(flat(&[0.3], 1), &lim, &p).unwrap();
-        assert_eq!(
-            (ct.segments.len(), ct.total, ct.potentials.len()),
-            (0, 0.0, 0)
-        );
+        assert_eq!((ct.segments.len(), ct.total, ct.potentials.len()), (0, 0.0, 0));
         let ct = cycle_time(flat(&[], 1), &lim, &p).unwrap();
         assert_eq!(ct.total, 0.0);
         let ct = cycle_time(flat(&[0.0, 2.0], 1), &lim, &p).unwrap();

@@ -288,13 +288,7 @@ impl JointLimits<'_> {
             "must be finite and > 0",
         )?;
         if let Some(a) = self.a_max {
-            check_per_joint(
-                "a_max",
-                a,
-                joints,
-                |v| v > 0.0,
-                "must be > 0 (+inf allowed)",
-            )?;
+            check_per_joint("a_max", a, joints, |v| v > 0.0, "must be > 0 (+inf allowed)")?;
         }
         Ok(())
     }
@@ -458,22 +452,13 @@ mod tests {
     #[test]
     fn rows_get_and_len_agree() {
         let v = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
-        let r = Rows::Flat {
-            values: &v,
-            width: 3,
-        };
+        let r = Rows::Flat { values: &v, width: 3 };
         assert_eq!((r.len(), r.get(1), r.get(2)), (2, Some(&v[3..6]), None));
-        let r = Rows::Flat {
-            values: &v,
-            width: 0,
-        };
+        let r = Rows::Flat { values: &v, width: 0 };
         assert_eq!((r.len(), r.get(0)), (0, None));
         let nested = vec![vec![1.0], vec![2.0, 3.0]];
         let r = Rows::Nested(&nested);
-        assert_eq!(
-            (r.len(), r.get(1), r.get(9)),
-            (2, Some(&[2.0, 3.0][..]), None)
-        );
+        assert_eq!((r.len(), r.get(1), r.get(9)), (2, Some(&[2.0, 3.0][..]), None));
         assert!(Rows::<f64>::Nested(&[]).is_empty());
     }
 
@@ -508,33 +493,13 @@ mod tests {
     fn slightly_denormalized_quaternion_passes_then_fails() {
         let mut p = [Isometry3::identity()];
         let q = [0.0];
-        p[0].rotation = nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(
-            1.0 + 0.9e-6,
-            0.0,
-            0.0,
-            0.0,
-        ));
-        let t = TrajectoryData::new(
-            Rows::Flat {
-                values: &q,
-                width: 1,
-            },
-            &p,
-        );
+        p[0].rotation =
+            nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(1.0 + 0.9e-6, 0.0, 0.0, 0.0));
+        let t = TrajectoryData::new(Rows::Flat { values: &q, width: 1 }, &p);
         assert!(t.validate(None).is_ok());
-        p[0].rotation = nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(
-            1.0 + 2e-6,
-            0.0,
-            0.0,
-            0.0,
-        ));
-        let t = TrajectoryData::new(
-            Rows::Flat {
-                values: &q,
-                width: 1,
-            },
-            &p,
-        );
+        p[0].rotation =
+            nalgebra::UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(1.0 + 2e-6, 0.0, 0.0, 0.0));
+        let t = TrajectoryData::new(Rows::Flat { values: &q, width: 1 }, &p);
         assert!(matches!(
             t.validate(None),
             Err(ScoreError::NonUnitQuaternion { index: 0, .. })

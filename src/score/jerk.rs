@@ -302,8 +302,7 @@ mod tests {
         assert_eq!(joint_slowdown(1.0, &p), 4.0);
         assert!((joint_slowdown(10.0, &p) - 7.0).abs() < 1e-15);
         assert!(
-            (cartesian_slowdown(1.0, &p) - (707.106_781_186_547_5 + 1.587_401_051_968_199_4)).abs()
-                < 1e-9
+            (cartesian_slowdown(1.0, &p) - (707.106_781_186_547_5 + 1.587_401_051_968_199_4)).abs() < 1e-9
         );
         assert!(p.validate().is_ok());
     }

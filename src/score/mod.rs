@@ -20,8 +20,7 @@ pub use criteria::{
     orientation_half_angle,
 };
 pub use cycle_time::{
-    CycleTime, CycleTimeParams, SegmentTime, TimePotential, cycle_time, ptp_joint_time,
-    ptp_segment_time,
+    CycleTime, CycleTimeParams, SegmentTime, TimePotential, cycle_time, ptp_joint_time, ptp_segment_time,
 };
 pub use error::ScoreError;
 pub use input::{JointLimits, QUATERNION_NORM_TOLERANCE, Rows, ScoreInput, Shape, TrajectoryData};
@@ -29,9 +28,7 @@ pub use jerk::{
     JerkPeakParams, Peak, cartesian_slowdown, find_peaks, joint_slowdown, third_derivative,
     third_derivative_weights, third_difference,
 };
-pub use robot_points::{
-    ChainSamples, PointSet, robot_link_points, sample_chain, shape_extreme_points,
-};
+pub use robot_points::{ChainSamples, PointSet, robot_link_points, sample_chain, shape_extreme_points};
 pub use scoring::{ScoreParams, ScoreReport, Series, score};
 
 #[cfg(test)]

@@ -5,8 +5,8 @@ use super::cycle_time::{CycleTime, CycleTimeParams, cycle_time_unchecked};
 use super::error::ScoreError;
 use super::input::{ScoreInput, Shape};
 use super::jerk::{
-    JerkPeakParams, Peak, PeakDetector, cartesian_slowdown, joint_slowdown,
-    third_derivative_weights, third_difference,
+    JerkPeakParams, Peak, PeakDetector, cartesian_slowdown, joint_slowdown, third_derivative_weights,
+    third_difference,
 };
 
 /// Options of [`score`].

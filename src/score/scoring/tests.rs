@@ -27,21 +27,13 @@ fn run(input: &ScoreInput<'_>) -> ScoreReport {
 }
 
 fn scores_of(q: &[Vec<f64>], poses: &[Isometry3<f64>]) -> Scores {
-    run(&ScoreInput::new(TrajectoryData::new(
-        Rows::Nested(q),
-        poses,
-    )))
-    .scores
+    run(&ScoreInput::new(TrajectoryData::new(Rows::Nested(q), poses))).scores
 }
 
 #[test]
 fn straight_joint_moves_jd_and_cpc_by_hand() {
     // steps (1, 0.5, −1) and (0.5, 0, −2): JD = 2.5 + 2.5
-    let q = vec![
-        vec![0.0, 0.0, 0.0],
-        vec![1.0, 0.5, -1.0],
-        vec![1.5, 0.5, -3.0],
-    ];
+    let q = vec![vec![0.0, 0.0, 0.0], vec![1.0, 0.5, -1.0], vec![1.5, 0.5, -3.0]];
     let poses = still_poses(3);
     let t = TrajectoryData::new(Rows::Nested(&q), &poses);
     let r = run(&ScoreInput::new(t));
@@ -123,9 +115,7 @@ fn cartesian_straight_line_cd_is_its_length() {
 
 /// Linear series, exact in binary, with waypoint `k` displaced.
 fn spike(n: usize, k: usize) -> (Vec<Vec<f64>>, Vec<Isometry3<f64>>) {
-    let mut q: Vec<Vec<f64>> = (0..n)
-        .map(|i| vec![0.5 * i as f64, -0.25 * i as f64])
-        .collect();
+    let mut q: Vec<Vec<f64>> = (0..n).map(|i| vec![0.5 * i as f64, -0.25 * i as f64]).collect();
     q[k][0] += 0.5;
     q[k][1] += 0.25;
     let mut poses: Vec<_> = (0..n).map(|i| at(0.25 * i as f64, 0.0, 1.0)).collect();
@@ -136,10 +126,7 @@ fn spike(n: usize, k: usize) -> (Vec<Vec<f64>>, Vec<Isometry3<f64>>) {
 #[test]
 fn jerk_spike_by_hand() {
     let (q, poses) = spike(12, 4);
-    let r = run(&ScoreInput::new(TrajectoryData::new(
-        Rows::Nested(&q),
-        &poses,
-    )));
+    let r = run(&ScoreInput::new(TrajectoryData::new(Rows::Nested(&q), &poses)));
     let s = r.scores;
     let se = r.series.unwrap();
     // Δ³ = (1, −3, 3, −1)·d at waypoints 4..7; d = 0.5 and 0.25 → JJ = 8·0.75
@@ -268,10 +255,7 @@ fn short_trajectories_have_documented_answers() {
     for n in 0..4 {
         let q: Vec<Vec<f64>> = (0..n).map(|i| vec![i as f64, 2.0 * i as f64]).collect();
         let poses: Vec<_> = (0..n).map(|i| at(i as f64, 0.0, 0.0)).collect();
-        let r = run(&ScoreInput::new(TrajectoryData::new(
-            Rows::Nested(&q),
-            &poses,
-        )));
+        let r = run(&ScoreInput::new(TrajectoryData::new(Rows::Nested(&q), &poses)));
         let s = r.scores;
         assert_eq!(s.waypoints, n);
         assert_eq!(
@@ -322,10 +306,7 @@ fn series_sum_to_the_totals() {
             )
         })
         .collect();
-    let r = run(&ScoreInput::new(TrajectoryData::new(
-        Rows::Nested(&q),
-        &poses,
-    )));
+    let r = run(&ScoreInput::new(TrajectoryData::new(Rows::Nested(&q), &poses)));
     let se = r.series.unwrap();
     let sum = |v: &[f64]| v.iter().sum::<f64>();
     let s = r.scores;
@@ -548,10 +529,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     let t = TrajectoryData::new(Rows::Nested(&good), &bad_poses);
     assert_eq!(
         err(&ScoreInput::new(t)),
-        ScoreError::NonUnitQuaternion {
-            index: 2,
-            norm: 2.0
-        }
+        ScoreError::NonUnitQuaternion { index: 2, norm: 2.0 }
     );
     let mut bad_poses = poses.clone();
     bad_poses[0].rotation = UnitQuaternion::new_unchecked(Quaternion::new(1.0, f64::NAN, 0.0, 0.0));
@@ -594,11 +572,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
             ..
         }
     ));
-    let pts = vec![
-        vec![o],
-        vec![Point3::new(0.0, f64::NEG_INFINITY, 0.0)],
-        vec![o],
-    ];
+    let pts = vec![vec![o], vec![Point3::new(0.0, f64::NEG_INFINITY, 0.0)], vec![o]];
     let t = TrajectoryData {
         robot_points: Some(Rows::Nested(&pts)),
         ..tr(&good)
@@ -723,10 +697,7 @@ fn arb_trajectory() -> impl Strategy<Value = Trajectory> {
                 ),
                 n,
             ),
-            prop::collection::vec(
-                prop::collection::vec(prop::array::uniform3(-1.0..1.0f64), k),
-                n,
-            ),
+            prop::collection::vec(prop::collection::vec(prop::array::uniform3(-1.0..1.0f64), k), n),
             prop::collection::vec(0.0..5.0f64, m),
         )
             .prop_map(|(q, poses, pts, w)| {
@@ -803,12 +774,7 @@ proptest! {
 /// The S0 formulas written out literally (acos of the printed dot product,
 /// nested sums over index ranges), to check the single pass against.
 #[allow(clippy::needless_range_loop)] // indices on purpose: it mirrors the formulas
-fn reference(
-    q: &[Vec<f64>],
-    poses: &[Isometry3<f64>],
-    pts: &[Vec<Point3<f64>>],
-    w: &[f64],
-) -> [f64; 10] {
+fn reference(q: &[Vec<f64>], poses: &[Isometry3<f64>], pts: &[Vec<Point3<f64>>], w: &[f64]) -> [f64; 10] {
     let n = q.len();
     let m = q[0].len();
     let p = |i: usize| poses[i].translation.vector;
