@@ -167,13 +167,21 @@ pub fn sample_chain(
     let mut poses = Vec::with_capacity(n);
     let mut points = Vec::with_capacity(n * local.len());
     let mut frames = Vec::with_capacity(chain.links().len());
+    // The tip link closes `links()`, so with link frames at hand its frame is
+    // the tool pose and a second FK pass is not needed.
+    let tip_is_last = chain.links().last().is_some_and(|l| l.name == chain.tip_link());
     for i in 0..n {
         let q = joints.row(i);
-        poses.push(chain.fk(q));
-        if !local.is_empty() {
-            chain.link_frames_into(q, &mut frames);
-            points.extend(local.iter().map(|(link, p)| frames[*link] * p));
+        if local.is_empty() {
+            poses.push(chain.fk(q));
+            continue;
         }
+        chain.link_frames_into(q, &mut frames);
+        match frames.last() {
+            Some(tip) if tip_is_last => poses.push(*tip),
+            _ => poses.push(chain.fk(q)),
+        }
+        points.extend(local.iter().map(|(link, p)| frames[*link] * p));
     }
     Ok(ChainSamples {
         poses,
@@ -216,6 +224,22 @@ mod tests {
         .unwrap();
         let far = s.points.iter().map(|p| p.coords.norm()).fold(0.0, f64::max);
         assert!((far - 1.02).abs() < 1e-12, "{far}");
+    }
+
+    #[test]
+    fn tool_pose_from_link_frames_equals_fk() {
+        for name in crate::robot::BUILTIN_NAMES {
+            let chain = builtin_chain(name).unwrap();
+            let m = chain.dof();
+            let q: Vec<f64> = (0..3 * m).map(|k| 0.1 + 0.37 * (k as f64).sin()).collect();
+            let rows = Rows::Flat { values: &q, width: m };
+            let plain = sample_chain(&chain, rows, None).unwrap();
+            let with_points = sample_chain(&chain, rows, Some(PointSet::LinkOrigins)).unwrap();
+            for (a, b) in plain.poses.iter().zip(&with_points.poses) {
+                let d = (a.to_homogeneous() - b.to_homogeneous()).norm();
+                assert!(d < 1e-12, "{name}: {d}");
+            }
+        }
     }
 
     #[test]

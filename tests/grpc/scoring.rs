@@ -583,3 +583,73 @@ async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
         .await
         .expect("still serving");
 }
+
+/// A URDF without speed limits: no cycle time, a reason naming the joint; the
+/// limits can come with the request instead. Inline models get a model id.
+#[tokio::test]
+async fn cycle_time_needs_speed_limits() {
+    const NO_SPEED: &str = r#"<robot name="slider">
+      <link name="base"/><link name="carriage"/><link name="tool"/>
+      <joint name="rail" type="prismatic"><parent link="base"/><child link="carriage"/>
+        <origin xyz="0 0 0" rpy="0 0 0"/><axis xyz="1 0 0"/>
+        <limit lower="-1" upper="1" effort="1" velocity="0"/></joint>
+      <joint name="wrist" type="revolute"><parent link="carriage"/><child link="tool"/>
+        <origin xyz="0 0 0.2" rpy="0 0 0"/><axis xyz="0 0 1"/>
+        <limit lower="-3" upper="3" effort="1" velocity="2"/></joint>
+    </robot>"#;
+    let server = start(ServerConfig::default()).await;
+    let mut scoring = ScoringServiceClient::new(server.channel.clone());
+    let robot = Some(pb::RobotRef {
+        source: Some(pb::robot_ref::Source::Urdf(NO_SPEED.into())),
+        ..Default::default()
+    });
+    // The carriage slides 0.3 m in three steps while the wrist turns 0.6 rad.
+    let rows: Vec<Vec<f64>> = (0..4).map(|i| vec![0.1 * i as f64, 0.2 * i as f64]).collect();
+    let reply = scoring
+        .score_trajectory(pb::ScoreTrajectoryRequest {
+            robot: robot.clone(),
+            trajectory: Some(trajectory(&rows)),
+            options: None,
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(!reply.criteria.contains_key("cycle_time"));
+    assert!(reply.cycle_time.is_none());
+    assert!(
+        reply.cycle_time_unavailable.contains("\"rail\""),
+        "{}",
+        reply.cycle_time_unavailable
+    );
+    assert_eq!(reply.model_id.len(), 32);
+    // Prismatic joint: JD mixes metres and radians, CD is the slide, OC the turn.
+    close(reply.criteria["JD"], 0.3 + 0.6, 1e-12, "JD");
+    close(reply.criteria["CD"], 0.3, 1e-12, "CD");
+    close(reply.criteria["OC_geodesic"], 0.6, 1e-12, "OC_geodesic");
+    let reply = scoring
+        .score_trajectory(pb::ScoreTrajectoryRequest {
+            robot: Some(pb::RobotRef {
+                source: Some(pb::robot_ref::Source::ModelId(reply.model_id)),
+                ..Default::default()
+            }),
+            trajectory: Some(trajectory(&rows)),
+            options: Some(pb::ScoreOptions {
+                max_velocity: vec![0.5, 2.0],
+                ..Default::default()
+            }),
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    // Per step: rail 0.1 m / 0.5 m/s = 0.2 s, wrist 0.2 rad / 2 rad/s = 0.1 s.
+    close(reply.criteria["cycle_time"], 0.6, 1e-12, "cycle time");
+    assert!(reply.cycle_time_unavailable.is_empty());
+    assert!(
+        reply
+            .cycle_time
+            .unwrap()
+            .segments
+            .iter()
+            .all(|s| s.limiting_joint == 0)
+    );
+}
