@@ -14,9 +14,17 @@ mod architecture {
     #[test]
     fn domain_rooms_do_not_name_tonic_or_prost() {
         let rooms = ["robot", "linalg", "ik", "plan", "nbv", "mobile", "score"];
-        let banned = [concat!("ton", "ic::"), concat!("pro", "st::"), concat!("use ", "ton", "ic")];
+        let banned = [
+            concat!("ton", "ic::"),
+            concat!("pro", "st::"),
+            concat!("use ", "ton", "ic"),
+        ];
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-        let mut stack: Vec<_> = rooms.iter().map(|r| root.join(r)).filter(|p| p.exists()).collect();
+        let mut stack: Vec<_> = rooms
+            .iter()
+            .map(|r| root.join(r))
+            .filter(|p| p.exists())
+            .collect();
         let mut checked = 0;
         while let Some(path) = stack.pop() {
             if path.is_dir() {

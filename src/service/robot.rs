@@ -9,8 +9,8 @@ use tonic::{Request, Response, Status};
 
 use super::convert::{matrix_out, pose_out, vec3_out};
 use super::pb::{self, robot_service_server::RobotService};
-use super::status::robot_error;
 use super::server::Shared;
+use super::status::robot_error;
 use super::{Compute, ModelStore};
 use crate::robot::{BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf};
 
