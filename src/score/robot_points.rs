@@ -167,6 +167,7 @@ pub fn sample_chain(
     let mut poses = Vec::with_capacity(n);
     let mut points = Vec::with_capacity(n * local.len());
     let mut frames = Vec::with_capacity(chain.links().len());
+    let mut mats = Vec::with_capacity(chain.links().len());
     // The tip link closes `links()`, so with link frames at hand its frame is
     // the tool pose and a second FK pass is not needed.
     let tip_is_last = chain.links().last().is_some_and(|l| l.name == chain.tip_link());
@@ -181,7 +182,18 @@ pub fn sample_chain(
             Some(tip) if tip_is_last => poses.push(*tip),
             _ => poses.push(chain.fk(q)),
         }
-        points.extend(local.iter().map(|(link, p)| frames[*link] * p));
+        // Rotation matrices once per link: 15 flops per point instead of a
+        // quaternion rotation's ~30.
+        mats.clear();
+        mats.extend(
+            frames
+                .iter()
+                .map(|f| (f.rotation.to_rotation_matrix(), f.translation.vector)),
+        );
+        points.extend(local.iter().map(|(link, p)| {
+            let (r, t) = &mats[*link];
+            Point3::from(r * p.coords + t)
+        }));
     }
     Ok(ChainSamples {
         poses,
