@@ -136,3 +136,21 @@ def test_bad_options_and_sets(client):
         client.score("planar_2", arc(), timestamps=[0.0, 1.0])
     with pytest.raises(ValueError):
         client.compare({"a": [arc()]})
+
+
+@pytest.mark.parametrize("n, m", [(1, 1), (3, 2), (17, 6), (2000, 7), (5, 16)])
+def test_fast_encoding_equals_one_point_per_row(n, m):
+    rng = np.random.default_rng(n * 100 + m)
+    q = rng.normal(size=(n, m))
+    q[0, 0] = -0.0
+    slow = kinplan.v1.common_pb2.JointTrajectory(
+        points=[kinplan.v1.common_pb2.JointPoint(positions=row) for row in q.tolist()]
+    )
+    assert trajectory_to_proto(q) == slow
+    ts = np.cumsum(rng.uniform(0.1, 1.0, size=n))
+    for point, t in zip(slow.points, ts):
+        point.time_from_start = t
+    assert trajectory_to_proto(q, ts) == slow
+    assert trajectory_to_proto(q.astype(np.float32)).points[0].positions[0] == pytest.approx(q[0, 0], rel=1e-6)
+    with pytest.raises(ValueError):
+        trajectory_to_proto(q, ts[:-1])
