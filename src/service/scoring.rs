@@ -22,9 +22,10 @@ use crate::score::{
 };
 
 /// Requests with at least this many waypoints (all trajectories together)
-/// are scored on the CPU pool; smaller ones inline (they take well under a
-/// millisecond).
-const INLINE_WAYPOINTS: usize = 2_000;
+/// are scored on the CPU pool; smaller ones inline on the async runtime
+/// (at most ~1 ms of FK and criteria for a 6-joint arm with collision-shape
+/// points, see benches/RESULTS.md).
+const INLINE_WAYPOINTS: usize = 500;
 
 pub struct ScoringApi {
     models: Arc<ModelStore>,
