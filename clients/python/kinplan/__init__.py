@@ -7,12 +7,15 @@
 from ._convert import matrix_to_pose, pose_to_matrix
 from .client import Client, Robot, RobotDescription
 from .errors import KinplanError
+from .scoring import Comparison, Scores
 
 __all__ = [
     "Client",
+    "Comparison",
     "KinplanError",
     "Robot",
     "RobotDescription",
+    "Scores",
     "matrix_to_pose",
     "pose_to_matrix",
 ]
