@@ -4,6 +4,7 @@
 //! The domain rooms (`robot`, …) never name tonic or prost; `service` is the
 //! only layer that does.
 
+pub mod mobile;
 pub mod robot;
 pub mod score;
 pub mod service;

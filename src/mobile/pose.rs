@@ -1,0 +1,170 @@
+//! Planar pose, point and body twist, and exact integration of a constant twist.
+
+use serde::{Deserialize, Serialize};
+
+use super::angle::{sinc, versinc, wrap_angle};
+use super::error::{MobileError, check_finite};
+
+/// A point in the world frame, m.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Point2 {
+    /// x, m.
+    pub x: f64,
+    /// y, m.
+    pub y: f64,
+}
+
+impl Point2 {
+    /// A point from its coordinates.
+    pub const fn new(x: f64, y: f64) -> Self {
+        Self { x, y }
+    }
+
+    /// Euclidean distance, m.
+    pub fn distance(self, other: Point2) -> f64 {
+        (self.x - other.x).hypot(self.y - other.y)
+    }
+
+    /// Rejects NaN or infinite coordinates.
+    pub fn validate(&self, field: &str) -> Result<(), MobileError> {
+        if self.x.is_finite() && self.y.is_finite() {
+            return Ok(());
+        }
+        check_finite(&format!("{field}.x"), self.x)?;
+        check_finite(&format!("{field}.y"), self.y)
+    }
+}
+
+/// Robot pose in the world frame: position of the reference point (m) and heading θ (rad,
+/// counter-clockwise from +x).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    /// x, m.
+    pub x: f64,
+    /// y, m.
+    pub y: f64,
+    /// Heading θ, rad.
+    pub theta: f64,
+}
+
+impl Pose {
+    /// A pose from its coordinates.
+    pub const fn new(x: f64, y: f64, theta: f64) -> Self {
+        Self { x, y, theta }
+    }
+
+    /// The position.
+    pub fn point(&self) -> Point2 {
+        Point2::new(self.x, self.y)
+    }
+
+    /// Rejects NaN or infinite components.
+    pub fn validate(&self, field: &str) -> Result<(), MobileError> {
+        if self.x.is_finite() && self.y.is_finite() && self.theta.is_finite() {
+            return Ok(());
+        }
+        check_finite(&format!("{field}.x"), self.x)?;
+        check_finite(&format!("{field}.y"), self.y)?;
+        check_finite(&format!("{field}.theta"), self.theta)
+    }
+}
+
+/// Body-frame velocity: `vx` forward (m/s), `vy` to the left (m/s, non-zero only for
+/// holonomic chassis), `omega` yaw rate (rad/s, counter-clockwise).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Twist {
+    /// Forward speed, m/s.
+    pub vx: f64,
+    /// Lateral speed (left positive), m/s.
+    pub vy: f64,
+    /// Yaw rate, rad/s.
+    pub omega: f64,
+}
+
+impl Twist {
+    /// Zero velocity.
+    pub const ZERO: Twist = Twist {
+        vx: 0.0,
+        vy: 0.0,
+        omega: 0.0,
+    };
+
+    /// A twist of a non-holonomic (unicycle-like) robot: forward speed and yaw rate.
+    pub const fn unicycle(v: f64, omega: f64) -> Self {
+        Self {
+            vx: v,
+            vy: 0.0,
+            omega,
+        }
+    }
+
+    /// Every component multiplied by `s`.
+    pub fn scaled(self, s: f64) -> Self {
+        Self {
+            vx: self.vx * s,
+            vy: self.vy * s,
+            omega: self.omega * s,
+        }
+    }
+
+    /// Rejects NaN or infinite components.
+    pub fn validate(&self, field: &str) -> Result<(), MobileError> {
+        if self.vx.is_finite() && self.vy.is_finite() && self.omega.is_finite() {
+            return Ok(());
+        }
+        check_finite(&format!("{field}.vx"), self.vx)?;
+        check_finite(&format!("{field}.vy"), self.vy)?;
+        check_finite(&format!("{field}.omega"), self.omega)
+    }
+}
+
+/// Pose after applying the body twist `t` constant for `dt` seconds (exact arc):
+///
+/// Δ_body = [sin(ωdt)/ω · vx − (1 − cos ωdt)/ω · vy,  (1 − cos ωdt)/ω · vx + sin(ωdt)/ω · vy],
+/// rotated by θ into the world frame; θ ← wrap(θ + ω dt).
+pub fn integrate_twist(p: Pose, t: Twist, dt: f64) -> Pose {
+    let phi = t.omega * dt;
+    let s = dt * sinc(phi);
+    let c = dt * versinc(phi);
+    let bx = s * t.vx - c * t.vy;
+    let by = c * t.vx + s * t.vy;
+    let (sn, cs) = p.theta.sin_cos();
+    Pose {
+        x: p.x + cs * bx - sn * by,
+        y: p.y + sn * bx + cs * by,
+        theta: wrap_angle(p.theta + phi),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn quarter_circle_lands_on_the_arc() {
+        // v = 1 m/s, ω = 1 rad/s for π/2 s: a quarter of the unit circle, from (0,0,0) to (1,1,π/2).
+        let p = integrate_twist(
+            Pose::new(0.0, 0.0, 0.0),
+            Twist::unicycle(1.0, 1.0),
+            PI / 2.0,
+        );
+        assert!((p.x - 1.0).abs() < 1e-12 && (p.y - 1.0).abs() < 1e-12);
+        assert!((p.theta - PI / 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn straight_lateral_motion_of_a_holonomic_base() {
+        let p = integrate_twist(
+            Pose::new(1.0, 2.0, PI / 2.0),
+            Twist {
+                vx: 0.0,
+                vy: 1.0,
+                omega: 0.0,
+            },
+            2.0,
+        );
+        // Heading +y, moving left means −x.
+        assert!((p.x + 1.0).abs() < 1e-12 && (p.y - 2.0).abs() < 1e-12);
+    }
+}
