@@ -93,8 +93,7 @@ impl Tally {
             Outcome::Timeout => self.timeout += 1,
             Outcome::NoPath => {
                 self.no_path += 1;
-                self.returned_to_h +=
-                    (run.no_path_reason == Some(NoPathReason::ReturnedToHit)) as usize;
+                self.returned_to_h += (run.no_path_reason == Some(NoPathReason::ReturnedToHit)) as usize;
             }
             _ => {}
         }
@@ -331,8 +330,7 @@ fn main() {
         let t0 = Instant::now();
         let mut vdf = Tally::default();
         for w in &worlds {
-            let run =
-                navigate(&chassis, start, goal, &w.world, &nav, &|| false).expect("valid input");
+            let run = navigate(&chassis, start, goal, &w.world, &nav, &|| false).expect("valid input");
             vdf.add(&run, w.reference, goal);
         }
         vdf.print(name, t0.elapsed().as_secs_f64());

@@ -69,10 +69,7 @@ fn world(seed: u64) -> Option<World> {
 }
 
 fn main() {
-    let n: usize = std::env::args()
-        .nth(1)
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(60);
+    let n: usize = std::env::args().nth(1).and_then(|s| s.parse().ok()).unwrap_or(60);
     let worlds: Vec<World> = (0..).filter_map(world).take(n).collect();
     let chassis = Chassis::Differential(DifferentialParams::default());
     let start = Pose::new(-2.25, 3.0, 1.57);

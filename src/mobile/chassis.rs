@@ -214,12 +214,7 @@ impl Chassis {
                 check_positive("omni.wheel_radius", p.wheel_radius)?;
                 check_positive("omni.center_distance", p.center_distance)?;
                 check_positive("omni.max_wheel_speed", p.max_wheel_speed)?;
-                check_range(
-                    "omni.first_wheel_angle",
-                    p.first_wheel_angle,
-                    -2.0 * PI,
-                    2.0 * PI,
-                )
+                check_range("omni.first_wheel_angle", p.first_wheel_angle, -2.0 * PI, 2.0 * PI)
             }
             Chassis::Differential(p) => {
                 check_positive("differential.wheel_radius", p.wheel_radius)?;
@@ -243,11 +238,7 @@ impl Chassis {
             // max_i |sin φ_i|, at least sin 60°.
             Chassis::Omni(p) => {
                 let m = (0..3)
-                    .map(|i| {
-                        (p.first_wheel_angle + i as f64 * 2.0 * PI / 3.0)
-                            .sin()
-                            .abs()
-                    })
+                    .map(|i| (p.first_wheel_angle + i as f64 * 2.0 * PI / 3.0).sin().abs())
                     .fold(0.0, f64::max);
                 p.max_wheel_speed / m
             }

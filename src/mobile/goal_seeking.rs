@@ -113,8 +113,7 @@ mod tests {
     #[test]
     fn goal_behind_saturates_steering() {
         let p = SteeringParams::default();
-        let c =
-            goal_seeking_step(Pose::new(0.0, 0.0, 0.0), Point2::new(-1.0, 0.1), 0.1, &p).unwrap();
+        let c = goal_seeking_step(Pose::new(0.0, 0.0, 0.0), Point2::new(-1.0, 0.1), 0.1, &p).unwrap();
         assert!((c.steer - 70f64.to_radians()).abs() < 1e-12);
         // ω = v tan70° / 0.6 = 0.5 · 2.747477 / 0.6 = 2.289565.
         assert!((c.twist.omega - 2.289_564_5).abs() < 1e-6);
@@ -123,8 +122,7 @@ mod tests {
     #[test]
     fn speed_halves_the_last_step() {
         let p = SteeringParams::default();
-        let c =
-            goal_seeking_step(Pose::new(0.0, 0.0, 0.0), Point2::new(0.02, 0.0), 0.1, &p).unwrap();
+        let c = goal_seeking_step(Pose::new(0.0, 0.0, 0.0), Point2::new(0.02, 0.0), 0.1, &p).unwrap();
         assert!((c.speed - 0.1).abs() < 1e-12); // Z/(2dt) = 0.02/0.2
         assert!(goal_seeking_finished(1.0, 1.0, 1e-4));
         assert!(!goal_seeking_finished(1.0, 0.9, 1e-4));
@@ -133,25 +131,9 @@ mod tests {
     #[test]
     fn bad_input() {
         let p = SteeringParams::default();
-        assert!(
-            goal_seeking_step(
-                Pose::new(0.0, f64::NAN, 0.0),
-                Point2::new(1.0, 0.0),
-                0.1,
-                &p
-            )
-            .is_err()
-        );
-        assert!(
-            goal_seeking_step(Pose::new(0.0, 0.0, 0.0), Point2::new(1.0, 0.0), -0.1, &p).is_err()
-        );
-        let bad = SteeringParams {
-            max_steer: 2.0,
-            ..p
-        };
-        assert!(matches!(
-            bad.validate(),
-            Err(MobileError::OutOfRange { .. })
-        ));
+        assert!(goal_seeking_step(Pose::new(0.0, f64::NAN, 0.0), Point2::new(1.0, 0.0), 0.1, &p).is_err());
+        assert!(goal_seeking_step(Pose::new(0.0, 0.0, 0.0), Point2::new(1.0, 0.0), -0.1, &p).is_err());
+        let bad = SteeringParams { max_steer: 2.0, ..p };
+        assert!(matches!(bad.validate(), Err(MobileError::OutOfRange { .. })));
     }
 }

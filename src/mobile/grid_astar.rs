@@ -284,10 +284,7 @@ mod tests {
         for s in p.windows(2) {
             for k in 0..=20 {
                 let t = k as f64 / 20.0;
-                let q = Point2::new(
-                    s[0].x + t * (s[1].x - s[0].x),
-                    s[0].y + t * (s[1].y - s[0].y),
-                );
+                let q = Point2::new(s[0].x + t * (s[1].x - s[0].x), s[0].y + t * (s[1].y - s[0].y));
                 assert!(w.distance(q).0 > 0.25);
             }
         }

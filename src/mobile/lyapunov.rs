@@ -106,11 +106,7 @@ pub fn lyapunov_step(
     Ok(lyapunov_step_unchecked(state, goal, params))
 }
 
-pub(crate) fn lyapunov_step_unchecked(
-    state: Pose,
-    goal: Pose,
-    p: &LyapunovParams,
-) -> LyapunovCommand {
+pub(crate) fn lyapunov_step_unchecked(state: Pose, goal: Pose, p: &LyapunovParams) -> LyapunovCommand {
     let (sg, cg) = goal.theta.sin_cos();
     let dx = state.x - goal.x;
     let dy = state.y - goal.y;
@@ -182,16 +178,8 @@ mod tests {
         assert!(c.twist.vx.abs() < 1e-12);
         assert!((c.twist.omega - 0.3 * FRAC_PI_2).abs() < 1e-12);
         // Same pose in a goal frame shifted to (2, 3) and rotated by π/2: (2+1, 3+0, π/2).
-        let c2 = lyapunov_step(
-            Pose::new(3.0, 3.0, FRAC_PI_2),
-            Pose::new(2.0, 3.0, FRAC_PI_2),
-            &p,
-        )
-        .unwrap();
-        assert!(
-            (c2.twist.omega - c.twist.omega).abs() < 1e-12
-                && (c2.v_value - c.v_value).abs() < 1e-12
-        );
+        let c2 = lyapunov_step(Pose::new(3.0, 3.0, FRAC_PI_2), Pose::new(2.0, 3.0, FRAC_PI_2), &p).unwrap();
+        assert!((c2.twist.omega - c.twist.omega).abs() < 1e-12 && (c2.v_value - c.v_value).abs() < 1e-12);
     }
 
     #[test]
@@ -209,14 +197,7 @@ mod tests {
             ..LyapunovParams::default()
         };
         assert!(lyapunov_step(Pose::new(1.0, 0.0, 0.0), g, &huge).is_err());
-        assert!(
-            lyapunov_step(
-                Pose::new(1.0, 0.0, f64::INFINITY),
-                g,
-                &LyapunovParams::default()
-            )
-            .is_err()
-        );
+        assert!(lyapunov_step(Pose::new(1.0, 0.0, f64::INFINITY), g, &LyapunovParams::default()).is_err());
     }
 
     #[test]

@@ -37,8 +37,7 @@ pub use simulate::{
     NavigateParams, Outcome, RunMetrics, SimParams, SimRun, follow_path, navigate, navigate_astar,
 };
 pub use vector_distance::{
-    NavMode, NoPathReason, TurnPreference, TurnSide, VdfEvent, VdfOutput, VdfParams, VdfState,
-    vdf_step,
+    NavMode, NoPathReason, TurnPreference, TurnSide, VdfEvent, VdfOutput, VdfParams, VdfState, vdf_step,
 };
 pub use wheel_kinematics::WheelState;
 pub use world::{Obstacle, World};

@@ -25,11 +25,7 @@ pub struct PathNode {
 impl PathNode {
     /// A node without heading.
     pub const fn at(x: f64, y: f64) -> Self {
-        Self {
-            x,
-            y,
-            heading: None,
-        }
+        Self { x, y, heading: None }
     }
 
     /// The position.
@@ -208,8 +204,7 @@ pub(crate) fn path_follow_unchecked(
     }
     let final_heading = next.target == last && node.heading.is_some();
     let near_final = d < params.switching_distance.max(params.pure_pursuit.lookahead);
-    let use_lyapunov =
-        params.controller == ControllerKind::Lyapunov || (final_heading && near_final);
+    let use_lyapunov = params.controller == ControllerKind::Lyapunov || (final_heading && near_final);
     let twist = if use_lyapunov {
         let heading = node.heading.unwrap_or_else(|| {
             if next.target < last {
@@ -241,18 +236,15 @@ pub(crate) fn path_follow_unchecked(
                 next.segment = c.segment;
                 c.twist
             }
-            ControllerKind::GoalSeeking => {
-                goal_seeking_step(state, node.point(), dt, &params.steering)
-                    .map(|c| c.twist)
-                    .unwrap_or(Twist::ZERO)
-            }
+            ControllerKind::GoalSeeking => goal_seeking_step(state, node.point(), dt, &params.steering)
+                .map(|c| c.twist)
+                .unwrap_or(Twist::ZERO),
             _ => shortest_path_step(state, node.point(), dt, &params.steering)
                 .map(|c| c.twist)
                 .unwrap_or(Twist::ZERO),
         }
     };
-    if next.target != progress.target.min(last) && params.controller != ControllerKind::PurePursuit
-    {
+    if next.target != progress.target.min(last) && params.controller != ControllerKind::PurePursuit {
         next.segment = 0;
     }
     PathFollowStep {
@@ -289,8 +281,7 @@ mod tests {
             heading: Some(1.0),
         }];
         let p = PathFollowParams::default();
-        let s =
-            path_follow_step(Pose::default(), &path, PathFollowState::default(), 0.1, &p).unwrap();
+        let s = path_follow_step(Pose::default(), &path, PathFollowState::default(), 0.1, &p).unwrap();
         assert!(!s.reached);
         assert!(s.twist.omega > 0.0);
         let s = path_follow_step(
@@ -316,8 +307,6 @@ mod tests {
             y: 0.0,
             heading: Some(f64::NAN),
         }];
-        assert!(
-            path_follow_step(Pose::default(), &nan, PathFollowState::default(), 0.1, &p).is_err()
-        );
+        assert!(path_follow_step(Pose::default(), &nan, PathFollowState::default(), 0.1, &p).is_err());
     }
 }

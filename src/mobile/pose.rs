@@ -144,11 +144,7 @@ mod tests {
     #[test]
     fn quarter_circle_lands_on_the_arc() {
         // v = 1 m/s, ω = 1 rad/s for π/2 s: a quarter of the unit circle, from (0,0,0) to (1,1,π/2).
-        let p = integrate_twist(
-            Pose::new(0.0, 0.0, 0.0),
-            Twist::unicycle(1.0, 1.0),
-            PI / 2.0,
-        );
+        let p = integrate_twist(Pose::new(0.0, 0.0, 0.0), Twist::unicycle(1.0, 1.0), PI / 2.0);
         assert!((p.x - 1.0).abs() < 1e-12 && (p.y - 1.0).abs() < 1e-12);
         assert!((p.theta - PI / 2.0).abs() < 1e-12);
     }

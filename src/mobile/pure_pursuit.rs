@@ -178,8 +178,7 @@ pub(crate) fn pure_pursuit_unchecked(
     let d2 = xl * xl + yl * yl;
     let curvature = if d2 > 1e-12 { 2.0 * yl / d2 } else { 0.0 };
     let bearing = wrap_angle(yl.atan2(xl));
-    let twist = if params.rotate_to_heading && d2 > 1e-12 && bearing.abs() > params.rotate_min_angle
-    {
+    let twist = if params.rotate_to_heading && d2 > 1e-12 && bearing.abs() > params.rotate_min_angle {
         Twist::unicycle(0.0, params.rotate_yaw_rate.copysign(bearing))
     } else {
         let to_end = me.distance(last);
@@ -207,13 +206,7 @@ mod tests {
     #[test]
     fn point_behind_triggers_rotation_in_place() {
         let path = [Point2::new(0.0, 0.0), Point2::new(-5.0, 0.0)];
-        let c = pure_pursuit_step(
-            Pose::new(0.0, 0.0, 0.0),
-            &path,
-            0,
-            &PurePursuitParams::default(),
-        )
-        .unwrap();
+        let c = pure_pursuit_step(Pose::new(0.0, 0.0, 0.0), &path, 0, &PurePursuitParams::default()).unwrap();
         assert_eq!(c.twist.vx, 0.0);
         assert!((c.twist.omega.abs() - 1.8).abs() < 1e-12);
         assert!((c.lookahead_point.x + 0.6).abs() < 1e-12);
@@ -223,13 +216,7 @@ mod tests {
     fn approach_speed_scales_down() {
         // Robot 0.3 m from the end, facing it: v = 0.5 · 0.3 / 0.6 = 0.25, κ = 0.
         let path = [Point2::new(-1.0, 0.0), Point2::new(0.3, 0.0)];
-        let c = pure_pursuit_step(
-            Pose::new(0.0, 0.0, 0.0),
-            &path,
-            0,
-            &PurePursuitParams::default(),
-        )
-        .unwrap();
+        let c = pure_pursuit_step(Pose::new(0.0, 0.0, 0.0), &path, 0, &PurePursuitParams::default()).unwrap();
         assert!((c.twist.vx - 0.25).abs() < 1e-12 && c.twist.omega.abs() < 1e-12);
     }
 

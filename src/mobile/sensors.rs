@@ -143,10 +143,7 @@ mod tests {
             noise_sigma: 0.05,
             ..RangeSensorParams::default()
         };
-        let (mut a, mut b) = (
-            RangeSensors::new(p, 7).unwrap(),
-            RangeSensors::new(p, 7).unwrap(),
-        );
+        let (mut a, mut b) = (RangeSensors::new(p, 7).unwrap(), RangeSensors::new(p, 7).unwrap());
         let (mut da, mut db) = ([0.0; 8], [0.0; 8]);
         a.sense(&w, Pose::default(), 0.1, &mut da);
         b.sense(&w, Pose::default(), 0.1, &mut db);

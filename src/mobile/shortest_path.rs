@@ -53,12 +53,10 @@ mod tests {
     #[test]
     fn goal_to_the_left_steers_left_and_goal_behind_saturates() {
         let p = SteeringParams::default();
-        let c =
-            shortest_path_step(Pose::new(0.0, 0.0, 0.0), Point2::new(1.0, 1.0), 0.1, &p).unwrap();
+        let c = shortest_path_step(Pose::new(0.0, 0.0, 0.0), Point2::new(1.0, 1.0), 0.1, &p).unwrap();
         // Even δ = 70° turns only ds·tan70°/L = 0.05·2.7475/0.6 = 13.1° < 45°: saturates.
         assert!((c.steer - p.max_steer).abs() < 1e-12);
-        let back =
-            shortest_path_step(Pose::new(0.0, 0.0, 0.0), Point2::new(-3.0, -0.5), 0.1, &p).unwrap();
+        let back = shortest_path_step(Pose::new(0.0, 0.0, 0.0), Point2::new(-3.0, -0.5), 0.1, &p).unwrap();
         assert!((back.steer + p.max_steer).abs() < 1e-12);
     }
 
@@ -69,10 +67,7 @@ mod tests {
         // goal at a small angle instead: bearing 2°, ds = 0.05, θ' = 2° (approx) → δ =
         // atan(0.6·0.0349/0.05) = 22.7°; the 1° grid gives 22° or 23°.
         let p = SteeringParams::default();
-        let g = Point2::new(
-            100.0 * 2f64.to_radians().cos(),
-            100.0 * 2f64.to_radians().sin(),
-        );
+        let g = Point2::new(100.0 * 2f64.to_radians().cos(), 100.0 * 2f64.to_radians().sin());
         let c = shortest_path_step(Pose::new(0.0, 0.0, 0.0), g, 0.1, &p).unwrap();
         let d = c.steer.to_degrees();
         assert!((22.0..=23.0 + 1e-9).contains(&d), "{d}");

@@ -6,9 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::chassis::Chassis;
 use super::error::{MobileError, check_positive};
 use super::grid_astar::{GridAstarParams, plan_grid_astar};
-use super::path_follow::{
-    PathFollowParams, PathFollowState, PathNode, path_follow_unchecked, validate_path,
-};
+use super::path_follow::{PathFollowParams, PathFollowState, PathNode, path_follow_unchecked, validate_path};
 use super::pose::{Point2, Pose, Twist, integrate_twist};
 use super::sensors::{RangeSensorParams, RangeSensors};
 use super::vector_distance::{NavMode, NoPathReason, VdfEvent, VdfParams, VdfState, vdf_step_mut};
@@ -108,12 +106,7 @@ impl SimParams {
         check_positive("sim.dt", self.dt)?;
         check_positive("sim.max_time", self.max_time)?;
         super::error::check_range("sim.dt", self.dt, 0.0, self.max_time)?;
-        super::error::check_range(
-            "sim.max_time / sim.dt",
-            self.max_time / self.dt,
-            0.0,
-            MAX_STEPS,
-        )
+        super::error::check_range("sim.max_time / sim.dt", self.max_time / self.dt, 0.0, MAX_STEPS)
     }
 }
 
@@ -162,11 +155,7 @@ fn advance(
     (p, applied, min_c, None)
 }
 
-fn start_check(
-    world: Option<&World>,
-    start: Pose,
-    radius: f64,
-) -> Result<Option<f64>, MobileError> {
+fn start_check(world: Option<&World>, start: Pose, radius: f64) -> Result<Option<f64>, MobileError> {
     let Some(w) = world else { return Ok(None) };
     let (d, i) = w.distance(start.point());
     let c = d - radius;
@@ -366,11 +355,7 @@ pub fn navigate_astar(
             ..SimRun::default()
         });
     };
-    let path: Vec<PathNode> = points
-        .iter()
-        .skip(1)
-        .map(|p| PathNode::at(p.x, p.y))
-        .collect();
+    let path: Vec<PathNode> = points.iter().skip(1).map(|p| PathNode::at(p.x, p.y)).collect();
     if path.is_empty() {
         return Ok(SimRun {
             outcome: Outcome::Reached,
@@ -567,11 +552,7 @@ mod tests {
             .unwrap();
             assert_eq!(run.outcome, Outcome::Reached, "{ctl:?}");
             let last = run.states.last().unwrap();
-            assert!(
-                (last.x - 3.0).abs() < 0.02
-                    && (last.y - 1.0).abs() < 0.02
-                    && last.theta.abs() < 0.0175
-            );
+            assert!((last.x - 3.0).abs() < 0.02 && (last.y - 1.0).abs() < 0.02 && last.theta.abs() < 0.0175);
         }
         // Steered controllers on MOBIL-II to a point without heading.
         let path = [PathNode::at(2.0, 1.0), PathNode::at(4.0, -1.0)];
@@ -638,9 +619,7 @@ mod tests {
         let p = NavigateParams::default();
         let c = Chassis::default();
         assert!(matches!(
-            navigate(&c, Pose::default(), Point2::new(1.0, 0.0), &w, &p, &|| {
-                false
-            }),
+            navigate(&c, Pose::default(), Point2::new(1.0, 0.0), &w, &p, &|| { false }),
             Err(MobileError::StartInCollision { obstacle: 0, .. })
         ));
         let bad_dt = NavigateParams {
@@ -655,10 +634,7 @@ mod tests {
             max_time: 1e3,
             ..SimParams::default()
         };
-        assert!(matches!(
-            too_long.validate(),
-            Err(MobileError::OutOfRange { .. })
-        ));
+        assert!(matches!(too_long.validate(), Err(MobileError::OutOfRange { .. })));
         assert!(
             navigate(
                 &c,

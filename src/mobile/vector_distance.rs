@@ -207,15 +207,11 @@ impl VdfState {
         let s: Self = serde_json::from_slice(token).map_err(|e| MobileError::BadToken {
             reason: e.to_string(),
         })?;
-        let bad = |r: &str| MobileError::BadToken {
-            reason: r.to_owned(),
-        };
+        let bad = |r: &str| MobileError::BadToken { reason: r.to_owned() };
         if !s.locked_direction.is_finite() || !s.hit_distance.is_finite() {
             return Err(bad("non-finite angle or distance"));
         }
-        if s.hit_point
-            .is_some_and(|h| !(h.x.is_finite() && h.y.is_finite()))
-        {
+        if s.hit_point.is_some_and(|h| !(h.x.is_finite() && h.y.is_finite())) {
             return Err(bad("non-finite hit point"));
         }
         if s.history.len() > MAX_TOKEN_HISTORY || s.history.iter().any(|d| !d.is_finite()) {
@@ -404,8 +400,8 @@ pub(crate) fn vdf_step_mut(
         NavMode::Track => {
             let h = s.hit_point.unwrap_or(me);
             let all_clear = readings.iter().all(|&d| d > p.safe_distance);
-            let on_line = line_distance(me, h, goal) < p.leave_tolerance
-                && z < s.hit_distance - p.leave_tolerance;
+            let on_line =
+                line_distance(me, h, goal) < p.leave_tolerance && z < s.hit_distance - p.leave_tolerance;
             if all_clear || (on_line && goal_open) {
                 s.mode = NavMode::Rotate;
                 s.steps_in_mode = 0;
@@ -446,29 +442,18 @@ pub(crate) fn vdf_step_mut(
         NavMode::Rotate => goal_dir,
         NavMode::Lock => s.locked_direction,
         NavMode::Track => {
-            let (imin, dmin) =
-                readings
-                    .iter()
-                    .copied()
-                    .enumerate()
-                    .fold(
-                        (0, f64::INFINITY),
-                        |a, (i, d)| if d < a.1 { (i, d) } else { a },
-                    );
+            let (imin, dmin) = readings
+                .iter()
+                .copied()
+                .enumerate()
+                .fold((0, f64::INFINITY), |a, (i, d)| if d < a.1 { (i, d) } else { a });
             let obstacle_dir = pose.theta + TAU * imin as f64 / n as f64;
             let target = 0.8 * p.safe_distance;
             let off = (FRAC_PI_2 + p.wall_gain * (target - dmin)).clamp(FRAC_PI_4, 3.0 * FRAC_PI_4);
             obstacle_dir + sign * off
         }
     };
-    let (fx, fy) = vector_sum(
-        readings,
-        pose.theta,
-        centre,
-        s.mode != NavMode::Rotate,
-        s.side,
-        p,
-    );
+    let (fx, fy) = vector_sum(readings, pose.theta, centre, s.mode != NavMode::Rotate, s.side, p);
     let raw = if fx.hypot(fy) > 1e-9 {
         fy.atan2(fx)
     } else {
@@ -560,11 +545,7 @@ fn choose_side(readings: &[f64], theta: f64, goal_dir: f64, p: &VdfParams) -> Tu
                 l += w * reading_at(readings, theta, goal_dir + a).min(p.safe_distance * 4.0);
                 r += w * reading_at(readings, theta, goal_dir - a).min(p.safe_distance * 4.0);
             }
-            if r > l {
-                TurnSide::Right
-            } else {
-                TurnSide::Left
-            }
+            if r > l { TurnSide::Right } else { TurnSide::Left }
         }
     }
 }

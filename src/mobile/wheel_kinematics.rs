@@ -72,10 +72,7 @@ impl Chassis {
     /// let (w, _) = Chassis::default().inverse_kinematics(Twist::unicycle(0.98, 0.0)).unwrap();
     /// assert!(matches!(w, WheelState::Differential { left, right } if (left - 10.0).abs() < 1e-9 && left == right));
     /// ```
-    pub fn inverse_kinematics(
-        &self,
-        twist: Twist,
-    ) -> Result<(WheelState, Saturation), MobileError> {
+    pub fn inverse_kinematics(&self, twist: Twist) -> Result<(WheelState, Saturation), MobileError> {
         self.validate()?;
         twist.validate("twist")?;
         let (t, sat) = self.saturate(twist);
@@ -102,8 +99,8 @@ impl Chassis {
                 let mut speeds = [0.0; 3];
                 for (i, s) in speeds.iter_mut().enumerate() {
                     let phi = p.first_wheel_angle + i as f64 * 2.0 * PI / 3.0;
-                    *s = (-phi.sin() * t.vx + phi.cos() * t.vy + p.center_distance * t.omega)
-                        / p.wheel_radius;
+                    *s =
+                        (-phi.sin() * t.vx + phi.cos() * t.vy + p.center_distance * t.omega) / p.wheel_radius;
                 }
                 WheelState::Omni { speeds }
             }
@@ -213,9 +210,7 @@ mod tests {
             })
             .unwrap();
         assert!(!s.any());
-        let WheelState::Omni { speeds } = w else {
-            panic!()
-        };
+        let WheelState::Omni { speeds } = w else { panic!() };
         for u in speeds {
             assert!((u - 3.0).abs() < 1e-12);
         }
@@ -231,9 +226,7 @@ mod tests {
                 omega: 0.0,
             })
             .unwrap();
-        let WheelState::Omni { speeds } = w else {
-            panic!()
-        };
+        let WheelState::Omni { speeds } = w else { panic!() };
         assert!(
             (speeds[0] + 3.0).abs() < 1e-12
                 && (speeds[1] - 1.5).abs() < 1e-12
@@ -269,10 +262,7 @@ mod tests {
 
     #[test]
     fn steering_limit_is_respected_for_any_command() {
-        for c in [
-            Chassis::mobil_ii(),
-            Chassis::Tricycle(TricycleParams::default()),
-        ] {
+        for c in [Chassis::mobil_ii(), Chassis::Tricycle(TricycleParams::default())] {
             for &(v, w) in &[(0.5, 10.0), (-0.3, -4.0), (0.01, 1.0), (1.0, -1.0)] {
                 let (wh, s) = c.inverse_kinematics(Twist::unicycle(v, w)).unwrap();
                 let max = 70f64.to_radians() + 1e-9;

@@ -51,9 +51,7 @@ impl Obstacle {
                     let a = vertices[i];
                     let b = vertices[(i + 1) % n];
                     best = best.min(segment_distance(p, a, b));
-                    if (a.y > p.y) != (b.y > p.y)
-                        && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y)
-                    {
+                    if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y) {
                         inside = !inside;
                     }
                 }
@@ -228,17 +226,9 @@ mod tests {
         assert!((w.obstacles()[1].signed_distance(Point2::new(-2.0, 0.0)) + 1.0).abs() < 1e-12);
         let all = [0, 1];
         assert!((w.raycast(Point2::new(0.0, 0.0), 0.0, 10.0, &all) - 2.0).abs() < 1e-12);
-        assert!(
-            (w.raycast(Point2::new(0.0, 0.0), std::f64::consts::PI, 10.0, &all) - 1.0).abs()
-                < 1e-12
-        );
+        assert!((w.raycast(Point2::new(0.0, 0.0), std::f64::consts::PI, 10.0, &all) - 1.0).abs() < 1e-12);
         assert_eq!(
-            w.raycast(
-                Point2::new(0.0, 0.0),
-                std::f64::consts::FRAC_PI_2,
-                10.0,
-                &all
-            ),
+            w.raycast(Point2::new(0.0, 0.0), std::f64::consts::FRAC_PI_2, 10.0, &all),
             10.0
         );
     }
