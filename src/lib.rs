@@ -4,6 +4,8 @@
 //! The domain rooms (`robot`, …) never name tonic or prost; `service` is the
 //! only layer that does.
 
+pub mod ik;
+pub mod linalg;
 pub mod mobile;
 pub mod robot;
 pub mod score;

@@ -1,0 +1,134 @@
+//! TRAC-IK-protocol benchmark: N random reachable poses per arm (FK of uniform random
+//! joints within limits), seed at the middle of the limits, tolerance 1e-5 m / rad,
+//! 5 ms budget. Prints success rate, mean and median µs per method × solver.
+//!
+//! `cargo run --release --example ik_bench -- [N] [arm,...] [method,...]`
+//! methods: ji-svd ji-rlxa lm-svd lm-rlxa newton-svd newton-rlxa ccd fabrik lr
+//! `POS=1` uses position-only targets; `NOBUDGET=1` replaces the 5 ms budget by 200 restarts.
+
+use std::time::{Duration, Instant};
+
+use kinplan::ik::{IkMethod, IkParams, IkSolver, IkTarget};
+use kinplan::linalg::LinearSolverKind;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn method(name: &str) -> (IkMethod, LinearSolverKind) {
+    use IkMethod::*;
+    use LinearSolverKind::*;
+    match name {
+        "ji-svd" => (JacobianInverse, SvdPseudoinverse),
+        "ji-rlxa" => (JacobianInverse, AngleRelaxation),
+        "lm-svd" => (LevenbergMarquardt, SvdPseudoinverse),
+        "lm-rlxa" => (LevenbergMarquardt, AngleRelaxation),
+        "newton-svd" => (Newton, SvdPseudoinverse),
+        "newton-rlxa" => (Newton, AngleRelaxation),
+        "ccd" => (Ccd, SvdPseudoinverse),
+        "fabrik" => (Fabrik, SvdPseudoinverse),
+        "lr" => (LengthRelaxation, SvdPseudoinverse),
+        other => panic!("unknown method {other}"),
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1000);
+    let arms: Vec<String> = args
+        .get(2)
+        .map(|s| s.split(',').map(String::from).collect())
+        .unwrap_or_else(|| {
+            [
+                "kuka_kr210_r2700_extra",
+                "kuka_kr120_r2500_pro",
+                "abb_irb4600_60_205",
+                "ur5",
+                "franka_panda",
+                "kuka_lbr_iiwa14_r820",
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+        });
+    let methods: Vec<String> = args
+        .get(3)
+        .map(|s| s.split(',').map(String::from).collect())
+        .unwrap_or_else(|| vec!["lm-svd".into()]);
+    let position_only = std::env::var("POS").is_ok();
+    println!(
+        "| arm | method | N | success % | mean µs | median µs | p99 µs | mean attempts | mean iterations |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for arm in &arms {
+        let chain = kinplan::robot::builtin_chain(arm).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(2026);
+        let targets: Vec<IkTarget> = (0..n)
+            .map(|_| {
+                let q: Vec<f64> = chain.limits().map(|(lo, hi)| rng.random_range(lo..=hi)).collect();
+                let t = chain.fk(&q);
+                if position_only {
+                    IkTarget::Position(nalgebra::Point3::from(t.translation.vector))
+                } else {
+                    IkTarget::Pose(t)
+                }
+            })
+            .collect();
+        let seed = chain.mid_limits();
+        for m in &methods {
+            let (method, linear_solver) = method(m);
+            let params = IkParams {
+                method,
+                linear_solver,
+                max_restarts: 100_000,
+                time_budget: Some(Duration::from_millis(5)),
+                ..IkParams::default()
+            };
+            let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+            let mut params = params;
+            if let Some(v) = env("MAX_STEP") {
+                params.max_step = v;
+            }
+            if let Some(v) = env("DAMPING") {
+                params.damping = v;
+            }
+            if let Some(v) = env("STALL") {
+                params.stall_iterations = v as usize;
+            }
+            if let Some(v) = env("MAXIT") {
+                params.max_iterations = v as usize;
+            }
+            if std::env::var("NOBUDGET").is_ok() {
+                // load-independent success rate: no wall clock, 200 restarts
+                params.time_budget = None;
+                params.max_restarts = 200;
+            }
+            let mut solver = IkSolver::new(&chain);
+            let mut times = Vec::with_capacity(n);
+            let mut ok = 0;
+            let mut attempts = 0;
+            let mut iters = 0;
+            for (i, t) in targets.iter().enumerate() {
+                let t0 = Instant::now();
+                let r = solver
+                    .solve(t, Some(&seed), &params, i as u64, &|| false)
+                    .unwrap();
+                times.push(t0.elapsed().as_secs_f64() * 1e6);
+                attempts += r.attempts;
+                iters += r.total_iterations;
+                if r.success() {
+                    ok += 1;
+                }
+            }
+            let mean = times.iter().sum::<f64>() / n as f64;
+            times.sort_by(f64::total_cmp);
+            println!(
+                "| {arm} | {m} | {n} | {:.2} | {:.1} | {:.1} | {:.1} | {:.2} | {:.1} |",
+                100.0 * ok as f64 / n as f64,
+                mean,
+                times[n / 2],
+                times[(n * 99) / 100],
+                attempts as f64 / n as f64,
+                iters as f64 / n as f64
+            );
+        }
+    }
+}

@@ -1,0 +1,252 @@
+//! Jacobian inverse, Levenberg–Marquardt and Newton iterations (S2 §3.1,
+//! ALGORITHMS.md §2), each with the SVD pseudoinverse or angle relaxation as the
+//! linear solver. One attempt from the joints in the workspace.
+//!
+//! With the geometric Jacobian `J(q)` (rows: linear, angular velocity, base frame; only
+//! the 3 linear rows for position targets) and the pose error `e(q)`:
+//! - Jacobian inverse (S2 eq. 33/35): solve `J Δq = e`, `q ← q + Δq`.
+//! - Levenberg–Marquardt (S2 eq. 36/37): solve `[J; √μ I] Δq = [e; 0]`. With SVD this is
+//!   `Δq = Σ σᵢ/(σᵢ² + μ) vᵢ uᵢᵀ e`, the same least-squares solution without forming
+//!   `JᵀJ`; with RLXA the augmented system itself is relaxed.
+//! - Newton (S2 eq. 29/30 with `f = −e`): solve `J q_{k+1} = J q_k + e` for `q_{k+1}`
+//!   (a fresh solve from zero; for redundant chains the pseudoinverse drops the null-space
+//!   part of `q_k` — faithful to the source, which found it poor with RLXA).
+//!
+//! Every step is scaled so `max|Δqᵢ| ≤ max_step`, then clamped into the limits.
+
+use nalgebra::Isometry3;
+use rand_chacha::ChaCha8Rng;
+
+use super::solve::{Attempt, Clock, IkWorkspace, is_converged};
+use super::{IkMethod, IkParams, IkStatus, IkTarget, JointLimitMode, PoseError, pose_error};
+use crate::linalg::{LinearSolverKind, RlxaParams};
+use crate::robot::Chain;
+
+const MU_MAX: f64 = 1e8;
+
+pub(crate) fn run(
+    chain: &Chain,
+    target: &IkTarget,
+    params: &IkParams,
+    ws: &mut IkWorkspace,
+    rng: &mut ChaCha8Rng,
+    clock: &Clock<'_>,
+) -> Attempt {
+    let n = chain.dof();
+    let task = target.task_dim();
+    let lm = params.method == IkMethod::LevenbergMarquardt;
+    let rlxa = params.linear_solver == LinearSolverKind::AngleRelaxation;
+    let rows = if lm && rlxa { task + n } else { task };
+    ws.ensure_system(rows, n);
+    IkWorkspace::apply_limits(&ws.limits, params.joint_limits, &mut ws.q);
+
+    let mut tip: Isometry3<f64> = chain.jacobian_into(&ws.q, &mut ws.jac);
+    let mut err = pose_error(&tip, target);
+    let mut best = err;
+    ws.q_best.copy_from_slice(&ws.q);
+    let mut stall_ref = err.squared();
+    let mut since_progress = 0usize;
+    let mu_min = params.damping * 1e-4;
+    let mut mu = params.damping;
+    // true while ws.svd holds the decomposition of the current J (LM retries reuse it)
+    let mut decomposed = false;
+    // Every decomposition warm-starts from the last right singular vectors (any orthogonal
+    // start is valid for one-sided Jacobi; the workspace resets V per request).
+    let cold = false;
+    let inner: RlxaParams = params.rlxa;
+
+    let mut it = 0;
+    let status = loop {
+        if is_converged(&err, target, params) {
+            break IkStatus::Converged;
+        }
+        if it >= params.max_iterations {
+            break IkStatus::MaxIterations;
+        }
+        if let Some(s) = clock.interrupted() {
+            break s;
+        }
+        it += 1;
+
+        // Assemble and solve the linear system for the step ws.x (Δq).
+        match (params.method, rlxa) {
+            (IkMethod::JacobianInverse | IkMethod::LevenbergMarquardt, false) => {
+                if !decomposed {
+                    copy_task_rows(ws, task, n);
+                    if cold {
+                        ws.svd.decompose(&ws.a);
+                    } else {
+                        ws.svd.decompose_warm(&ws.a);
+                    }
+                    decomposed = true;
+                }
+                for r in 0..task {
+                    ws.b[r] = err.e[r];
+                }
+                let damping = if lm { mu } else { 0.0 };
+                ws.svd
+                    .solve_decomposed(&ws.b, damping, params.singular_value_tolerance, &mut ws.x);
+            }
+            (IkMethod::Newton, false) => {
+                copy_task_rows(ws, task, n);
+                fill_newton_rhs(ws, &err, task, n);
+                if cold {
+                    ws.svd.decompose(&ws.a);
+                } else {
+                    ws.svd.decompose_warm(&ws.a);
+                }
+                ws.svd
+                    .solve_decomposed(&ws.b, 0.0, params.singular_value_tolerance, &mut ws.x);
+                for k in 0..n {
+                    ws.x[k] -= ws.q[k];
+                }
+            }
+            (IkMethod::JacobianInverse | IkMethod::LevenbergMarquardt, true) => {
+                copy_task_rows(ws, task, n);
+                for r in 0..task {
+                    ws.b[r] = err.e[r];
+                }
+                if lm {
+                    let s = mu.sqrt();
+                    for r in 0..n {
+                        for c in 0..n {
+                            ws.a[(task + r, c)] = if r == c { s } else { 0.0 };
+                        }
+                        ws.b[task + r] = 0.0;
+                    }
+                }
+                ws.x.fill(0.0);
+                let _ = ws.rlxa.solve_into(&ws.a, &ws.b, &mut ws.x, &inner, rng, None);
+            }
+            (IkMethod::Newton, true) => {
+                copy_task_rows(ws, task, n);
+                fill_newton_rhs(ws, &err, task, n);
+                ws.x.fill(0.0);
+                let _ = ws.rlxa.solve_into(&ws.a, &ws.b, &mut ws.x, &inner, rng, None);
+                for k in 0..n {
+                    ws.x[k] -= ws.q[k];
+                }
+            }
+            _ => unreachable_method(),
+        }
+
+        // Active set: a joint sitting on a limit whose step points further out is locked
+        // (its column zeroed) and the step re-solved, so clamping does not stall LM.
+        if params.joint_limits == JointLimitMode::Clamp
+            && params.method != IkMethod::Newton
+            && lock_limited_columns(ws, task, n)
+        {
+            if rlxa {
+                ws.x.fill(0.0);
+                let _ = ws.rlxa.solve_into(&ws.a, &ws.b, &mut ws.x, &inner, rng, None);
+            } else {
+                ws.svd.decompose_warm(&ws.a);
+                let damping = if lm { mu } else { 0.0 };
+                ws.svd
+                    .solve_decomposed(&ws.b, damping, params.singular_value_tolerance, &mut ws.x);
+            }
+        }
+
+        // Step limit, trial point, limits.
+        let largest = ws.x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale = if largest.is_finite() && largest > params.max_step {
+            params.max_step / largest
+        } else {
+            1.0
+        };
+        if !largest.is_finite() {
+            ws.x.fill(0.0);
+        }
+        for k in 0..n {
+            ws.q_trial[k] = ws.q[k] + scale * ws.x[k];
+        }
+        IkWorkspace::apply_limits(&ws.limits, params.joint_limits, &mut ws.q_trial);
+
+        if lm && params.adaptive_damping {
+            let trial_tip = chain.jacobian_into(&ws.q_trial, &mut ws.jac_trial);
+            let trial_err = pose_error(&trial_tip, target);
+            if trial_err.squared() < err.squared() {
+                std::mem::swap(&mut ws.q, &mut ws.q_trial);
+                std::mem::swap(&mut ws.jac, &mut ws.jac_trial);
+                mu = (mu * 0.1).max(mu_min);
+                tip = trial_tip;
+                err = trial_err;
+                decomposed = false;
+            } else {
+                mu *= 10.0;
+                if mu > MU_MAX {
+                    break IkStatus::Stalled;
+                }
+            }
+        } else {
+            std::mem::swap(&mut ws.q, &mut ws.q_trial);
+            tip = chain.jacobian_into(&ws.q, &mut ws.jac);
+            err = pose_error(&tip, target);
+            decomposed = false;
+        }
+
+        if err.squared() < best.squared() {
+            best = err;
+            ws.q_best.copy_from_slice(&ws.q);
+        }
+        if err.squared() < 0.99 * stall_ref {
+            stall_ref = err.squared();
+            since_progress = 0;
+        } else {
+            since_progress += 1;
+            if params.stall_iterations > 0 && since_progress >= params.stall_iterations {
+                break IkStatus::Stalled;
+            }
+        }
+    };
+    let _ = tip;
+    if status != IkStatus::Converged && best.squared() < err.squared() {
+        ws.q.copy_from_slice(&ws.q_best);
+        err = best;
+    }
+    Attempt {
+        status,
+        iterations: it,
+        error: err,
+    }
+}
+
+/// Zeroes the task rows of column `k` when joint `k` is on a limit and `Δq_k` points
+/// outward. Returns whether any column was locked.
+fn lock_limited_columns(ws: &mut IkWorkspace, task: usize, n: usize) -> bool {
+    let mut any = false;
+    for k in 0..n {
+        let (lo, hi) = ws.limits[k];
+        if (ws.q[k] <= lo && ws.x[k] < 0.0) || (ws.q[k] >= hi && ws.x[k] > 0.0) {
+            for r in 0..task {
+                ws.a[(r, k)] = 0.0;
+            }
+            any = true;
+        }
+    }
+    any
+}
+
+#[inline]
+fn copy_task_rows(ws: &mut IkWorkspace, task: usize, n: usize) {
+    for c in 0..n {
+        for r in 0..task {
+            ws.a[(r, c)] = ws.jac[(r, c)];
+        }
+    }
+}
+
+/// `b = J q + e` (S2 eq. 30 with `f(q) = −e(q)`).
+#[inline]
+fn fill_newton_rhs(ws: &mut IkWorkspace, err: &PoseError, task: usize, n: usize) {
+    for r in 0..task {
+        let mut s = err.e[r];
+        for c in 0..n {
+            s += ws.jac[(r, c)] * ws.q[c];
+        }
+        ws.b[r] = s;
+    }
+}
+
+#[cold]
+fn unreachable_method() {}
