@@ -11,7 +11,8 @@ use super::convert::{matrix_out, pose_out, vec3_out};
 use super::pb::{self, robot_service_server::RobotService};
 use super::server::Shared;
 use super::status::robot_error;
-use super::{Compute, ModelStore};
+use super::models::Resolved;
+use super::{Budget, Compute, ModelStore};
 use crate::robot::{BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf};
 
 pub struct RobotApi {
@@ -25,6 +26,22 @@ impl RobotApi {
             models: shared.models,
             compute: shared.compute,
         }
+    }
+
+    /// The named robot, with `q` (the request's `joint_positions`) checked
+    /// against its joint count.
+    async fn robot_at(
+        &self,
+        robot: Option<&pb::RobotRef>,
+        q: &[f64],
+        budget: &Budget,
+    ) -> Result<Resolved, Status> {
+        let robot = self.models.resolve(robot, &self.compute, budget).await?;
+        robot
+            .chain
+            .check_joints(q)
+            .map_err(|e| robot_error(e, "joint_positions"))?;
+        Ok(robot)
     }
 }
 
@@ -69,15 +86,9 @@ impl RobotService for RobotApi {
     ) -> Result<Response<pb::ForwardKinematicsResponse>, Status> {
         let (_permit, budget) = self.compute.admit(&request)?;
         let req = request.get_ref();
-        let robot = self
-            .models
-            .resolve(req.robot.as_ref(), &self.compute, &budget)
-            .await?;
-        let chain = &robot.chain;
         let q = &req.joint_positions;
-        chain
-            .check_joints(q)
-            .map_err(|e| robot_error(e, "joint_positions"))?;
+        let robot = self.robot_at(req.robot.as_ref(), q, &budget).await?;
+        let chain = &robot.chain;
         let links = if req.include_links {
             let mut frames = Vec::with_capacity(chain.links().len());
             chain.link_frames_into(q, &mut frames);
@@ -106,15 +117,8 @@ impl RobotService for RobotApi {
     ) -> Result<Response<pb::JacobianResponse>, Status> {
         let (_permit, budget) = self.compute.admit(&request)?;
         let req = request.get_ref();
-        let robot = self
-            .models
-            .resolve(req.robot.as_ref(), &self.compute, &budget)
-            .await?;
         let q = &req.joint_positions;
-        robot
-            .chain
-            .check_joints(q)
-            .map_err(|e| robot_error(e, "joint_positions"))?;
+        let robot = self.robot_at(req.robot.as_ref(), q, &budget).await?;
         let mut jacobian = nalgebra::Matrix6xX::zeros(robot.chain.dof());
         let tool = robot.chain.jacobian_into(q, &mut jacobian);
         Ok(Response::new(pb::JacobianResponse {
