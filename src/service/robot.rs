@@ -8,10 +8,10 @@ use std::sync::Arc;
 use tonic::{Request, Response, Status};
 
 use super::convert::{matrix_out, pose_out, vec3_out};
+use super::models::Resolved;
 use super::pb::{self, robot_service_server::RobotService};
 use super::server::Shared;
 use super::status::robot_error;
-use super::models::Resolved;
 use super::{Budget, Compute, ModelStore};
 use crate::robot::{BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf};
 
