@@ -8,6 +8,7 @@ mod compute;
 #[allow(dead_code)] // helpers for the request types of services still to come
 mod convert;
 mod metrics;
+mod mobile;
 mod models;
 mod robot;
 mod scoring;

@@ -11,6 +11,8 @@ use tonic::transport::Server;
 use tonic_health::ServingStatus;
 
 use super::metrics::MetricsLayer;
+use super::mobile::MobileApi;
+use super::pb::mobile_service_server::MobileServiceServer;
 use super::pb::{
     self, robot_service_server::RobotServiceServer, scoring_service_server::ScoringServiceServer,
 };
@@ -87,8 +89,9 @@ pub async fn serve(
     }
     let robot = service!(RobotServiceServer, RobotApi::new(shared.clone()));
     let scoring = service!(ScoringServiceServer, ScoringApi::new(shared.clone()));
+    let mobile = service!(MobileServiceServer, MobileApi::new(shared.clone()));
 
-    let services = [name_of(&robot), name_of(&scoring)];
+    let services = [name_of(&robot), name_of(&scoring), name_of(&mobile)];
     let (health, health_service) = tonic_health::server::health_reporter();
     for name in services {
         health.set_service_status(name, ServingStatus::Serving).await;
@@ -120,6 +123,7 @@ pub async fn serve(
         .add_service(reflection_v1alpha)
         .add_service(robot)
         .add_service(scoring)
+        .add_service(mobile)
         .serve_with_incoming_shutdown(TcpListenerStream::new(listener), drain)
         .await?;
     Ok(())
