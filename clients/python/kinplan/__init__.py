@@ -7,15 +7,20 @@
 from ._convert import matrix_to_pose, pose_to_matrix
 from .client import Client, Robot, RobotDescription
 from .errors import KinplanError
+from .mobile import Mobile, MobileRun, StepResult, WheelKinematics
 from .scoring import Comparison, Scores
 
 __all__ = [
     "Client",
     "Comparison",
     "KinplanError",
+    "Mobile",
+    "MobileRun",
     "Robot",
     "RobotDescription",
     "Scores",
+    "StepResult",
+    "WheelKinematics",
     "matrix_to_pose",
     "pose_to_matrix",
 ]

@@ -9,13 +9,14 @@ import numpy as np
 
 from ._convert import joints, matrix_from_proto, pose_to_matrix
 from .errors import KinplanError
+from .mobile import MobileMixin
 from .scoring import ScoringMixin
 from .v1 import common_pb2, robot_pb2, robot_pb2_grpc
 
 DEFAULT_TIMEOUT = 30.0
 
 
-class Client(ScoringMixin):
+class Client(ScoringMixin, MobileMixin):
     """A connection to a kinplan server.
 
     `timeout` (seconds) is the default deadline of every call; each method
