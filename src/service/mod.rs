@@ -7,6 +7,7 @@ pub mod pb;
 mod compute;
 #[allow(dead_code)] // helpers for the request types of services still to come
 mod convert;
+mod kinematics;
 mod metrics;
 mod mobile;
 mod models;

@@ -10,8 +10,10 @@ use tokio_stream::wrappers::TcpListenerStream;
 use tonic::transport::Server;
 use tonic_health::ServingStatus;
 
+use super::kinematics::KinematicsApi;
 use super::metrics::MetricsLayer;
 use super::mobile::MobileApi;
+use super::pb::kinematics_service_server::KinematicsServiceServer;
 use super::pb::mobile_service_server::MobileServiceServer;
 use super::pb::{
     self, robot_service_server::RobotServiceServer, scoring_service_server::ScoringServiceServer,
@@ -90,8 +92,14 @@ pub async fn serve(
     let robot = service!(RobotServiceServer, RobotApi::new(shared.clone()));
     let scoring = service!(ScoringServiceServer, ScoringApi::new(shared.clone()));
     let mobile = service!(MobileServiceServer, MobileApi::new(shared.clone()));
+    let kinematics = service!(KinematicsServiceServer, KinematicsApi::new(shared.clone()));
 
-    let services = [name_of(&robot), name_of(&scoring), name_of(&mobile)];
+    let services = [
+        name_of(&robot),
+        name_of(&scoring),
+        name_of(&mobile),
+        name_of(&kinematics),
+    ];
     let (health, health_service) = tonic_health::server::health_reporter();
     for name in services {
         health.set_service_status(name, ServingStatus::Serving).await;
@@ -124,6 +132,7 @@ pub async fn serve(
         .add_service(robot)
         .add_service(scoring)
         .add_service(mobile)
+        .add_service(kinematics)
         .serve_with_incoming_shutdown(TcpListenerStream::new(listener), drain)
         .await?;
     Ok(())
