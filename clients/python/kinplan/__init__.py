@@ -7,19 +7,26 @@
 from ._convert import matrix_to_pose, pose_to_matrix
 from .client import Client, Robot, RobotDescription
 from .errors import KinplanError
+from .kinematics import IkBatchResult, IkResult, IkSolution, IkStream, LinearSolution, TrackResult
 from .mobile import Mobile, MobileRun, StepResult, WheelKinematics
 from .scoring import Comparison, Scores
 
 __all__ = [
     "Client",
     "Comparison",
+    "IkBatchResult",
+    "IkResult",
+    "IkSolution",
+    "IkStream",
     "KinplanError",
+    "LinearSolution",
     "Mobile",
     "MobileRun",
     "Robot",
     "RobotDescription",
     "Scores",
     "StepResult",
+    "TrackResult",
     "WheelKinematics",
     "matrix_to_pose",
     "pose_to_matrix",

@@ -9,6 +9,7 @@ import numpy as np
 
 from ._convert import joints, matrix_from_proto, pose_to_matrix
 from .errors import KinplanError
+from .kinematics import KinematicsMixin, RobotKinematicsMixin
 from .mobile import MobileMixin
 from .scoring import ScoringMixin
 from .v1 import common_pb2, robot_pb2, robot_pb2_grpc
@@ -16,7 +17,7 @@ from .v1 import common_pb2, robot_pb2, robot_pb2_grpc
 DEFAULT_TIMEOUT = 30.0
 
 
-class Client(ScoringMixin, MobileMixin):
+class Client(ScoringMixin, MobileMixin, KinematicsMixin):
     """A connection to a kinplan server.
 
     `timeout` (seconds) is the default deadline of every call; each method
@@ -107,7 +108,7 @@ class RobotDescription:
         return len(self.joint_names)
 
 
-class Robot:
+class Robot(RobotKinematicsMixin):
     """A robot on a server. Inline URDFs are sent once, then referred to by
     the content hash the server returns; if a replica does not hold it
     (NOT_FOUND), the URDF is sent again by itself."""
