@@ -6,8 +6,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use tokio::net::TcpListener;
-use tokio_stream::wrappers::TcpListenerStream;
 use tonic::transport::Server;
+use tonic::transport::server::TcpIncoming;
 use tonic_health::ServingStatus;
 
 use super::kinematics::KinematicsApi;
@@ -133,7 +133,13 @@ pub async fn serve(
         .add_service(scoring)
         .add_service(mobile)
         .add_service(kinematics)
-        .serve_with_incoming_shutdown(TcpListenerStream::new(listener), drain)
+        .serve_with_incoming_shutdown(
+            // Small replies must not wait for Nagle + delayed ACK (40 ms on loopback).
+            TcpIncoming::from(listener)
+                .with_nodelay(Some(true))
+                .with_keepalive(Some(Duration::from_secs(60))),
+            drain,
+        )
         .await?;
     Ok(())
 }
