@@ -66,9 +66,12 @@ def _choice(table: Mapping, value: Any, what: str) -> int:
     return table[value]
 
 
+_IK_STATUS = {v: kinematics_pb2.IkStatus.Name(v).removeprefix("IK_STATUS_").lower() for v in kinematics_pb2.IkStatus.values()}
+
+
 def _ik_status(value: int) -> str:
     """``"converged"``, ``"max_iterations"``, ``"stalled"``, ``"time_budget"``, ``"cancelled"``."""
-    return kinematics_pb2.IkStatus.Name(value).removeprefix("IK_STATUS_").lower()
+    return _IK_STATUS.get(value) or kinematics_pb2.IkStatus.Name(value).removeprefix("IK_STATUS_").lower()
 
 
 def target_to_pose(T: Any) -> common_pb2.Pose:
