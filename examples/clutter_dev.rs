@@ -2,7 +2,8 @@
 //! (cellular-automaton clutter of 0.075 m cylinders on a 0.15 m grid inside a 4.5 m wide
 //! corridor), used to choose d_sa without looking at the BARN worlds.
 //!
-//! Usage: cargo run --release --example clutter_dev -- [n_worlds]
+//! Usage: cargo run --release --example clutter_dev -- [n_worlds] [retry]
+//! (`retry`: also with `VdfParams::retry_other_side`)
 
 #![allow(clippy::needless_range_loop)]
 
@@ -74,8 +75,15 @@ fn main() {
     let chassis = Chassis::Differential(DifferentialParams::default());
     let start = Pose::new(-2.25, 3.0, 1.57);
     let goal = Point2::new(-2.25, 13.0);
+    let retries: Vec<bool> = match std::env::args().nth(2).as_deref() {
+        Some("retry") => vec![false, true],
+        _ => vec![false],
+    };
     for d_sa in [0.1, 0.15, 0.2, 0.3] {
-        for guard in [false, true] {
+        for (guard, retry) in [false, true]
+            .into_iter()
+            .flat_map(|g| retries.iter().map(move |&r| (g, r)))
+        {
             let nav = NavigateParams {
                 sim: SimParams {
                     robot_radius: 0.22,
@@ -87,6 +95,7 @@ fn main() {
                     safe_distance: d_sa,
                     release_distance: 2.0 * d_sa,
                     avoid_blocked_heading: guard,
+                    retry_other_side: retry,
                     ..VdfParams::default()
                 },
                 ..NavigateParams::default()
@@ -104,7 +113,7 @@ fn main() {
                 }
             }
             println!(
-                "d_sa={d_sa:.2} release={:.2} guard={guard}: reached {ok}/{n} collision {col} no_path {np} timeout {to}",
+                "d_sa={d_sa:.2} release={:.2} guard={guard} retry_other_side={retry}: reached {ok}/{n} collision {col} no_path {np} timeout {to}",
                 2.0 * d_sa
             );
         }

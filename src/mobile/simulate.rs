@@ -474,6 +474,25 @@ mod tests {
         .unwrap();
         assert_eq!(run.outcome, Outcome::NoPath, "{:?}", run.metrics);
         assert!(!run.hit_points.is_empty());
+        // Going round the other way once does not change the verdict; it takes longer.
+        let retry = NavigateParams {
+            vdf: VdfParams {
+                retry_other_side: true,
+                ..VdfParams::default()
+            },
+            ..p
+        };
+        let again = navigate(
+            &Chassis::default(),
+            Pose::new(0.0, 0.0, 0.0),
+            Point2::new(6.0, 0.0),
+            &w,
+            &retry,
+            &|| false,
+        )
+        .unwrap();
+        assert_eq!(again.outcome, Outcome::NoPath, "{:?}", again.metrics);
+        assert!(again.metrics.steps > run.metrics.steps);
     }
 
     #[test]

@@ -107,6 +107,11 @@ pub struct VdfParams {
     pub wall_gain: f64,
     /// The goal is reached within this distance, m (default 0.1).
     pub goal_tolerance: f64,
+    /// Before reporting NO_PATH, go round the other way once: flip the turning side, take the
+    /// current position as a new H and restart the no-path watch (the direction-switching
+    /// refinement of the Bug family; S1 gives up at once). Default false (literal S1).
+    #[serde(default)]
+    pub retry_other_side: bool,
 }
 
 impl Default for VdfParams {
@@ -132,6 +137,7 @@ impl Default for VdfParams {
             hit_radius: 0.25,
             wall_gain: 3.0,
             goal_tolerance: 0.1,
+            retry_other_side: false,
         }
     }
 }
@@ -189,6 +195,9 @@ pub struct VdfState {
     pub best_distance: Option<f64>,
     /// Steps since `best_distance` last improved by c2.
     pub steps_since_progress: u64,
+    /// The other turning side has been tried for the current H ([`VdfParams::retry_other_side`]).
+    #[serde(default)]
+    pub side_retried: bool,
 }
 
 const MAX_TOKEN_HISTORY: usize = 100_000;
@@ -423,15 +432,39 @@ pub(crate) fn vdf_step_mut(
         } else {
             s.steps_since_progress += 1;
         }
-        if z < s.hit_distance - p.no_path_min - 3.0 * p.hit_radius {
+        let give_up = if z < s.hit_distance - p.no_path_min - 3.0 * p.hit_radius {
             // Clearly past the obstacle of H: forget it.
             s.hit_point = None;
             s.best_distance = None;
             s.steps_since_progress = 0;
+            s.side_retried = false;
+            None
         } else if s.left_hit_zone && dh < p.hit_radius {
-            return stop(s.mode, VdfEvent::NoPath(NoPathReason::ReturnedToHit));
+            Some(NoPathReason::ReturnedToHit)
         } else if s.steps_since_progress >= p.no_path_steps as u64 {
-            return stop(s.mode, VdfEvent::NoPath(NoPathReason::NoProgress));
+            Some(NoPathReason::NoProgress)
+        } else {
+            None
+        };
+        if let Some(reason) = give_up {
+            if !p.retry_other_side || s.side_retried {
+                return stop(s.mode, VdfEvent::NoPath(reason));
+            }
+            // Go round the other way from here, once.
+            s.side_retried = true;
+            s.side = match s.side {
+                TurnSide::Left => TurnSide::Right,
+                TurnSide::Right => TurnSide::Left,
+            };
+            s.side_chosen = true;
+            s.mode = NavMode::Track;
+            s.steps_in_mode = 0;
+            s.hit_point = Some(me);
+            s.hit_distance = z;
+            s.left_hit_zone = false;
+            s.best_distance = Some(z);
+            s.steps_since_progress = 0;
+            event = Some(VdfEvent::Hit(me));
         }
     }
     let sign = match s.side {
@@ -651,6 +684,59 @@ mod tests {
         }
         assert_eq!(s.mode, NavMode::Track);
         assert_eq!(hit, Some(Point2::new(0.0, 0.0)));
+    }
+
+    /// `retry_other_side`: the first "no path" verdict (no progress for m steps) flips the
+    /// turning side and restarts the watch from a new H at the current position; the second
+    /// verdict stands. Without the option the first verdict stands (literal S1).
+    #[test]
+    fn retry_other_side_flips_once_then_gives_up() {
+        let h = Point2::new(0.0, 0.0);
+        let stuck = VdfState {
+            mode: NavMode::Track,
+            side: TurnSide::Left,
+            side_chosen: true,
+            hit_point: Some(h),
+            hit_distance: 5.0,
+            best_distance: Some(5.0),
+            steps_since_progress: 999,
+            ..VdfState::default()
+        };
+        // At (0, 0.1), goal (5, 0): z = 5.001, no improvement, the 1000th step without progress.
+        let pose = Pose::new(0.0, 0.1, 0.0);
+        let goal = Point2::new(5.0, 0.0);
+        let mut readings = [2.0; 8];
+        readings[0] = 0.1;
+        let literal = VdfParams::default();
+        let (_, out) = vdf_step(&stuck, pose, goal, &readings, &sensors(), &literal).unwrap();
+        assert_eq!(out.event, Some(VdfEvent::NoPath(NoPathReason::NoProgress)));
+        let retry = VdfParams {
+            retry_other_side: true,
+            ..VdfParams::default()
+        };
+        let (next, out) = vdf_step(&stuck, pose, goal, &readings, &sensors(), &retry).unwrap();
+        assert_eq!(out.event, Some(VdfEvent::Hit(pose.point())));
+        assert_eq!(next.side, TurnSide::Right);
+        assert!(next.side_retried);
+        assert_eq!(next.hit_point, Some(pose.point()));
+        assert_eq!(next.steps_since_progress, 0);
+        assert!(out.twist.vx.is_finite());
+        // Stuck again for m steps: now the verdict stands.
+        let again = VdfState {
+            steps_since_progress: 999,
+            ..next
+        };
+        let (_, out) = vdf_step(&again, pose, goal, &readings, &sensors(), &retry).unwrap();
+        assert_eq!(out.event, Some(VdfEvent::NoPath(NoPathReason::NoProgress)));
+    }
+
+    /// Tokens written before `side_retried` existed still decode.
+    #[test]
+    fn token_without_side_retried_decodes() {
+        let mut v: serde_json::Value = serde_json::from_slice(&VdfState::default().to_token()).unwrap();
+        v.as_object_mut().unwrap().remove("side_retried");
+        let s = VdfState::from_token(&serde_json::to_vec(&v).unwrap()).unwrap();
+        assert!(!s.side_retried);
     }
 
     #[test]

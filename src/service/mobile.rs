@@ -593,6 +593,7 @@ fn vdf_in(v: Option<&pb::VectorDistanceParams>) -> Result<VdfParams, Status> {
         hit_radius: v.hit_radius.unwrap_or(d.hit_radius),
         wall_gain: v.wall_gain.unwrap_or(d.wall_gain),
         goal_tolerance: v.goal_tolerance.unwrap_or(d.goal_tolerance),
+        retry_other_side: v.retry_other_side.unwrap_or(d.retry_other_side),
     };
     p.validate().map_err(mobile_error)?;
     Ok(p)

@@ -464,6 +464,16 @@ async fn navigate_reaches_walled_in_is_no_path_and_collisions_are_reported() {
     assert!(!run.hit_points.is_empty());
     assert_ne!(run.no_path_reason, pb::NoPathReason::Unspecified as i32);
     assert!(run.metrics.unwrap().min_clearance.unwrap() >= 0.0);
+    // Going round the other way once first (vdf.retry_other_side): still NO_PATH, later.
+    let steps = run.metrics.unwrap().steps;
+    let mut req = navigate(ring.clone(), (6.0, 0.0), 300.0);
+    req.vdf = Some(pb::VectorDistanceParams {
+        retry_other_side: Some(true),
+        ..Default::default()
+    });
+    let again = client.navigate(req).await.unwrap().into_inner();
+    assert_eq!(again.outcome, pb::Outcome::NoPath as i32);
+    assert!(again.metrics.unwrap().steps > steps);
     let mut req = navigate(ring, (6.0, 0.0), 300.0);
     req.navigator = pb::Navigator::GridAstar as i32;
     let run = client.navigate(req).await.unwrap().into_inner();

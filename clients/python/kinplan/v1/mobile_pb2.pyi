@@ -317,7 +317,7 @@ class PathNode(_message.Message):
     def __init__(self, x: _Optional[float] = ..., y: _Optional[float] = ..., heading: _Optional[float] = ...) -> None: ...
 
 class VectorDistanceParams(_message.Message):
-    __slots__ = ("safe_distance", "magnitude", "weight_decay", "turn_gain", "release_distance", "turn", "max_speed", "max_yaw_rate", "heading_gain", "slow_distance", "allow_reverse", "avoid_blocked_heading", "progress_steps", "progress_min", "no_path_steps", "no_path_min", "leave_tolerance", "hit_radius", "wall_gain", "goal_tolerance")
+    __slots__ = ("safe_distance", "magnitude", "weight_decay", "turn_gain", "release_distance", "turn", "max_speed", "max_yaw_rate", "heading_gain", "slow_distance", "allow_reverse", "avoid_blocked_heading", "progress_steps", "progress_min", "no_path_steps", "no_path_min", "leave_tolerance", "hit_radius", "wall_gain", "goal_tolerance", "retry_other_side")
     SAFE_DISTANCE_FIELD_NUMBER: _ClassVar[int]
     MAGNITUDE_FIELD_NUMBER: _ClassVar[int]
     WEIGHT_DECAY_FIELD_NUMBER: _ClassVar[int]
@@ -338,6 +338,7 @@ class VectorDistanceParams(_message.Message):
     HIT_RADIUS_FIELD_NUMBER: _ClassVar[int]
     WALL_GAIN_FIELD_NUMBER: _ClassVar[int]
     GOAL_TOLERANCE_FIELD_NUMBER: _ClassVar[int]
+    RETRY_OTHER_SIDE_FIELD_NUMBER: _ClassVar[int]
     safe_distance: float
     magnitude: float
     weight_decay: float
@@ -358,7 +359,8 @@ class VectorDistanceParams(_message.Message):
     hit_radius: float
     wall_gain: float
     goal_tolerance: float
-    def __init__(self, safe_distance: _Optional[float] = ..., magnitude: _Optional[float] = ..., weight_decay: _Optional[float] = ..., turn_gain: _Optional[float] = ..., release_distance: _Optional[float] = ..., turn: _Optional[_Union[TurnPreference, str]] = ..., max_speed: _Optional[float] = ..., max_yaw_rate: _Optional[float] = ..., heading_gain: _Optional[float] = ..., slow_distance: _Optional[float] = ..., allow_reverse: _Optional[bool] = ..., avoid_blocked_heading: _Optional[bool] = ..., progress_steps: _Optional[int] = ..., progress_min: _Optional[float] = ..., no_path_steps: _Optional[int] = ..., no_path_min: _Optional[float] = ..., leave_tolerance: _Optional[float] = ..., hit_radius: _Optional[float] = ..., wall_gain: _Optional[float] = ..., goal_tolerance: _Optional[float] = ...) -> None: ...
+    retry_other_side: bool
+    def __init__(self, safe_distance: _Optional[float] = ..., magnitude: _Optional[float] = ..., weight_decay: _Optional[float] = ..., turn_gain: _Optional[float] = ..., release_distance: _Optional[float] = ..., turn: _Optional[_Union[TurnPreference, str]] = ..., max_speed: _Optional[float] = ..., max_yaw_rate: _Optional[float] = ..., heading_gain: _Optional[float] = ..., slow_distance: _Optional[float] = ..., allow_reverse: _Optional[bool] = ..., avoid_blocked_heading: _Optional[bool] = ..., progress_steps: _Optional[int] = ..., progress_min: _Optional[float] = ..., no_path_steps: _Optional[int] = ..., no_path_min: _Optional[float] = ..., leave_tolerance: _Optional[float] = ..., hit_radius: _Optional[float] = ..., wall_gain: _Optional[float] = ..., goal_tolerance: _Optional[float] = ..., retry_other_side: _Optional[bool] = ...) -> None: ...
 
 class RangeSensorParams(_message.Message):
     __slots__ = ("count", "max_range", "beam_width", "rays_per_beam", "noise_sigma")
