@@ -371,7 +371,7 @@ impl Options {
             Some(t) => {
                 return Err(invalid(
                     "options.time_budget",
-                    format!("must be finite and > 0 seconds, got {t}"),
+                    format!("must be finite, > 0 and < 1e9 seconds, got {t}"),
                 ));
             }
         };
@@ -424,13 +424,13 @@ fn fresh(budget: &Budget) -> Budget {
 }
 
 /// The request's deadline less a reply reserve (a tenth of the remaining
-/// time, 0.2–20 ms, at most half of it), so that an answer cut by the budget
+/// time, 0.2–100 ms, at most half of it), so that an answer cut by the budget
 /// still reaches the caller before its deadline.
 fn soft_deadline(deadline: Option<Instant>) -> Option<Instant> {
     let deadline = deadline?;
     let remaining = deadline.saturating_duration_since(Instant::now());
     let reserve = (remaining / 10)
-        .clamp(Duration::from_micros(200), Duration::from_millis(20))
+        .clamp(Duration::from_micros(200), Duration::from_millis(100))
         .min(remaining / 2);
     Some(deadline - reserve)
 }
@@ -806,7 +806,7 @@ mod tests {
         let reserve = (now + Duration::from_millis(12)) - soft;
         assert!(reserve >= Duration::from_micros(1100) && reserve <= Duration::from_micros(1200));
         let soft = soft_deadline(Some(now + Duration::from_secs(60))).unwrap();
-        assert_eq!((now + Duration::from_secs(60)) - soft, Duration::from_millis(20));
+        assert_eq!((now + Duration::from_secs(60)) - soft, Duration::from_millis(100));
         assert_eq!(
             time_budget(Some(Duration::from_millis(3)), None),
             Some(Duration::from_millis(3))

@@ -380,7 +380,7 @@ async fn time_budgets_and_deadlines_end_promptly_with_a_status() {
 
     // the gRPC deadline is the budget: the answer arrives before it
     let mut request = tonic::Request::new(ik_request("kuka_kr210_r2700_extra", &target, endless));
-    request.set_timeout(Duration::from_millis(300));
+    request.set_timeout(Duration::from_millis(500));
     let started = Instant::now();
     let reply = ik
         .solve_ik(request)
@@ -390,9 +390,10 @@ async fn time_budgets_and_deadlines_end_promptly_with_a_status() {
     let wall = started.elapsed();
     assert_eq!(reply.status, pb::IkStatus::TimeBudget as i32);
     assert!(reply.best_attempt.is_some() && !reply.success);
-    assert!(wall < Duration::from_millis(300), "{wall:?}");
+    assert!(wall < Duration::from_millis(500), "{wall:?}");
+    // budget = the deadline less a reserve of a tenth (50 ms here)
     assert!(
-        reply.elapsed_us >= 200_000,
+        reply.elapsed_us >= 400_000,
         "used most of the deadline: {}",
         reply.elapsed_us
     );
@@ -404,7 +405,7 @@ async fn time_budgets_and_deadlines_end_promptly_with_a_status() {
         seed: Vec::new(),
         options: Some(endless),
     });
-    request.set_timeout(Duration::from_millis(300));
+    request.set_timeout(Duration::from_millis(500));
     let reply = ik.solve_ik_batch(request).await.unwrap().into_inner();
     assert_eq!(reply.results.len(), 8);
     assert_eq!(reply.succeeded, 0);
