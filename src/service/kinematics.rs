@@ -35,8 +35,13 @@ use crate::robot::Chain;
 
 /// Most targets in one `SolveIkBatch`.
 pub const MAX_BATCH_TARGETS: usize = 10_000;
-/// Most poses of a `TrackPath` (explicit poses, or line/circle steps).
-pub const MAX_PATH_POSES: usize = 100_000;
+/// Most poses of a `TrackPath` (explicit poses, or line/circle steps): the reply
+/// then stays under ~9 MB for a 7-joint arm (the default message limit is 16 MB).
+pub const MAX_PATH_POSES: usize = 50_000;
+/// Most solutions one target may ask for.
+pub const MAX_SOLUTIONS: u32 = 1_000;
+/// Most solutions a whole batch may ask for (targets × num_solutions).
+pub const MAX_BATCH_SOLUTIONS: usize = 100_000;
 /// Most entries of a `SolveLinearSystem` matrix.
 pub const MAX_MATRIX_ENTRIES: usize = 10_000;
 /// Most RLXA work (iteration cap × m × n) of one `SolveLinearSystem`: about a
@@ -122,6 +127,16 @@ impl KinematicsService for KinematicsApi {
             ));
         }
         let mut options = Options::from_proto(req.options.as_ref(), RESTARTS_SOLVE)?;
+        if req.targets.len() * options.params.num_solutions > MAX_BATCH_SOLUTIONS {
+            return Err(invalid(
+                "options.num_solutions",
+                format!(
+                    "{} targets x {} solutions exceed the limit of {MAX_BATCH_SOLUTIONS} per batch",
+                    req.targets.len(),
+                    options.params.num_solutions
+                ),
+            ));
+        }
         // the explicit budget is per target; the deadline bounds the batch (below)
         options.params.time_budget = time_budget(options.time_budget, None);
         let targets = req
@@ -354,6 +369,12 @@ impl Options {
         };
         if let Some(n) = o.rlxa_max_iterations {
             rlxa.max_iterations = n as usize;
+        }
+        if o.num_solutions > MAX_SOLUTIONS {
+            return Err(invalid(
+                "options.num_solutions",
+                format!("{} exceeds the limit of {MAX_SOLUTIONS}", o.num_solutions),
+            ));
         }
         let joint_limits = match pb::JointLimitMode::try_from(o.joint_limits) {
             Ok(pb::JointLimitMode::Unspecified | pb::JointLimitMode::Clamp) => JointLimitMode::Clamp,

@@ -983,6 +983,17 @@ async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
         ("no targets", batch(vec![]), "targets"),
         ("too many targets", batch(vec![good; 10_001]), "targets"),
         (
+            "too many solutions over the batch",
+            pb::SolveIkBatchRequest {
+                options: Some(pb::IkOptions {
+                    num_solutions: 1_000,
+                    ..Default::default()
+                }),
+                ..batch(vec![good; 200])
+            },
+            "options.num_solutions",
+        ),
+        (
             "NaN target",
             batch(vec![good, good, nan]),
             "targets[2].position.y",
