@@ -815,6 +815,18 @@ fn assert_field(status: &tonic::Status, code: Code, field: &str, what: &str) {
 #[tokio::test]
 async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
     let server = start(ServerConfig::default()).await;
+    let mut health = tonic_health::pb::health_client::HealthClient::new(server.channel.clone());
+    let reply = health
+        .check(tonic_health::pb::HealthCheckRequest {
+            service: "kinplan.v1.KinematicsService".into(),
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert_eq!(
+        reply.status(),
+        tonic_health::pb::health_check_response::ServingStatus::Serving
+    );
     let mut ik = KinematicsServiceClient::new(server.channel.clone());
     let chain = kinplan::robot::builtin_chain("kuka_kr210_r2700_extra").unwrap();
     let target = chain.fk(&[0.1, -1.4, 1.5, 0.2, 0.5, 0.3]);

@@ -216,3 +216,27 @@ def test_solve_linear_against_numpy(client):
     np.testing.assert_allclose(s.x, np.linalg.pinv(A) @ b, atol=1e-10)
     r = client.solve_linear(A, b, "angle_relaxation_safeguarded", tolerance=1e-6, max_iterations=200_000)
     assert r.residual_norm < 1e-6 and r.x[1] == 0.0  # the zero column is skipped
+
+
+TWO_LINK = """<robot name="two_link">
+  <link name="base"/><link name="upper"/><link name="tool"/>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/>
+    <origin xyz="0 0 0.5" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="2"/></joint>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="tool"/>
+    <origin xyz="0.4 0 0" rpy="0 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="2"/></joint>
+</robot>"""
+
+
+def test_inline_urdf_by_hand(client):
+    # the tool sits on the elbow axis: 0.4 (cos a, sin a) at height 0.5
+    robot = client.robot(urdf=TWO_LINK)
+    a = 0.7
+    T = np.eye(4)
+    T[:3, 3] = (0.4 * math.cos(a), 0.4 * math.sin(a), 0.5)
+    r = robot.ik(T, seed=[0.0, 0.0], position_only=True)
+    assert r.success and abs(r.q[0] - a) < 1e-4
+    assert len(robot.model_id) == 32
+    again = robot.ik(T, seed=[0.0, 0.0], position_only=True)  # sent by model id now
+    np.testing.assert_array_equal(again.q, r.q)
