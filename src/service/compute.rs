@@ -37,12 +37,19 @@ impl Budget {
     }
 }
 
-/// Raises the cancellation flag when the request's future is dropped.
-struct CancelOnDrop(Arc<AtomicBool>);
+/// Raises the cancellation flag if the request's future is dropped (caller
+/// gone, deadline) before the work's answer arrived; disarmed on completion so
+/// the budget stays usable for the request's next computation.
+struct CancelOnDrop {
+    flag: Arc<AtomicBool>,
+    armed: bool,
+}
 
 impl Drop for CancelOnDrop {
     fn drop(&mut self) {
-        self.0.store(true, Ordering::Relaxed);
+        if self.armed {
+            self.flag.store(true, Ordering::Relaxed);
+        }
     }
 }
 
@@ -99,7 +106,10 @@ impl Compute {
         if budget.should_stop() {
             return Err(deadline_exceeded());
         }
-        let _cancel_on_drop = CancelOnDrop(budget.cancelled.clone());
+        let mut cancel_on_drop = CancelOnDrop {
+            flag: budget.cancelled.clone(),
+            armed: true,
+        };
         let (tx, rx) = oneshot::channel();
         let inner = budget.clone();
         self.pool.spawn(move || {
@@ -115,6 +125,7 @@ impl Compute {
                 .map_err(|_| deadline_exceeded())?,
             None => rx.await,
         };
+        cancel_on_drop.armed = false;
         match received {
             Ok(Ok(value)) => Ok(value),
             Ok(Err(_panic)) => {
@@ -131,7 +142,7 @@ fn deadline_exceeded() -> Status {
 }
 
 /// Parses the `grpc-timeout` header: up to 8 digits and a unit (H M S m u n).
-fn grpc_timeout(metadata: &tonic::metadata::MetadataMap) -> Option<Duration> {
+pub(crate) fn grpc_timeout(metadata: &tonic::metadata::MetadataMap) -> Option<Duration> {
     let value = metadata.get("grpc-timeout")?.to_str().ok()?;
     let (digits, unit) = value.split_at(value.len().checked_sub(1)?);
     let n: u64 = digits.parse().ok()?;
@@ -182,6 +193,11 @@ mod tests {
         // Either the work saw the deadline and returned, or the timer fired.
         assert!(result.is_ok() || result.unwrap_err().code() == tonic::Code::DeadlineExceeded);
         assert!(started.elapsed() < Duration::from_secs(2));
+        // A finished run leaves the budget usable for the next one.
+        let reused = Budget::new(None);
+        assert_eq!(compute.run(&reused, |_| 1).await.unwrap(), 1);
+        assert!(!reused.should_stop());
+        assert_eq!(compute.run(&reused, |_| 2).await.unwrap(), 2);
         let panicking = compute
             .run(&Budget::new(None), |_| -> i32 { panic!("boom") })
             .await;

@@ -87,7 +87,7 @@ impl KinematicsService for KinematicsApi {
         let chain = robot.chain.clone();
         let result = self
             .compute
-            .run(&fresh(&budget), move |b| {
+            .run(&budget, move |b| {
                 solve_ik(
                     &chain,
                     &target,
@@ -150,7 +150,7 @@ impl KinematicsService for KinematicsApi {
         let soft = soft_deadline(budget.deadline());
         let reply = self
             .compute
-            .run(&fresh(&budget), move |b| {
+            .run(&budget, move |b| {
                 let start = Instant::now();
                 let stop = || b.should_stop() || soft.is_some_and(|d| Instant::now() >= d);
                 let results = solve_ik_batch(
@@ -220,7 +220,7 @@ impl KinematicsService for KinematicsApi {
         };
         let result = self
             .compute
-            .run(&fresh(&budget), move |b| {
+            .run(&budget, move |b| {
                 track_path(&chain, &targets, &seed, &params, options.rng_seed, &|| {
                     b.should_stop()
                 })
@@ -239,7 +239,7 @@ impl KinematicsService for KinematicsApi {
         let (permit, _) = self.compute.admit(&request)?;
         // A controller's stream lives as long as the controller runs: only a
         // deadline the client sets bounds it, not the server's default.
-        let deadline = client_deadline(request.metadata()).map(|t| Instant::now() + t);
+        let deadline = super::compute::grpc_timeout(request.metadata()).map(|t| Instant::now() + t);
         let inbound = request.into_inner();
         let (tx, rx) = tokio::sync::mpsc::channel(4);
         let models = self.models.clone();
@@ -435,13 +435,6 @@ fn linear_solver_in(field: &str, value: i32) -> Result<Option<RlxaVariant>, Stat
         Ok(pb::LinearSolver::AngleRelaxationSafeguarded) => Ok(Some(RlxaVariant::Safeguarded)),
         Err(_) => Err(invalid(field, format!("unknown value {value}"))),
     }
-}
-
-/// A budget with the request's deadline for one [`Compute::run`]: a run raises
-/// its budget's cancellation flag when it ends, so a budget already used (to
-/// parse an inline URDF) would stop the next computation at once.
-fn fresh(budget: &Budget) -> Budget {
-    Budget::new(budget.deadline())
 }
 
 /// The request's deadline less a reply reserve (a tenth of the remaining
@@ -642,22 +635,6 @@ fn with_sequence(status: Status, sequence: u64) -> Status {
     let details = status.get_error_details();
     let message = format!("{} (stream message with sequence {sequence})", status.message());
     Status::with_error_details(status.code(), message, details)
-}
-
-/// The deadline the client set (`grpc-timeout`: up to 8 digits and a unit).
-fn client_deadline(metadata: &tonic::metadata::MetadataMap) -> Option<Duration> {
-    let value = metadata.get("grpc-timeout")?.to_str().ok()?;
-    let (digits, unit) = value.split_at(value.len().checked_sub(1)?);
-    let n: u64 = digits.parse().ok()?;
-    Some(match unit {
-        "H" => Duration::from_secs(n.saturating_mul(3600)),
-        "M" => Duration::from_secs(n.saturating_mul(60)),
-        "S" => Duration::from_secs(n),
-        "m" => Duration::from_millis(n),
-        "u" => Duration::from_micros(n),
-        "n" => Duration::from_nanos(n),
-        _ => return None,
-    })
 }
 
 fn micros(d: Duration) -> u64 {
