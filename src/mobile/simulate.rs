@@ -202,6 +202,13 @@ pub fn follow_path(
     validate_path(path)?;
     follow.validate()?;
     sim.validate()?;
+    // A steered chassis cannot turn in place: pure pursuit's rotate-to-heading is ignored for
+    // it (as its parameter documents), instead of being clamped to a standstill.
+    let mut follow = *follow;
+    if chassis.max_curvature().is_some() {
+        follow.pure_pursuit.rotate_to_heading = false;
+    }
+    let follow = &follow;
     let mut run = SimRun::default();
     run.metrics.min_clearance = start_check(world, start, sim.robot_radius)?;
     let steps = (sim.max_time / sim.dt).ceil() as usize;
@@ -444,6 +451,39 @@ mod tests {
             assert!(run.metrics.min_clearance.unwrap() >= 0.0 || run.outcome == Outcome::Collision);
         }
         assert!(failures.is_empty(), "{failures:?}");
+    }
+
+    /// Regression: pure pursuit's rotate-to-heading asks for ω ≠ 0 at v = 0, which a steered
+    /// chassis clamps to nothing; the car stood still until the timeout. The docs say steered
+    /// chassis ignore it, and `follow_path` now does.
+    #[test]
+    fn steered_chassis_do_not_rotate_in_place_under_pure_pursuit() {
+        // Node at a bearing of atan2(2, 1) = 63° > rotate_min_angle (45°).
+        let path = [PathNode::at(1.0, 2.0)];
+        let follow = PathFollowParams {
+            controller: ControllerKind::PurePursuit,
+            goal_tolerance: 0.05,
+            ..PathFollowParams::default()
+        };
+        for chassis in [Chassis::mobil_ii(), Chassis::Tricycle(Default::default())] {
+            let run = follow_path(
+                &chassis,
+                Pose::default(),
+                &path,
+                None,
+                &follow,
+                &SimParams::default(),
+                &|| false,
+            )
+            .unwrap();
+            assert_eq!(
+                run.outcome,
+                Outcome::Reached,
+                "{}: {:?}",
+                chassis.name(),
+                run.metrics
+            );
+        }
     }
 
     #[test]
