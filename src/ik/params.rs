@@ -82,8 +82,10 @@ pub struct IkParams {
     pub num_solutions: usize,
     /// Two solutions are the same when every joint differs by less than this (rad or m, > 0). Default 1e-3.
     pub distinct_tolerance: f64,
-    /// End an attempt early when the error has not dropped by 1 % over this many
-    /// iterations (count; 0 disables; CCD uses 10× this). Default 6.
+    /// End an attempt early when the error has not made progress over this many
+    /// iterations (count; 0 disables). Progress = squared error below 0.9× its value at
+    /// the last reset for the Jacobian methods, 0.99× for CCD (which uses 10× this count),
+    /// FABRIK and length relaxation. Default 6.
     pub stall_iterations: usize,
     /// Wall-clock budget for the whole request; `None` = no limit. Default none.
     pub time_budget: Option<Duration>,

@@ -114,6 +114,9 @@ pub struct IkWorkspace {
     pub(crate) q_trial: Vec<f64>,
     pub(crate) q_best: Vec<f64>,
     pub(crate) limits: Vec<(f64, f64)>,
+    /// Per joint: rotational with a range of at least one full turn (such a joint can
+    /// leave its range by whole turns without changing the pose).
+    pub(crate) wraps: Vec<bool>,
     pub(crate) jac: Matrix6xX<f64>,
     pub(crate) jac_trial: Matrix6xX<f64>,
     pub(crate) a: DMatrix<f64>,
@@ -134,6 +137,11 @@ impl IkWorkspace {
             q_trial: vec![0.0; n],
             q_best: vec![0.0; n],
             limits: chain.limits().collect(),
+            wraps: chain
+                .joints()
+                .iter()
+                .map(|j| j.is_rotational() && j.upper - j.lower >= std::f64::consts::TAU)
+                .collect(),
             jac: Matrix6xX::zeros(n),
             jac_trial: Matrix6xX::zeros(n),
             a: DMatrix::zeros(6, n),
@@ -164,6 +172,24 @@ impl IkWorkspace {
                     *v = lo;
                 } else if *v > hi {
                     *v = hi;
+                }
+            }
+        }
+    }
+
+    /// Like [`apply_limits`](Self::apply_limits), but a joint flagged in `wraps` that left
+    /// its range is first moved back by whole turns (same pose, so the error is unchanged
+    /// and the iterate does not stick to a limit it crossed only by turning past it).
+    pub(crate) fn apply_limits_wrapping(
+        limits: &[(f64, f64)],
+        wraps: &[bool],
+        mode: JointLimitMode,
+        q: &mut [f64],
+    ) {
+        if mode == JointLimitMode::Clamp {
+            for ((v, &(lo, hi)), &w) in q.iter_mut().zip(limits).zip(wraps) {
+                if *v < lo || *v > hi {
+                    *v = wrap_into_limits(*v, lo, hi, w, mode);
                 }
             }
         }

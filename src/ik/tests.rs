@@ -588,3 +588,35 @@ fn svd_workspace_handles_redundant_jacobians() {
     let sweeps = ws.decompose(&a);
     assert!(sweeps < 20, "{sweeps} sweeps");
 }
+
+#[test]
+fn wrapping_keeps_the_pose_and_only_turns_full_turn_joints() {
+    use super::solve::IkWorkspace;
+    // UR5: every joint has ±2π, so leaving the range is undone by a whole turn.
+    let ur5 = crate::robot::builtin_chain("ur5").unwrap();
+    let ws = IkWorkspace::new(&ur5);
+    assert!(ws.wraps.iter().all(|&w| w));
+    let q_out = [7.0, -6.5, 0.3, 6.9, -7.1, 0.0];
+    let mut q = q_out;
+    IkWorkspace::apply_limits_wrapping(&ws.limits, &ws.wraps, JointLimitMode::Clamp, &mut q);
+    for (v, &(lo, hi)) in q.iter().zip(&ws.limits) {
+        assert!((lo..=hi).contains(v));
+    }
+    let (a, b) = (ur5.fk(&q_out), ur5.fk(&q));
+    assert!((a.translation.vector - b.translation.vector).norm() < 1e-12);
+    assert!(a.rotation.angle_to(&b.rotation) < 1e-12);
+    // Panda: no joint spans a full turn, so the same call clamps.
+    let panda = crate::robot::builtin_chain("franka_panda").unwrap();
+    let ws = IkWorkspace::new(&panda);
+    assert!(ws.wraps.iter().all(|&w| !w));
+    let mut q: Vec<f64> = ws.limits.iter().map(|&(_, hi)| hi + 0.5).collect();
+    IkWorkspace::apply_limits_wrapping(&ws.limits, &ws.wraps, JointLimitMode::Clamp, &mut q);
+    for (v, &(_, hi)) in q.iter().zip(&ws.limits) {
+        assert_eq!(*v, hi);
+    }
+    // Ignore leaves everything alone.
+    let mut q = q_out;
+    let ws = IkWorkspace::new(&ur5);
+    IkWorkspace::apply_limits_wrapping(&ws.limits, &ws.wraps, JointLimitMode::Ignore, &mut q);
+    assert_eq!(q, q_out);
+}

@@ -121,6 +121,13 @@ fn jacobi_solve(a: &DMatrix<f64>, b: &DVector<f64>, tol: f64) -> DVector<f64> {
 /// the pseudoinverse for `μ = 0` and the damped least-squares (Levenberg–Marquardt) step
 /// `[J; √μ I] Δq = [e; 0]` for `μ > 0` (S2 eq. 36/37, solved without forming `JᵀJ`).
 ///
+/// Sweeps run until no pair has `|wᵢᵀwⱼ| > 1e-10 ‖wᵢ‖‖wⱼ‖`. When `W` has at most 8 rows
+/// (every 6×n and 3×n IK Jacobian with n ≤ 8) the sweeps run on fixed-size stack arrays
+/// padded to an even length, with the squared column norms cached across a sweep
+/// (`‖wᵢ'‖² = α − tγ`, `‖wⱼ'‖² = β + tγ`, recomputed at the start of each sweep) and the
+/// rotation from two square roots; larger shapes use general slice code. Both are the
+/// same cyclic one-sided Jacobi method.
+///
 /// The workspace resizes itself when the shape changes (the only allocation).
 #[derive(Debug, Clone)]
 pub struct SvdWorkspace {
@@ -179,13 +186,8 @@ impl SvdWorkspace {
     pub fn decompose(&mut self, a: &DMatrix<f64>) -> usize {
         let (m, n) = a.shape();
         self.ensure(m, n);
-        if self.transposed {
-            self.w.tr_copy_from(a);
-        } else {
-            self.w.copy_from(a);
-        }
         self.v.fill_with_identity();
-        self.sweep_until_orthogonal(a.norm_squared())
+        self.decompose_from_v(a)
     }
 
     /// Like [`decompose`](Self::decompose) but starts from the rotation `V` of the previous
@@ -196,7 +198,33 @@ impl SvdWorkspace {
         if !self.ensure(m, n) {
             return self.decompose(a);
         }
-        // W = Â V by hand: nalgebra's dynamic gemm may allocate packing buffers.
+        self.decompose_from_v(a)
+    }
+
+    /// `W = Â V` with the current `V`, then Jacobi sweeps. Small shapes (`max(m, n) ≤ 8`,
+    /// every IK Jacobian) run on fixed-size stack arrays, so the column loops are unrolled
+    /// and vectorised; larger ones use the general slice code. Both perform the same
+    /// rotations in the same order.
+    fn decompose_from_v(&mut self, a: &DMatrix<f64>) -> usize {
+        let frob2 = a.norm_squared();
+        let sweeps = match self.w.nrows() {
+            1 | 2 => self.fixed::<2>(a, frob2),
+            3 | 4 => self.fixed::<4>(a, frob2),
+            5 | 6 => self.fixed::<6>(a, frob2),
+            7 | 8 => self.fixed::<8>(a, frob2),
+            _ => {
+                self.load_w(a);
+                self.sweep_until_orthogonal(frob2)
+            }
+        };
+        self.sweeps = sweeps;
+        sweeps
+    }
+
+    /// General path: `W = Â V` by hand (nalgebra's dynamic gemm may allocate packing
+    /// buffers).
+    fn load_w(&mut self, a: &DMatrix<f64>) {
+        let m = a.nrows();
         let (rows, k) = self.w.shape();
         let av = a.as_slice();
         let (vv, wv) = (self.v.as_slice(), self.w.as_mut_slice());
@@ -222,12 +250,91 @@ impl SvdWorkspace {
                 }
             }
         }
-        self.sweep_until_orthogonal(a.norm_squared())
+    }
+
+    /// Fixed-size path for `W` with `rows ≤ L` rows and `k ≤ rows` columns, `L` even so
+    /// the column loops map onto pairs of SIMD lanes. Columns of `W` and `V` are padded
+    /// with zeros to length `L`; rotations keep the padding zero.
+    fn fixed<const L: usize>(&mut self, a: &DMatrix<f64>, frob2: f64) -> usize {
+        let (rows, k) = self.w.shape();
+        debug_assert!(k <= rows && rows <= L && L <= MAX_FIXED && L.is_multiple_of(2));
+        let m = a.nrows();
+        let av = a.as_slice();
+        // columns of Â
+        let mut ac = [[0.0f64; L]; MAX_FIXED];
+        for (c, col) in ac.iter_mut().enumerate().take(k) {
+            for (r, x) in col.iter_mut().enumerate().take(rows) {
+                *x = if self.transposed {
+                    av[r * m + c]
+                } else {
+                    av[c * rows + r]
+                };
+            }
+        }
+        let mut v = [[0.0f64; L]; MAX_FIXED];
+        let vs = self.v.as_slice();
+        for (j, col) in v.iter_mut().enumerate().take(k) {
+            col[..k].copy_from_slice(&vs[j * k..(j + 1) * k]);
+        }
+        // W = Â V
+        let mut w = [[0.0f64; L]; MAX_FIXED];
+        for j in 0..k {
+            let mut acc = [0.0f64; L];
+            for c in 0..k {
+                let vcj = v[j][c];
+                for r in 0..L {
+                    acc[r] += ac[c][r] * vcj;
+                }
+            }
+            w[j] = acc;
+        }
+        let negligible = f64::EPSILON * f64::EPSILON * frob2;
+        // Squared column norms, recomputed exactly at the start of every sweep and updated
+        // by the rotation identities ‖wᵢ'‖² = α − tγ, ‖wⱼ'‖² = β + tγ inside it, so a pair
+        // costs one dot product instead of three.
+        let mut norms = [0.0f64; MAX_FIXED];
+        let tol2 = ORTHOGONAL * ORTHOGONAL;
+        let mut sweep = 0;
+        while sweep < MAX_SWEEPS {
+            sweep += 1;
+            let mut rotated = false;
+            for (d, col) in norms.iter_mut().zip(&w).take(k) {
+                *d = dot(col, col);
+            }
+            for i in 0..k {
+                for j in (i + 1)..k {
+                    let (alpha, beta) = (norms[i], norms[j]);
+                    if alpha <= negligible || beta <= negligible {
+                        continue;
+                    }
+                    let gamma = dot(&w[i], &w[j]);
+                    if gamma * gamma <= tol2 * alpha * beta {
+                        continue;
+                    }
+                    let (c, s, t) = fast_rotation(alpha, beta, gamma);
+                    rotated = true;
+                    norms[i] = alpha - t * gamma;
+                    norms[j] = beta + t * gamma;
+                    rotate_pair(&mut w, i, j, c, s);
+                    rotate_pair(&mut v, i, j, c, s);
+                }
+            }
+            if !rotated {
+                break;
+            }
+        }
+        let ws = self.w.as_mut_slice();
+        let vs = self.v.as_mut_slice();
+        for j in 0..k {
+            ws[j * rows..(j + 1) * rows].copy_from_slice(&w[j][..rows]);
+            vs[j * k..(j + 1) * k].copy_from_slice(&v[j][..k]);
+            self.sigma[j] = w[j].iter().map(|x| x * x).sum::<f64>().sqrt();
+        }
+        sweep
     }
 
     fn sweep_until_orthogonal(&mut self, frob2: f64) -> usize {
         let (m, n) = self.w.shape();
-        const MAX_SWEEPS: usize = 60;
         // Columns whose squared norm is below this are numerically zero: leave them.
         let negligible = f64::EPSILON * f64::EPSILON * frob2;
         let w = self.w.as_mut_slice();
@@ -247,18 +354,10 @@ impl SvdWorkspace {
                         beta += wj[k] * wj[k];
                         gamma += wi[k] * wj[k];
                     }
-                    if gamma == 0.0
-                        || alpha <= negligible
-                        || beta <= negligible
-                        || gamma.abs() <= 1e-10 * (alpha * beta).sqrt()
-                    {
+                    let Some((c, s)) = jacobi_rotation(alpha, beta, gamma, negligible) else {
                         continue;
-                    }
+                    };
                     rotated = true;
-                    let zeta = (beta - alpha) / (2.0 * gamma);
-                    let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
-                    let c = 1.0 / (1.0 + t * t).sqrt();
-                    let s = c * t;
                     for k in 0..m {
                         let (x, y) = (wi[k], wj[k]);
                         wi[k] = c * x - s * y;
@@ -281,7 +380,6 @@ impl SvdWorkspace {
         for j in 0..n {
             self.sigma[j] = self.w.column(j).norm();
         }
-        self.sweeps = sweep;
         sweep
     }
 
@@ -351,6 +449,72 @@ impl SvdWorkspace {
     }
 }
 
+const MAX_SWEEPS: usize = 60;
+/// Largest `W` row count handled by the fixed-size path.
+const MAX_FIXED: usize = 8;
+/// Column pairs with `|wᵢᵀwⱼ| ≤ ORTHOGONAL · ‖wᵢ‖‖wⱼ‖` count as orthogonal.
+const ORTHOGONAL: f64 = 1e-10;
+
+/// The Jacobi rotation `(c, s)` that makes columns with Gram entries `α = ‖wᵢ‖²`,
+/// `β = ‖wⱼ‖²`, `γ = wᵢᵀwⱼ` orthogonal, or `None` when they already are (or one is
+/// numerically zero).
+#[inline(always)]
+fn jacobi_rotation(alpha: f64, beta: f64, gamma: f64, negligible: f64) -> Option<(f64, f64)> {
+    if gamma == 0.0
+        || alpha <= negligible
+        || beta <= negligible
+        || gamma.abs() <= ORTHOGONAL * (alpha * beta).sqrt()
+    {
+        return None;
+    }
+    let zeta = (beta - alpha) / (2.0 * gamma);
+    let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
+    let c = 1.0 / (1.0 + t * t).sqrt();
+    Some((c, c * t))
+}
+
+/// The same rotation as [`jacobi_rotation`] (for a pair known to need one), with two
+/// square roots and two divisions instead of three each: with `d = β − α`,
+/// `t = 2γ / (d + sign(d) √(d² + 4γ²))` (= `sign(ζ)/(|ζ| + √(1 + ζ²))`, `ζ = d/(2γ)`),
+/// `c = 1/√(1 + t²)`, `s = c t`. Returns `(c, s, t)`.
+#[inline(always)]
+fn fast_rotation(alpha: f64, beta: f64, gamma: f64) -> (f64, f64, f64) {
+    let d = beta - alpha;
+    let g2 = 2.0 * gamma;
+    let h = (d * d + g2 * g2).sqrt();
+    let t = if h.is_finite() {
+        g2 / (d + d.signum() * h)
+    } else {
+        let zeta = d / g2;
+        zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt())
+    };
+    let c = 1.0 / (1.0 + t * t).sqrt();
+    (c, c * t, t)
+}
+
+/// Dot product of even-length columns with two partial sums (SIMD lanes).
+#[inline(always)]
+fn dot<const L: usize>(x: &[f64; L], y: &[f64; L]) -> f64 {
+    let mut acc = [0.0f64; 2];
+    for (xp, yp) in x.chunks_exact(2).zip(y.chunks_exact(2)) {
+        acc[0] += xp[0] * yp[0];
+        acc[1] += xp[1] * yp[1];
+    }
+    acc[0] + acc[1]
+}
+
+/// `(xᵢ, xⱼ) ← (c xᵢ − s xⱼ, s xᵢ + c xⱼ)` on two fixed-size columns.
+#[inline(always)]
+fn rotate_pair<const L: usize>(cols: &mut [[f64; L]; MAX_FIXED], i: usize, j: usize, c: f64, s: f64) {
+    debug_assert!(i < j);
+    let (head, tail) = cols.split_at_mut(j);
+    for (x, y) in head[i].iter_mut().zip(tail[0].iter_mut()) {
+        let (a, b) = (*x, *y);
+        *x = c * a - s * b;
+        *y = s * a + c * b;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -411,6 +575,125 @@ mod tests {
         ws.solve_into(&a, &b, mu, &PseudoinverseParams::default(), &mut x)
             .unwrap();
         assert!((x - reference).norm() < 1e-10);
+    }
+
+    /// Checks one decomposition held in `ws` against `a`: `Â V = W` (so `A = U Σ Vᵀ` with
+    /// `U = W Σ⁻¹`), `V` orthogonal, `W` columns orthogonal, singular values = nalgebra's.
+    fn check_decomposition(ws: &SvdWorkspace, a: &DMatrix<f64>, what: &str) {
+        let (m, n) = a.shape();
+        let ahat = if m < n { a.transpose() } else { a.clone() };
+        let k = ahat.ncols();
+        let scale = a.norm().max(1.0);
+        // exact reconstruction Â = W Vᵀ
+        let recon = &ws.w * ws.v.transpose();
+        assert!(
+            (&recon - &ahat).norm() <= 1e-13 * scale,
+            "{what}: reconstruction {}",
+            (&recon - &ahat).norm()
+        );
+        // V orthogonal
+        let vtv = ws.v.transpose() * &ws.v;
+        assert!(
+            (vtv - DMatrix::identity(k, k)).norm() <= 1e-13,
+            "{what}: V not orthogonal"
+        );
+        // W columns orthogonal (relative to their norms), i.e. U orthogonal on σ > 0
+        for i in 0..k {
+            for j in (i + 1)..k {
+                let (wi, wj) = (ws.w.column(i), ws.w.column(j));
+                let (ni, nj) = (wi.norm(), wj.norm());
+                if ni > 1e-12 * scale && nj > 1e-12 * scale {
+                    assert!(wi.dot(&wj).abs() <= 1e-9 * ni * nj, "{what}: w{i}·w{j}");
+                }
+            }
+        }
+        let mut ours: Vec<f64> = ws.singular_values().iter().cloned().collect();
+        ours.sort_by(|x, y| y.total_cmp(x));
+        let theirs = a.clone().svd(false, false).singular_values;
+        for (i, s) in theirs.iter().enumerate() {
+            assert!(
+                (ours[i] - s).abs() <= 1e-12 * scale,
+                "{what}: σ{i} {} vs {}",
+                ours[i],
+                s
+            );
+        }
+        for s in ours.iter().skip(theirs.len()) {
+            assert!(s.abs() <= 1e-12 * scale, "{what}: extra σ {s}");
+        }
+    }
+
+    #[test]
+    fn fixed_size_path_decomposes_every_small_shape() {
+        // every shape with max(m, n) ≤ 8 (fixed-size path), plus shapes on the general path
+        let mut shapes: Vec<(usize, usize)> = (1..=8).flat_map(|m| (1..=8).map(move |n| (m, n))).collect();
+        shapes.extend([(9, 6), (6, 9), (12, 10), (3, 11)]);
+        for (m, n) in shapes {
+            for seed in 0..4u64 {
+                let mut a = lcg_matrix(m, n, 1000 + seed * 97 + (m * 13 + n) as u64);
+                if seed == 2 && n >= 3 {
+                    // rank-deficient: a repeated column and a zero column
+                    let c0 = a.column(0).into_owned();
+                    a.set_column(n - 1, &c0);
+                    a.column_mut(1).fill(0.0);
+                }
+                if seed == 3 && m >= 2 {
+                    // rank-deficient: a row that is a combination of two others
+                    let r = a.row(0) * 0.5 - a.row(1) * 2.0;
+                    a.set_row(m - 1, &r);
+                }
+                let mut ws = SvdWorkspace::new(m, n);
+                ws.decompose(&a);
+                check_decomposition(&ws, &a, &format!("{m}x{n} seed {seed} cold"));
+                // warm start from the previous rotation on a nearby matrix
+                let b = &a + lcg_matrix(m, n, 7 + seed) * 0.05;
+                ws.decompose_warm(&b);
+                check_decomposition(&ws, &b, &format!("{m}x{n} seed {seed} warm"));
+            }
+        }
+    }
+
+    #[test]
+    fn fixed_size_path_matches_general_path() {
+        // The fixed-size code (cached norms, two-root rotation) and the general slice code
+        // must give the same decomposition up to rounding.
+        for (m, n) in [(6, 6), (6, 7), (3, 6), (7, 6), (5, 8)] {
+            let a = lcg_matrix(m, n, (m * 7 + n) as u64);
+            let mut fast = SvdWorkspace::new(m, n);
+            fast.decompose(&a);
+            let mut slow = SvdWorkspace::new(m, n);
+            let ahat = if m < n { a.transpose() } else { a.clone() };
+            slow.w.copy_from(&ahat);
+            slow.v.fill_with_identity();
+            slow.sweep_until_orthogonal(a.norm_squared());
+            let b = DVector::from_fn(m, |i, _| (i as f64 * 0.7).cos());
+            let (mut xf, mut xs) = (DVector::zeros(n), DVector::zeros(n));
+            for mu in [0.0, 1e-3, 0.5] {
+                fast.solve_decomposed(&b, mu, 1e-10, &mut xf);
+                slow.solve_decomposed(&b, mu, 1e-10, &mut xs);
+                assert!((&xf - &xs).norm() <= 1e-10 * xs.norm().max(1.0), "{m}x{n} μ={mu}");
+            }
+        }
+    }
+
+    #[test]
+    fn damped_solution_matches_normal_equations_on_jacobian_shapes() {
+        for (m, n) in [(6, 6), (6, 7), (3, 6), (3, 7), (6, 3)] {
+            let a = lcg_matrix(m, n, (31 * m + n) as u64);
+            let b = DVector::from_fn(m, |i, _| (i as f64).sin() + 0.3);
+            let mut ws = SvdWorkspace::new(m, n);
+            let mut x = DVector::zeros(n);
+            for mu in [1e-7, 1e-3, 0.3, 10.0] {
+                let lhs = a.transpose() * &a + DMatrix::identity(n, n) * mu;
+                let reference = lhs.lu().solve(&(a.transpose() * &b)).unwrap();
+                ws.solve_into(&a, &b, mu, &PseudoinverseParams::default(), &mut x)
+                    .unwrap();
+                assert!(
+                    (&x - &reference).norm() <= 1e-8 * reference.norm().max(1.0),
+                    "{m}x{n} μ={mu}"
+                );
+            }
+        }
     }
 
     #[test]
