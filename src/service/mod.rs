@@ -5,7 +5,6 @@
 pub mod pb;
 
 mod compute;
-#[allow(dead_code)] // helpers for the request types of services still to come
 mod convert;
 mod kinematics;
 mod metrics;
