@@ -11,7 +11,7 @@
 
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
-use super::solve::{Attempt, Clock, IkWorkspace, is_converged, wrap_into_limits};
+use super::solve::{Attempt, Clock, IkWorkspace, Progress, is_converged, wrap_into_limits};
 use super::{IkParams, IkStatus, IkTarget, pose_error};
 use crate::robot::Chain;
 
@@ -48,8 +48,8 @@ pub(crate) fn run(
     };
     IkWorkspace::apply_limits(&ws.limits, params.joint_limits, &mut ws.q);
     let mut best_sq = f64::INFINITY;
-    let mut stall_ref = f64::INFINITY;
-    let mut since_progress = 0;
+    // CCD creeps: 10x the Jacobian methods' patience, and 1 % counts as progress.
+    let mut progress = Progress::new(0.99, 10 * params.stall_iterations, f64::INFINITY);
     let mut it = 0;
     let mut cur = [Vector3::zeros(); 4];
     let (status, err) = loop {
@@ -68,15 +68,8 @@ pub(crate) fn run(
         if let Some(s) = clock.interrupted() {
             break (s, err);
         }
-        if err.squared() < 0.99 * stall_ref {
-            stall_ref = err.squared();
-            since_progress = 0;
-        } else {
-            since_progress += 1;
-            // CCD creeps: give it 10× the Jacobian methods' patience.
-            if params.stall_iterations > 0 && since_progress >= 10 * params.stall_iterations {
-                break (IkStatus::Stalled, err);
-            }
+        if progress.stalled(err.squared()) {
+            break (IkStatus::Stalled, err);
         }
         it += 1;
         for i in (0..n).rev() {

@@ -17,7 +17,7 @@
 use nalgebra::Isometry3;
 use rand_chacha::ChaCha8Rng;
 
-use super::solve::{Attempt, Clock, IkWorkspace, is_converged};
+use super::solve::{Attempt, Clock, IkWorkspace, Progress, is_converged};
 use super::{IkMethod, IkParams, IkStatus, IkTarget, JointLimitMode, PoseError, pose_error};
 use crate::linalg::{LinearSolverKind, RlxaParams};
 use crate::robot::Chain;
@@ -50,8 +50,7 @@ pub(crate) fn run(
     let mut err = pose_error(&tip, target);
     let mut best = err;
     ws.q_best.copy_from_slice(&ws.q);
-    let mut stall_ref = err.squared();
-    let mut since_progress = 0usize;
+    let mut progress = Progress::new(STALL_PROGRESS, params.stall_iterations, err.squared());
     let mu_min = params.damping * 1e-4;
     let mut mu = params.damping;
     // true while ws.svd holds the decomposition of the current J (LM retries reuse it)
@@ -195,14 +194,8 @@ pub(crate) fn run(
             best = err;
             ws.q_best.copy_from_slice(&ws.q);
         }
-        if err.squared() < STALL_PROGRESS * stall_ref {
-            stall_ref = err.squared();
-            since_progress = 0;
-        } else {
-            since_progress += 1;
-            if params.stall_iterations > 0 && since_progress >= params.stall_iterations {
-                break IkStatus::Stalled;
-            }
+        if progress.stalled(err.squared()) {
+            break IkStatus::Stalled;
         }
     };
     let _ = tip;

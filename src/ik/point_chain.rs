@@ -13,7 +13,7 @@ use nalgebra::{Isometry3, Vector3};
 
 use super::fabrik::{PointChainReport, fabrik_core};
 use super::length_relaxation::{RelaxationGraph, length_relaxation_core};
-use super::solve::{Attempt, Clock, IkWorkspace, is_converged, wrap_into_limits};
+use super::solve::{Attempt, Clock, IkWorkspace, Progress, is_converged, wrap_into_limits};
 use super::{IkError, IkMethod, IkParams, IkStatus, IkTarget, pose_error};
 use crate::robot::Chain;
 
@@ -100,8 +100,7 @@ pub(crate) fn run(
     let inner_tol = params.position_tolerance / (2.0 * n as f64 + 2.0);
     let mut it = 0;
     let mut best_sq = f64::INFINITY;
-    let mut stall_ref = f64::INFINITY;
-    let mut since_progress = 0;
+    let mut progress = Progress::new(0.99, STALL_OUTER, f64::INFINITY);
     let (status, err) = loop {
         let tip = chain.joint_frames_into(&ws.q, &mut ws.frames);
         let err = pose_error(&tip, target);
@@ -118,14 +117,8 @@ pub(crate) fn run(
         if let Some(s) = clock.interrupted() {
             break (s, err);
         }
-        if err.squared() < 0.99 * stall_ref {
-            stall_ref = err.squared();
-            since_progress = 0;
-        } else {
-            since_progress += 1;
-            if since_progress >= STALL_OUTER {
-                break (IkStatus::Stalled, err);
-            }
+        if progress.stalled(err.squared()) {
+            break (IkStatus::Stalled, err);
         }
         let budget = params.max_iterations - it;
         let mut keep_going = || clock.interrupted().is_none();

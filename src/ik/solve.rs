@@ -222,6 +222,38 @@ pub(crate) fn wrap_into_limits(v: f64, lo: f64, hi: f64, rotational: bool, mode:
     }
 }
 
+/// Stall bookkeeping shared by the iterative methods: an attempt makes progress when
+/// its squared error falls below `fraction` × the value at the last progress; after
+/// `patience` iterations without progress it has stalled (`patience` 0 never stalls).
+pub(crate) struct Progress {
+    fraction: f64,
+    patience: usize,
+    reference: f64,
+    since: usize,
+}
+
+impl Progress {
+    pub(crate) fn new(fraction: f64, patience: usize, initial_squared_error: f64) -> Self {
+        Self {
+            fraction,
+            patience,
+            reference: initial_squared_error,
+            since: 0,
+        }
+    }
+
+    /// Records one iteration's squared error; true once the attempt has stalled.
+    pub(crate) fn stalled(&mut self, squared_error: f64) -> bool {
+        if squared_error < self.fraction * self.reference {
+            self.reference = squared_error;
+            self.since = 0;
+            return false;
+        }
+        self.since += 1;
+        self.patience > 0 && self.since >= self.patience
+    }
+}
+
 /// Validates a request shared by every front.
 pub(crate) fn validate_request(
     chain: &Chain,
