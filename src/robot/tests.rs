@@ -309,3 +309,28 @@ fn mesh_files_are_reported_not_read() {
         }
     );
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig { cases: 64, ..Default::default() })]
+
+    /// Mangled URDFs (text cut, spliced or replaced by XML-significant or non-finite
+    /// text) are answered with an error or a chain, never a panic, and a chain they
+    /// yield evaluates without panicking.
+    #[test]
+    fn mangled_urdfs_never_panic(
+        robot in 0usize..BUILTIN_NAMES.len(),
+        cut in 0usize..20_000,
+        len in 0usize..64,
+        insert in proptest::sample::select(vec!["", "<", ">", "\"", "nan", "inf", "-1e309", "<joint", "</robot>", "&amp;", "\u{0}"]),
+    ) {
+        let text = builtin_urdf(BUILTIN_NAMES[robot]).unwrap();
+        let start = text.char_indices().map(|(i, _)| i).find(|&i| i >= cut.min(text.len())).unwrap_or(text.len());
+        let end = text.char_indices().map(|(i, _)| i).find(|&i| i >= start + len).unwrap_or(text.len());
+        let mangled = format!("{}{insert}{}", &text[..start], &text[end..]);
+        if let Ok(chain) = parse_chain(&mangled, &ChainSpec::default(), UrdfLimits::default()) {
+            let q = vec![0.0; chain.dof()];
+            let _ = chain.fk(&q);
+            let _ = chain.jacobian(&q);
+        }
+    }
+}
