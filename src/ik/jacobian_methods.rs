@@ -62,6 +62,7 @@ pub(crate) fn run(
 
     let mut it = 0;
     let status = loop {
+        ws.record(params, &err);
         if is_converged(&err, target, params) {
             break IkStatus::Converged;
         }

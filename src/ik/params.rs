@@ -89,6 +89,10 @@ pub struct IkParams {
     pub stall_iterations: usize,
     /// Wall-clock budget for the whole request; `None` = no limit. Default none.
     pub time_budget: Option<Duration>,
+    /// Record each solution's error at the start of every iteration of its attempt
+    /// ([`IkSolution::history`](super::IkSolution::history)). Default off (nothing is
+    /// recorded, nothing allocated).
+    pub record_history: bool,
 }
 
 impl Default for IkParams {
@@ -115,6 +119,7 @@ impl Default for IkParams {
             distinct_tolerance: 1e-3,
             stall_iterations: 6,
             time_budget: None,
+            record_history: false,
         }
     }
 }

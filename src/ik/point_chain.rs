@@ -104,6 +104,7 @@ pub(crate) fn run(
     let (status, err) = loop {
         let tip = chain.joint_frames_into(&ws.q, &mut ws.frames);
         let err = pose_error(&tip, target);
+        ws.record(params, &err);
         if err.squared() < best_sq {
             best_sq = err.squared();
             ws.q_best.copy_from_slice(&ws.q);

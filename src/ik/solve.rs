@@ -43,6 +43,10 @@ pub struct IkSolution {
     pub status: IkStatus,
     /// 0 = from the seed, k = k-th random restart.
     pub attempt: usize,
+    /// With [`IkParams::record_history`]: `(position error m, orientation error rad)` at
+    /// the start of every iteration of the attempt, ending with the error returned;
+    /// empty otherwise.
+    pub history: Vec<(f64, f64)>,
 }
 
 /// Everything a request produced.
@@ -126,6 +130,8 @@ pub struct IkWorkspace {
     pub(crate) rlxa: RlxaWorkspace,
     pub(crate) frames: Vec<Isometry3<f64>>,
     pub(crate) points: super::point_chain::PointWorkspace,
+    /// Error history of the current attempt (only with `IkParams::record_history`).
+    pub(crate) history: Vec<(f64, f64)>,
 }
 
 impl IkWorkspace {
@@ -151,6 +157,22 @@ impl IkWorkspace {
             rlxa: RlxaWorkspace::new(6, n),
             frames: Vec::with_capacity(n),
             points: super::point_chain::PointWorkspace::default(),
+            history: Vec::new(),
+        }
+    }
+
+    /// Appends one iteration's error to the history when the request asked for it.
+    #[inline]
+    pub(crate) fn record(&mut self, params: &IkParams, err: &PoseError) {
+        if params.record_history {
+            self.history.push((err.position, err.orientation));
+        }
+    }
+
+    /// Makes the history end with the error the attempt returns.
+    pub(crate) fn finish_history(&mut self, params: &IkParams, err: &PoseError) {
+        if params.record_history && self.history.last() != Some(&(err.position, err.orientation)) {
+            self.history.push((err.position, err.orientation));
         }
     }
 
@@ -382,7 +404,9 @@ impl<'c> IkSolver<'c> {
                 break;
             }
             attempts += 1;
+            self.ws.history.clear();
             let out = run_attempt(chain, target, params, &mut self.ws, &mut rng, clock);
+            self.ws.finish_history(params, &out.error);
             total_iterations += out.iterations;
             let make = |ws: &IkWorkspace| IkSolution {
                 joints: ws.q.clone(),
@@ -392,6 +416,7 @@ impl<'c> IkSolver<'c> {
                 elapsed_us: clock.elapsed_us(),
                 status: out.status,
                 attempt,
+                history: ws.history.clone(),
             };
             if out.status == IkStatus::Converged {
                 let distinct = solutions.iter().all(|s| {

@@ -620,3 +620,37 @@ fn wrapping_keeps_the_pose_and_only_turns_full_turn_joints() {
     IkWorkspace::apply_limits_wrapping(&ws.limits, &ws.wraps, JointLimitMode::Ignore, &mut q);
     assert_eq!(q, q_out);
 }
+
+/// The error history on request: it starts at the seed's error (computed here from
+/// FK), ends at the returned error, has one entry per iteration plus the final one,
+/// and never rises for Levenberg–Marquardt (only error-decreasing steps are accepted).
+#[test]
+fn error_history_on_request() {
+    let chain = builtin_chain("kuka_kr210_r2700_extra").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let target_pose = chain.fk(&random_joints(&chain, &mut rng));
+    let target = IkTarget::Pose(target_pose);
+    let params = IkParams {
+        record_history: true,
+        ..IkParams::default()
+    };
+    let seed = chain.mid_limits();
+    let r = solve_ik(&chain, &target, Some(&seed), &params, 4, &never).unwrap();
+    let s = &r.solutions[0];
+    assert_eq!(s.history.len(), s.iterations + 1);
+    let at_seed = chain.fk(&seed);
+    let p0 = (at_seed.translation.vector - target_pose.translation.vector).norm();
+    let r0 = (target_pose.rotation * at_seed.rotation.inverse()).angle();
+    if s.attempt == 0 {
+        assert!((s.history[0].0 - p0).abs() < 1e-12 && (s.history[0].1 - r0).abs() < 1e-9);
+    }
+    let last = *s.history.last().unwrap();
+    assert_eq!(last, (s.position_error, s.orientation_error));
+    for w in s.history.windows(2) {
+        let (a, b) = (w[0].0.powi(2) + w[0].1.powi(2), w[1].0.powi(2) + w[1].1.powi(2));
+        assert!(b <= a * (1.0 + 1e-12), "error rose: {w:?}");
+    }
+    let quiet = solve_ik(&chain, &target, Some(&seed), &IkParams::default(), 4, &never).unwrap();
+    assert!(quiet.solutions[0].history.is_empty());
+    assert_eq!(quiet.solutions[0].joints, s.joints);
+}

@@ -415,6 +415,7 @@ impl Options {
             num_solutions: (o.num_solutions as usize).max(1),
             distinct_tolerance: o.distinct_tolerance.unwrap_or(d.distinct_tolerance),
             time_budget,
+            record_history: o.return_history,
             ..d
         };
         params.validate().map_err(|e| ik_error(e, "target", ""))?;
@@ -660,6 +661,8 @@ fn solution_out(s: IkSolution) -> pb::IkSolution {
         elapsed_us: s.elapsed_us,
         status: status_out(s.status),
         attempt: s.attempt as u32,
+        position_error_history: s.history.iter().map(|h| h.0).collect(),
+        orientation_error_history: s.history.iter().map(|h| h.1).collect(),
     }
 }
 

@@ -1231,3 +1231,46 @@ async fn inline_urdf_is_solved_and_gets_a_model_id() {
     );
     assert_eq!(reply.model_id.len(), 32);
 }
+
+/// `return_history`: each solution's per-iteration errors, starting at the seed's
+/// error (from the server's FK, compared here) and ending at the returned error.
+#[tokio::test]
+async fn error_history_on_request() {
+    let server = start(ServerConfig::default()).await;
+    let mut ik = KinematicsServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let target = fk(&mut robots, "ur5", &[1.0, -0.7, 1.9, 0.5, -1.0, 2.0]).await;
+    let seed = vec![0.9, -0.8, 1.7, 0.4, -0.9, 1.8];
+    let at_seed = fk(&mut robots, "ur5", &seed).await;
+    let request = pb::SolveIkRequest {
+        seed: seed.clone(),
+        options: Some(pb::IkOptions {
+            return_history: true,
+            ..Default::default()
+        }),
+        ..ik_request("ur5", &target, Default::default())
+    };
+    let reply = ik.solve_ik(request).await.unwrap().into_inner();
+    let s = &reply.solutions[0];
+    assert_eq!(s.attempt, 0);
+    assert_eq!(s.position_error_history.len(), s.iterations as usize + 1);
+    assert_eq!(s.orientation_error_history.len(), s.position_error_history.len());
+    let (p0, r0) = distance(&at_seed, &target);
+    assert!(
+        (s.position_error_history[0] - p0).abs() < 1e-9,
+        "{} vs {p0}",
+        s.position_error_history[0]
+    );
+    assert!((s.orientation_error_history[0] - r0).abs() < 1e-6);
+    assert_eq!(*s.position_error_history.last().unwrap(), s.position_error);
+    assert_eq!(*s.orientation_error_history.last().unwrap(), s.orientation_error);
+    let without = ik
+        .solve_ik(pb::SolveIkRequest {
+            seed,
+            ..ik_request("ur5", &target, Default::default())
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(without.solutions[0].position_error_history.is_empty());
+}

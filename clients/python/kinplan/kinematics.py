@@ -107,6 +107,7 @@ def ik_options(
     max_step: Optional[float] = None,
     distinct_tolerance: Optional[float] = None,
     rlxa_max_iterations: Optional[int] = None,
+    history: bool = False,
 ) -> kinematics_pb2.IkOptions:
     """IkOptions from Python values; ``None`` means the server's documented
     default. Values are checked by the server, which names a bad field."""
@@ -118,6 +119,7 @@ def ik_options(
         num_solutions=int(num_solutions or 0),
         rng_seed=int(rng_seed),
         joint_limits=_choice(JOINT_LIMITS, joint_limits, "joint_limits"),
+        return_history=bool(history),
     )
     for name, value, kind in (
         ("position_tolerance", position_tolerance, float),
@@ -139,7 +141,9 @@ def ik_options(
 class IkSolution:
     """One answer: joints ``q`` (rad, m for prismatic joints), errors of its
     true FK (m, rad), iterations of its attempt, µs since the request began,
-    the attempt's status and index (0 = from the seed)."""
+    the attempt's status and index (0 = from the seed). With ``history=True``
+    in the request, ``history`` is an (iterations + 1) x 2 array of the
+    (position m, orientation rad) error at the start of every iteration."""
 
     q: np.ndarray
     position_error: float
@@ -148,6 +152,7 @@ class IkSolution:
     elapsed_us: int
     status: str
     attempt: int
+    history: Optional[np.ndarray] = None
 
     @classmethod
     def from_proto(cls, s: kinematics_pb2.IkSolution) -> "IkSolution":
@@ -159,6 +164,11 @@ class IkSolution:
             elapsed_us=s.elapsed_us,
             status=_ik_status(s.status),
             attempt=s.attempt,
+            history=(
+                np.column_stack([s.position_error_history, s.orientation_error_history])
+                if len(s.position_error_history)
+                else None
+            ),
         )
 
 
@@ -438,7 +448,8 @@ class RobotKinematicsMixin:
         to ``seed``. Further options: ``max_iterations``, ``damping``,
         ``rng_seed``, ``joint_limits`` ("clamp"/"ignore"), ``time_budget``
         (s; default: the call's deadline), ``adaptive_damping``,
-        ``max_step``, ``distinct_tolerance``, ``rlxa_max_iterations``."""
+        ``max_step``, ``distinct_tolerance``, ``rlxa_max_iterations``,
+        ``history`` (True: each solution carries its per-iteration errors)."""
         o = ik_options(
             method,
             linear_solver,

@@ -240,3 +240,17 @@ def test_inline_urdf_by_hand(client):
     assert len(robot.model_id) == 32
     again = robot.ik(T, seed=[0.0, 0.0], position_only=True)  # sent by model id now
     np.testing.assert_array_equal(again.q, r.q)
+
+
+def test_error_history_on_request(client):
+    robot = client.robot("ur5")
+    q = np.array([1.0, -0.7, 1.9, 0.5, -1.0, 2.0])
+    seed = q - 0.1
+    T = robot.fk(q)
+    r = robot.ik(T, seed=seed, history=True)
+    s = r.solutions[0]
+    assert s.history.shape == (s.iterations + 1, 2)
+    dp, dr = pose_distance(robot.fk(seed), T)
+    assert abs(s.history[0, 0] - dp) < 1e-9 and abs(s.history[0, 1] - dr) < 1e-6
+    assert tuple(s.history[-1]) == (s.position_error, s.orientation_error)
+    assert robot.ik(T, seed=seed).solutions[0].history is None

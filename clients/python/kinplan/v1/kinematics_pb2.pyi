@@ -70,7 +70,7 @@ LINEAR_SOLVE_STATUS_CONVERGED: LinearSolveStatus
 LINEAR_SOLVE_STATUS_ITERATION_CAP: LinearSolveStatus
 
 class IkOptions(_message.Message):
-    __slots__ = ("method", "linear_solver", "position_tolerance", "orientation_tolerance", "position_only", "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits", "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations")
+    __slots__ = ("method", "linear_solver", "position_tolerance", "orientation_tolerance", "position_only", "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits", "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations", "return_history")
     METHOD_FIELD_NUMBER: _ClassVar[int]
     LINEAR_SOLVER_FIELD_NUMBER: _ClassVar[int]
     POSITION_TOLERANCE_FIELD_NUMBER: _ClassVar[int]
@@ -87,6 +87,7 @@ class IkOptions(_message.Message):
     MAX_STEP_FIELD_NUMBER: _ClassVar[int]
     DISTINCT_TOLERANCE_FIELD_NUMBER: _ClassVar[int]
     RLXA_MAX_ITERATIONS_FIELD_NUMBER: _ClassVar[int]
+    RETURN_HISTORY_FIELD_NUMBER: _ClassVar[int]
     method: IkMethod
     linear_solver: LinearSolver
     position_tolerance: float
@@ -103,7 +104,8 @@ class IkOptions(_message.Message):
     max_step: float
     distinct_tolerance: float
     rlxa_max_iterations: int
-    def __init__(self, method: _Optional[_Union[IkMethod, str]] = ..., linear_solver: _Optional[_Union[LinearSolver, str]] = ..., position_tolerance: _Optional[float] = ..., orientation_tolerance: _Optional[float] = ..., position_only: _Optional[bool] = ..., max_iterations: _Optional[int] = ..., damping: _Optional[float] = ..., max_restarts: _Optional[int] = ..., num_solutions: _Optional[int] = ..., rng_seed: _Optional[int] = ..., joint_limits: _Optional[_Union[JointLimitMode, str]] = ..., time_budget: _Optional[float] = ..., adaptive_damping: _Optional[bool] = ..., max_step: _Optional[float] = ..., distinct_tolerance: _Optional[float] = ..., rlxa_max_iterations: _Optional[int] = ...) -> None: ...
+    return_history: bool
+    def __init__(self, method: _Optional[_Union[IkMethod, str]] = ..., linear_solver: _Optional[_Union[LinearSolver, str]] = ..., position_tolerance: _Optional[float] = ..., orientation_tolerance: _Optional[float] = ..., position_only: _Optional[bool] = ..., max_iterations: _Optional[int] = ..., damping: _Optional[float] = ..., max_restarts: _Optional[int] = ..., num_solutions: _Optional[int] = ..., rng_seed: _Optional[int] = ..., joint_limits: _Optional[_Union[JointLimitMode, str]] = ..., time_budget: _Optional[float] = ..., adaptive_damping: _Optional[bool] = ..., max_step: _Optional[float] = ..., distinct_tolerance: _Optional[float] = ..., rlxa_max_iterations: _Optional[int] = ..., return_history: _Optional[bool] = ...) -> None: ...
 
 class SolveIkRequest(_message.Message):
     __slots__ = ("robot", "target", "seed", "options")
@@ -118,7 +120,7 @@ class SolveIkRequest(_message.Message):
     def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., target: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., seed: _Optional[_Iterable[float]] = ..., options: _Optional[_Union[IkOptions, _Mapping]] = ...) -> None: ...
 
 class IkSolution(_message.Message):
-    __slots__ = ("joints", "position_error", "orientation_error", "iterations", "elapsed_us", "status", "attempt")
+    __slots__ = ("joints", "position_error", "orientation_error", "iterations", "elapsed_us", "status", "attempt", "position_error_history", "orientation_error_history")
     JOINTS_FIELD_NUMBER: _ClassVar[int]
     POSITION_ERROR_FIELD_NUMBER: _ClassVar[int]
     ORIENTATION_ERROR_FIELD_NUMBER: _ClassVar[int]
@@ -126,6 +128,8 @@ class IkSolution(_message.Message):
     ELAPSED_US_FIELD_NUMBER: _ClassVar[int]
     STATUS_FIELD_NUMBER: _ClassVar[int]
     ATTEMPT_FIELD_NUMBER: _ClassVar[int]
+    POSITION_ERROR_HISTORY_FIELD_NUMBER: _ClassVar[int]
+    ORIENTATION_ERROR_HISTORY_FIELD_NUMBER: _ClassVar[int]
     joints: _containers.RepeatedScalarFieldContainer[float]
     position_error: float
     orientation_error: float
@@ -133,7 +137,9 @@ class IkSolution(_message.Message):
     elapsed_us: int
     status: IkStatus
     attempt: int
-    def __init__(self, joints: _Optional[_Iterable[float]] = ..., position_error: _Optional[float] = ..., orientation_error: _Optional[float] = ..., iterations: _Optional[int] = ..., elapsed_us: _Optional[int] = ..., status: _Optional[_Union[IkStatus, str]] = ..., attempt: _Optional[int] = ...) -> None: ...
+    position_error_history: _containers.RepeatedScalarFieldContainer[float]
+    orientation_error_history: _containers.RepeatedScalarFieldContainer[float]
+    def __init__(self, joints: _Optional[_Iterable[float]] = ..., position_error: _Optional[float] = ..., orientation_error: _Optional[float] = ..., iterations: _Optional[int] = ..., elapsed_us: _Optional[int] = ..., status: _Optional[_Union[IkStatus, str]] = ..., attempt: _Optional[int] = ..., position_error_history: _Optional[_Iterable[float]] = ..., orientation_error_history: _Optional[_Iterable[float]] = ...) -> None: ...
 
 class SolveIkResponse(_message.Message):
     __slots__ = ("solutions", "best_attempt", "success", "status", "attempts", "total_iterations", "elapsed_us", "model_id")
