@@ -53,16 +53,12 @@ const RESTARTS_SOLVE: usize = 200;
 const RESTARTS_WARM: usize = 0;
 
 pub struct KinematicsApi {
-    models: Arc<ModelStore>,
-    compute: Arc<Compute>,
+    shared: Shared,
 }
 
 impl KinematicsApi {
     pub fn new(shared: Shared) -> Self {
-        Self {
-            models: shared.models,
-            compute: shared.compute,
-        }
+        Self { shared }
     }
 }
 
@@ -74,10 +70,9 @@ impl KinematicsService for KinematicsApi {
         &self,
         request: Request<pb::SolveIkRequest>,
     ) -> Result<Response<pb::SolveIkResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
-        let robot = self
-            .models
-            .resolve(request.get_ref().robot.as_ref(), &self.compute, &budget)
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
         let req = request.into_inner();
         let mut options = Options::from_proto(req.options.as_ref(), RESTARTS_SOLVE)?;
@@ -86,6 +81,7 @@ impl KinematicsService for KinematicsApi {
         let seed = (!req.seed.is_empty()).then_some(req.seed);
         let chain = robot.chain.clone();
         let result = self
+            .shared
             .compute
             .run(&budget, move |b| {
                 solve_ik(
@@ -108,10 +104,9 @@ impl KinematicsService for KinematicsApi {
         &self,
         request: Request<pb::SolveIkBatchRequest>,
     ) -> Result<Response<pb::SolveIkBatchResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
-        let robot = self
-            .models
-            .resolve(request.get_ref().robot.as_ref(), &self.compute, &budget)
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
         let req = request.into_inner();
         if req.targets.is_empty() {
@@ -149,6 +144,7 @@ impl KinematicsService for KinematicsApi {
         let chain = robot.chain.clone();
         let soft = soft_deadline(budget.deadline());
         let reply = self
+            .shared
             .compute
             .run(&budget, move |b| {
                 let start = Instant::now();
@@ -192,10 +188,9 @@ impl KinematicsService for KinematicsApi {
         &self,
         request: Request<pb::TrackPathRequest>,
     ) -> Result<Response<pb::TrackPathResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
-        let robot = self
-            .models
-            .resolve(request.get_ref().robot.as_ref(), &self.compute, &budget)
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
         let req = request.into_inner();
         let mut options = Options::from_proto(req.options.as_ref(), RESTARTS_WARM)?;
@@ -219,6 +214,7 @@ impl KinematicsService for KinematicsApi {
             stop_on_failure: req.stop_on_failure,
         };
         let result = self
+            .shared
             .compute
             .run(&budget, move |b| {
                 track_path(&chain, &targets, &seed, &params, options.rng_seed, &|| {
@@ -236,14 +232,14 @@ impl KinematicsService for KinematicsApi {
         &self,
         request: Request<Streaming<pb::StreamIkRequest>>,
     ) -> Result<Response<Self::StreamIkStream>, Status> {
-        let (permit, _) = self.compute.admit(&request)?;
+        let (permit, _) = self.shared.compute.admit(&request)?;
         // A controller's stream lives as long as the controller runs: only a
         // deadline the client sets bounds it, not the server's default.
         let deadline = super::compute::grpc_timeout(request.metadata()).map(|t| Instant::now() + t);
         let inbound = request.into_inner();
         let (tx, rx) = tokio::sync::mpsc::channel(4);
-        let models = self.models.clone();
-        let compute = self.compute.clone();
+        let models = self.shared.models.clone();
+        let compute = self.shared.compute.clone();
         tokio::spawn(async move {
             let _permit = permit;
             if let Err(status) = stream_loop(inbound, &tx, &models, &compute, deadline).await {
@@ -257,7 +253,7 @@ impl KinematicsService for KinematicsApi {
         &self,
         request: Request<pb::SolveLinearSystemRequest>,
     ) -> Result<Response<pb::SolveLinearSystemResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
+        let (_permit, budget) = self.shared.compute.admit(&request)?;
         let req = request.into_inner();
         let a = matrix_in("a", req.a.as_ref(), MAX_MATRIX_ENTRIES)?;
         if req.b.len() != a.nrows() {
@@ -311,6 +307,7 @@ impl KinematicsService for KinematicsApi {
             }
         };
         let (solution, elapsed) = self
+            .shared
             .compute
             .run(&budget, move |_| {
                 let start = Instant::now();

@@ -7,11 +7,8 @@
 //! request field. The service keeps no state: a controller's memory between `ControlStep`
 //! calls travels to the caller and back as an opaque token.
 
-use std::sync::Arc;
-
 use tonic::{Request, Response, Status};
 
-use super::Compute;
 use super::pb::{self, mobile_service_server::MobileService};
 use super::server::Shared;
 use super::status::invalid;
@@ -39,14 +36,12 @@ pub const MAX_RAYS_PER_BEAM: u32 = 100;
 pub const MAX_TOKEN_BYTES: usize = 1 << 20;
 
 pub struct MobileApi {
-    compute: Arc<Compute>,
+    shared: Shared,
 }
 
 impl MobileApi {
     pub fn new(shared: Shared) -> Self {
-        Self {
-            compute: shared.compute,
-        }
+        Self { shared }
     }
 }
 
@@ -56,7 +51,7 @@ impl MobileService for MobileApi {
         &self,
         request: Request<pb::WheelKinematicsRequest>,
     ) -> Result<Response<pb::WheelKinematicsResponse>, Status> {
-        let _admitted = self.compute.admit(&request)?;
+        let _admitted = self.shared.compute.admit(&request)?;
         let req = request.into_inner();
         let chassis = chassis_in(req.chassis.as_ref());
         use pb::wheel_kinematics_request::Input;
@@ -93,7 +88,7 @@ impl MobileService for MobileApi {
         &self,
         request: Request<pb::ControlStepRequest>,
     ) -> Result<Response<pb::ControlStepResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
+        let (_permit, budget) = self.shared.compute.admit(&request)?;
         let req = request.into_inner();
         if req.state_token.len() > MAX_TOKEN_BYTES {
             return Err(invalid(
@@ -105,7 +100,8 @@ impl MobileService for MobileApi {
         if req.world.is_empty() {
             control_step(req).map(Response::new)
         } else {
-            self.compute
+            self.shared
+                .compute
                 .run(&budget, move |_| control_step(req))
                 .await?
                 .map(Response::new)
@@ -116,7 +112,7 @@ impl MobileService for MobileApi {
         &self,
         request: Request<pb::FollowPathRequest>,
     ) -> Result<Response<pb::MobileRun>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
+        let (_permit, budget) = self.shared.compute.admit(&request)?;
         let req = request.into_inner();
         let chassis = chassis_in(req.chassis.as_ref());
         let start = pose_in(req.start.as_ref());
@@ -129,6 +125,7 @@ impl MobileService for MobileApi {
         };
         let sim = sim_in(req.sim.as_ref())?;
         let run = self
+            .shared
             .compute
             .run(&budget, move |b| {
                 follow_path(&chassis, start, &path, world.as_ref(), &follow, &sim, &|| {
@@ -144,7 +141,7 @@ impl MobileService for MobileApi {
         &self,
         request: Request<pb::NavigateRequest>,
     ) -> Result<Response<pb::MobileRun>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
+        let (_permit, budget) = self.shared.compute.admit(&request)?;
         let req = request.into_inner();
         let chassis = chassis_in(req.chassis.as_ref());
         let start = pose_in(req.start.as_ref());
@@ -161,7 +158,8 @@ impl MobileService for MobileApi {
                     vdf: vdf_in(req.vdf.as_ref())?,
                     seed: req.seed,
                 };
-                self.compute
+                self.shared
+                    .compute
                     .run(&budget, move |b| {
                         navigate(&chassis, start, goal, &world, &params, &|| b.should_stop())
                     })
@@ -175,7 +173,8 @@ impl MobileService for MobileApi {
                 };
                 let follow = follow_in(controller, req.follow.as_ref(), "controller")?;
                 let astar = astar_in(req.astar.as_ref())?;
-                self.compute
+                self.shared
+                    .compute
                     .run(&budget, move |b| {
                         navigate_astar(&chassis, start, goal, &world, &astar, &follow, &sim, &|| {
                             b.should_stop()

@@ -3,45 +3,21 @@
 //! FK and Jacobians cost microseconds (bounded by the URDF element limit), so
 //! they run inline; model parsing goes to the CPU pool.
 
-use std::sync::Arc;
-
 use tonic::{Request, Response, Status};
 
 use super::convert::{matrix_out, pose_out, vec3_out};
-use super::models::Resolved;
 use super::pb::{self, robot_service_server::RobotService};
 use super::server::Shared;
 use super::status::robot_error;
-use super::{Budget, Compute, ModelStore};
 use crate::robot::{BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf};
 
 pub struct RobotApi {
-    models: Arc<ModelStore>,
-    compute: Arc<Compute>,
+    shared: Shared,
 }
 
 impl RobotApi {
     pub fn new(shared: Shared) -> Self {
-        Self {
-            models: shared.models,
-            compute: shared.compute,
-        }
-    }
-
-    /// The named robot, with `q` (the request's `joint_positions`) checked
-    /// against its joint count.
-    async fn robot_at(
-        &self,
-        robot: Option<&pb::RobotRef>,
-        q: &[f64],
-        budget: &Budget,
-    ) -> Result<Resolved, Status> {
-        let robot = self.models.resolve(robot, &self.compute, budget).await?;
-        robot
-            .chain
-            .check_joints(q)
-            .map_err(|e| robot_error(e, "joint_positions"))?;
-        Ok(robot)
+        Self { shared }
     }
 }
 
@@ -51,7 +27,7 @@ impl RobotService for RobotApi {
         &self,
         request: Request<pb::ListRobotsRequest>,
     ) -> Result<Response<pb::ListRobotsResponse>, Status> {
-        let _admitted = self.compute.admit(&request)?;
+        let _admitted = self.shared.compute.admit(&request)?;
         let robots = BUILTIN_NAMES
             .iter()
             .map(|name| {
@@ -72,10 +48,9 @@ impl RobotService for RobotApi {
         &self,
         request: Request<pb::DescribeRobotRequest>,
     ) -> Result<Response<pb::DescribeRobotResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
-        let robot = self
-            .models
-            .resolve(request.get_ref().robot.as_ref(), &self.compute, &budget)
+        let (_permit, _budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
         Ok(Response::new(describe(&robot.chain, robot.model_id)))
     }
@@ -84,10 +59,16 @@ impl RobotService for RobotApi {
         &self,
         request: Request<pb::ForwardKinematicsRequest>,
     ) -> Result<Response<pb::ForwardKinematicsResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
+        let (_permit, _, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
         let req = request.get_ref();
         let q = &req.joint_positions;
-        let robot = self.robot_at(req.robot.as_ref(), q, &budget).await?;
+        robot
+            .chain
+            .check_joints(q)
+            .map_err(|e| robot_error(e, "joint_positions"))?;
         let chain = &robot.chain;
         let links = if req.include_links {
             let mut frames = Vec::with_capacity(chain.links().len());
@@ -115,10 +96,16 @@ impl RobotService for RobotApi {
         &self,
         request: Request<pb::JacobianRequest>,
     ) -> Result<Response<pb::JacobianResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
-        let req = request.get_ref();
-        let q = &req.joint_positions;
-        let robot = self.robot_at(req.robot.as_ref(), q, &budget).await?;
+        let (_permit, _, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
+        let q = &request.get_ref().joint_positions;
+        let _req = request.get_ref();
+        robot
+            .chain
+            .check_joints(q)
+            .map_err(|e| robot_error(e, "joint_positions"))?;
         let mut jacobian = nalgebra::Matrix6xX::zeros(robot.chain.dof());
         let tool = robot.chain.jacobian_into(q, &mut jacobian);
         Ok(Response::new(pb::JacobianResponse {

@@ -7,14 +7,13 @@
 //! Requests with many waypoints run on the CPU pool.
 
 use std::collections::HashMap;
-use std::sync::Arc;
 
 use tonic::{Request, Response, Status};
 
+use super::Budget;
 use super::pb::{self, scoring_service_server::ScoringService};
 use super::server::Shared;
 use super::status::invalid;
-use super::{Budget, Compute, ModelStore};
 use crate::robot::Chain;
 use crate::score::{
     self, CycleTime, CycleTimeParams, JerkPeakParams, JointLimits, LabelledSet, PointSet, Rows, ScoreError,
@@ -28,16 +27,12 @@ use crate::score::{
 const INLINE_WAYPOINTS: usize = 500;
 
 pub struct ScoringApi {
-    models: Arc<ModelStore>,
-    compute: Arc<Compute>,
+    shared: Shared,
 }
 
 impl ScoringApi {
     pub fn new(shared: Shared) -> Self {
-        Self {
-            models: shared.models,
-            compute: shared.compute,
-        }
+        Self { shared }
     }
 
     /// Runs `work` inline for small requests, on the CPU pool for large ones.
@@ -50,7 +45,7 @@ impl ScoringApi {
         if waypoints < INLINE_WAYPOINTS {
             work(budget)
         } else {
-            self.compute.run(budget, work).await?
+            self.shared.compute.run(budget, work).await?
         }
     }
 }
@@ -61,10 +56,9 @@ impl ScoringService for ScoringApi {
         &self,
         request: Request<pb::ScoreTrajectoryRequest>,
     ) -> Result<Response<pb::ScoreTrajectoryResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
-        let robot = self
-            .models
-            .resolve(request.get_ref().robot.as_ref(), &self.compute, &budget)
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
         let req = request.into_inner();
         let chain = robot.chain.clone();
@@ -86,10 +80,9 @@ impl ScoringService for ScoringApi {
         &self,
         request: Request<pb::CompareTrajectoriesRequest>,
     ) -> Result<Response<pb::CompareTrajectoriesResponse>, Status> {
-        let (_permit, budget) = self.compute.admit(&request)?;
-        let robot = self
-            .models
-            .resolve(request.get_ref().robot.as_ref(), &self.compute, &budget)
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
         let req = request.into_inner();
         if req.sets.is_empty() {

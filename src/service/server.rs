@@ -6,6 +6,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use tokio::net::TcpListener;
+use tokio::sync::OwnedSemaphorePermit;
 use tonic::transport::Server;
 use tonic::transport::server::TcpIncoming;
 use tonic_health::ServingStatus;
@@ -13,6 +14,7 @@ use tonic_health::ServingStatus;
 use super::kinematics::KinematicsApi;
 use super::metrics::MetricsLayer;
 use super::mobile::MobileApi;
+use super::models::Resolved;
 use super::pb::kinematics_service_server::KinematicsServiceServer;
 use super::pb::mobile_service_server::MobileServiceServer;
 use super::pb::{
@@ -20,7 +22,7 @@ use super::pb::{
 };
 use super::robot::RobotApi;
 use super::scoring::ScoringApi;
-use super::{Compute, ModelStore};
+use super::{Budget, Compute, ModelStore};
 use crate::robot::UrdfLimits;
 
 /// Everything the server can be told; `Default` is what `kinplan serve`
@@ -149,6 +151,21 @@ pub async fn serve(
 pub struct Shared {
     pub models: Arc<ModelStore>,
     pub compute: Arc<Compute>,
+}
+
+impl Shared {
+    /// The first steps of every call about a robot: admission (or shedding with
+    /// RESOURCE_EXHAUSTED), the request's budget, and the robot it names, from the
+    /// cache or parsed on the CPU pool. Hold the permit until the reply.
+    pub async fn admit_robot<T>(
+        &self,
+        request: &tonic::Request<T>,
+        robot: Option<&pb::RobotRef>,
+    ) -> Result<(OwnedSemaphorePermit, Budget, Resolved), tonic::Status> {
+        let (permit, budget) = self.compute.admit(request)?;
+        let robot = self.models.resolve(robot, &self.compute, &budget).await?;
+        Ok((permit, budget, robot))
+    }
 }
 
 fn name_of<S: tonic::server::NamedService>(_: &S) -> &'static str {
