@@ -199,6 +199,16 @@ pub fn track_path(
     })
 }
 
+fn check_steps(steps: usize) -> Result<(), IkError> {
+    if steps == 0 {
+        return Err(IkError::InvalidPath {
+            field: "steps",
+            reason: "must be >= 1",
+        });
+    }
+    Ok(())
+}
+
 /// `steps + 1` poses from `start` to `end`: position interpolated linearly, orientation
 /// by slerp (m, base frame).
 pub fn line_path(
@@ -206,12 +216,7 @@ pub fn line_path(
     end: &Isometry3<f64>,
     steps: usize,
 ) -> Result<Vec<Isometry3<f64>>, IkError> {
-    if steps == 0 {
-        return Err(IkError::InvalidPath {
-            field: "steps",
-            reason: "must be >= 1",
-        });
-    }
+    check_steps(steps)?;
     for p in [start, end] {
         IkTarget::Pose(*p).validate()?;
     }
@@ -238,12 +243,7 @@ pub fn circle_path(
     angle_step: f64,
     steps: usize,
 ) -> Result<Vec<Isometry3<f64>>, IkError> {
-    if steps == 0 {
-        return Err(IkError::InvalidPath {
-            field: "steps",
-            reason: "must be >= 1",
-        });
-    }
+    check_steps(steps)?;
     if !angle_step.is_finite() {
         return Err(IkError::InvalidPath {
             field: "angle_step",

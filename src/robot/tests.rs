@@ -174,7 +174,7 @@ fn zero_poses_match_hand_derived_positions() {
         ("kuka_kr120_r2500_pro", Vector3::new(2.715, 0.0, 0.634)),
         // Arm 2 vertical: x = 175 + 960 + 135, z = 495 + 900 + 175 mm.
         ("abb_irb4600_60_205", Vector3::new(1.27, 0.0, 1.57)),
-        // UR5 zero: x = a2 + a3, y = −(d4 + d6)... in the DH base frame.
+        // UR5 zero, DH base frame: x = a2 + a3, y = −(d4 + d6), z = d1 − d5.
         ("ur5", Vector3::new(-0.81725, -0.19145, -0.005491)),
         ("kuka_lbr_iiwa14_r820", Vector3::new(0.0, 0.0, 1.261)),
         ("planar_4", Vector3::new(1.0, 0.0, 0.0)),
@@ -195,7 +195,6 @@ fn jacobian_matches_finite_differences() {
         for _ in 0..20 {
             let q = random_q(&chain, &mut rng);
             let jac = chain.jacobian(&q);
-            let t0 = chain.fk(&q);
             for i in 0..chain.dof() {
                 let mut qp = q.clone();
                 let mut qm = q.clone();
@@ -210,7 +209,6 @@ fn jacobian_matches_finite_differences() {
                 let err_w = (col.fixed_rows::<3>(3) - w).norm();
                 assert!(err_v < 1e-6 && err_w < 1e-6, "{name} joint {i}: {err_v} {err_w}");
             }
-            let _ = t0;
         }
     }
 }
