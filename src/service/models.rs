@@ -98,19 +98,19 @@ impl ModelStore {
         let (id, text) = match &robot.source {
             None => return Err(invalid("robot", "one of name, urdf or model_id is required")),
             Some(Source::Name(name)) => {
-                if spec != ChainSpec::default() {
-                    let urdf = crate::robot::builtin_urdf(name).map_err(|e| robot_error(e, ""))?;
-                    let chain = self.parse(urdf.into(), spec, compute, budget).await?;
+                if spec == ChainSpec::default() {
+                    let chain = builtin_chain(name).map_err(|e| robot_error(e, ""))?;
                     return Ok(Resolved {
                         chain,
                         model_id: Vec::new(),
                     });
                 }
-                let chain = builtin_chain(name).map_err(|e| robot_error(e, ""))?;
-                return Ok(Resolved {
-                    chain,
-                    model_id: Vec::new(),
-                });
+                // Another chain of a built-in: parsed once, then cached like any URDF.
+                let urdf = crate::robot::builtin_urdf(name).map_err(|e| robot_error(e, ""))?;
+                (
+                    Sha256::digest(urdf.as_bytes()).into(),
+                    Some(Arc::<str>::from(urdf)),
+                )
             }
             Some(Source::Urdf(text)) => {
                 if text.len() > self.limits.max_bytes {
@@ -133,12 +133,14 @@ impl ModelStore {
                 (id, None)
             }
         };
+        // Built-in robots are named, not identified by hash.
+        let model_id = match &robot.source {
+            Some(Source::Name(_)) => Vec::new(),
+            _ => id.to_vec(),
+        };
         let key = (id, spec.clone());
         if let Some(chain) = self.chains.lock().expect("cache lock").get(&key) {
-            return Ok(Resolved {
-                chain,
-                model_id: id.to_vec(),
-            });
+            return Ok(Resolved { chain, model_id });
         }
         let text = match text {
             Some(t) => t,
@@ -152,10 +154,7 @@ impl ModelStore {
         let chain = self.parse(text.clone(), spec, compute, budget).await?;
         self.texts.lock().expect("cache lock").insert(id, text);
         self.chains.lock().expect("cache lock").insert(key, chain.clone());
-        Ok(Resolved {
-            chain,
-            model_id: id.to_vec(),
-        })
+        Ok(Resolved { chain, model_id })
     }
 
     async fn parse(
@@ -171,5 +170,52 @@ impl ModelStore {
             .await?
             .map(Arc::new)
             .map_err(|e| robot_error(e, ""))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn named(name: &str, tip: &str) -> pb::RobotRef {
+        pb::RobotRef {
+            source: Some(Source::Name(name.into())),
+            tip_link: tip.into(),
+            ..Default::default()
+        }
+    }
+
+    /// A built-in's other chain, or an inline URDF, is parsed once and then served
+    /// from the cache (the same shared chain comes back).
+    #[tokio::test]
+    async fn models_are_parsed_once() {
+        let store = ModelStore::new(UrdfLimits::default(), 8);
+        let compute = Compute::new(1, 4, None);
+        let budget = Budget::new(None);
+        let flange = named("kuka_kr210_r2700_extra", "flange");
+        let a = store.resolve(Some(&flange), &compute, &budget).await.unwrap();
+        let b = store.resolve(Some(&flange), &compute, &budget).await.unwrap();
+        assert!(Arc::ptr_eq(&a.chain, &b.chain));
+        assert_eq!(a.chain.tip_link(), "flange");
+        assert!(a.model_id.is_empty());
+        let default = store
+            .resolve(Some(&named("kuka_kr210_r2700_extra", "")), &compute, &budget)
+            .await
+            .unwrap();
+        assert_eq!(default.chain.tip_link(), "tool0");
+        assert!(!Arc::ptr_eq(&a.chain, &default.chain));
+
+        let inline = pb::RobotRef {
+            source: Some(Source::Urdf(crate::robot::builtin_urdf("ur5").unwrap().into())),
+            ..Default::default()
+        };
+        let c = store.resolve(Some(&inline), &compute, &budget).await.unwrap();
+        let by_id = pb::RobotRef {
+            source: Some(Source::ModelId(c.model_id.clone())),
+            ..Default::default()
+        };
+        let d = store.resolve(Some(&by_id), &compute, &budget).await.unwrap();
+        assert!(Arc::ptr_eq(&c.chain, &d.chain));
+        assert_eq!(c.model_id.len(), 32);
     }
 }
