@@ -70,10 +70,11 @@ impl RobotService for RobotApi {
             .check_joints(q)
             .map_err(|e| robot_error(e, "joint_positions"))?;
         let chain = &robot.chain;
-        let links = if req.include_links {
+        // With links, the tip link's frame (the last one) is the tool pose: one FK pass.
+        let (tool, links) = if req.include_links {
             let mut frames = Vec::with_capacity(chain.links().len());
             chain.link_frames_into(q, &mut frames);
-            chain
+            let links = chain
                 .links()
                 .iter()
                 .zip(&frames)
@@ -81,12 +82,13 @@ impl RobotService for RobotApi {
                     name: link.name.clone(),
                     pose: Some(pose_out(pose)),
                 })
-                .collect()
+                .collect();
+            (frames.last().copied().unwrap_or_else(|| chain.fk(q)), links)
         } else {
-            Vec::new()
+            (chain.fk(q), Vec::new())
         };
         Ok(Response::new(pb::ForwardKinematicsResponse {
-            tool_pose: Some(pose_out(&chain.fk(q))),
+            tool_pose: Some(pose_out(&tool)),
             links,
             model_id: robot.model_id,
         }))
