@@ -82,6 +82,18 @@ impl Default for PathFollowParams {
 }
 
 impl PathFollowParams {
+    /// These parameters as `chassis` can carry them out: a steered chassis (one
+    /// with a curvature limit) cannot turn in place, so pure pursuit's
+    /// rotate-to-heading is switched off for it instead of being clamped to a
+    /// standstill (as [`PurePursuitParams::rotate_to_heading`] documents).
+    pub fn for_chassis(&self, chassis: &super::Chassis) -> Self {
+        let mut params = *self;
+        if chassis.max_curvature().is_some() {
+            params.pure_pursuit.rotate_to_heading = false;
+        }
+        params
+    }
+
     /// Positive distances and tolerances; nested parameter sets valid.
     pub fn validate(&self) -> Result<(), MobileError> {
         check_positive("follow.switching_distance", self.switching_distance)?;

@@ -202,13 +202,7 @@ pub fn follow_path(
     validate_path(path)?;
     follow.validate()?;
     sim.validate()?;
-    // A steered chassis cannot turn in place: pure pursuit's rotate-to-heading is ignored for
-    // it (as its parameter documents), instead of being clamped to a standstill.
-    let mut follow = *follow;
-    if chassis.max_curvature().is_some() {
-        follow.pure_pursuit.rotate_to_heading = false;
-    }
-    let follow = &follow;
+    let follow = &follow.for_chassis(chassis);
     let mut run = SimRun::default();
     run.metrics.min_clearance = start_check(world, start, sim.robot_radius)?;
     let steps = (sim.max_time / sim.dt).ceil() as usize;

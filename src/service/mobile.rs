@@ -246,11 +246,7 @@ fn control_step(req: pb::ControlStepRequest) -> Result<pb::ControlStepResponse, 
     }
     let path = path_in(&req.path)?;
     validate_path(&path).map_err(mobile_error)?;
-    let mut follow = follow_in(req.controller, req.follow.as_ref(), "controller")?;
-    // As in FollowPath: a steered chassis ignores pure pursuit's rotate-to-heading.
-    if chassis.max_curvature().is_some() {
-        follow.pure_pursuit.rotate_to_heading = false;
-    }
+    let follow = follow_in(req.controller, req.follow.as_ref(), "controller")?.for_chassis(&chassis);
     let progress: PathFollowState = if req.state_token.is_empty() {
         PathFollowState::default()
     } else {
