@@ -344,6 +344,22 @@ impl<'c> IkSolver<'c> {
         }
     }
 
+    /// A solver reusing `workspace` (from [`into_workspace`](Self::into_workspace) of an
+    /// earlier solver), so a long-lived caller — a `StreamIk` session — allocates its
+    /// buffers once. A workspace sized for another chain is replaced.
+    pub fn with_workspace(chain: &'c Chain, workspace: IkWorkspace) -> Self {
+        let fits = workspace.q.len() == chain.dof() && workspace.limits.iter().copied().eq(chain.limits());
+        Self {
+            chain,
+            ws: if fits { workspace } else { IkWorkspace::new(chain) },
+        }
+    }
+
+    /// Gives the buffers back for [`with_workspace`](Self::with_workspace).
+    pub fn into_workspace(self) -> IkWorkspace {
+        self.ws
+    }
+
     pub fn chain(&self) -> &'c Chain {
         self.chain
     }

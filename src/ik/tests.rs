@@ -654,3 +654,28 @@ fn error_history_on_request() {
     assert!(quiet.solutions[0].history.is_empty());
     assert_eq!(quiet.solutions[0].joints, s.joints);
 }
+
+/// A solver built on a lent workspace answers exactly as a fresh one (the StreamIk
+/// session reuses one workspace for every target), and a workspace of another chain is
+/// not reused.
+#[test]
+fn reused_workspace_gives_the_fresh_answer() {
+    let panda = builtin_chain("franka_panda").unwrap();
+    let ur5 = builtin_chain("ur5").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(41);
+    let params = IkParams::default();
+    let mut workspace = IkWorkspace::new(&ur5); // wrong chain: must be replaced
+    for i in 0..20 {
+        let target = IkTarget::Pose(panda.fk(&random_joints(&panda, &mut rng)));
+        let fresh = solve_ik(&panda, &target, None, &params, i, &never).unwrap();
+        let mut solver = IkSolver::with_workspace(&panda, workspace);
+        let reused = solver.solve(&target, None, &params, i, &never).unwrap();
+        workspace = solver.into_workspace();
+        assert_eq!(fresh.solutions.len(), reused.solutions.len(), "target {i}");
+        for (a, b) in fresh.solutions.iter().zip(&reused.solutions) {
+            assert_eq!(a.joints, b.joints, "target {i}");
+            assert_eq!(a.iterations, b.iterations, "target {i}");
+        }
+        assert_eq!(fresh.total_iterations, reused.total_iterations, "target {i}");
+    }
+}

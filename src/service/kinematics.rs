@@ -24,8 +24,8 @@ use super::server::Shared;
 use super::status::{invalid, robot_error};
 use super::{Budget, Compute, ModelStore};
 use crate::ik::{
-    IkError, IkMethod, IkParams, IkResult, IkSolution, IkStatus, IkTarget, JointLimitMode, TrackParams,
-    TrackResult, circle_path, line_path, solve_ik, solve_ik_batch, track_path,
+    IkError, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
+    JointLimitMode, TrackParams, TrackResult, circle_path, line_path, solve_ik, solve_ik_batch, track_path,
 };
 use crate::linalg::{
     LinalgError, LinearSolution, LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus,
@@ -557,6 +557,9 @@ async fn stream_loop(
         chain: Arc<Chain>,
         options: Options,
         previous: Vec<f64>,
+        /// The solver's buffers, lent to each solve and handed back (`None` only if a
+        /// solve never ran, e.g. its deadline passed in the queue).
+        workspace: Option<IkWorkspace>,
     }
     let mut session: Option<Session> = None;
     while let Some(msg) = inbound.message().await? {
@@ -573,6 +576,7 @@ async fn stream_loop(
                 model_id = robot.model_id.clone();
                 session.insert(Session {
                     previous: robot.chain.mid_limits(),
+                    workspace: Some(IkWorkspace::new(&robot.chain)),
                     chain: robot.chain,
                     options,
                 })
@@ -603,14 +607,16 @@ async fn stream_loop(
         params.time_budget = time_budget(st.options.time_budget, soft_deadline(deadline));
         let chain = st.chain.clone();
         let rng_seed = st.options.rng_seed;
-        let result = compute
+        let workspace = st.workspace.take().unwrap_or_else(|| IkWorkspace::new(&chain));
+        let (result, workspace) = compute
             .run(&Budget::new(deadline), move |b| {
-                solve_ik(&chain, &target, Some(&seed), &params, rng_seed, &|| {
-                    b.should_stop()
-                })
+                let mut solver = IkSolver::with_workspace(&chain, workspace);
+                let result = solver.solve(&target, Some(&seed), &params, rng_seed, &|| b.should_stop());
+                (result, solver.into_workspace())
             })
-            .await?
-            .map_err(|e| at(ik_error(e, "target", "")))?;
+            .await?;
+        st.workspace = Some(workspace);
+        let result = result.map_err(|e| at(ik_error(e, "target", "")))?;
         if let Some(best) = result.best() {
             st.previous.copy_from_slice(&best.joints);
         }
