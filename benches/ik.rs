@@ -1,5 +1,7 @@
-//! Criterion micro-benchmarks (seeded): one LM+SVD solve on the KR 210 and the UR5 from
-//! the middle of the limits, and one RLXA / SVD solve of a 6×6 Jacobian system.
+//! Criterion micro-benchmarks (seeded): one LM+SVD solve on the KR 210, the UR5 and the
+//! Panda from the middle of the limits, one RLXA / SVD solve of a 6×6 Jacobian system,
+//! and cold Jacobi decompositions of Panda 6×7 Jacobians at the default orthogonality
+//! (1e-10) and at the IK steps' 1e-4.
 //! The full TRAC-IK-protocol and S2 tables are `examples/ik_bench.rs` and
 //! `examples/s2_tables.rs` (see IK_RESULTS.md).
 
@@ -13,7 +15,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 fn ik(c: &mut Criterion) {
-    for arm in ["kuka_kr210_r2700_extra", "ur5"] {
+    for arm in ["kuka_kr210_r2700_extra", "ur5", "franka_panda"] {
         let chain = kinplan::robot::builtin_chain(arm).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let targets: Vec<IkTarget> = (0..64)
@@ -61,5 +63,26 @@ fn linear(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, ik, linear);
+fn decompositions(c: &mut Criterion) {
+    let chain = kinplan::robot::builtin_chain("franka_panda").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let jacobians: Vec<DMatrix<f64>> = (0..256)
+        .map(|_| {
+            let q: Vec<f64> = chain.limits().map(|(lo, hi)| rng.random_range(lo..=hi)).collect();
+            DMatrix::from_iterator(6, 7, chain.jacobian(&q).iter().cloned())
+        })
+        .collect();
+    for (name, tolerance) in [("1e-10", 1e-10), ("1e-4", 1e-4)] {
+        let mut ws = SvdWorkspace::new(6, 7).with_orthogonality(tolerance);
+        let mut k = 0;
+        c.bench_function(&format!("svd_decompose_panda_6x7_orth_{name}"), |b| {
+            b.iter(|| {
+                k = (k + 1) % jacobians.len();
+                ws.decompose(black_box(&jacobians[k]))
+            })
+        });
+    }
+}
+
+criterion_group!(benches, ik, linear, decompositions);
 criterion_main!(benches);
