@@ -5,7 +5,14 @@
 //! `cargo run --release --example ik_bench -- [N] [arm,...] [method,...]`
 //! methods: ji-svd ji-rlxa lm-svd lm-rlxa newton-svd newton-rlxa ccd fabrik lr
 //! `POS=1` uses position-only targets; `NOBUDGET=1` replaces the 5 ms budget by 200 restarts.
+//! `DUMP_TARGETS=<dir>` also writes, per arm, `<dir>/<arm>.csv` (a header line, then one
+//! line per target: the sampled joint values, then the full target pose `x y z qx qy qz qw`
+//! in the base frame, metres and unit quaternion) and `<dir>/<arm>.json` (base and tip
+//! links, joint names, limits and the IK seed, i.e. the middle of the limits), so that
+//! other solvers can be run on exactly these targets (`benches/anchors/`).
 
+use std::io::Write;
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use kinplan::ik::{IkMethod, IkParams, IkSolver, IkTarget};
@@ -61,10 +68,13 @@ fn main() {
     for arm in &arms {
         let chain = kinplan::robot::builtin_chain(arm).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(2026);
-        let targets: Vec<IkTarget> = (0..n)
-            .map(|_| {
-                let q: Vec<f64> = chain.limits().map(|(lo, hi)| rng.random_range(lo..=hi)).collect();
-                let t = chain.fk(&q);
+        let samples: Vec<Vec<f64>> = (0..n)
+            .map(|_| chain.limits().map(|(lo, hi)| rng.random_range(lo..=hi)).collect())
+            .collect();
+        let targets: Vec<IkTarget> = samples
+            .iter()
+            .map(|q| {
+                let t = chain.fk(q);
                 if position_only {
                     IkTarget::Position(nalgebra::Point3::from(t.translation.vector))
                 } else {
@@ -73,6 +83,10 @@ fn main() {
             })
             .collect();
         let seed = chain.mid_limits();
+        if let Ok(dir) = std::env::var("DUMP_TARGETS") {
+            dump_targets(Path::new(&dir), arm, &chain, &samples, &seed)
+                .unwrap_or_else(|e| panic!("DUMP_TARGETS={dir}: {e}"));
+        }
         for m in &methods {
             let (method, linear_solver) = method(m);
             let params = IkParams {
@@ -131,4 +145,43 @@ fn main() {
             );
         }
     }
+}
+
+/// Writes `<dir>/<arm>.csv` (joint samples and their FK poses) and `<dir>/<arm>.json`
+/// (chain and seed). Floats use Rust's shortest round-trip formatting, so a reader
+/// parsing them as f64 gets the exact values used here.
+fn dump_targets(
+    dir: &Path,
+    arm: &str,
+    chain: &kinplan::robot::Chain,
+    samples: &[Vec<f64>],
+    seed: &[f64],
+) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let mut csv = std::io::BufWriter::new(std::fs::File::create(dir.join(format!("{arm}.csv")))?);
+    let mut header: Vec<String> = (0..chain.dof()).map(|i| format!("q{i}")).collect();
+    header.extend(["x", "y", "z", "qx", "qy", "qz", "qw"].map(String::from));
+    writeln!(csv, "{}", header.join(","))?;
+    for q in samples {
+        let t = chain.fk(q);
+        let p = t.translation.vector;
+        let r = t.rotation;
+        let mut row: Vec<String> = q.iter().map(|v| v.to_string()).collect();
+        row.extend([p.x, p.y, p.z, r.i, r.j, r.k, r.w].iter().map(|v| v.to_string()));
+        writeln!(csv, "{}", row.join(","))?;
+    }
+    csv.flush()?;
+    let json = serde_json::json!({
+        "arm": arm,
+        "base_link": chain.base_link(),
+        "tip_link": chain.tip_link(),
+        "n": samples.len(),
+        "rng": "ChaCha8 seed 2026, uniform in the limits",
+        "joints": chain.joints().iter().map(|j| j.name.as_str()).collect::<Vec<_>>(),
+        "lower": chain.limits().map(|(lo, _)| lo).collect::<Vec<_>>(),
+        "upper": chain.limits().map(|(_, hi)| hi).collect::<Vec<_>>(),
+        "seed": seed,
+    });
+    let json = serde_json::to_string_pretty(&json).map_err(std::io::Error::other)?;
+    std::fs::write(dir.join(format!("{arm}.json")), json)
 }
