@@ -26,7 +26,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::solve::{Attempt, Clock, IkWorkspace, Progress, is_converged};
 use super::{IkMethod, IkParams, IkStatus, IkTarget, JointLimitMode, PoseError, pose_error};
-use crate::linalg::{LinearSolverKind, RlxaParams};
+use crate::linalg::{LinearSolverKind, RlxaParams, SvdWorkspace};
 use crate::robot::Chain;
 
 const MU_MAX: f64 = 1e8;
@@ -36,11 +36,11 @@ const MU_MAX: f64 = 1e8;
 /// iterations per target by 1–15 % on the benchmark arms at equal success
 /// (IK_RESULTS.md §0).
 const STALL_PROGRESS: f64 = 0.9;
-/// Orthogonality tolerance of the Jacobi SVD behind each step (see
-/// [`SvdWorkspace::with_orthogonality`](crate::linalg::SvdWorkspace::with_orthogonality)):
-/// a step accurate to ~1e-4 relative converges as fast as an exact one (identical
-/// iteration counts on every benchmark arm at 1e-4 and 1e-3; 1e-2 costs 1–4 % more) and
-/// needs ~20 % fewer sweeps than the default 1e-10.
+/// Orthogonality tolerance of the Jacobi SVD behind each Jacobian-inverse and LM step
+/// (see [`SvdWorkspace::with_orthogonality`]): a step accurate to ~1e-4 relative
+/// converges as fast as an exact one (identical iteration counts on every benchmark arm
+/// at 1e-4 and 1e-3; 1e-2 costs 1–4 % more) and needs ~15 % fewer sweeps than the
+/// default 1e-10. Newton keeps the default.
 pub(crate) const STEP_ORTHOGONALITY: f64 = 1e-4;
 
 pub(crate) fn run(
@@ -57,6 +57,13 @@ pub(crate) fn run(
     let rlxa = params.linear_solver == LinearSolverKind::AngleRelaxation;
     let rows = if lm && rlxa { task + n } else { task };
     ws.ensure_system(rows, n);
+    // Inexact steps are fine when the unknown is the step (JI, LM), not when it is the
+    // new iterate (Newton): see SvdWorkspace::with_orthogonality.
+    ws.svd.set_orthogonality(if params.method == IkMethod::Newton {
+        SvdWorkspace::DEFAULT_ORTHOGONALITY
+    } else {
+        STEP_ORTHOGONALITY
+    });
     IkWorkspace::apply_limits(&ws.limits, params.joint_limits, &mut ws.q);
 
     let mut tip: Isometry3<f64> = chain.jacobian_into(&ws.q, &mut ws.jac);

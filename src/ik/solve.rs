@@ -153,7 +153,7 @@ impl IkWorkspace {
             a: DMatrix::zeros(6, n),
             b: DVector::zeros(6),
             x: DVector::zeros(n),
-            svd: SvdWorkspace::new(6, n).with_orthogonality(super::jacobian_methods::STEP_ORTHOGONALITY),
+            svd: SvdWorkspace::new(6, n),
             rlxa: RlxaWorkspace::new(6, n),
             frames: Vec::with_capacity(n),
             points: super::point_chain::PointWorkspace::default(),

@@ -679,3 +679,34 @@ fn reused_workspace_gives_the_fresh_answer() {
         assert_eq!(fresh.total_iterations, reused.total_iterations, "target {i}");
     }
 }
+
+/// Newton solves for the new iterate `q_{k+1}`, so its SVD must be accurate to the
+/// tolerance, not merely to the step (regression: with the IK steps' loose 1e-4
+/// orthogonality it stalled at ~1e-4 and needed ~60 attempts per KR 210 target). On a
+/// square full-rank arm it takes the Jacobian-inverse path, so it must need about as
+/// few attempts.
+#[test]
+fn newton_svd_converges_like_the_jacobian_inverse_on_a_six_axis_arm() {
+    let chain = builtin_chain("kuka_kr210_r2700_extra").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(77);
+    let targets: Vec<IkTarget> = (0..40)
+        .map(|_| IkTarget::Pose(chain.fk(&random_joints(&chain, &mut rng))))
+        .collect();
+    let attempts = |method| {
+        let p = jacobian_params(method, LinearSolverKind::SvdPseudoinverse);
+        targets
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let r = solve_ik(&chain, t, None, &p, i as u64, &never).unwrap();
+                assert!(r.success(), "{method:?} target {i}");
+                r.attempts
+            })
+            .sum::<usize>()
+    };
+    let (newton, ji) = (attempts(IkMethod::Newton), attempts(IkMethod::JacobianInverse));
+    assert!(
+        newton <= ji + ji / 2,
+        "Newton {newton} attempts vs Jacobian inverse {ji}"
+    );
+}

@@ -164,13 +164,24 @@ impl SvdWorkspace {
     /// The columns of `A V` are orthogonal to `τ`, so `σⱼ` are accurate to about `τ²`
     /// and a pseudoinverse solution to about `τ` relative times the conditioning of the
     /// (damped) system. A Newton-type iteration needs no more than the accuracy it is
-    /// converging by (inexact Newton; Dembo, Eisenstat & Steihaug 1982): the IK
-    /// methods use `1e-4`, which leaves their iteration counts unchanged on every
-    /// benchmark arm and saves about a fifth of the sweeps (`benches/IK_RESULTS.md`).
+    /// converging by (inexact Newton; Dembo, Eisenstat & Steihaug 1982) when the unknown
+    /// is the step itself: the Jacobian-inverse and Levenberg–Marquardt steps use `1e-4`,
+    /// which leaves their iteration counts unchanged on every benchmark arm and saves
+    /// ~15 % of the sweeps (`benches/IK_RESULTS.md`). Not when the unknown is the new
+    /// iterate (Newton's `J q_{k+1} = J q_k + e`): its error `τ‖q‖` does not shrink with
+    /// `e`, so Newton keeps the default.
     pub fn with_orthogonality(mut self, tolerance: f64) -> Self {
-        self.orthogonality = tolerance.clamp(1e-15, 1e-2);
+        self.set_orthogonality(tolerance);
         self
     }
+
+    /// In-place form of [`with_orthogonality`](Self::with_orthogonality).
+    pub fn set_orthogonality(&mut self, tolerance: f64) {
+        self.orthogonality = tolerance.clamp(1e-15, 1e-2);
+    }
+
+    /// The default orthogonality tolerance (`1e-10`).
+    pub const DEFAULT_ORTHOGONALITY: f64 = ORTHOGONAL;
 
     /// Singular values of the last decomposed matrix (unordered; `min(m, n)` of them
     /// when m < n, otherwise n).
