@@ -346,7 +346,6 @@ impl SvdWorkspace {
         // costs one dot product instead of three.
         let mut norms = [0.0f64; MAX_FIXED];
         let tol2 = self.orthogonality * self.orthogonality;
-        let order = RoundRobin::new(k);
         let mut sweep = 0;
         while sweep < MAX_SWEEPS {
             sweep += 1;
@@ -354,23 +353,22 @@ impl SvdWorkspace {
             for (d, col) in norms.iter_mut().zip(&w).take(k) {
                 *d = dot(col, col);
             }
-            for round in order.rounds() {
-                for &(i, j) in round {
-                    let (alpha, beta) = (norms[i], norms[j]);
-                    if alpha <= negligible || beta <= negligible {
-                        continue;
-                    }
-                    let gamma = dot(&w[i], &w[j]);
-                    if gamma * gamma <= tol2 * alpha * beta {
-                        continue;
-                    }
-                    let (c, s, t) = fast_rotation(alpha, beta, gamma);
-                    rotated = true;
-                    norms[i] = alpha - t * gamma;
-                    norms[j] = beta + t * gamma;
-                    rotate_pair(&mut w, i, j, c, s);
-                    rotate_pair(&mut v, i, j, c, s);
+            for &(i, j) in &ROUND_ROBIN[k][..k * k.saturating_sub(1) / 2] {
+                let (i, j) = (i as usize, j as usize);
+                let (alpha, beta) = (norms[i], norms[j]);
+                if alpha <= negligible || beta <= negligible {
+                    continue;
                 }
+                let gamma = dot(&w[i], &w[j]);
+                if gamma * gamma <= tol2 * alpha * beta {
+                    continue;
+                }
+                let (c, s, t) = fast_rotation(alpha, beta, gamma);
+                rotated = true;
+                norms[i] = alpha - t * gamma;
+                norms[j] = beta + t * gamma;
+                rotate_pair(&mut w, i, j, c, s);
+                rotate_pair(&mut v, i, j, c, s);
             }
             if !rotated {
                 break;
@@ -454,18 +452,21 @@ impl SvdWorkspace {
         if smax == 0.0 {
             return;
         }
+        // Plain slices: nalgebra's generic column views cost more than these few flops.
+        let (rows, w, v) = (self.w.nrows(), self.w.as_slice(), self.v.as_slice());
+        let (b, x) = (b.as_slice(), x.as_mut_slice());
         for j in 0..k {
             let s = self.sigma[j];
             if s <= cut || s == 0.0 {
                 continue;
             }
             let denom = s * s + damping;
-            if self.transposed {
-                let coef = self.v.column(j).dot(b) / denom;
-                x.axpy(coef, &self.w.column(j), 1.0);
-            } else {
-                let coef = self.w.column(j).dot(b) / denom;
-                x.axpy(coef, &self.v.column(j), 1.0);
+            let (wj, vj) = (&w[j * rows..(j + 1) * rows], &v[j * k..(j + 1) * k]);
+            // transposed: coefficient from V, direction from W; otherwise the reverse
+            let (coef_col, dir_col) = if self.transposed { (vj, wj) } else { (wj, vj) };
+            let coef = coef_col.iter().zip(b).map(|(p, q)| p * q).sum::<f64>() / denom;
+            for (xi, d) in x.iter_mut().zip(dir_col) {
+                *xi += coef * d;
             }
         }
     }
@@ -505,52 +506,58 @@ impl SvdWorkspace {
 
 const MAX_SWEEPS: usize = 60;
 
-/// The round-robin (Brent–Luk) ordering of the column pairs of one sweep: `k − 1` rounds
-/// (k even; an odd `k` gets a dummy column) of `k/2` disjoint pairs. Pairs within a round
-/// touch different columns, so their rotations are independent and overlap in the CPU
-/// pipeline instead of waiting on each other as in the row-cyclic order.
-struct RoundRobin {
-    pairs: [(usize, usize); MAX_FIXED * (MAX_FIXED - 1) / 2],
-    /// End index in `pairs` of each round.
-    ends: [usize; MAX_FIXED],
-    rounds: usize,
-}
+/// Column pairs of one sweep for `MAX_FIXED` columns.
+const PAIRS: usize = MAX_FIXED * (MAX_FIXED - 1) / 2;
 
-impl RoundRobin {
-    fn new(k: usize) -> Self {
+/// The round-robin (Brent–Luk) order of the column pairs of one sweep, for every column
+/// count `k ≤ MAX_FIXED` (entry `k`, its first `k(k−1)/2` pairs), built at compile time:
+/// `k − 1` rounds (k even; an odd `k` gets a dummy column) of disjoint pairs, seat 0
+/// fixed and the other seats moving one place per round (circle method). Pairs within
+/// a round touch different columns, so their rotations are independent and overlap in
+/// the CPU pipeline instead of waiting on each other as in the row-cyclic order.
+const ROUND_ROBIN: [[(u8, u8); PAIRS]; MAX_FIXED + 1] = round_robin_tables();
+
+const fn round_robin_tables() -> [[(u8, u8); PAIRS]; MAX_FIXED + 1] {
+    let mut out = [[(0u8, 0u8); PAIRS]; MAX_FIXED + 1];
+    let mut k = 2;
+    while k <= MAX_FIXED {
         let p = k + (k % 2);
         let mut seats = [0usize; MAX_FIXED];
-        for (i, s) in seats.iter_mut().enumerate().take(p) {
-            *s = i;
+        let mut i = 0;
+        while i < p {
+            seats[i] = i;
+            i += 1;
         }
-        let mut out = Self {
-            pairs: [(0, 0); MAX_FIXED * (MAX_FIXED - 1) / 2],
-            ends: [0; MAX_FIXED],
-            rounds: p.saturating_sub(1),
-        };
         let mut len = 0;
-        for r in 0..out.rounds {
-            for i in 0..p / 2 {
+        let mut round = 0;
+        while round + 1 < p {
+            let mut i = 0;
+            while i < p / 2 {
                 let (a, b) = (seats[i], seats[p - 1 - i]);
                 if a < k && b < k {
-                    out.pairs[len] = (a.min(b), a.max(b));
+                    out[k][len] = if a < b {
+                        (a as u8, b as u8)
+                    } else {
+                        (b as u8, a as u8)
+                    };
                     len += 1;
                 }
+                i += 1;
             }
-            out.ends[r] = len;
-            // circle method: seat 0 stays, the others move one place
-            seats[1..p].rotate_right(1);
+            let last = seats[p - 1];
+            let mut j = p - 1;
+            while j > 1 {
+                seats[j] = seats[j - 1];
+                j -= 1;
+            }
+            seats[1] = last;
+            round += 1;
         }
-        out
+        k += 1;
     }
-
-    fn rounds(&self) -> impl Iterator<Item = &[(usize, usize)]> {
-        (0..self.rounds).map(move |r| {
-            let start = if r == 0 { 0 } else { self.ends[r - 1] };
-            &self.pairs[start..self.ends[r]]
-        })
-    }
+    out
 }
+
 /// Largest `W` row count handled by the fixed-size path.
 const MAX_FIXED: usize = 8;
 /// Default orthogonality tolerance: pairs with `|wᵢᵀwⱼ| ≤ ORTHOGONAL · ‖wᵢ‖‖wⱼ‖` count
@@ -774,6 +781,31 @@ mod tests {
                 fast.solve_decomposed(&b, mu, 1e-10, &mut xf);
                 slow.solve_decomposed(&b, mu, 1e-10, &mut xs);
                 assert!((&xf - &xs).norm() <= 1e-10 * xs.norm().max(1.0), "{m}x{n} μ={mu}");
+            }
+        }
+    }
+
+    /// Every round-robin table visits each column pair exactly once, in rounds of
+    /// disjoint pairs.
+    #[test]
+    fn round_robin_tables_cover_every_pair_once() {
+        for k in 2..=MAX_FIXED {
+            let pairs = &ROUND_ROBIN[k][..k * (k - 1) / 2];
+            let mut seen = std::collections::HashSet::new();
+            for &(i, j) in pairs {
+                assert!(i < j && (j as usize) < k, "k={k}: ({i}, {j})");
+                assert!(seen.insert((i, j)), "k={k}: ({i}, {j}) twice");
+            }
+            let per_round = k / 2;
+            for round in pairs.chunks(per_round) {
+                let mut cols: Vec<u8> = round.iter().flat_map(|&(i, j)| [i, j]).collect();
+                cols.sort_unstable();
+                cols.dedup();
+                assert_eq!(
+                    cols.len(),
+                    2 * round.len(),
+                    "k={k}: round {round:?} shares a column"
+                );
             }
         }
     }
