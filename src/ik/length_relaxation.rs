@@ -204,7 +204,7 @@ impl RelaxationGraph {
 mod tests {
     use super::*;
 
-    /// S2 Fig. 27 construction on the UR5 (3-D, offsets): the sweeps must shrink the
+    /// S2 Fig. 27 construction (rigid form) on the UR5 (3-D, offsets): the sweeps must shrink the
     /// largest link-length violation by an order of magnitude from the first sweep.
     #[test]
     fn virtual_joint_graph_relaxes_towards_consistent_lengths() {
@@ -215,24 +215,11 @@ mod tests {
         let mut frames = Vec::new();
         let tip = chain.joint_frames_into(&q0, &mut frames);
         let n = chain.dof();
+        let mut points: Vec<Vector3<f64>> = frames.iter().map(|f| f.translation.vector).collect();
+        points.push(tip.translation.vector);
         let mut g = RelaxationGraph::default();
-        for (i, f) in frames.iter().enumerate() {
-            g.add_point(f.translation.vector, i == 0);
-        }
-        g.add_point(tip.translation.vector, true);
-        for (i, f) in frames.iter().enumerate() {
-            let z = f.rotation * chain.joints()[i].axis.into_inner();
-            g.add_point(f.translation.vector + z * 0.2, i == 0);
-        }
+        super::super::point_chain::build_virtual_graph(&chain, &frames, &points, 0.2, &mut g);
         let v = |i: usize| n + 1 + i;
-        for i in 0..n {
-            g.link_current(i, i + 1);
-            g.link_current(i, v(i));
-            if i > 0 {
-                g.link_current(v(i), i - 1);
-            }
-            g.link_current(v(i), i + 1);
-        }
         g.points[n] = goal;
         g.sweep_from(&[0, v(0)]);
         g.sweep_from(&[n]);

@@ -211,7 +211,7 @@ pub(crate) fn run(
 /// structure keeps exactly the `n` joint rotations as its motions (checked by the rank
 /// of its rigidity matrix in the tests); without it every `vᵢ` could also spin about
 /// `pᵢ₋₁–pᵢ`. `p₀`, `v₀` (the base axis) and `pₙ` are fixed.
-fn build_virtual_graph(
+pub(crate) fn build_virtual_graph(
     chain: &Chain,
     frames: &[Isometry3<f64>],
     points: &[Vector3<f64>],
