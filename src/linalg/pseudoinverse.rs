@@ -582,23 +582,31 @@ fn jacobi_rotation(alpha: f64, beta: f64, gamma: f64, negligible: f64, tolerance
     Some((c, c * t))
 }
 
-/// The same rotation as [`jacobi_rotation`] (for a pair known to need one), with two
-/// square roots and two divisions instead of three each: with `d = β − α`,
-/// `t = 2γ / (d + sign(d) √(d² + 4γ²))` (= `sign(ζ)/(|ζ| + √(1 + ζ²))`, `ζ = d/(2γ)`),
-/// `c = 1/√(1 + t²)`, `s = c t`. Returns `(c, s, t)`.
+/// The same rotation as [`jacobi_rotation`] (for a pair known to need one), with a
+/// shorter chain of dependent square roots and divisions (the latency of a sweep): with
+/// `d = β − α`, `h = √(d² + 4γ²)`, `m = h + |d|` and `r = √(2hm)`,
+/// `c = m / r`, `s = sign(d) 2γ / r`, `t = s / c = sign(d) 2γ / m` — the same
+/// `t = sign(ζ)/(|ζ| + √(1 + ζ²))`, `ζ = d/(2γ)`, `c = 1/√(1 + t²)` (since
+/// `m² + 4γ² = 2hm`), with one division on the path to `(c, s)` instead of two.
+/// Returns `(c, s, t)`.
 #[inline(always)]
 fn fast_rotation(alpha: f64, beta: f64, gamma: f64) -> (f64, f64, f64) {
     let d = beta - alpha;
     let g2 = 2.0 * gamma;
     let h = (d * d + g2 * g2).sqrt();
-    let t = if h.is_finite() {
-        g2 / (d + d.signum() * h)
+    let m = h + d.abs();
+    let r2 = 2.0 * h * m;
+    if r2.is_finite() && r2 > 0.0 {
+        let inv_r = 1.0 / r2.sqrt();
+        let sg = d.signum() * g2;
+        (m * inv_r, sg * inv_r, sg / m)
     } else {
+        // squares overflowed: the ζ form
         let zeta = d / g2;
-        zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt())
-    };
-    let c = 1.0 / (1.0 + t * t).sqrt();
-    (c, c * t, t)
+        let t = zeta.signum() / (zeta.abs() + (1.0 + zeta * zeta).sqrt());
+        let c = 1.0 / (1.0 + t * t).sqrt();
+        (c, c * t, t)
+    }
 }
 
 /// Dot product of even-length columns with two partial sums (SIMD lanes).
