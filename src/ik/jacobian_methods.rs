@@ -237,32 +237,37 @@ pub(crate) fn run(
     }
 }
 
-/// Zeroes the task rows of column `k` when joint `k` is on a limit and the descent
-/// direction of `½‖e‖²`, `gₖ = (Jᵀe)ₖ`, points outward: the binding set of a projected
-/// Newton step, chosen before the solve.
+/// Binding set before the solve: a joint on a limit whose descent direction of `½‖e‖²`,
+/// `gₖ = (Jᵀe)ₖ`, points outward (projected Newton).
 fn bind_by_gradient(ws: &mut IkWorkspace, err: &PoseError, task: usize, n: usize) {
+    bind_outward(ws, task, n, |ws, k| {
+        (0..task).map(|r| ws.a[(r, k)] * err.e[r]).sum()
+    });
+}
+
+/// Binding set after the solve: a joint on a limit whose step `Δqₖ` points outward.
+/// Returns whether any column was bound.
+fn lock_limited_columns(ws: &mut IkWorkspace, task: usize, n: usize) -> bool {
+    bind_outward(ws, task, n, |ws, k| ws.x[k])
+}
+
+/// Zeroes the task rows of column `k` for every joint `k` on a limit whose
+/// `direction(ws, k)` points out of its range; true when any column was zeroed.
+fn bind_outward(
+    ws: &mut IkWorkspace,
+    task: usize,
+    n: usize,
+    direction: impl Fn(&IkWorkspace, usize) -> f64,
+) -> bool {
+    let mut any = false;
     for k in 0..n {
         let (lo, hi) = ws.limits[k];
         let (at_lo, at_hi) = (ws.q[k] <= lo, ws.q[k] >= hi);
         if !(at_lo || at_hi) {
             continue;
         }
-        let g: f64 = (0..task).map(|r| ws.a[(r, k)] * err.e[r]).sum();
-        if (at_lo && g < 0.0) || (at_hi && g > 0.0) {
-            for r in 0..task {
-                ws.a[(r, k)] = 0.0;
-            }
-        }
-    }
-}
-
-/// Zeroes the task rows of column `k` when joint `k` is on a limit and `Δq_k` points
-/// outward. Returns whether any column was locked.
-fn lock_limited_columns(ws: &mut IkWorkspace, task: usize, n: usize) -> bool {
-    let mut any = false;
-    for k in 0..n {
-        let (lo, hi) = ws.limits[k];
-        if (ws.q[k] <= lo && ws.x[k] < 0.0) || (ws.q[k] >= hi && ws.x[k] > 0.0) {
+        let d = direction(ws, k);
+        if (at_lo && d < 0.0) || (at_hi && d > 0.0) {
             for r in 0..task {
                 ws.a[(r, k)] = 0.0;
             }
