@@ -75,9 +75,6 @@ pub(crate) fn run(
     let mut mu = params.damping;
     // true while ws.svd holds the decomposition of the current J (LM retries reuse it)
     let mut decomposed = false;
-    // Every decomposition warm-starts from the last right singular vectors (any orthogonal
-    // start is valid for one-sided Jacobi; the workspace resets V per request).
-    let cold = false;
     let inner: RlxaParams = params.rlxa;
 
     let mut it = 0;
@@ -102,11 +99,9 @@ pub(crate) fn run(
                     if params.joint_limits == JointLimitMode::Clamp {
                         bind_by_gradient(ws, &err, task, n);
                     }
-                    if cold {
-                        ws.svd.decompose(&ws.a);
-                    } else {
-                        ws.svd.decompose_warm(&ws.a);
-                    }
+                    // Warm start from the last right singular vectors (any orthogonal
+                    // start is valid for one-sided Jacobi; the solver resets V per request).
+                    ws.svd.decompose_warm(&ws.a);
                     decomposed = true;
                 }
                 for r in 0..task {
@@ -119,11 +114,7 @@ pub(crate) fn run(
             (IkMethod::Newton, false) => {
                 copy_task_rows(ws, task, n);
                 fill_newton_rhs(ws, &err, task, n);
-                if cold {
-                    ws.svd.decompose(&ws.a);
-                } else {
-                    ws.svd.decompose_warm(&ws.a);
-                }
+                ws.svd.decompose_warm(&ws.a);
                 ws.svd
                     .solve_decomposed(&ws.b, 0.0, params.singular_value_tolerance, &mut ws.x);
                 for k in 0..n {
