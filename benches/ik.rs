@@ -8,15 +8,15 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use kinplan::ik::{IkParams, IkSolver, IkTarget};
-use kinplan::linalg::{PseudoinverseParams, RlxaParams, SvdWorkspace, solve_angle_relaxation};
+use kinplan_core::ik::{IkParams, IkSolver, IkTarget};
+use kinplan_core::linalg::{PseudoinverseParams, RlxaParams, SvdWorkspace, solve_angle_relaxation};
 use nalgebra::{DMatrix, DVector};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 fn ik(c: &mut Criterion) {
     for arm in ["kuka_kr210_r2700_extra", "ur5", "franka_panda"] {
-        let chain = kinplan::robot::builtin_chain(arm).unwrap();
+        let chain = kinplan_core::robot::builtin_chain(arm).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let targets: Vec<IkTarget> = (0..64)
             .map(|_| {
@@ -41,7 +41,7 @@ fn ik(c: &mut Criterion) {
 }
 
 fn linear(c: &mut Criterion) {
-    let chain = kinplan::robot::builtin_chain("kuka_kr210_r2700_extra").unwrap();
+    let chain = kinplan_core::robot::builtin_chain("kuka_kr210_r2700_extra").unwrap();
     let j = chain.jacobian(&[0.1, -1.2, 1.0, 0.2, 0.8, 0.1]);
     let a = DMatrix::from_iterator(6, 6, j.iter().cloned());
     let b = DVector::from_fn(6, |i, _| 0.01 * (i as f64 + 1.0));
@@ -64,7 +64,7 @@ fn linear(c: &mut Criterion) {
 }
 
 fn decompositions(c: &mut Criterion) {
-    let chain = kinplan::robot::builtin_chain("franka_panda").unwrap();
+    let chain = kinplan_core::robot::builtin_chain("franka_panda").unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let jacobians: Vec<DMatrix<f64>> = (0..256)
         .map(|_| {

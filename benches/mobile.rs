@@ -9,7 +9,7 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use kinplan::mobile::{
+use kinplan_core::mobile::{
     Chassis, LyapunovParams, NavigateParams, Obstacle, PathFollowParams, PathFollowState, PathNode, Point2,
     Pose, PurePursuitParams, RangeSensorParams, RangeSensors, VdfParams, VdfState, World, lyapunov_step,
     navigate, path_follow_step, pure_pursuit_step, vdf_step,

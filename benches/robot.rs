@@ -4,7 +4,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use kinplan::robot::builtin_chain;
+use kinplan_core::robot::builtin_chain;
 use nalgebra::Matrix6xX;
 
 fn fk_and_jacobian(c: &mut Criterion) {

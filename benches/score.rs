@@ -7,8 +7,8 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use kinplan::robot::builtin_chain;
-use kinplan::score::{
+use kinplan_core::robot::builtin_chain;
+use kinplan_core::score::{
     JointLimits, LabelledSet, PointSet, Rows, ScoreInput, ScoreParams, TrajectoryData, compare, sample_chain,
     score,
 };

@@ -6,8 +6,8 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use kinplan::ik::{IkMethod, IkParams, IkSolver, IkTarget};
-use kinplan::linalg::LinearSolverKind;
+use kinplan_core::ik::{IkMethod, IkParams, IkSolver, IkTarget};
+use kinplan_core::linalg::LinearSolverKind;
 use nalgebra::Point3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -66,7 +66,7 @@ fn main() {
             true,
         ),
     ] {
-        let chain = kinplan::robot::builtin_chain(arm).unwrap();
+        let chain = kinplan_core::robot::builtin_chain(arm).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let targets: Vec<IkTarget> = (0..200)
             .map(|_| {

@@ -5,7 +5,7 @@
 //!
 //! Usage: cargo run --release --example barn -- /path/to/barn_worlds.json
 
-use kinplan::mobile::*;
+use kinplan_core::mobile::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::time::Instant;

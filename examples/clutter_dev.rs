@@ -7,7 +7,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use kinplan::mobile::*;
+use kinplan_core::mobile::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use kinplan::service::pb::{self, robot_ref::Source, robot_service_client::RobotServiceClient};
+use kinplan_server::service::pb::{self, robot_ref::Source, robot_service_client::RobotServiceClient};
 
 #[tokio::main(flavor = "current_thread")]
 async fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -15,8 +15,8 @@ use std::io::Write;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use kinplan::ik::{IkMethod, IkParams, IkSolver, IkTarget};
-use kinplan::linalg::LinearSolverKind;
+use kinplan_core::ik::{IkMethod, IkParams, IkSolver, IkTarget};
+use kinplan_core::linalg::LinearSolverKind;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -66,7 +66,7 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     for arm in &arms {
-        let chain = kinplan::robot::builtin_chain(arm).unwrap();
+        let chain = kinplan_core::robot::builtin_chain(arm).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(2026);
         let samples: Vec<Vec<f64>> = (0..n)
             .map(|_| chain.limits().map(|(lo, hi)| rng.random_range(lo..=hi)).collect())
@@ -153,7 +153,7 @@ fn main() {
 fn dump_targets(
     dir: &Path,
     arm: &str,
-    chain: &kinplan::robot::Chain,
+    chain: &kinplan_core::robot::Chain,
     samples: &[Vec<f64>],
     seed: &[f64],
 ) -> std::io::Result<()> {

@@ -1,7 +1,7 @@
 //! Diagnostic for the TRAC-IK-protocol benchmark (no wall clock; deterministic):
 //! distribution of attempts, iterations spent in failed attempts vs the final one.
 //! `cargo run --release --example ik_diag -- [N] [arm,...]`
-use kinplan::ik::{IkParams, IkSolver, IkTarget};
+use kinplan_core::ik::{IkParams, IkSolver, IkTarget};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -13,7 +13,7 @@ fn main() {
         .map(|s| s.split(',').map(String::from).collect())
         .unwrap_or_else(|| vec!["kuka_kr210_r2700_extra".into()]);
     for arm in &arms {
-        let chain = kinplan::robot::builtin_chain(arm).unwrap();
+        let chain = kinplan_core::robot::builtin_chain(arm).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(2026);
         let qs: Vec<Vec<f64>> = (0..n)
             .map(|_| chain.limits().map(|(lo, hi)| rng.random_range(lo..=hi)).collect())

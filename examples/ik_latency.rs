@@ -18,7 +18,9 @@
 
 use std::time::Instant;
 
-use kinplan::service::pb::{self, kinematics_service_client::KinematicsServiceClient, robot_ref::Source};
+use kinplan_server::service::pb::{
+    self, kinematics_service_client::KinematicsServiceClient, robot_ref::Source,
+};
 use nalgebra::{Isometry3, Vector3};
 use rand::{Rng, SeedableRng};
 
@@ -70,7 +72,7 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     let address = args.next().unwrap_or_else(|| "127.0.0.1:50051".into());
     let calls: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(2000);
     let mut client = KinematicsServiceClient::connect(format!("http://{address}")).await?;
-    let chain = kinplan::robot::builtin_chain(ROBOT)?;
+    let chain = kinplan_core::robot::builtin_chain(ROBOT)?;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2026);
     let joints: Vec<Vec<f64>> = (0..calls)
         .map(|_| {

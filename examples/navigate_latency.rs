@@ -10,7 +10,7 @@
 use std::future::Future;
 use std::time::Instant;
 
-use kinplan::service::pb::{self, mobile_service_client::MobileServiceClient};
+use kinplan_server::service::pb::{self, mobile_service_client::MobileServiceClient};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

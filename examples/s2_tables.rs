@@ -5,8 +5,8 @@
 use std::f64::consts::PI;
 use std::time::{Duration, Instant};
 
-use kinplan::ik::{IkMethod, IkParams, IkSolver, IkTarget, TrackParams, circle_path, track_path};
-use kinplan::linalg::{
+use kinplan_core::ik::{IkMethod, IkParams, IkSolver, IkTarget, TrackParams, circle_path, track_path};
+use kinplan_core::linalg::{
     LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus, solve_angle_relaxation,
     solve_pseudoinverse,
 };
@@ -194,7 +194,7 @@ fn track_tables() {
     for start in ["away", "singular"] {
         for (step_name, step) in [("π/50", PI / 50.0), ("π/100", PI / 100.0)] {
             for n in 2..=10 {
-                let chain = kinplan::robot::builtin_chain(&format!("planar_{n}")).unwrap();
+                let chain = kinplan_core::robot::builtin_chain(&format!("planar_{n}")).unwrap();
                 let q0: Vec<f64> = if start == "away" {
                     vec![0.3; n]
                 } else {
@@ -229,7 +229,7 @@ fn track_tables() {
                     let ok = r
                         .steps
                         .iter()
-                        .filter(|s| s.status == kinplan::ik::IkStatus::Converged)
+                        .filter(|s| s.status == kinplan_core::ik::IkStatus::Converged)
                         .count();
                     cells.push(format!(
                         "{mean:.0} / {:.3} / {:.0}",
@@ -246,7 +246,7 @@ fn track_tables() {
     );
     println!("| start | step | {} |", header[..4].join(" | "));
     println!("|---|---|{}", "---|".repeat(4));
-    let chain = kinplan::robot::builtin_chain("kuka_kr210_r2700_extra").unwrap();
+    let chain = kinplan_core::robot::builtin_chain("kuka_kr210_r2700_extra").unwrap();
     for (start, q0) in [
         ("away", [0.1, -1.2, 1.0, 0.2, 0.8, 0.1]),
         ("singular (A5 = 0)", [0.0, -PI / 2.0, PI / 2.0, 0.0, 0.0, 0.0]),
@@ -278,7 +278,7 @@ fn track_tables() {
                 let ok = r
                     .steps
                     .iter()
-                    .filter(|s| s.status == kinplan::ik::IkStatus::Converged)
+                    .filter(|s| s.status == kinplan_core::ik::IkStatus::Converged)
                     .count();
                 cells.push(format!(
                     "{mean:.0} / {:.4} / {:.0}",
@@ -299,7 +299,7 @@ fn heuristic_table() {
     println!("| n | length relaxation | FABRIK | CCD |");
     println!("|---|---|---|---|");
     for n in 2..=10 {
-        let chain = kinplan::robot::builtin_chain(&format!("planar_{n}")).unwrap();
+        let chain = kinplan_core::robot::builtin_chain(&format!("planar_{n}")).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(n as u64);
         let targets: Vec<IkTarget> = (0..100)
             .map(|_| {

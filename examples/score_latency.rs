@@ -9,7 +9,7 @@
 
 use std::time::Instant;
 
-use kinplan::service::pb::{self, robot_ref::Source, scoring_service_client::ScoringServiceClient};
+use kinplan_server::service::pb::{self, robot_ref::Source, scoring_service_client::ScoringServiceClient};
 
 #[tokio::main(flavor = "current_thread")]
 async fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -481,7 +481,7 @@ def main():
     ap.add_argument("--arms", default=",".join(ARMS))
     ap.add_argument("--anchors", default="tracik,tracik-strict,kdl,kdl-strict,kdl-5ms,kdl-lma")
     ap.add_argument("-n", type=int, default=0, help="use only the first N targets (0: all)")
-    ap.add_argument("--urdf-dir", default=str(REPO / "src/robot/builtin"))
+    ap.add_argument("--urdf-dir", default=str(REPO / "crates/kinplan-core/src/robot/builtin"))
     ap.add_argument(
         "--tracik-floor",
         action="store_true",

@@ -8,8 +8,8 @@
 use std::f64::consts::PI;
 use std::time::{Duration, Instant};
 
-use kinplan::service::ServerConfig;
-use kinplan::service::pb::{
+use kinplan_server::service::ServerConfig;
+use kinplan_server::service::pb::{
     self, kinematics_service_client::KinematicsServiceClient, robot_service_client::RobotServiceClient,
 };
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
@@ -57,7 +57,7 @@ fn distance(a: &Isometry3<f64>, b: &Isometry3<f64>) -> (f64, f64) {
 
 /// Joints drawn uniformly inside the limits of a built-in arm.
 fn random_joints(name: &str, rng: &mut rand_chacha::ChaCha8Rng) -> Vec<f64> {
-    let chain = kinplan::robot::builtin_chain(name).unwrap();
+    let chain = kinplan_core::robot::builtin_chain(name).unwrap();
     chain
         .joints()
         .iter()
@@ -140,7 +140,7 @@ async fn fk_of_ik_is_the_target_on_several_arms() {
         "franka_panda",
         "kuka_lbr_iiwa14_r820",
     ] {
-        let chain = kinplan::robot::builtin_chain(name).unwrap();
+        let chain = kinplan_core::robot::builtin_chain(name).unwrap();
         for k in 0..4 {
             let q = random_joints(name, &mut rng);
             let target = fk(&mut robots, name, &q).await;
@@ -463,7 +463,7 @@ async fn track_path_follows_a_circle_continuously() {
     let mut ik = KinematicsServiceClient::new(server.channel.clone());
     let mut robots = RobotServiceClient::new(server.channel.clone());
     let name = "kuka_kr210_r2700_extra";
-    let chain = kinplan::robot::builtin_chain(name).unwrap();
+    let chain = kinplan_core::robot::builtin_chain(name).unwrap();
     let seed = vec![0.2, -1.6, 1.7, 0.3, 0.8, -0.2];
     let start = fk(&mut robots, name, &seed).await;
     // S2: a 10 mm circle, steps of pi/50, from the tool pose at the seed
@@ -828,7 +828,7 @@ async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
         tonic_health::pb::health_check_response::ServingStatus::Serving
     );
     let mut ik = KinematicsServiceClient::new(server.channel.clone());
-    let chain = kinplan::robot::builtin_chain("kuka_kr210_r2700_extra").unwrap();
+    let chain = kinplan_core::robot::builtin_chain("kuka_kr210_r2700_extra").unwrap();
     let target = chain.fk(&[0.1, -1.4, 1.5, 0.2, 0.5, 0.3]);
     let ok = ik_request("kuka_kr210_r2700_extra", &target, Default::default());
     let with = |f: &dyn Fn(&mut pb::SolveIkRequest)| {

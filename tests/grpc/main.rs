@@ -6,8 +6,8 @@ mod mobile;
 mod robot;
 mod scoring;
 
-use kinplan::service::pb::{self, robot_ref::Source};
-use kinplan::service::{ServerConfig, serve};
+use kinplan_server::service::pb::{self, robot_ref::Source};
+use kinplan_server::service::{ServerConfig, serve};
 use tonic::transport::Channel;
 
 pub struct TestServer {

@@ -1,0 +1,534 @@
+//! The `solve_ik` front: validation, seeded random restarts, distinct solutions,
+//! time budget and cancellation around the per-attempt algorithms.
+
+use std::time::{Duration, Instant};
+
+use nalgebra::{DMatrix, DVector, Isometry3, Matrix6xX};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::{IkError, IkMethod, IkParams, IkTarget, JointLimitMode, PoseError};
+use crate::linalg::{RlxaWorkspace, SvdWorkspace};
+use crate::robot::{Chain, JointKind};
+
+/// How an attempt (or the whole request) ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum IkStatus {
+    /// Within both tolerances.
+    Converged,
+    /// The per-attempt iteration cap (or, for the request, every restart) was used up.
+    MaxIterations,
+    /// The error stopped decreasing (the attempt was abandoned for a restart).
+    Stalled,
+    /// The time budget ran out.
+    TimeBudget,
+    /// The caller's cancellation closure returned true.
+    Cancelled,
+}
+
+/// One IK answer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IkSolution {
+    /// Joint values (rad or m), chain order.
+    pub joints: Vec<f64>,
+    /// `‖p* − p‖` of `fk(joints)` (m).
+    pub position_error: f64,
+    /// Rotation angle of `R* Rᵀ` (rad); 0 for position targets.
+    pub orientation_error: f64,
+    /// Iterations of the attempt that produced it.
+    pub iterations: usize,
+    /// Time from the start of the request until this attempt ended (µs).
+    pub elapsed_us: u64,
+    /// How its attempt ended.
+    pub status: IkStatus,
+    /// 0 = from the seed, k = k-th random restart.
+    pub attempt: usize,
+    /// With [`IkParams::record_history`]: `(position error m, orientation error rad)` at
+    /// the start of every iteration of the attempt, ending with the error returned;
+    /// empty otherwise.
+    pub history: Vec<(f64, f64)>,
+}
+
+/// Everything a request produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IkResult {
+    /// Distinct converged solutions, nearest to the seed first (≤ `num_solutions`).
+    pub solutions: Vec<IkSolution>,
+    /// When nothing converged: the attempt with the lowest error, **not a solution**.
+    pub best_attempt: Option<IkSolution>,
+    /// Why the search stopped: `Converged` when `num_solutions` were found, otherwise
+    /// `MaxIterations` (restarts exhausted), `TimeBudget` or `Cancelled`.
+    pub stop_reason: IkStatus,
+    /// Attempts run (1 + restarts used).
+    pub attempts: usize,
+    /// Iterations summed over all attempts.
+    pub total_iterations: usize,
+    /// Wall time of the request (µs).
+    pub elapsed_us: u64,
+}
+
+impl IkResult {
+    /// True when at least one converged solution was found.
+    pub fn success(&self) -> bool {
+        !self.solutions.is_empty()
+    }
+    /// First solution, or the flagged best attempt.
+    pub fn best(&self) -> Option<&IkSolution> {
+        self.solutions.first().or(self.best_attempt.as_ref())
+    }
+}
+
+/// Deadline and cancellation, checked once per iteration.
+pub(crate) struct Clock<'a> {
+    pub start: Instant,
+    pub deadline: Option<Instant>,
+    pub should_stop: &'a (dyn Fn() -> bool + Sync),
+}
+
+impl Clock<'_> {
+    #[inline]
+    pub fn interrupted(&self) -> Option<IkStatus> {
+        if let Some(d) = self.deadline
+            && Instant::now() >= d
+        {
+            return Some(IkStatus::TimeBudget);
+        }
+        if (self.should_stop)() {
+            return Some(IkStatus::Cancelled);
+        }
+        None
+    }
+    pub fn elapsed_us(&self) -> u64 {
+        self.start.elapsed().as_micros().min(u64::MAX as u128) as u64
+    }
+}
+
+/// How one attempt ended; the joints are left in `IkWorkspace::q`.
+pub(crate) struct Attempt {
+    pub status: IkStatus,
+    pub iterations: usize,
+    pub error: PoseError,
+}
+
+/// Preallocated buffers for every method, sized for one chain and reused across
+/// attempts, requests and path steps.
+#[derive(Debug, Clone)]
+pub struct IkWorkspace {
+    pub(crate) q: Vec<f64>,
+    pub(crate) q_trial: Vec<f64>,
+    pub(crate) q_best: Vec<f64>,
+    pub(crate) limits: Vec<(f64, f64)>,
+    /// Per joint: rotational with a range of at least one full turn (such a joint can
+    /// leave its range by whole turns without changing the pose).
+    pub(crate) wraps: Vec<bool>,
+    pub(crate) jac: Matrix6xX<f64>,
+    pub(crate) jac_trial: Matrix6xX<f64>,
+    pub(crate) a: DMatrix<f64>,
+    pub(crate) b: DVector<f64>,
+    pub(crate) x: DVector<f64>,
+    pub(crate) svd: SvdWorkspace,
+    pub(crate) rlxa: RlxaWorkspace,
+    pub(crate) frames: Vec<Isometry3<f64>>,
+    pub(crate) points: super::point_chain::PointWorkspace,
+    /// Error history of the current attempt (only with `IkParams::record_history`).
+    pub(crate) history: Vec<(f64, f64)>,
+}
+
+impl IkWorkspace {
+    /// Buffers for `chain` (the only allocation of a solve).
+    pub fn new(chain: &Chain) -> Self {
+        let n = chain.dof();
+        Self {
+            q: vec![0.0; n],
+            q_trial: vec![0.0; n],
+            q_best: vec![0.0; n],
+            limits: chain.limits().collect(),
+            wraps: chain
+                .joints()
+                .iter()
+                .map(|j| j.is_rotational() && j.upper - j.lower >= std::f64::consts::TAU)
+                .collect(),
+            jac: Matrix6xX::zeros(n),
+            jac_trial: Matrix6xX::zeros(n),
+            a: DMatrix::zeros(6, n),
+            b: DVector::zeros(6),
+            x: DVector::zeros(n),
+            svd: SvdWorkspace::new(6, n),
+            rlxa: RlxaWorkspace::new(6, n),
+            frames: Vec::with_capacity(n),
+            points: super::point_chain::PointWorkspace::default(),
+            history: Vec::new(),
+        }
+    }
+
+    /// Appends one iteration's error to the history when the request asked for it.
+    #[inline]
+    pub(crate) fn record(&mut self, params: &IkParams, err: &PoseError) {
+        if params.record_history {
+            self.history.push((err.position, err.orientation));
+        }
+    }
+
+    /// Makes the history end with the error the attempt returns.
+    pub(crate) fn finish_history(&mut self, params: &IkParams, err: &PoseError) {
+        if params.record_history && self.history.last() != Some(&(err.position, err.orientation)) {
+            self.history.push((err.position, err.orientation));
+        }
+    }
+
+    pub(crate) fn ensure_system(&mut self, rows: usize, cols: usize) {
+        if self.a.shape() != (rows, cols) {
+            self.a = DMatrix::zeros(rows, cols);
+            self.b = DVector::zeros(rows);
+        }
+        if self.x.len() != cols {
+            self.x = DVector::zeros(cols);
+        }
+    }
+
+    /// Clamps `q` into the limits when `mode` is `Clamp` (unlimited joints untouched).
+    pub(crate) fn apply_limits(limits: &[(f64, f64)], mode: JointLimitMode, q: &mut [f64]) {
+        if mode == JointLimitMode::Clamp {
+            for (v, &(lo, hi)) in q.iter_mut().zip(limits) {
+                if *v < lo {
+                    *v = lo;
+                } else if *v > hi {
+                    *v = hi;
+                }
+            }
+        }
+    }
+
+    /// Like [`apply_limits`](Self::apply_limits), but a joint flagged in `wraps` that left
+    /// its range is first moved back by whole turns (same pose, so the error is unchanged
+    /// and the iterate does not stick to a limit it crossed only by turning past it).
+    pub(crate) fn apply_limits_wrapping(
+        limits: &[(f64, f64)],
+        wraps: &[bool],
+        mode: JointLimitMode,
+        q: &mut [f64],
+    ) {
+        if mode == JointLimitMode::Clamp {
+            for ((v, &(lo, hi)), &w) in q.iter_mut().zip(limits).zip(wraps) {
+                if *v < lo || *v > hi {
+                    *v = wrap_into_limits(*v, lo, hi, w, mode);
+                }
+            }
+        }
+    }
+}
+
+/// Puts a rotational joint value into `[lo, hi]` by adding whole turns when that is
+/// possible, otherwise clamps (or leaves it, when `mode` is `Ignore`).
+#[inline]
+pub(crate) fn wrap_into_limits(v: f64, lo: f64, hi: f64, rotational: bool, mode: JointLimitMode) -> f64 {
+    use std::f64::consts::TAU;
+    if (lo..=hi).contains(&v) {
+        return v;
+    }
+    if rotational && v.is_finite() {
+        let k = if v > hi {
+            ((v - hi) / TAU).ceil()
+        } else {
+            -((lo - v) / TAU).ceil()
+        };
+        let w = v - k * TAU;
+        if (lo..=hi).contains(&w) {
+            return w;
+        }
+    }
+    if mode == JointLimitMode::Clamp {
+        v.clamp(lo, hi)
+    } else {
+        v
+    }
+}
+
+/// Stall bookkeeping shared by the iterative methods: an attempt makes progress when
+/// its squared error falls below `fraction` × the value at the last progress; after
+/// `patience` iterations without progress it has stalled (`patience` 0 never stalls).
+pub(crate) struct Progress {
+    fraction: f64,
+    patience: usize,
+    reference: f64,
+    since: usize,
+}
+
+impl Progress {
+    pub(crate) fn new(fraction: f64, patience: usize, initial_squared_error: f64) -> Self {
+        Self {
+            fraction,
+            patience,
+            reference: initial_squared_error,
+            since: 0,
+        }
+    }
+
+    /// Records one iteration's squared error; true once the attempt has stalled.
+    pub(crate) fn stalled(&mut self, squared_error: f64) -> bool {
+        if squared_error < self.fraction * self.reference {
+            self.reference = squared_error;
+            self.since = 0;
+            return false;
+        }
+        self.since += 1;
+        self.patience > 0 && self.since >= self.patience
+    }
+}
+
+/// Validates a request shared by every front.
+pub(crate) fn validate_request(
+    chain: &Chain,
+    target: &IkTarget,
+    seed: Option<&[f64]>,
+    params: &IkParams,
+) -> Result<(), IkError> {
+    if chain.dof() == 0 {
+        return Err(IkError::EmptyChain);
+    }
+    params.validate()?;
+    target.validate()?;
+    if let Some(s) = seed {
+        if s.len() != chain.dof() {
+            return Err(IkError::WrongSeedLength {
+                expected: chain.dof(),
+                got: s.len(),
+            });
+        }
+        if let Some(index) = s.iter().position(|v| !v.is_finite()) {
+            return Err(IkError::NonFiniteSeed { index });
+        }
+    }
+    match params.method {
+        IkMethod::Fabrik | IkMethod::LengthRelaxation => {
+            super::point_chain::check_servable(chain, target, params.method)?
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// Uniform sample inside the limits (unlimited — or astronomically wide — revolute
+/// joints: [−π, π]; prismatic: [−1, 1] m).
+pub(crate) fn random_in_limits(chain: &Chain, rng: &mut ChaCha8Rng, out: &mut [f64]) {
+    for (v, j) in out.iter_mut().zip(chain.joints()) {
+        let (lo, hi) = if j.lower.is_finite() && j.upper.is_finite() && (j.upper - j.lower).is_finite() {
+            (j.lower, j.upper)
+        } else if j.kind == JointKind::Prismatic {
+            (-1.0, 1.0)
+        } else {
+            (-std::f64::consts::PI, std::f64::consts::PI)
+        };
+        *v = if hi > lo { rng.random_range(lo..=hi) } else { lo };
+    }
+}
+
+pub(crate) fn is_converged(err: &PoseError, target: &IkTarget, params: &IkParams) -> bool {
+    err.position <= params.position_tolerance
+        && (target.is_position_only() || err.orientation <= params.orientation_tolerance)
+}
+
+/// A reusable IK solver for one chain: owns the workspace so repeated requests
+/// (batches, path steps, streams) do not allocate in their iterations.
+#[derive(Debug, Clone)]
+pub struct IkSolver<'c> {
+    chain: &'c Chain,
+    ws: IkWorkspace,
+}
+
+impl<'c> IkSolver<'c> {
+    pub fn new(chain: &'c Chain) -> Self {
+        Self {
+            chain,
+            ws: IkWorkspace::new(chain),
+        }
+    }
+
+    /// A solver reusing `workspace` (from [`into_workspace`](Self::into_workspace) of an
+    /// earlier solver), so a long-lived caller — a `StreamIk` session — allocates its
+    /// buffers once. A workspace sized for another chain is replaced.
+    pub fn with_workspace(chain: &'c Chain, workspace: IkWorkspace) -> Self {
+        let fits = workspace.q.len() == chain.dof() && workspace.limits.iter().copied().eq(chain.limits());
+        Self {
+            chain,
+            ws: if fits { workspace } else { IkWorkspace::new(chain) },
+        }
+    }
+
+    /// Gives the buffers back for [`with_workspace`](Self::with_workspace).
+    pub fn into_workspace(self) -> IkWorkspace {
+        self.ws
+    }
+
+    pub fn chain(&self) -> &'c Chain {
+        self.chain
+    }
+
+    /// See [`solve_ik`].
+    pub fn solve(
+        &mut self,
+        target: &IkTarget,
+        seed: Option<&[f64]>,
+        params: &IkParams,
+        rng_seed: u64,
+        should_stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<IkResult, IkError> {
+        validate_request(self.chain, target, seed, params)?;
+        let start = Instant::now();
+        let clock = Clock {
+            start,
+            deadline: params.time_budget.map(|b| start + b),
+            should_stop,
+        };
+        Ok(self.solve_validated(target, seed, params, rng_seed, &clock))
+    }
+
+    pub(crate) fn solve_validated(
+        &mut self,
+        target: &IkTarget,
+        seed: Option<&[f64]>,
+        params: &IkParams,
+        rng_seed: u64,
+        clock: &Clock<'_>,
+    ) -> IkResult {
+        let chain = self.chain;
+        let seed_q: Vec<f64> = match seed {
+            Some(s) => s.to_vec(),
+            None => chain.mid_limits(),
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(rng_seed);
+        // same request ⇒ same floating-point path, whatever was solved before
+        self.ws.svd.reset();
+        let mut solutions: Vec<IkSolution> = Vec::new();
+        let mut best: Option<IkSolution> = None;
+        let mut best_sq = f64::INFINITY;
+        let mut stop_reason = IkStatus::MaxIterations;
+        let mut attempts = 0;
+        let mut total_iterations = 0;
+        for attempt in 0..=params.max_restarts {
+            if attempt == 0 {
+                self.ws.q.copy_from_slice(&seed_q);
+            } else {
+                let mut q = std::mem::take(&mut self.ws.q);
+                random_in_limits(chain, &mut rng, &mut q);
+                self.ws.q = q;
+            }
+            if attempt > 0
+                && let Some(s) = clock.interrupted()
+            {
+                stop_reason = s;
+                break;
+            }
+            attempts += 1;
+            self.ws.history.clear();
+            let out = run_attempt(chain, target, params, &mut self.ws, &mut rng, clock);
+            self.ws.finish_history(params, &out.error);
+            total_iterations += out.iterations;
+            let make = |ws: &IkWorkspace| IkSolution {
+                joints: ws.q.clone(),
+                position_error: out.error.position,
+                orientation_error: out.error.orientation,
+                iterations: out.iterations,
+                elapsed_us: clock.elapsed_us(),
+                status: out.status,
+                attempt,
+                history: ws.history.clone(),
+            };
+            if out.status == IkStatus::Converged {
+                let distinct = solutions.iter().all(|s| {
+                    s.joints
+                        .iter()
+                        .zip(&self.ws.q)
+                        .any(|(a, b)| (a - b).abs() >= params.distinct_tolerance)
+                });
+                if distinct {
+                    solutions.push(make(&self.ws));
+                }
+                if solutions.len() >= params.num_solutions {
+                    stop_reason = IkStatus::Converged;
+                    break;
+                }
+            } else {
+                // only a new best attempt is copied out (no allocation per failed attempt)
+                let sq = out.error.squared();
+                if sq < best_sq || best.is_none() {
+                    best_sq = sq;
+                    best = Some(make(&self.ws));
+                }
+                if matches!(out.status, IkStatus::TimeBudget | IkStatus::Cancelled) {
+                    stop_reason = out.status;
+                    break;
+                }
+            }
+        }
+        let dist = |q: &[f64]| q.iter().zip(&seed_q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+        solutions.sort_by(|a, b| dist(&a.joints).total_cmp(&dist(&b.joints)));
+        IkResult {
+            best_attempt: if solutions.is_empty() { best } else { None },
+            solutions,
+            stop_reason,
+            attempts,
+            total_iterations,
+            elapsed_us: clock.elapsed_us(),
+        }
+    }
+}
+
+pub(crate) fn run_attempt(
+    chain: &Chain,
+    target: &IkTarget,
+    params: &IkParams,
+    ws: &mut IkWorkspace,
+    rng: &mut ChaCha8Rng,
+    clock: &Clock<'_>,
+) -> Attempt {
+    match params.method {
+        IkMethod::JacobianInverse | IkMethod::LevenbergMarquardt | IkMethod::Newton => {
+            super::jacobian_methods::run(chain, target, params, ws, rng, clock)
+        }
+        IkMethod::Ccd => super::ccd::run(chain, target, params, ws, clock),
+        IkMethod::Fabrik | IkMethod::LengthRelaxation => {
+            super::point_chain::run(chain, target, params, ws, clock)
+        }
+    }
+}
+
+/// Solves inverse kinematics for `chain` (ALGORITHMS.md §2).
+///
+/// The first attempt starts at `seed` (default: middle of the limits); further attempts
+/// start at joints drawn uniformly inside the limits from a ChaCha8 RNG seeded with
+/// `rng_seed`, so the same input gives the same answer. The search stops when
+/// `params.num_solutions` distinct converged solutions are found, the restarts are used
+/// up, `params.time_budget` has elapsed or `should_stop()` returns true (both checked
+/// every iteration). Solutions are ranked by Euclidean joint distance to the seed; when
+/// none converged, [`IkResult::best_attempt`] holds the lowest-error attempt, flagged.
+///
+/// ```
+/// use kinplan_core::ik::{solve_ik, IkParams, IkTarget};
+/// let chain = kinplan_core::robot::builtin_chain("ur5").unwrap();
+/// let q = [0.3, -1.2, 1.4, -0.8, 1.1, 0.2];
+/// let target = IkTarget::Pose(chain.fk(&q));
+/// let r = solve_ik(&chain, &target, None, &IkParams::default(), 7, &|| false).unwrap();
+/// assert!(r.success());
+/// let s = &r.solutions[0];
+/// assert!(s.position_error <= 1e-5 && s.orientation_error <= 1e-5);
+/// let fk = chain.fk(&s.joints);
+/// assert!((fk.translation.vector - target.position()).norm() <= 1e-5);
+/// ```
+pub fn solve_ik(
+    chain: &Chain,
+    target: &IkTarget,
+    seed: Option<&[f64]>,
+    params: &IkParams,
+    rng_seed: u64,
+    should_stop: &(dyn Fn() -> bool + Sync),
+) -> Result<IkResult, IkError> {
+    IkSolver::new(chain).solve(target, seed, params, rng_seed, should_stop)
+}
+
+/// Convenience for callers holding a deadline instead of a budget.
+pub fn budget_until(deadline: Instant) -> Duration {
+    deadline
+        .saturating_duration_since(Instant::now())
+        .max(Duration::from_nanos(1))
+}

@@ -1,0 +1,13 @@
+//! kinplan-core: the domain core of kinplan — robot models, kinematics,
+//! linear solvers, inverse kinematics, trajectory scoring and mobile-robot
+//! control — as a plain library of pure functions over nalgebra types.
+//!
+//! This crate knows nothing of gRPC: it does not depend on tonic, prost or
+//! tokio (the server crate `kinplan-server` adapts it to the wire), so Rust
+//! users can depend on the algorithms alone.
+
+pub mod ik;
+pub mod linalg;
+pub mod mobile;
+pub mod robot;
+pub mod score;

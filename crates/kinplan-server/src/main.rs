@@ -1,0 +1,136 @@
+//! `kinplan serve`: the gRPC server with built-in defaults; every setting is
+//! a flag and an environment variable.
+
+use std::net::SocketAddr;
+use std::time::Duration;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use kinplan_server::service::{ServerConfig, serve};
+
+#[derive(Parser)]
+#[command(name = "kinplan", version, about = "Stateless gRPC motion-planning service")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run the gRPC server.
+    Serve(ServeArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum LogFormat {
+    Text,
+    Json,
+}
+
+#[derive(clap::Args)]
+struct ServeArgs {
+    /// Address to listen on.
+    #[arg(long, env = "KINPLAN_LISTEN", default_value = "127.0.0.1:50051")]
+    listen: SocketAddr,
+    /// Threads of the async runtime (0: one per core).
+    #[arg(long, env = "KINPLAN_WORKER_THREADS", default_value_t = 0)]
+    worker_threads: usize,
+    /// Threads of the CPU pool that runs the algorithms (0: one per core).
+    #[arg(long, env = "KINPLAN_CPU_THREADS", default_value_t = 0)]
+    cpu_threads: usize,
+    /// Largest request or response message, bytes.
+    #[arg(long, env = "KINPLAN_MAX_MESSAGE_BYTES", default_value_t = 16 * 1024 * 1024)]
+    max_message_bytes: usize,
+    /// Deadline (seconds) for requests that bring none; 0 for none.
+    #[arg(long, env = "KINPLAN_REQUEST_TIMEOUT_SECS", default_value_t = 60.0)]
+    request_timeout_secs: f64,
+    /// Requests in the server at once; more are shed with RESOURCE_EXHAUSTED.
+    #[arg(long, env = "KINPLAN_CONCURRENCY_LIMIT", default_value_t = 256)]
+    concurrency_limit: usize,
+    /// Serve Prometheus metrics over HTTP on this address (off when unset).
+    #[arg(long, env = "KINPLAN_METRICS_LISTEN")]
+    metrics_listen: Option<SocketAddr>,
+    /// Log format.
+    #[arg(long, env = "KINPLAN_LOG_FORMAT", value_enum, default_value = "text")]
+    log_format: LogFormat,
+    /// Seconds between reporting NOT_SERVING and closing the listener.
+    #[arg(long, env = "KINPLAN_DRAIN_DELAY_SECS", default_value_t = 0.0)]
+    drain_delay_secs: f64,
+    /// Largest inline URDF, bytes.
+    #[arg(long, env = "KINPLAN_MAX_URDF_BYTES", default_value_t = 2 * 1024 * 1024)]
+    max_urdf_bytes: usize,
+    /// Parsed robot models kept in the cache.
+    #[arg(long, env = "KINPLAN_MODEL_CACHE", default_value_t = 256)]
+    model_cache: usize,
+}
+
+fn main() {
+    let Command::Serve(args) = Cli::parse().command;
+    init_logging(args.log_format);
+    if let Err(err) = run(args) {
+        tracing::error!("{err}");
+        eprintln!("kinplan: {err}");
+        std::process::exit(1);
+    }
+}
+
+fn init_logging(format: LogFormat) {
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
+    let builder = tracing_subscriber::fmt().with_env_filter(filter);
+    match format {
+        LogFormat::Text => builder.init(),
+        LogFormat::Json => builder.json().init(),
+    }
+}
+
+fn seconds(value: f64, flag: &str) -> Result<Duration, String> {
+    Duration::try_from_secs_f64(value).map_err(|_| format!("{flag} must be a non-negative number of seconds"))
+}
+
+fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    let mut runtime = tokio::runtime::Builder::new_multi_thread();
+    if args.worker_threads > 0 {
+        runtime.worker_threads(args.worker_threads);
+    }
+    let runtime = runtime.enable_all().build()?;
+    let timeout = seconds(args.request_timeout_secs, "--request-timeout-secs")?;
+    let config = ServerConfig {
+        cpu_threads: args.cpu_threads,
+        max_message_bytes: args.max_message_bytes,
+        request_timeout: (!timeout.is_zero()).then_some(timeout),
+        concurrency_limit: args.concurrency_limit,
+        max_urdf_bytes: args.max_urdf_bytes,
+        model_cache_entries: args.model_cache,
+        drain_delay: seconds(args.drain_delay_secs, "--drain-delay-secs")?,
+    };
+    runtime.block_on(async move {
+        if let Some(addr) = args.metrics_listen {
+            metrics_exporter_prometheus::PrometheusBuilder::new()
+                .with_http_listener(addr)
+                .set_buckets_for_metric(
+                    metrics_exporter_prometheus::Matcher::Full("grpc_server_handling_seconds".into()),
+                    kinplan_server::service::HANDLING_BUCKETS,
+                )?
+                .install()?;
+            tracing::info!(%addr, "metrics on http://{addr}/metrics");
+        }
+        let listener = tokio::net::TcpListener::bind(args.listen).await?;
+        serve(config, listener, shutdown_signal()).await
+    })
+}
+
+/// Resolves on SIGINT or SIGTERM.
+async fn shutdown_signal() {
+    let interrupt = tokio::signal::ctrl_c();
+    #[cfg(unix)]
+    {
+        let mut term = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
+            .expect("SIGTERM handler installs");
+        tokio::select! {
+            _ = interrupt => {},
+            _ = term.recv() => {},
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = interrupt.await;
+}

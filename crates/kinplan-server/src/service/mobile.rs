@@ -1,0 +1,737 @@
+//! `MobileService`: chassis wheel kinematics, one controller step, and simulated path
+//! following and navigation (ALGORITHMS.md §6, [`kinplan_core::mobile`]).
+//!
+//! Thin adapter: admit → proto messages into domain values (unset fields: the domain's
+//! defaults; sizes bounded) → the domain function → reply. Simulations run on the CPU pool and
+//! stop when the request's budget says so; [`MobileError`]s become INVALID_ARGUMENT naming the
+//! request field. The service keeps no state: a controller's memory between `ControlStep`
+//! calls travels to the caller and back as an opaque token.
+
+use tonic::{Request, Response, Status};
+
+use super::pb::{self, mobile_service_server::MobileService};
+use super::server::Shared;
+use super::status::invalid;
+use kinplan_core::mobile::{
+    CarParams, Chassis, ControllerKind, DifferentialParams, GridAstarParams, MobileError, NavMode,
+    NavigateParams, NoPathReason, Obstacle, OmniParams, Outcome, PathFollowParams, PathFollowState, PathNode,
+    Point2, Pose, RangeSensorParams, RangeSensors, Saturation, SimParams, SimRun, TricycleParams,
+    TurnPreference, Twist, VdfEvent, VdfParams, VdfState, WheelState, World, follow_path, navigate,
+    navigate_astar, path_follow_step, validate_path, vdf_step,
+};
+
+/// Largest simulation accepted: `sim.max_time / sim.dt` steps.
+pub const MAX_STEPS: f64 = 100_000.0;
+/// Largest world accepted, obstacles.
+pub const MAX_OBSTACLES: usize = 10_000;
+/// Largest polygon accepted, vertices.
+pub const MAX_POLYGON_VERTICES: usize = 1_000;
+/// Longest path accepted, nodes.
+pub const MAX_PATH_NODES: usize = 10_000;
+/// Largest sensor ring accepted.
+pub const MAX_SENSORS: u32 = 360;
+/// Most rays per sensor beam accepted.
+pub const MAX_RAYS_PER_BEAM: u32 = 100;
+/// Largest state token accepted, bytes.
+pub const MAX_TOKEN_BYTES: usize = 1 << 20;
+
+pub struct MobileApi {
+    shared: Shared,
+}
+
+impl MobileApi {
+    pub fn new(shared: Shared) -> Self {
+        Self { shared }
+    }
+}
+
+#[tonic::async_trait]
+impl MobileService for MobileApi {
+    async fn wheel_kinematics(
+        &self,
+        request: Request<pb::WheelKinematicsRequest>,
+    ) -> Result<Response<pb::WheelKinematicsResponse>, Status> {
+        let _admitted = self.shared.compute.admit(&request)?;
+        let req = request.into_inner();
+        let chassis = chassis_in(req.chassis.as_ref());
+        use pb::wheel_kinematics_request::Input;
+        let reply = match req.input {
+            None => {
+                return Err(invalid(
+                    "input",
+                    "give either twist (inverse) or wheels (forward)",
+                ));
+            }
+            Some(Input::Twist(t)) => {
+                let (wheels, sat) = chassis.inverse_kinematics(twist_in(&t)).map_err(mobile_error)?;
+                let (applied, _) = chassis.saturate(twist_in(&t));
+                pb::WheelKinematicsResponse {
+                    twist: Some(twist_out(applied)),
+                    wheels: Some(wheels_out(&wheels)),
+                    saturation: Some(saturation_out(sat)),
+                }
+            }
+            Some(Input::Wheels(w)) => {
+                let wheels = wheels_in(&w)?;
+                let twist = chassis.forward_kinematics(&wheels).map_err(mobile_error)?;
+                pb::WheelKinematicsResponse {
+                    twist: Some(twist_out(twist)),
+                    wheels: Some(w),
+                    saturation: Some(saturation_out(Saturation::NONE)),
+                }
+            }
+        };
+        Ok(Response::new(reply))
+    }
+
+    async fn control_step(
+        &self,
+        request: Request<pb::ControlStepRequest>,
+    ) -> Result<Response<pb::ControlStepResponse>, Status> {
+        let (_permit, budget) = self.shared.compute.admit(&request)?;
+        let req = request.into_inner();
+        if req.state_token.len() > MAX_TOKEN_BYTES {
+            return Err(invalid(
+                "state_token",
+                format!("{} bytes, at most {MAX_TOKEN_BYTES}", req.state_token.len()),
+            ));
+        }
+        // Sensing a world costs up to obstacles × rays: the CPU pool; the rest inline.
+        if req.world.is_empty() {
+            control_step(req).map(Response::new)
+        } else {
+            self.shared
+                .compute
+                .run(&budget, move |_| control_step(req))
+                .await?
+                .map(Response::new)
+        }
+    }
+
+    async fn follow_path(
+        &self,
+        request: Request<pb::FollowPathRequest>,
+    ) -> Result<Response<pb::MobileRun>, Status> {
+        let (_permit, budget) = self.shared.compute.admit(&request)?;
+        let req = request.into_inner();
+        let chassis = chassis_in(req.chassis.as_ref());
+        let start = pose_in(req.start.as_ref());
+        let path = path_in(&req.path)?;
+        let follow = follow_in(req.controller, req.follow.as_ref(), "controller")?;
+        let world = if req.world.is_empty() {
+            None
+        } else {
+            Some(world_in(&req.world)?)
+        };
+        let sim = sim_in(req.sim.as_ref())?;
+        let run = self
+            .shared
+            .compute
+            .run(&budget, move |b| {
+                follow_path(&chassis, start, &path, world.as_ref(), &follow, &sim, &|| {
+                    b.should_stop()
+                })
+            })
+            .await?
+            .map_err(mobile_error)?;
+        Ok(Response::new(run_out(run)))
+    }
+
+    async fn navigate(
+        &self,
+        request: Request<pb::NavigateRequest>,
+    ) -> Result<Response<pb::MobileRun>, Status> {
+        let (_permit, budget) = self.shared.compute.admit(&request)?;
+        let req = request.into_inner();
+        let chassis = chassis_in(req.chassis.as_ref());
+        let start = pose_in(req.start.as_ref());
+        let goal = point_in(req.goal.as_ref());
+        let world = world_in(&req.world)?;
+        let sim = sim_in(req.sim.as_ref())?;
+        let navigator = pb::Navigator::try_from(req.navigator)
+            .map_err(|_| invalid("navigator", format!("unknown navigator {}", req.navigator)))?;
+        let run = match navigator {
+            pb::Navigator::Unspecified | pb::Navigator::VectorDistance => {
+                let params = NavigateParams {
+                    sim,
+                    sensors: sensors_in(req.sensors.as_ref())?,
+                    vdf: vdf_in(req.vdf.as_ref())?,
+                    seed: req.seed,
+                };
+                self.shared
+                    .compute
+                    .run(&budget, move |b| {
+                        navigate(&chassis, start, goal, &world, &params, &|| b.should_stop())
+                    })
+                    .await?
+            }
+            pb::Navigator::GridAstar => {
+                let controller = if req.controller == pb::Controller::Unspecified as i32 {
+                    pb::Controller::PurePursuit as i32
+                } else {
+                    req.controller
+                };
+                let follow = follow_in(controller, req.follow.as_ref(), "controller")?;
+                let astar = astar_in(req.astar.as_ref())?;
+                self.shared
+                    .compute
+                    .run(&budget, move |b| {
+                        navigate_astar(&chassis, start, goal, &world, &astar, &follow, &sim, &|| {
+                            b.should_stop()
+                        })
+                    })
+                    .await?
+            }
+        }
+        .map_err(mobile_error)?;
+        let grid = navigator == pb::Navigator::GridAstar;
+        let mut out = run_out(run);
+        if grid && out.outcome == pb::Outcome::NoPath as i32 {
+            out.no_path_reason = pb::NoPathReason::NoGridPath as i32;
+        }
+        Ok(Response::new(out))
+    }
+}
+
+/// One controller step: vector distance with its `VdfState` token, or a path-following
+/// controller with its `PathFollowState` token (JSON).
+fn control_step(req: pb::ControlStepRequest) -> Result<pb::ControlStepResponse, Status> {
+    let chassis = chassis_in(req.chassis.as_ref());
+    chassis.validate().map_err(mobile_error)?;
+    let state = pose_in(req.state.as_ref());
+    let dt = req.dt.unwrap_or(0.05);
+    if req.controller == pb::Controller::VectorDistance as i32 {
+        let sensors = sensors_in(req.sensors.as_ref())?;
+        let vdf = vdf_in(req.vdf.as_ref())?;
+        let memory = VdfState::from_token(&req.state_token).map_err(mobile_error)?;
+        let readings = if !req.readings.is_empty() || req.world.is_empty() {
+            req.readings
+        } else {
+            let world = world_in(&req.world)?;
+            let radius = req.robot_radius.unwrap_or(SimParams::default().robot_radius);
+            if !(radius.is_finite() && radius > 0.0) {
+                return Err(invalid("robot_radius", format!("must be positive, got {radius}")));
+            }
+            state.validate("state").map_err(mobile_error)?;
+            let mut ring = RangeSensors::new(sensors, req.seed).map_err(mobile_error)?;
+            let mut out = vec![0.0; sensors.count];
+            ring.sense(&world, state, radius, &mut out);
+            out
+        };
+        let goal = point_in(req.goal.as_ref());
+        let (next, out) = vdf_step(&memory, state, goal, &readings, &sensors, &vdf).map_err(mobile_error)?;
+        let (applied, sat) = chassis.saturate(out.twist);
+        let (mut hit, mut leave, mut no_path, mut reached) = (None, None, false, false);
+        match out.event {
+            Some(VdfEvent::Reached) => reached = true,
+            Some(VdfEvent::Hit(h)) => hit = Some(point_out(h)),
+            Some(VdfEvent::Leave(l)) => leave = Some(point_out(l)),
+            Some(VdfEvent::NoPath(_)) => no_path = true,
+            None => {}
+        }
+        return Ok(pb::ControlStepResponse {
+            command: Some(twist_out(out.twist)),
+            applied: Some(twist_out(applied)),
+            saturation: Some(saturation_out(sat)),
+            reached,
+            state_token: next.to_token(),
+            target_node: 0,
+            mode: mode_out(out.mode) as i32,
+            readings,
+            force: Some(point_out(out.force)),
+            hit_point: hit,
+            leave_point: leave,
+            no_path,
+        });
+    }
+    let path = path_in(&req.path)?;
+    validate_path(&path).map_err(mobile_error)?;
+    let follow = follow_in(req.controller, req.follow.as_ref(), "controller")?.for_chassis(&chassis);
+    let progress: PathFollowState = if req.state_token.is_empty() {
+        PathFollowState::default()
+    } else {
+        serde_json::from_slice(&req.state_token)
+            .map_err(|e| invalid("state_token", format!("controller token is invalid: {e}")))?
+    };
+    if progress.target >= path.len() || progress.segment >= path.len() {
+        return Err(invalid(
+            "state_token",
+            format!(
+                "token points at node {} of a {}-node path",
+                progress.target.max(progress.segment),
+                path.len()
+            ),
+        ));
+    }
+    let s = path_follow_step(state, &path, progress, dt, &follow).map_err(mobile_error)?;
+    let (applied, sat) = chassis.saturate(s.twist);
+    Ok(pb::ControlStepResponse {
+        command: Some(twist_out(s.twist)),
+        applied: Some(twist_out(applied)),
+        saturation: Some(saturation_out(sat)),
+        reached: s.reached,
+        state_token: serde_json::to_vec(&s.next).unwrap_or_default(),
+        target_node: s.next.target as u32,
+        ..Default::default()
+    })
+}
+
+/// INVALID_ARGUMENT naming the request field that a [`MobileError`] is about.
+fn mobile_error(err: MobileError) -> Status {
+    let text = err.to_string();
+    let field = match &err {
+        MobileError::NotFinite { field, .. }
+        | MobileError::NotPositive { field, .. }
+        | MobileError::OutOfRange { field, .. }
+        | MobileError::TooFew { field, .. } => proto_field(field),
+        MobileError::EmptyPath => "path".into(),
+        MobileError::BadToken { .. } => "state_token".into(),
+        MobileError::StartInCollision { .. } => "start".into(),
+        MobileError::WheelMismatch { .. } => "wheels".into(),
+    };
+    invalid(field, text)
+}
+
+/// The domain names fields after its own parameter structs; the proto nests them.
+fn proto_field(domain: &str) -> String {
+    for chassis in ["tricycle.", "car.", "omni.", "differential."] {
+        if domain.starts_with(chassis) {
+            return format!("chassis.{domain}");
+        }
+    }
+    for nested in ["lyapunov.", "pure_pursuit.", "steering."] {
+        if domain.starts_with(nested) {
+            return format!("follow.{domain}");
+        }
+    }
+    if domain == "sim.max_time / sim.dt" {
+        return "sim.max_time".into();
+    }
+    if let Some(rest) = domain.strip_prefix("pose") {
+        return format!("state{rest}");
+    }
+    if let Some(rest) = domain.strip_prefix("world[")
+        && let Some((index, member)) = rest.split_once("].")
+    {
+        let shape = if member.starts_with("vertices") {
+            "polygon"
+        } else {
+            "circle"
+        };
+        return format!("world[{index}].{shape}.{member}");
+    }
+    domain.to_owned()
+}
+
+fn pose_in(p: Option<&pb::Pose2D>) -> Pose {
+    p.map_or(Pose::default(), |p| Pose::new(p.x, p.y, p.theta))
+}
+
+fn point_in(p: Option<&pb::Point2D>) -> Point2 {
+    p.map_or(Point2::new(0.0, 0.0), |p| Point2::new(p.x, p.y))
+}
+
+fn twist_in(t: &pb::Twist2D) -> Twist {
+    Twist {
+        vx: t.vx,
+        vy: t.vy,
+        omega: t.omega,
+    }
+}
+
+fn pose_out(p: &Pose) -> pb::Pose2D {
+    pb::Pose2D {
+        x: p.x,
+        y: p.y,
+        theta: p.theta,
+    }
+}
+
+fn point_out(p: Point2) -> pb::Point2D {
+    pb::Point2D { x: p.x, y: p.y }
+}
+
+fn twist_out(t: Twist) -> pb::Twist2D {
+    pb::Twist2D {
+        vx: t.vx,
+        vy: t.vy,
+        omega: t.omega,
+    }
+}
+
+fn saturation_out(s: Saturation) -> pb::Saturation {
+    pb::Saturation {
+        speed_scale: s.speed_scale,
+        steering_clamped: s.steering_clamped,
+        lateral_dropped: s.lateral_dropped,
+    }
+}
+
+/// Unset chassis: differential drive; unset parameters: the kind's defaults (MOBIL-II for the
+/// car, OMR-III for the omni base). Validation happens in the domain functions.
+fn chassis_in(c: Option<&pb::Chassis>) -> Chassis {
+    use pb::chassis::Kind;
+    match c.and_then(|c| c.kind.as_ref()) {
+        None => Chassis::default(),
+        Some(Kind::Tricycle(p)) => {
+            let d = TricycleParams::default();
+            Chassis::Tricycle(TricycleParams {
+                wheelbase: p.wheelbase.unwrap_or(d.wheelbase),
+                wheel_radius: p.wheel_radius.unwrap_or(d.wheel_radius),
+                max_steer: p.max_steer.unwrap_or(d.max_steer),
+                max_speed: p.max_speed.unwrap_or(d.max_speed),
+            })
+        }
+        Some(Kind::Car(p)) => {
+            let d = CarParams::default();
+            Chassis::Car(CarParams {
+                wheelbase: p.wheelbase.unwrap_or(d.wheelbase),
+                track: p.track.unwrap_or(d.track),
+                wheel_radius: p.wheel_radius.unwrap_or(d.wheel_radius),
+                max_steer: p.max_steer.unwrap_or(d.max_steer),
+                max_speed: p.max_speed.unwrap_or(d.max_speed),
+            })
+        }
+        Some(Kind::Omni(p)) => {
+            let d = OmniParams::default();
+            Chassis::Omni(OmniParams {
+                wheel_radius: p.wheel_radius.unwrap_or(d.wheel_radius),
+                center_distance: p.center_distance.unwrap_or(d.center_distance),
+                first_wheel_angle: p.first_wheel_angle.unwrap_or(d.first_wheel_angle),
+                max_wheel_speed: p.max_wheel_speed.unwrap_or(d.max_wheel_speed),
+            })
+        }
+        Some(Kind::Differential(p)) => {
+            let d = DifferentialParams::default();
+            Chassis::Differential(DifferentialParams {
+                wheel_radius: p.wheel_radius.unwrap_or(d.wheel_radius),
+                track: p.track.unwrap_or(d.track),
+                max_wheel_speed: p.max_wheel_speed.unwrap_or(d.max_wheel_speed),
+            })
+        }
+    }
+}
+
+fn wheels_in(w: &pb::WheelState) -> Result<WheelState, Status> {
+    use pb::wheel_state::Kind;
+    Ok(match &w.kind {
+        None => return Err(invalid("wheels", "give the wheel state of the chassis")),
+        Some(Kind::Tricycle(t)) => WheelState::Tricycle {
+            speed: t.speed,
+            steer: t.steer,
+        },
+        Some(Kind::Car(c)) => WheelState::Car {
+            rear_left: c.rear_left,
+            rear_right: c.rear_right,
+            steer_left: c.steer_left,
+            steer_right: c.steer_right,
+        },
+        Some(Kind::Omni(o)) => {
+            let speeds: [f64; 3] = o.speeds.as_slice().try_into().map_err(|_| {
+                invalid(
+                    "wheels.omni.speeds",
+                    format!("needs exactly 3 wheel speeds, got {}", o.speeds.len()),
+                )
+            })?;
+            WheelState::Omni { speeds }
+        }
+        Some(Kind::Differential(d)) => WheelState::Differential {
+            left: d.left,
+            right: d.right,
+        },
+    })
+}
+
+fn wheels_out(w: &WheelState) -> pb::WheelState {
+    use pb::wheel_state::Kind;
+    let kind = match *w {
+        WheelState::Tricycle { speed, steer } => Kind::Tricycle(pb::TricycleWheels { speed, steer }),
+        WheelState::Car {
+            rear_left,
+            rear_right,
+            steer_left,
+            steer_right,
+        } => Kind::Car(pb::CarWheels {
+            rear_left,
+            rear_right,
+            steer_left,
+            steer_right,
+        }),
+        WheelState::Omni { speeds } => Kind::Omni(pb::OmniWheels {
+            speeds: speeds.to_vec(),
+        }),
+        WheelState::Differential { left, right } => {
+            Kind::Differential(pb::DifferentialWheels { left, right })
+        }
+    };
+    pb::WheelState { kind: Some(kind) }
+}
+
+fn path_in(path: &[pb::PathNode]) -> Result<Vec<PathNode>, Status> {
+    if path.len() > MAX_PATH_NODES {
+        return Err(invalid(
+            "path",
+            format!("{} nodes, at most {MAX_PATH_NODES}", path.len()),
+        ));
+    }
+    Ok(path
+        .iter()
+        .map(|n| PathNode {
+            x: n.x,
+            y: n.y,
+            heading: n.heading,
+        })
+        .collect())
+}
+
+fn world_in(obstacles: &[pb::Obstacle]) -> Result<World, Status> {
+    use pb::obstacle::Shape;
+    if obstacles.len() > MAX_OBSTACLES {
+        return Err(invalid(
+            "world",
+            format!("{} obstacles, at most {MAX_OBSTACLES}", obstacles.len()),
+        ));
+    }
+    let mut out = Vec::with_capacity(obstacles.len());
+    for (i, o) in obstacles.iter().enumerate() {
+        out.push(match &o.shape {
+            None => return Err(invalid(format!("world[{i}]"), "give a circle or a polygon")),
+            Some(Shape::Circle(c)) => {
+                let centre = point_in(c.center.as_ref());
+                Obstacle::circle(centre.x, centre.y, c.radius)
+            }
+            Some(Shape::Polygon(p)) => {
+                if p.vertices.len() > MAX_POLYGON_VERTICES {
+                    return Err(invalid(
+                        format!("world[{i}].polygon.vertices"),
+                        format!("{} vertices, at most {MAX_POLYGON_VERTICES}", p.vertices.len()),
+                    ));
+                }
+                Obstacle::Polygon {
+                    vertices: p.vertices.iter().map(|v| Point2::new(v.x, v.y)).collect(),
+                }
+            }
+        });
+    }
+    World::new(out).map_err(mobile_error)
+}
+
+fn sim_in(s: Option<&pb::SimOptions>) -> Result<SimParams, Status> {
+    let d = SimParams::default();
+    let sim = s.map_or(d, |s| SimParams {
+        robot_radius: s.robot_radius.unwrap_or(d.robot_radius),
+        dt: s.dt.unwrap_or(d.dt),
+        max_time: s.max_time.unwrap_or(d.max_time),
+    });
+    sim.validate().map_err(mobile_error)?;
+    let steps = sim.max_time / sim.dt;
+    if steps > MAX_STEPS {
+        return Err(invalid(
+            "sim.max_time",
+            format!("max_time / dt = {steps:.0} steps, at most {MAX_STEPS}"),
+        ));
+    }
+    Ok(sim)
+}
+
+fn sensors_in(s: Option<&pb::RangeSensorParams>) -> Result<RangeSensorParams, Status> {
+    let d = RangeSensorParams::default();
+    let Some(s) = s else { return Ok(d) };
+    let count = s.count.unwrap_or(d.count as u32);
+    if count > MAX_SENSORS {
+        return Err(invalid(
+            "sensors.count",
+            format!("{count}, at most {MAX_SENSORS}"),
+        ));
+    }
+    let rays = s.rays_per_beam.unwrap_or(d.rays_per_beam as u32);
+    if rays > MAX_RAYS_PER_BEAM {
+        return Err(invalid(
+            "sensors.rays_per_beam",
+            format!("{rays}, at most {MAX_RAYS_PER_BEAM}"),
+        ));
+    }
+    let p = RangeSensorParams {
+        count: count as usize,
+        max_range: s.max_range.unwrap_or(d.max_range),
+        beam_width: s.beam_width.unwrap_or(d.beam_width),
+        rays_per_beam: rays as usize,
+        noise_sigma: s.noise_sigma.unwrap_or(d.noise_sigma),
+    };
+    p.validate().map_err(mobile_error)?;
+    Ok(p)
+}
+
+fn vdf_in(v: Option<&pb::VectorDistanceParams>) -> Result<VdfParams, Status> {
+    let d = VdfParams::default();
+    let Some(v) = v else { return Ok(d) };
+    let turn = match pb::TurnPreference::try_from(v.turn) {
+        Ok(pb::TurnPreference::Unspecified | pb::TurnPreference::Auto) => TurnPreference::Auto,
+        Ok(pb::TurnPreference::Left) => TurnPreference::Left,
+        Ok(pb::TurnPreference::Right) => TurnPreference::Right,
+        Err(_) => return Err(invalid("vdf.turn", format!("unknown turn preference {}", v.turn))),
+    };
+    let p = VdfParams {
+        safe_distance: v.safe_distance.unwrap_or(d.safe_distance),
+        magnitude: v.magnitude.unwrap_or(d.magnitude),
+        weight_decay: v.weight_decay.unwrap_or(d.weight_decay),
+        turn_gain: v.turn_gain.unwrap_or(d.turn_gain),
+        release_distance: v.release_distance.unwrap_or(d.release_distance),
+        turn,
+        max_speed: v.max_speed.unwrap_or(d.max_speed),
+        max_yaw_rate: v.max_yaw_rate.unwrap_or(d.max_yaw_rate),
+        heading_gain: v.heading_gain.unwrap_or(d.heading_gain),
+        slow_distance: v.slow_distance.unwrap_or(d.slow_distance),
+        allow_reverse: v.allow_reverse.unwrap_or(d.allow_reverse),
+        avoid_blocked_heading: v.avoid_blocked_heading.unwrap_or(d.avoid_blocked_heading),
+        progress_steps: v.progress_steps.map_or(d.progress_steps, |n| n as usize),
+        progress_min: v.progress_min.unwrap_or(d.progress_min),
+        no_path_steps: v.no_path_steps.map_or(d.no_path_steps, |n| n as usize),
+        no_path_min: v.no_path_min.unwrap_or(d.no_path_min),
+        leave_tolerance: v.leave_tolerance.unwrap_or(d.leave_tolerance),
+        hit_radius: v.hit_radius.unwrap_or(d.hit_radius),
+        wall_gain: v.wall_gain.unwrap_or(d.wall_gain),
+        goal_tolerance: v.goal_tolerance.unwrap_or(d.goal_tolerance),
+        retry_other_side: v.retry_other_side.unwrap_or(d.retry_other_side),
+    };
+    p.validate().map_err(mobile_error)?;
+    Ok(p)
+}
+
+fn astar_in(a: Option<&pb::GridAstarOptions>) -> Result<GridAstarParams, Status> {
+    let d = GridAstarParams::default();
+    let p = a.map_or(d, |a| GridAstarParams {
+        resolution: a.resolution.unwrap_or(d.resolution),
+        inflation: a.inflation.unwrap_or(d.inflation),
+        padding: a.padding.unwrap_or(d.padding),
+        max_cells: a
+            .max_cells
+            .map_or(d.max_cells, |n| n.min(d.max_cells as u64) as usize),
+    });
+    p.validate().map_err(mobile_error)?;
+    Ok(p)
+}
+
+/// Path-follower parameters; `controller` must be a path-following one.
+fn follow_in(
+    controller: i32,
+    f: Option<&pb::FollowOptions>,
+    controller_field: &str,
+) -> Result<PathFollowParams, Status> {
+    let kind = match pb::Controller::try_from(controller) {
+        Ok(pb::Controller::Unspecified | pb::Controller::Lyapunov) => ControllerKind::Lyapunov,
+        Ok(pb::Controller::PurePursuit) => ControllerKind::PurePursuit,
+        Ok(pb::Controller::GoalSeeking) => ControllerKind::GoalSeeking,
+        Ok(pb::Controller::ShortestPath) => ControllerKind::ShortestPath,
+        Ok(pb::Controller::VectorDistance) => {
+            return Err(invalid(
+                controller_field,
+                "CONTROLLER_VECTOR_DISTANCE does not follow paths (use Navigate or ControlStep)",
+            ));
+        }
+        Err(_) => {
+            return Err(invalid(
+                controller_field,
+                format!("unknown controller {controller}"),
+            ));
+        }
+    };
+    let d = PathFollowParams::default();
+    let mut p = PathFollowParams {
+        controller: kind,
+        ..d
+    };
+    if let Some(f) = f {
+        p.switching_distance = f.switching_distance.unwrap_or(d.switching_distance);
+        p.goal_tolerance = f.goal_tolerance.unwrap_or(d.goal_tolerance);
+        p.heading_tolerance = f.heading_tolerance.unwrap_or(d.heading_tolerance);
+        if let Some(l) = &f.lyapunov {
+            let d = d.lyapunov;
+            p.lyapunov.gamma = l.gamma.unwrap_or(d.gamma);
+            p.lyapunov.k = l.k.unwrap_or(d.k);
+            p.lyapunov.h = l.h.unwrap_or(d.h);
+            p.lyapunov.lambda = l.lambda.unwrap_or(d.lambda);
+            p.lyapunov.max_speed = l.max_speed.unwrap_or(d.max_speed);
+            p.lyapunov.max_yaw_rate = l.max_yaw_rate.unwrap_or(d.max_yaw_rate);
+        }
+        if let Some(pp) = &f.pure_pursuit {
+            let d = d.pure_pursuit;
+            p.pure_pursuit.lookahead = pp.lookahead.unwrap_or(d.lookahead);
+            p.pure_pursuit.desired_speed = pp.desired_speed.unwrap_or(d.desired_speed);
+            p.pure_pursuit.approach_distance = pp.approach_distance.unwrap_or(d.approach_distance);
+            p.pure_pursuit.min_approach_speed = pp.min_approach_speed.unwrap_or(d.min_approach_speed);
+            p.pure_pursuit.rotate_to_heading = pp.rotate_to_heading.unwrap_or(d.rotate_to_heading);
+            p.pure_pursuit.rotate_min_angle = pp.rotate_min_angle.unwrap_or(d.rotate_min_angle);
+            p.pure_pursuit.rotate_yaw_rate = pp.rotate_yaw_rate.unwrap_or(d.rotate_yaw_rate);
+        }
+        if let Some(s) = &f.steering {
+            let d = d.steering;
+            p.steering.speed = s.speed.unwrap_or(d.speed);
+            p.steering.wheelbase = s.wheelbase.unwrap_or(d.wheelbase);
+            p.steering.max_steer = s.max_steer.unwrap_or(d.max_steer);
+            p.steering.epsilon = s.epsilon.unwrap_or(d.epsilon);
+            p.steering.candidates = s.candidates.map_or(d.candidates, |n| n.min(100_000) as usize);
+        }
+    }
+    p.validate().map_err(mobile_error)?;
+    Ok(p)
+}
+
+fn mode_out(m: NavMode) -> pb::NavMode {
+    match m {
+        NavMode::Rotate => pb::NavMode::Rotate,
+        NavMode::Lock => pb::NavMode::Lock,
+        NavMode::Track => pb::NavMode::Track,
+    }
+}
+
+fn run_out(run: SimRun) -> pb::MobileRun {
+    let outcome = match run.outcome {
+        Outcome::Reached => pb::Outcome::Reached,
+        Outcome::NoPath => pb::Outcome::NoPath,
+        Outcome::Timeout => pb::Outcome::Timeout,
+        Outcome::Collision => pb::Outcome::Collision,
+        Outcome::Cancelled => pb::Outcome::Cancelled,
+    };
+    let reason = match run.no_path_reason {
+        None => pb::NoPathReason::Unspecified,
+        Some(NoPathReason::ReturnedToHit) => pb::NoPathReason::ReturnedToHit,
+        Some(NoPathReason::NoProgress) => pb::NoPathReason::NoProgress,
+    };
+    pb::MobileRun {
+        outcome: outcome as i32,
+        states: run.states.iter().map(pose_out).collect(),
+        commands: run.commands.iter().map(|t| twist_out(*t)).collect(),
+        modes: run.modes.iter().map(|m| mode_out(*m) as i32).collect(),
+        hit_points: run.hit_points.iter().map(|p| point_out(*p)).collect(),
+        leave_points: run.leave_points.iter().map(|p| point_out(*p)).collect(),
+        no_path_reason: reason as i32,
+        collided_with: run.collided_with.map(|i| i as u32),
+        metrics: Some(pb::RunMetrics {
+            path_length: run.metrics.path_length,
+            time: run.metrics.time,
+            min_clearance: run.metrics.min_clearance,
+            steps: run.metrics.steps as u32,
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn domain_fields_become_request_fields() {
+        assert_eq!(proto_field("omni.wheel_radius"), "chassis.omni.wheel_radius");
+        assert_eq!(proto_field("lyapunov.gamma"), "follow.lyapunov.gamma");
+        assert_eq!(proto_field("sim.max_time / sim.dt"), "sim.max_time");
+        assert_eq!(proto_field("pose.x"), "state.x");
+        assert_eq!(proto_field("world[3].radius"), "world[3].circle.radius");
+        assert_eq!(
+            proto_field("world[2].vertices[1].y"),
+            "world[2].polygon.vertices[1].y"
+        );
+        assert_eq!(proto_field("vdf.safe_distance"), "vdf.safe_distance");
+        assert_eq!(proto_field("path[4].heading"), "path[4].heading");
+    }
+}

@@ -1,0 +1,193 @@
+//! `RobotService`: built-in robots, model descriptions, FK and Jacobians.
+//!
+//! FK and Jacobians cost microseconds (bounded by the URDF element limit), so
+//! they run inline; model parsing goes to the CPU pool.
+
+use tonic::{Request, Response, Status};
+
+use super::convert::{matrix_out, pose_out, vec3_out};
+use super::pb::{self, robot_service_server::RobotService};
+use super::server::Shared;
+use super::status::robot_error;
+use kinplan_core::robot::{BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf};
+
+pub struct RobotApi {
+    shared: Shared,
+}
+
+impl RobotApi {
+    pub fn new(shared: Shared) -> Self {
+        Self { shared }
+    }
+}
+
+#[tonic::async_trait]
+impl RobotService for RobotApi {
+    async fn list_robots(
+        &self,
+        request: Request<pb::ListRobotsRequest>,
+    ) -> Result<Response<pb::ListRobotsResponse>, Status> {
+        let _admitted = self.shared.compute.admit(&request)?;
+        let robots = BUILTIN_NAMES
+            .iter()
+            .map(|name| {
+                let chain = builtin_chain(name).map_err(|e| robot_error(e, ""))?;
+                Ok(pb::RobotSummary {
+                    name: name.to_string(),
+                    dof: chain.dof() as u32,
+                    description: builtin_urdf(name).map(urdf_comment).unwrap_or_default(),
+                    base_link: chain.base_link().into(),
+                    tip_link: chain.tip_link().into(),
+                })
+            })
+            .collect::<Result<_, Status>>()?;
+        Ok(Response::new(pb::ListRobotsResponse { robots }))
+    }
+
+    async fn describe_robot(
+        &self,
+        request: Request<pb::DescribeRobotRequest>,
+    ) -> Result<Response<pb::DescribeRobotResponse>, Status> {
+        let (_permit, _budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
+        Ok(Response::new(describe(&robot.chain, robot.model_id)))
+    }
+
+    async fn forward_kinematics(
+        &self,
+        request: Request<pb::ForwardKinematicsRequest>,
+    ) -> Result<Response<pb::ForwardKinematicsResponse>, Status> {
+        let (_permit, _, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
+        let req = request.get_ref();
+        let q = &req.joint_positions;
+        robot
+            .chain
+            .check_joints(q)
+            .map_err(|e| robot_error(e, "joint_positions"))?;
+        let chain = &robot.chain;
+        // With links, the tip link's frame (the last one) is the tool pose: one FK pass.
+        let (tool, links) = if req.include_links {
+            let mut frames = Vec::with_capacity(chain.links().len());
+            chain.link_frames_into(q, &mut frames);
+            let links = chain
+                .links()
+                .iter()
+                .zip(&frames)
+                .map(|(link, pose)| pb::LinkPose {
+                    name: link.name.clone(),
+                    pose: Some(pose_out(pose)),
+                })
+                .collect();
+            (frames.last().copied().unwrap_or_else(|| chain.fk(q)), links)
+        } else {
+            (chain.fk(q), Vec::new())
+        };
+        Ok(Response::new(pb::ForwardKinematicsResponse {
+            tool_pose: Some(pose_out(&tool)),
+            links,
+            model_id: robot.model_id,
+        }))
+    }
+
+    async fn jacobian(
+        &self,
+        request: Request<pb::JacobianRequest>,
+    ) -> Result<Response<pb::JacobianResponse>, Status> {
+        let (_permit, _, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
+        let q = &request.get_ref().joint_positions;
+        let _req = request.get_ref();
+        robot
+            .chain
+            .check_joints(q)
+            .map_err(|e| robot_error(e, "joint_positions"))?;
+        let mut jacobian = nalgebra::Matrix6xX::zeros(robot.chain.dof());
+        let tool = robot.chain.jacobian_into(q, &mut jacobian);
+        Ok(Response::new(pb::JacobianResponse {
+            jacobian: Some(matrix_out(&jacobian)),
+            tool_pose: Some(pose_out(&tool)),
+            model_id: robot.model_id,
+        }))
+    }
+}
+
+/// The first XML comment of a built-in URDF: its data source.
+fn urdf_comment(urdf: &str) -> String {
+    urdf.split_once("<!--")
+        .and_then(|(_, rest)| rest.split_once("-->"))
+        .map(|(comment, _)| comment.trim().to_string())
+        .unwrap_or_default()
+}
+
+fn describe(chain: &Chain, model_id: Vec<u8>) -> pb::DescribeRobotResponse {
+    let joints = chain
+        .joints()
+        .iter()
+        .map(|j| pb::JointInfo {
+            name: j.name.clone(),
+            r#type: match j.kind {
+                JointKind::Revolute => pb::JointType::Revolute,
+                JointKind::Continuous => pb::JointType::Continuous,
+                JointKind::Prismatic => pb::JointType::Prismatic,
+            } as i32,
+            origin: Some(pose_out(&j.origin)),
+            axis: Some(vec3_out(&j.axis)),
+            lower: j.lower,
+            upper: j.upper,
+            max_velocity: j.max_velocity.unwrap_or(0.0),
+        })
+        .collect();
+    let links = chain
+        .links()
+        .iter()
+        .zip(chain.collision())
+        .map(|(link, collision)| pb::LinkInfo {
+            name: link.name.clone(),
+            parent_joint: link.after_joint.map_or(-1, |j| j as i32),
+            offset: Some(pose_out(&link.offset)),
+            collision: collision
+                .shapes
+                .iter()
+                .map(|s| pb::CollisionGeometry {
+                    origin: Some(pose_out(&s.origin)),
+                    shape: Some(shape_out(&s.shape)),
+                })
+                .collect(),
+        })
+        .collect();
+    pb::DescribeRobotResponse {
+        name: chain.name().into(),
+        model_id,
+        base_link: chain.base_link().into(),
+        tip_link: chain.tip_link().into(),
+        joints,
+        links,
+        tip_offset: Some(pose_out(chain.tip_offset())),
+    }
+}
+
+fn shape_out(shape: &Shape) -> pb::collision_geometry::Shape {
+    use pb::collision_geometry::Shape as S;
+    match shape {
+        Shape::Box { half_extents } => S::Box(pb::Box {
+            size: Some(vec3_out(&(half_extents * 2.0))),
+        }),
+        Shape::Sphere { radius } => S::Sphere(pb::Sphere { radius: *radius }),
+        Shape::Cylinder { radius, length } => S::Cylinder(pb::Cylinder {
+            radius: *radius,
+            length: *length,
+        }),
+        Shape::Capsule { radius, length } => S::Capsule(pb::Capsule {
+            radius: *radius,
+            length: *length,
+        }),
+        Shape::MeshReference { filename } => S::MeshReference(filename.clone()),
+    }
+}

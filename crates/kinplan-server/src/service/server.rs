@@ -1,0 +1,175 @@
+//! Assembles the gRPC server: kinplan services, health, reflection, metrics
+//! layer, message limits and graceful shutdown.
+
+use std::future::Future;
+use std::sync::Arc;
+use std::time::Duration;
+
+use tokio::net::TcpListener;
+use tokio::sync::OwnedSemaphorePermit;
+use tonic::transport::Server;
+use tonic::transport::server::TcpIncoming;
+use tonic_health::ServingStatus;
+
+use super::kinematics::KinematicsApi;
+use super::metrics::MetricsLayer;
+use super::mobile::MobileApi;
+use super::models::Resolved;
+use super::pb::kinematics_service_server::KinematicsServiceServer;
+use super::pb::mobile_service_server::MobileServiceServer;
+use super::pb::{
+    self, robot_service_server::RobotServiceServer, scoring_service_server::ScoringServiceServer,
+};
+use super::robot::RobotApi;
+use super::scoring::ScoringApi;
+use super::{Budget, Compute, ModelStore};
+use kinplan_core::robot::UrdfLimits;
+
+/// Everything the server can be told; `Default` is what `kinplan serve`
+/// uses with no flags.
+#[derive(Debug, Clone)]
+pub struct ServerConfig {
+    /// CPU pool threads; 0 means one per core.
+    pub cpu_threads: usize,
+    /// Largest request or response message, bytes.
+    pub max_message_bytes: usize,
+    /// Deadline for requests that bring none.
+    pub request_timeout: Option<Duration>,
+    /// Requests in the server at once; more are shed with RESOURCE_EXHAUSTED.
+    pub concurrency_limit: usize,
+    /// Largest inline URDF, bytes.
+    pub max_urdf_bytes: usize,
+    /// Parsed models kept in the cache.
+    pub model_cache_entries: usize,
+    /// Time between reporting NOT_SERVING and closing the listener on
+    /// shutdown, so load balancers stop sending new calls first.
+    pub drain_delay: Duration,
+}
+
+impl Default for ServerConfig {
+    fn default() -> Self {
+        Self {
+            cpu_threads: 0,
+            max_message_bytes: 16 * 1024 * 1024,
+            request_timeout: Some(Duration::from_secs(60)),
+            concurrency_limit: 256,
+            max_urdf_bytes: 2 * 1024 * 1024,
+            model_cache_entries: 256,
+            drain_delay: Duration::ZERO,
+        }
+    }
+}
+
+type BoxError = Box<dyn std::error::Error + Send + Sync>;
+
+/// Serves on `listener` until `shutdown` resolves, then reports NOT_SERVING,
+/// waits `drain_delay`, stops accepting and finishes the calls in flight.
+pub async fn serve(
+    config: ServerConfig,
+    listener: TcpListener,
+    shutdown: impl Future<Output = ()> + Send + 'static,
+) -> Result<(), BoxError> {
+    let compute = Arc::new(Compute::new(
+        config.cpu_threads,
+        config.concurrency_limit,
+        config.request_timeout,
+    ));
+    let models = Arc::new(ModelStore::new(
+        UrdfLimits {
+            max_bytes: config.max_urdf_bytes,
+            ..UrdfLimits::default()
+        },
+        config.model_cache_entries,
+    ));
+    let shared = Shared { models, compute };
+    let limit = config.max_message_bytes;
+    // Each kinplan service: its adapter, with the message size limits.
+    macro_rules! service {
+        ($server:ident, $api:expr) => {
+            $server::new($api)
+                .max_decoding_message_size(limit)
+                .max_encoding_message_size(limit)
+        };
+    }
+    let robot = service!(RobotServiceServer, RobotApi::new(shared.clone()));
+    let scoring = service!(ScoringServiceServer, ScoringApi::new(shared.clone()));
+    let mobile = service!(MobileServiceServer, MobileApi::new(shared.clone()));
+    let kinematics = service!(KinematicsServiceServer, KinematicsApi::new(shared.clone()));
+
+    let services = [
+        name_of(&robot),
+        name_of(&scoring),
+        name_of(&mobile),
+        name_of(&kinematics),
+    ];
+    let (health, health_service) = tonic_health::server::health_reporter();
+    for name in services {
+        health.set_service_status(name, ServingStatus::Serving).await;
+    }
+    let reflection_v1 = tonic_reflection::server::Builder::configure()
+        .register_encoded_file_descriptor_set(pb::FILE_DESCRIPTOR_SET)
+        .register_encoded_file_descriptor_set(tonic_health::pb::FILE_DESCRIPTOR_SET)
+        .build_v1()?;
+    let reflection_v1alpha = tonic_reflection::server::Builder::configure()
+        .register_encoded_file_descriptor_set(pb::FILE_DESCRIPTOR_SET)
+        .register_encoded_file_descriptor_set(tonic_health::pb::FILE_DESCRIPTOR_SET)
+        .build_v1alpha()?;
+
+    let drain_delay = config.drain_delay;
+    let drain = async move {
+        shutdown.await;
+        tracing::info!(?drain_delay, "shutting down: reporting NOT_SERVING");
+        for name in services.into_iter().chain([""]) {
+            health.set_service_status(name, ServingStatus::NotServing).await;
+        }
+        tokio::time::sleep(drain_delay).await;
+        tracing::info!("closing the listener; finishing calls in flight");
+    };
+    tracing::info!(addr = ?listener.local_addr().ok(), "kinplan serving");
+    Server::builder()
+        .layer(MetricsLayer)
+        .add_service(health_service)
+        .add_service(reflection_v1)
+        .add_service(reflection_v1alpha)
+        .add_service(robot)
+        .add_service(scoring)
+        .add_service(mobile)
+        .add_service(kinematics)
+        .serve_with_incoming_shutdown(
+            // Small replies must not wait for Nagle + delayed ACK (40 ms on loopback).
+            TcpIncoming::from(listener)
+                .with_nodelay(Some(true))
+                .with_keepalive(Some(Duration::from_secs(60))),
+            drain,
+        )
+        .await?;
+    Ok(())
+}
+
+/// What every service adapter shares: the model cache and the CPU pool.
+#[derive(Clone)]
+pub struct Shared {
+    pub models: Arc<ModelStore>,
+    pub compute: Arc<Compute>,
+}
+
+impl Shared {
+    /// The first steps of every call about a robot: admission (or shedding with
+    /// RESOURCE_EXHAUSTED), the request's budget, and the robot it names, from the
+    /// cache or parsed on the CPU pool. Hold the permit until the reply.
+    pub async fn admit_robot<T>(
+        &self,
+        request: &tonic::Request<T>,
+        robot: Option<&pb::RobotRef>,
+    ) -> Result<(OwnedSemaphorePermit, Budget, Resolved), tonic::Status> {
+        let (permit, budget) = self.compute.admit(request)?;
+        let robot = self.models.resolve(robot, &self.compute, &budget).await?;
+        Ok((permit, budget, robot))
+    }
+}
+
+fn name_of<S: tonic::server::NamedService>(_: &S) -> &'static str {
+    S::NAME
+}
+
+pub use super::metrics::HANDLING_BUCKETS;

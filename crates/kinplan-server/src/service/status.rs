@@ -1,0 +1,79 @@
+//! Domain errors turned into `tonic::Status`, with `google.rpc.BadRequest`
+//! details naming the offending field.
+
+use tonic::{Code, Status};
+use tonic_types::{ErrorDetails, StatusExt};
+
+use kinplan_core::robot::RobotError;
+
+/// INVALID_ARGUMENT naming `field`, with a BadRequest field violation.
+pub fn invalid(field: impl Into<String>, description: impl Into<String>) -> Status {
+    field_status(Code::InvalidArgument, field, description)
+}
+
+/// NOT_FOUND naming `field`, with a BadRequest field violation.
+pub fn not_found(field: impl Into<String>, description: impl Into<String>) -> Status {
+    field_status(Code::NotFound, field, description)
+}
+
+fn field_status(code: Code, field: impl Into<String>, description: impl Into<String>) -> Status {
+    let field = field.into();
+    let description = description.into();
+    let message = format!("{field}: {description}");
+    Status::with_error_details(
+        code,
+        message,
+        ErrorDetails::with_bad_request_violation(field, description),
+    )
+}
+
+/// Maps a robot-model error; `joints_field` names the joint vector in the
+/// request, for errors about joint values.
+pub fn robot_error(err: RobotError, joints_field: &str) -> Status {
+    let text = err.to_string();
+    match err {
+        RobotError::UnknownRobot { .. } => not_found("robot.name", text),
+        RobotError::UnknownLink { .. } => not_found("robot.base_link/tip_link", text),
+        RobotError::AmbiguousTip { .. } | RobotError::NotSerialChain { .. } => {
+            invalid("robot.tip_link", text)
+        }
+        RobotError::WrongJointCount { .. } => invalid(joints_field, text),
+        RobotError::NonFiniteJoint { index } => invalid(format!("{joints_field}[{index}]"), text),
+        RobotError::MalformedUrdf(_)
+        | RobotError::UrdfTooLarge { .. }
+        | RobotError::TooManyElements { .. }
+        | RobotError::NonFiniteValue { .. }
+        | RobotError::NoSingleRoot { .. }
+        | RobotError::UnsupportedJoint { .. }
+        | RobotError::ZeroAxis { .. }
+        | RobotError::InvertedLimits { .. } => invalid("robot.urdf", text),
+    }
+}
+
+/// The canonical upper-case name of a gRPC status code, as metrics label it.
+pub fn code_name(code: i32) -> &'static str {
+    const NAMES: [&str; 17] = [
+        "OK",
+        "CANCELLED",
+        "UNKNOWN",
+        "INVALID_ARGUMENT",
+        "DEADLINE_EXCEEDED",
+        "NOT_FOUND",
+        "ALREADY_EXISTS",
+        "PERMISSION_DENIED",
+        "RESOURCE_EXHAUSTED",
+        "FAILED_PRECONDITION",
+        "ABORTED",
+        "OUT_OF_RANGE",
+        "UNIMPLEMENTED",
+        "INTERNAL",
+        "UNAVAILABLE",
+        "DATA_LOSS",
+        "UNAUTHENTICATED",
+    ];
+    usize::try_from(code)
+        .ok()
+        .and_then(|i| NAMES.get(i))
+        .copied()
+        .unwrap_or("UNKNOWN")
+}
