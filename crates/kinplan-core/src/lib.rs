@@ -6,6 +6,7 @@
 //! tokio (the server crate `kinplan-server` adapts it to the wire), so Rust
 //! users can depend on the algorithms alone.
 
+pub mod collision;
 pub mod ik;
 pub mod linalg;
 pub mod mobile;
