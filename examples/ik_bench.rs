@@ -43,19 +43,7 @@ fn main() {
     let arms: Vec<String> = args
         .get(2)
         .map(|s| s.split(',').map(String::from).collect())
-        .unwrap_or_else(|| {
-            [
-                "kuka_kr210_r2700_extra",
-                "kuka_kr120_r2500_pro",
-                "abb_irb4600_60_205",
-                "ur5",
-                "franka_panda",
-                "kuka_lbr_iiwa14_r820",
-            ]
-            .iter()
-            .map(|s| s.to_string())
-            .collect()
-        });
+        .unwrap_or_else(|| kinplan_core::robot::ARM_NAMES.map(String::from).to_vec());
     let methods: Vec<String> = args
         .get(3)
         .map(|s| s.split(',').map(String::from).collect())

@@ -133,13 +133,7 @@ async fn fk_of_ik_is_the_target_on_several_arms() {
     let mut ik = KinematicsServiceClient::new(server.channel.clone());
     let mut robots = RobotServiceClient::new(server.channel.clone());
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-    for name in [
-        "kuka_kr210_r2700_extra",
-        "abb_irb4600_60_205",
-        "ur5",
-        "franka_panda",
-        "kuka_lbr_iiwa14_r820",
-    ] {
+    for name in kinplan_core::robot::ARM_NAMES {
         let chain = kinplan_core::robot::builtin_chain(name).unwrap();
         for k in 0..4 {
             let q = random_joints(name, &mut rng);

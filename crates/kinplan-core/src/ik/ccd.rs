@@ -11,7 +11,8 @@
 
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
-use super::solve::{Attempt, Clock, IkWorkspace, Progress, is_converged, wrap_into_limits};
+use super::attempt::{Attempt, Clock, Progress, stop_before_iteration};
+use super::workspace::{IkWorkspace, wrap_into_limits};
 use super::{IkParams, IkStatus, IkTarget, pose_error};
 use crate::robot::Chain;
 
@@ -60,13 +61,7 @@ pub(crate) fn run(
             best_sq = err.squared();
             ws.q_best.copy_from_slice(&ws.q);
         }
-        if is_converged(&err, target, params) {
-            break (IkStatus::Converged, err);
-        }
-        if it >= params.max_iterations {
-            break (IkStatus::MaxIterations, err);
-        }
-        if let Some(s) = clock.interrupted() {
+        if let Some(s) = stop_before_iteration(&err, target, params, it, clock) {
             break (s, err);
         }
         if progress.stalled(err.squared()) {

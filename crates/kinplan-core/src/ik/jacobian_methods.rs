@@ -24,7 +24,8 @@
 use nalgebra::Isometry3;
 use rand_chacha::ChaCha8Rng;
 
-use super::solve::{Attempt, Clock, IkWorkspace, Progress, is_converged};
+use super::attempt::{Attempt, Clock, Progress, stop_before_iteration};
+use super::workspace::IkWorkspace;
 use super::{IkMethod, IkParams, IkStatus, IkTarget, JointLimitMode, PoseError, pose_error};
 use crate::linalg::{LinearSolverKind, RlxaParams, SvdWorkspace};
 use crate::robot::Chain;
@@ -80,13 +81,7 @@ pub(crate) fn run(
     let mut it = 0;
     let status = loop {
         ws.record(params, &err);
-        if is_converged(&err, target, params) {
-            break IkStatus::Converged;
-        }
-        if it >= params.max_iterations {
-            break IkStatus::MaxIterations;
-        }
-        if let Some(s) = clock.interrupted() {
+        if let Some(s) = stop_before_iteration(&err, target, params, it, clock) {
             break s;
         }
         it += 1;

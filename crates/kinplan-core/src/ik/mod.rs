@@ -1,6 +1,7 @@
 //! Inverse kinematics: Jacobian methods (with SVD or RLXA), CCD, FABRIK, length
 //! relaxation, restarts and time budgets, batches and Cartesian path tracking.
 
+mod attempt;
 mod ccd;
 mod error;
 mod fabrik;
@@ -11,6 +12,7 @@ mod point_chain;
 mod solve;
 mod target;
 mod track;
+mod workspace;
 
 #[cfg(test)]
 mod tests;
@@ -20,6 +22,7 @@ pub use fabrik::{PointChainReport, fabrik_points};
 pub use length_relaxation::{RelaxationGraph, length_relaxation_points, relax_length};
 pub use params::{IkMethod, IkParams, JointLimitMode};
 pub use point_chain::PointWorkspace;
-pub use solve::{IkResult, IkSolution, IkSolver, IkStatus, IkWorkspace, budget_until, solve_ik};
+pub use solve::{IkResult, IkSolution, IkSolver, IkStatus, budget_until, solve_ik};
 pub use target::{IkTarget, PoseError, pose_error};
 pub use track::{PathStep, TrackParams, TrackResult, circle_path, line_path, solve_ik_batch, track_path};
+pub use workspace::IkWorkspace;

@@ -14,14 +14,7 @@ use super::*;
 use crate::linalg::LinearSolverKind;
 use crate::robot::{BUILTIN_NAMES, Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
-const ARMS: [&str; 6] = [
-    "kuka_kr210_r2700_extra",
-    "kuka_kr120_r2500_pro",
-    "abb_irb4600_60_205",
-    "ur5",
-    "franka_panda",
-    "kuka_lbr_iiwa14_r820",
-];
+const ARMS: [&str; 6] = crate::robot::ARM_NAMES;
 
 fn never() -> bool {
     false
@@ -591,7 +584,7 @@ fn svd_workspace_handles_redundant_jacobians() {
 
 #[test]
 fn wrapping_keeps_the_pose_and_only_turns_full_turn_joints() {
-    use super::solve::IkWorkspace;
+    use super::workspace::IkWorkspace;
     // UR5: every joint has ±2π, so leaving the range is undone by a whole turn.
     let ur5 = crate::robot::builtin_chain("ur5").unwrap();
     let ws = IkWorkspace::new(&ur5);

@@ -5,7 +5,8 @@ use std::time::Instant;
 use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 
-use super::solve::{Clock, validate_request};
+use super::attempt::Clock;
+use super::solve::validate_request;
 use super::{IkError, IkParams, IkResult, IkSolver, IkStatus, IkTarget};
 use crate::robot::Chain;
 

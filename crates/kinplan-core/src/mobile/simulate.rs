@@ -126,33 +126,50 @@ pub struct NavigateParams {
     pub seed: u64,
 }
 
+/// What one simulated control period did.
+struct PeriodOutcome {
+    /// Pose at the end of the period (or where a collision stopped it).
+    pose: Pose,
+    /// The command after the chassis' saturation.
+    applied: Twist,
+    /// Smallest clearance seen over the sub-steps (m); `None` without a world.
+    min_clearance: Option<f64>,
+    /// Index of the obstacle hit, if the robot collided.
+    hit: Option<usize>,
+}
+
 /// Integrates one control period with sub-steps no longer than a quarter of the robot radius,
-/// checking the clearance after each. Returns (pose, clearance, obstacle hit).
+/// checking the clearance after each and stopping at the first collision.
 fn advance(
     world: Option<&World>,
     chassis: &Chassis,
     pose: Pose,
     cmd: Twist,
     sim: &SimParams,
-) -> (Pose, Twist, Option<f64>, Option<usize>) {
+) -> PeriodOutcome {
     let (applied, _) = chassis.saturate(cmd);
     let speed = applied.vx.hypot(applied.vy);
     let subs = ((speed * sim.dt / (0.25 * sim.robot_radius)).ceil() as usize).clamp(1, 1000);
     let h = sim.dt / subs as f64;
-    let mut p = pose;
-    let mut min_c: Option<f64> = None;
+    let mut outcome = PeriodOutcome {
+        pose,
+        applied,
+        min_clearance: None,
+        hit: None,
+    };
     for _ in 0..subs {
-        p = integrate_twist(p, applied, h);
+        outcome.pose = integrate_twist(outcome.pose, applied, h);
         if let Some(w) = world {
-            let (d, i) = w.distance(p.point());
+            let (d, i) = w.distance(outcome.pose.point());
             let c = d - sim.robot_radius;
-            min_c = Some(min_c.map_or(c, |m| m.min(c)));
+            outcome.min_clearance = Some(outcome.min_clearance.map_or(c, |m| m.min(c)));
             if c < 0.0 {
-                return (p, applied, min_c, i);
+                outcome.hit = i;
+                return outcome;
             }
         }
     }
-    (p, applied, min_c, None)
+    outcome
 }
 
 fn start_check(world: Option<&World>, start: Pose, radius: f64) -> Result<Option<f64>, MobileError> {
@@ -250,17 +267,17 @@ fn step_into(
     cmd: Twist,
     sim: &SimParams,
 ) -> bool {
-    let (p, applied, c, hit) = advance(world, chassis, *pose, cmd, sim);
-    run.metrics.path_length += p.point().distance(pose.point());
+    let period = advance(world, chassis, *pose, cmd, sim);
+    run.metrics.path_length += period.pose.point().distance(pose.point());
     run.metrics.time += sim.dt;
     run.metrics.steps += 1;
-    run.metrics.min_clearance = merge(run.metrics.min_clearance, c);
-    run.commands.push(applied);
-    run.states.push(p);
-    *pose = p;
-    if hit.is_some() {
+    run.metrics.min_clearance = merge(run.metrics.min_clearance, period.min_clearance);
+    run.commands.push(period.applied);
+    run.states.push(period.pose);
+    *pose = period.pose;
+    if period.hit.is_some() {
         run.outcome = Outcome::Collision;
-        run.collided_with = hit;
+        run.collided_with = period.hit;
         return true;
     }
     false

@@ -13,6 +13,17 @@ macro_rules! builtins {
     };
 }
 
+/// The six industrial arms among the built-ins (the planar chains left out): the
+/// one list that tests, benchmarks and examples iterate over.
+pub const ARM_NAMES: [&str; 6] = [
+    "kuka_kr210_r2700_extra",
+    "kuka_kr120_r2500_pro",
+    "abb_irb4600_60_205",
+    "ur5",
+    "franka_panda",
+    "kuka_lbr_iiwa14_r820",
+];
+
 builtins!(
     "kuka_kr210_r2700_extra",
     "kuka_kr120_r2500_pro",

@@ -7,7 +7,7 @@ mod error;
 mod geometry;
 mod urdf;
 
-pub use builtin::{BUILTIN_NAMES, builtin_chain, builtin_urdf};
+pub use builtin::{ARM_NAMES, BUILTIN_NAMES, builtin_chain, builtin_urdf};
 pub use chain::{Chain, Joint, JointKind, LinkFrame};
 pub use error::RobotError;
 pub use geometry::{CollisionShape, LinkCollision, Shape};

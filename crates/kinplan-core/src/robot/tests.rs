@@ -332,3 +332,11 @@ proptest::proptest! {
         }
     }
 }
+
+#[test]
+fn every_arm_name_is_a_built_in_with_six_or_seven_joints() {
+    for name in ARM_NAMES {
+        let dof = builtin_chain(name).unwrap().dof();
+        assert!(dof == 6 || dof == 7, "{name}: {dof} joints");
+    }
+}
