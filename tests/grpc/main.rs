@@ -2,6 +2,7 @@
 //! loopback port and calls it over gRPC, as clients do.
 
 mod kinematics;
+mod loadtest;
 mod mobile;
 mod robot;
 mod scoring;
@@ -11,6 +12,7 @@ use kinplan_server::service::{ServerConfig, serve};
 use tonic::transport::Channel;
 
 pub struct TestServer {
+    pub addr: std::net::SocketAddr,
     pub channel: Channel,
     pub stop: Option<tokio::sync::oneshot::Sender<()>>,
     pub handle: tokio::task::JoinHandle<()>,
@@ -33,6 +35,7 @@ pub async fn start(config: ServerConfig) -> TestServer {
         .await
         .unwrap();
     TestServer {
+        addr,
         channel,
         stop: Some(stop),
         handle,

@@ -1,10 +1,12 @@
 //! `kinplan serve`: the gRPC server with built-in defaults; every setting is
-//! a flag and an environment variable.
+//! a flag and an environment variable. `kinplan loadtest` drives a running
+//! server at high rate and reports latency percentiles and throughput.
 
 use std::net::SocketAddr;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use kinplan_server::loadtest::{LoadtestArgs, run_loadtest};
 use kinplan_server::service::{ServerConfig, serve};
 
 #[derive(Parser)]
@@ -18,6 +20,8 @@ struct Cli {
 enum Command {
     /// Run the gRPC server.
     Serve(ServeArgs),
+    /// Load-test a running server (latency percentiles, throughput, status codes).
+    Loadtest(LoadtestArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -64,13 +68,32 @@ struct ServeArgs {
 }
 
 fn main() {
-    let Command::Serve(args) = Cli::parse().command;
-    init_logging(args.log_format);
-    if let Err(err) = run(args) {
-        tracing::error!("{err}");
-        eprintln!("kinplan: {err}");
-        std::process::exit(1);
+    match Cli::parse().command {
+        Command::Serve(args) => {
+            init_logging(args.log_format);
+            if let Err(err) = run(args) {
+                tracing::error!("{err}");
+                eprintln!("kinplan: {err}");
+                std::process::exit(1);
+            }
+        }
+        Command::Loadtest(args) => {
+            if let Err(err) = loadtest(&args) {
+                eprintln!("kinplan loadtest: {err}");
+                std::process::exit(1);
+            }
+        }
     }
+}
+
+fn loadtest(args: &LoadtestArgs) -> Result<(), String> {
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+        .map_err(|e| e.to_string())?;
+    let report = runtime.block_on(run_loadtest(args))?;
+    print!("{}", report.summary());
+    Ok(())
 }
 
 fn init_logging(format: LogFormat) {

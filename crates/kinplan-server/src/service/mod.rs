@@ -18,3 +18,4 @@ mod status;
 pub use compute::{Budget, Compute};
 pub use models::ModelStore;
 pub use server::{HANDLING_BUCKETS, ServerConfig, serve};
+pub use status::code_name;

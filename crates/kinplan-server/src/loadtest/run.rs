@@ -1,0 +1,293 @@
+//! The load-test loop: `concurrency` workers spread over `connections`
+//! HTTP/2 connections, each sending calls back to back (or on a schedule when
+//! a target rate is set), until a call count or a duration is reached.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+use tonic::transport::{Channel, Endpoint};
+
+use super::report::{LatencyReport, Report};
+use super::workload::{Rpc, Workload, build_pool};
+use crate::service::code_name;
+use crate::service::pb::kinematics_service_client::KinematicsServiceClient;
+use crate::service::pb::robot_service_client::RobotServiceClient;
+use crate::service::pb::scoring_service_client::ScoringServiceClient;
+
+/// Options of `kinplan loadtest`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct LoadtestArgs {
+    /// Server address: host:port, or a URI with http://.
+    #[arg(long, default_value = "127.0.0.1:50051")]
+    pub target: String,
+    /// The RPC to call.
+    #[arg(long, value_enum, default_value = "fk")]
+    pub rpc: Rpc,
+    /// Built-in robot the requests name.
+    #[arg(long, default_value = "kuka_kr210_r2700_extra")]
+    pub robot: String,
+    /// Workers sending calls at once.
+    #[arg(long, default_value_t = 16)]
+    pub concurrency: usize,
+    /// HTTP/2 connections the workers share (round robin).
+    #[arg(long, default_value_t = 2)]
+    pub connections: usize,
+    /// Calls to send; 0: run for --duration.
+    #[arg(long, default_value_t = 0)]
+    pub total: u64,
+    /// Seconds to run when --total is 0.
+    #[arg(long, default_value_t = 10.0)]
+    pub duration: f64,
+    /// Target calls per second over all workers; 0: as fast as possible.
+    /// With a rate, latency counts from each call's scheduled start, so a
+    /// server that falls behind is not hidden (no coordinated omission).
+    #[arg(long, default_value_t = 0.0)]
+    pub rate: f64,
+    /// Deadline of each call, seconds.
+    #[arg(long, default_value_t = 1.0)]
+    pub timeout: f64,
+    /// Distinct prepared requests, cycled through.
+    #[arg(long, default_value_t = 1024)]
+    pub pool: usize,
+    /// Seed of the request pool.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Calls per worker before the clock starts (not counted).
+    #[arg(long, default_value_t = 20)]
+    pub warmup: u64,
+    /// Write the report as ghz-shaped JSON to this file.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Also report this process's CPU time over the run (the server's pid
+    /// when it runs on this machine; Linux /proc).
+    #[arg(long)]
+    pub server_pid: Option<u32>,
+}
+
+/// What one worker saw.
+#[derive(Default)]
+struct Tally {
+    latencies_ns: Vec<u64>,
+    codes: BTreeMap<String, u64>,
+    errors: BTreeMap<String, u64>,
+}
+
+/// Clients of every service on one connection.
+#[derive(Clone)]
+struct Clients {
+    robot: RobotServiceClient<Channel>,
+    kinematics: KinematicsServiceClient<Channel>,
+    scoring: ScoringServiceClient<Channel>,
+}
+
+impl Clients {
+    fn new(channel: Channel) -> Self {
+        Self {
+            robot: RobotServiceClient::new(channel.clone()),
+            kinematics: KinematicsServiceClient::new(channel.clone()),
+            scoring: ScoringServiceClient::new(channel),
+        }
+    }
+
+    /// Sends one call; the status code and, on failure, its message.
+    async fn call(&mut self, work: &Workload, timeout: Duration) -> Result<(), tonic::Status> {
+        fn req<T>(msg: T, timeout: Duration) -> tonic::Request<T> {
+            let mut r = tonic::Request::new(msg);
+            r.set_timeout(timeout);
+            r
+        }
+        match work {
+            Workload::Fk(m) => self
+                .robot
+                .forward_kinematics(req(m.clone(), timeout))
+                .await
+                .map(drop),
+            Workload::Jacobian(m) => self.robot.jacobian(req(m.clone(), timeout)).await.map(drop),
+            Workload::Ik(m) => self.kinematics.solve_ik(req(m.clone(), timeout)).await.map(drop),
+            Workload::Score(m) => self
+                .scoring
+                .score_trajectory(req(m.clone(), timeout))
+                .await
+                .map(drop),
+        }
+    }
+}
+
+fn call_name(rpc: Rpc) -> &'static str {
+    match rpc {
+        Rpc::Fk => "kinplan.v1.RobotService/ForwardKinematics",
+        Rpc::Jacobian => "kinplan.v1.RobotService/Jacobian",
+        Rpc::Ik | Rpc::IkCold => "kinplan.v1.KinematicsService/SolveIk",
+        Rpc::Score => "kinplan.v1.ScoringService/ScoreTrajectory",
+    }
+}
+
+/// Runs the load test and returns its report (also written as JSON when asked).
+pub async fn run_loadtest(args: &LoadtestArgs) -> Result<Report, String> {
+    if args.concurrency == 0 || args.connections == 0 {
+        return Err("--concurrency and --connections must be at least 1".into());
+    }
+    if !(args.rate >= 0.0 && args.rate.is_finite()) {
+        return Err("--rate must be a finite number >= 0".into());
+    }
+    let timeout = Duration::try_from_secs_f64(args.timeout)
+        .ok()
+        .filter(|d| !d.is_zero())
+        .ok_or("--timeout must be a positive number of seconds")?;
+    let duration = if args.total == 0 {
+        Some(
+            Duration::try_from_secs_f64(args.duration)
+                .ok()
+                .filter(|d| !d.is_zero())
+                .ok_or("--duration must be a positive number of seconds")?,
+        )
+    } else {
+        None
+    };
+    let pool = Arc::new(build_pool(args.rpc, &args.robot, args.pool, args.seed)?);
+    let uri = if args.target.contains("://") {
+        args.target.clone()
+    } else {
+        format!("http://{}", args.target)
+    };
+    let endpoint = Endpoint::from_shared(uri)
+        .map_err(|e| format!("--target: {e}"))?
+        .tcp_nodelay(true)
+        .connect_timeout(Duration::from_secs(5));
+    let mut connections = Vec::with_capacity(args.connections);
+    for _ in 0..args.connections {
+        let channel = endpoint.connect().await.map_err(|e| {
+            format!(
+                "cannot connect to {}: {e} (is `kinplan serve` running?)",
+                args.target
+            )
+        })?;
+        connections.push(Clients::new(channel));
+    }
+
+    // Warm-up: models cached, connections open, code paths hot.
+    for (i, clients) in connections.iter_mut().enumerate() {
+        for k in 0..args.warmup {
+            let _ = clients.call(&pool[(i + k as usize) % pool.len()], timeout).await;
+        }
+    }
+
+    let cpu_before = (
+        cpu_seconds("self"),
+        args.server_pid.and_then(|p| cpu_seconds(&p.to_string())),
+    );
+    let issued = Arc::new(AtomicU64::new(0));
+    let start = Instant::now();
+    let interval = (args.rate > 0.0).then(|| Duration::from_secs_f64(args.concurrency as f64 / args.rate));
+    let mut tasks = Vec::with_capacity(args.concurrency);
+    for w in 0..args.concurrency {
+        let mut clients = connections[w % connections.len()].clone();
+        let pool = pool.clone();
+        let issued = issued.clone();
+        let total = args.total;
+        // Workers' schedules are staggered evenly over one interval.
+        let offset = interval.map(|i| i.mul_f64(w as f64 / args.concurrency as f64));
+        tasks.push(tokio::spawn(async move {
+            let mut tally = Tally::default();
+            let mut k: u32 = 0;
+            loop {
+                let n = issued.fetch_add(1, Ordering::Relaxed);
+                if total > 0 && n >= total {
+                    break;
+                }
+                let scheduled = match (interval, offset) {
+                    (Some(i), Some(o)) => {
+                        let at = start + o + i * k;
+                        tokio::time::sleep_until(at.into()).await;
+                        at
+                    }
+                    _ => Instant::now(),
+                };
+                if duration.is_some_and(|d| scheduled.duration_since(start) >= d) {
+                    break;
+                }
+                k = k.saturating_add(1);
+                let result = clients.call(&pool[n as usize % pool.len()], timeout).await;
+                tally
+                    .latencies_ns
+                    .push(scheduled.elapsed().as_nanos().min(u64::MAX as u128) as u64);
+                let code = match &result {
+                    Ok(()) => "OK",
+                    Err(s) => code_name(s.code() as i32),
+                };
+                *tally.codes.entry(code.to_owned()).or_default() += 1;
+                if let Err(s) = result {
+                    let msg: String = s.message().chars().take(120).collect();
+                    *tally.errors.entry(format!("{code}: {msg}")).or_default() += 1;
+                }
+            }
+            tally
+        }));
+    }
+    let mut all = Tally::default();
+    for t in tasks {
+        let t = t.await.map_err(|e| format!("worker failed: {e}"))?;
+        all.latencies_ns.extend(t.latencies_ns);
+        for (k, v) in t.codes {
+            *all.codes.entry(k).or_default() += v;
+        }
+        for (k, v) in t.errors {
+            *all.errors.entry(k).or_default() += v;
+        }
+    }
+    let elapsed = start.elapsed();
+    let diff = |before: Option<f64>, after: Option<f64>| Some(after? - before?);
+    let report = Report {
+        call: call_name(args.rpc).to_owned(),
+        concurrency: args.concurrency,
+        connections: args.connections,
+        rate: args.rate,
+        elapsed,
+        latency: LatencyReport::from_latencies(&mut all.latencies_ns),
+        status_codes: all.codes,
+        errors: all.errors,
+        client_cpu_seconds: diff(cpu_before.0, cpu_seconds("self")),
+        server_cpu_seconds: diff(
+            cpu_before.1,
+            args.server_pid.and_then(|p| cpu_seconds(&p.to_string())),
+        ),
+    };
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&report.to_ghz_json()).map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("--json {}: {e}", path.display()))?;
+    }
+    Ok(report)
+}
+
+/// User + system CPU seconds of a process from `/proc/<pid>/stat` (fields 14
+/// and 15, in USER_HZ ticks of 1/100 s on Linux); `None` elsewhere.
+fn cpu_seconds(pid: &str) -> Option<f64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // The command name (field 2) is in parentheses and may contain spaces.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    Some((utime + stime) / 100.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn own_cpu_time_grows_with_work() {
+        let before = cpu_seconds("self").expect("Linux /proc");
+        let t = Instant::now();
+        let mut x = 0u64;
+        while t.elapsed() < Duration::from_millis(200) {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+        }
+        std::hint::black_box(x);
+        let after = cpu_seconds("self").unwrap();
+        assert!(after - before >= 0.05, "{before} -> {after}");
+    }
+}
