@@ -70,3 +70,20 @@ async fn an_unreachable_server_is_a_clear_error() {
         .unwrap();
     assert!(err.contains("is `kinplan serve` running?"), "{err}");
 }
+
+#[tokio::test]
+async fn health_reports_serving_and_unknown_services() {
+    use kinplan_server::loadtest::{HealthArgs, check_health};
+    let server = start(ServerConfig::default()).await;
+    let mut args = HealthArgs {
+        target: server.addr.to_string(),
+        service: String::new(),
+        timeout: 2.0,
+    };
+    assert_eq!(check_health(&args).await.unwrap(), "SERVING");
+    args.service = "kinplan.v1.RobotService".into();
+    assert_eq!(check_health(&args).await.unwrap(), "SERVING");
+    args.service = "no.such.Service".into();
+    let err = check_health(&args).await.unwrap_err();
+    assert!(err.starts_with("NotFound"), "{err}");
+}

@@ -6,7 +6,7 @@ use std::net::SocketAddr;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use kinplan_server::loadtest::{LoadtestArgs, run_loadtest};
+use kinplan_server::loadtest::{HealthArgs, LoadtestArgs, check_health, run_loadtest};
 use kinplan_server::service::{ServerConfig, serve};
 
 #[derive(Parser)]
@@ -22,6 +22,8 @@ enum Command {
     Serve(ServeArgs),
     /// Load-test a running server (latency percentiles, throughput, status codes).
     Loadtest(LoadtestArgs),
+    /// Ask a server for its health (exit 0 when SERVING).
+    Health(HealthArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -83,7 +85,24 @@ fn main() {
                 std::process::exit(1);
             }
         }
+        Command::Health(args) => match client_runtime().and_then(|rt| rt.block_on(check_health(&args))) {
+            Ok(status) => {
+                println!("{status}");
+                std::process::exit(if status == "SERVING" { 0 } else { 1 });
+            }
+            Err(err) => {
+                eprintln!("kinplan health: {err}");
+                std::process::exit(2);
+            }
+        },
     }
+}
+
+fn client_runtime() -> Result<tokio::runtime::Runtime, String> {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .map_err(|e| e.to_string())
 }
 
 fn loadtest(args: &LoadtestArgs) -> Result<(), String> {

@@ -1,12 +1,15 @@
 //! `kinplan loadtest`: drives a kinplan server over gRPC at high rate with
 //! built-in workloads (random reachable targets on built-in robots, so no
 //! files are needed) and reports latency percentiles, throughput and status
-//! codes, also as JSON shaped like ghz's report.
+//! codes, also as JSON shaped like ghz's report; `kinplan health` asks a
+//! server for its serving status.
 
+mod health;
 mod report;
 mod run;
 mod workload;
 
+pub use health::{HealthArgs, check_health};
 pub use report::{LatencyReport, Report};
 pub use run::{LoadtestArgs, run_loadtest};
 pub use workload::{Rpc, Workload};
