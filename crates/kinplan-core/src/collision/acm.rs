@@ -1,0 +1,205 @@
+//! The allowed-collision matrix: body pairs the checker never tests.
+//!
+//! Built as MoveIt's setup assistant does, once per robot model:
+//! 1. **adjacent** pairs (parent and child in the kinematic tree, links
+//!    without geometry skipped) are always allowed;
+//! 2. **default**: pairs in collision at the default state (every joint at
+//!    0, clamped into its limits);
+//! 3. **always**: pairs in collision in at least `always_fraction` of
+//!    `samples` uniformly random states;
+//! 4. **never**: pairs in collision in none of the samples.
+//!
+//! Steps 2–4 are a sampling heuristic: a pair that collides in fewer than
+//! about 1/`samples` of the joint space is allowed as "never" (MoveIt's
+//! default density of 10 000 samples has the same blind spot). The result
+//! depends only on the model and the parameters (seeded ChaCha8).
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use super::CollisionError;
+use super::model::{MAX_BODIES, RobotModel};
+use super::narrow::body_body_intersect;
+use nalgebra::Isometry3;
+
+/// Why a pair of bodies is not checked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AllowReason {
+    Adjacent,
+    Default,
+    Always,
+    Never,
+    /// Allowed by the caller.
+    User,
+}
+
+/// Symmetric matrix over a model's bodies (see the module doc).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AllowedCollisions {
+    n: usize,
+    reasons: Vec<Option<AllowReason>>,
+}
+
+/// Parameters of the sampling step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AcmParams {
+    /// Random states sampled (MoveIt setup assistant default: 10 000).
+    pub samples: usize,
+    /// Fraction of samples in collision from which a pair counts as
+    /// always colliding, in (0, 1] (setup assistant default: 0.95).
+    pub always_fraction: f64,
+    /// RNG seed.
+    pub seed: u64,
+}
+
+impl Default for AcmParams {
+    fn default() -> Self {
+        AcmParams {
+            samples: 10_000,
+            always_fraction: 0.95,
+            seed: 0,
+        }
+    }
+}
+
+impl AcmParams {
+    pub fn validate(&self) -> Result<(), CollisionError> {
+        if self.samples == 0 || self.samples > 10_000_000 {
+            return Err(CollisionError::OutOfRange {
+                field: "acm.samples".into(),
+                value: self.samples as f64,
+                lower: 1.0,
+                upper: 1e7,
+            });
+        }
+        if !(self.always_fraction > 0.0 && self.always_fraction <= 1.0) {
+            return Err(CollisionError::OutOfRange {
+                field: "acm.always_fraction".into(),
+                value: self.always_fraction,
+                lower: 0.0,
+                upper: 1.0,
+            });
+        }
+        Ok(())
+    }
+}
+
+impl AllowedCollisions {
+    /// Only adjacent pairs allowed.
+    pub fn adjacent(model: &RobotModel) -> Self {
+        let n = model.body_count();
+        let mut acm = AllowedCollisions {
+            n,
+            reasons: vec![None; n * n],
+        };
+        for a in 0..n {
+            for b in a + 1..n {
+                if model.adjacent(a, b) {
+                    acm.allow(a, b, AllowReason::Adjacent);
+                }
+            }
+        }
+        acm
+    }
+
+    /// Adjacent pairs plus the default, always and never pairs found by
+    /// sampling (see the module doc). Samples are checked on the rayon pool.
+    pub fn sampled(model: &RobotModel, params: &AcmParams) -> Result<Self, CollisionError> {
+        params.validate()?;
+        let mut acm = Self::adjacent(model);
+        let chain = model.chain();
+        let bounds: Vec<(f64, f64)> = chain
+            .limits()
+            .map(|(lo, hi)| {
+                if lo.is_finite() && hi.is_finite() {
+                    (lo, hi)
+                } else {
+                    (-std::f64::consts::PI, std::f64::consts::PI)
+                }
+            })
+            .collect();
+        let pairs: Vec<(usize, usize)> = acm.checked_pairs().collect();
+        let colliding = |q: &[f64], out: &mut [u32]| {
+            let mut poses = [Isometry3::identity(); MAX_BODIES];
+            model.body_poses(q, &mut poses);
+            for (k, &(a, b)) in pairs.iter().enumerate() {
+                let hit = body_body_intersect(&model.bodies[a], &poses[a], &model.bodies[b], &poses[b]);
+                out[k] += hit as u32;
+            }
+        };
+        // Default state.
+        let q0: Vec<f64> = bounds.iter().map(|&(lo, hi)| 0.0_f64.clamp(lo, hi)).collect();
+        let mut at_default = vec![0u32; pairs.len()];
+        colliding(&q0, &mut at_default);
+        // Random states, drawn sequentially so the set does not depend on
+        // the thread count.
+        let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
+        let dof = bounds.len();
+        let states: Vec<f64> = (0..params.samples * dof)
+            .map(|i| {
+                let (lo, hi) = bounds[i % dof];
+                rng.random_range(lo..=hi)
+            })
+            .collect();
+        let counts = states
+            .par_chunks(dof.max(1) * 64)
+            .map(|block| {
+                let mut c = vec![0u32; pairs.len()];
+                for q in block.chunks(dof.max(1)) {
+                    colliding(q, &mut c);
+                }
+                c
+            })
+            .reduce(
+                || vec![0u32; pairs.len()],
+                |mut x, y| {
+                    x.iter_mut().zip(y).for_each(|(a, b)| *a += b);
+                    x
+                },
+            );
+        let always = (params.always_fraction * params.samples as f64).ceil() as u32;
+        for (k, &(a, b)) in pairs.iter().enumerate() {
+            if at_default[k] > 0 {
+                acm.allow(a, b, AllowReason::Default);
+            } else if counts[k] >= always {
+                acm.allow(a, b, AllowReason::Always);
+            } else if counts[k] == 0 {
+                acm.allow(a, b, AllowReason::Never);
+            }
+        }
+        Ok(acm)
+    }
+
+    /// Number of bodies.
+    pub fn size(&self) -> usize {
+        self.n
+    }
+
+    /// Why `a`–`b` is allowed, or `None` when the pair is checked.
+    pub fn reason(&self, a: usize, b: usize) -> Option<AllowReason> {
+        if a == b {
+            return Some(AllowReason::Adjacent);
+        }
+        self.reasons.get(a * self.n + b).copied().flatten()
+    }
+
+    pub fn is_allowed(&self, a: usize, b: usize) -> bool {
+        self.reason(a, b).is_some()
+    }
+
+    /// Marks `a`–`b` (both orders) allowed. Out-of-range indices are ignored.
+    pub fn allow(&mut self, a: usize, b: usize, reason: AllowReason) {
+        if a < self.n && b < self.n {
+            self.reasons[a * self.n + b] = Some(reason);
+            self.reasons[b * self.n + a] = Some(reason);
+        }
+    }
+
+    /// The pairs `a < b` the checker tests.
+    pub fn checked_pairs(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        (0..self.n)
+            .flat_map(move |a| (a + 1..self.n).map(move |b| (a, b)))
+            .filter(|&(a, b)| !self.is_allowed(a, b))
+    }
+}

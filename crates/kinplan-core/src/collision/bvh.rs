@@ -1,0 +1,220 @@
+//! A static bounding-volume hierarchy over axis-aligned boxes: the broad
+//! phase of a scene, built once and queried without allocation.
+//!
+//! Build: top-down, each node split at the median centroid along the axis
+//! where the centroids spread most (`select_nth_unstable`, deterministic for
+//! a given input order), down to leaves of at most [`LEAF_SIZE`] items. The
+//! tree is balanced, so its depth is ⌈log₂(n / LEAF_SIZE)⌉ + 1 and a
+//! traversal stack of [`STACK`] entries suffices for any `n < 2^60`.
+
+use nalgebra::Vector3;
+
+/// Items per leaf.
+const LEAF_SIZE: usize = 2;
+/// Traversal stack depth.
+const STACK: usize = 64;
+
+/// An axis-aligned box `[min, max]` (metres, base frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Aabb {
+    pub min: Vector3<f64>,
+    pub max: Vector3<f64>,
+}
+
+impl Aabb {
+    pub fn empty() -> Self {
+        Aabb {
+            min: Vector3::repeat(f64::INFINITY),
+            max: Vector3::repeat(f64::NEG_INFINITY),
+        }
+    }
+
+    /// The box around a sphere of `radius` at `center`.
+    #[inline]
+    pub fn around_sphere(center: &Vector3<f64>, radius: f64) -> Self {
+        Aabb {
+            min: center - Vector3::repeat(radius),
+            max: center + Vector3::repeat(radius),
+        }
+    }
+
+    pub fn merge(&self, o: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.inf(&o.min),
+            max: self.max.sup(&o.max),
+        }
+    }
+
+    #[inline]
+    pub fn intersects(&self, o: &Aabb) -> bool {
+        self.min.x <= o.max.x
+            && o.min.x <= self.max.x
+            && self.min.y <= o.max.y
+            && o.min.y <= self.max.y
+            && self.min.z <= o.max.z
+            && o.min.z <= self.max.z
+    }
+
+    /// Squared distance from `p` to the box (0 inside).
+    #[inline]
+    pub fn distance_squared(&self, p: &Vector3<f64>) -> f64 {
+        let mut d2 = 0.0;
+        for k in 0..3 {
+            let e = (self.min[k] - p[k]).max(p[k] - self.max[k]).max(0.0);
+            d2 += e * e;
+        }
+        d2
+    }
+
+    fn center(&self) -> Vector3<f64> {
+        0.5 * (self.min + self.max)
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Node {
+    aabb: Aabb,
+    /// Leaf: first item in `order`; inner: index of the left child (the
+    /// right child is `start + 1`).
+    start: u32,
+    /// Items in a leaf, 0 for an inner node.
+    count: u32,
+}
+
+/// The hierarchy: `order` lists item ids leaf by leaf.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Bvh {
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+    /// `boxes[order[k]]`, stored in leaf order.
+    sorted: Vec<Aabb>,
+}
+
+impl Bvh {
+    /// Builds the tree over `boxes` (item `i` is `boxes[i]`).
+    pub fn build(boxes: &[Aabb]) -> Self {
+        if boxes.is_empty() {
+            return Bvh::default();
+        }
+        let mut order: Vec<u32> = (0..boxes.len() as u32).collect();
+        let mut nodes = vec![Node {
+            aabb: Aabb::empty(),
+            start: 0,
+            count: 0,
+        }];
+        // (node, first, end) ranges still to split.
+        let mut work = vec![(0usize, 0usize, boxes.len())];
+        while let Some((node, first, end)) = work.pop() {
+            let items = &mut order[first..end];
+            let aabb = items
+                .iter()
+                .fold(Aabb::empty(), |a, &i| a.merge(&boxes[i as usize]));
+            nodes[node].aabb = aabb;
+            if items.len() <= LEAF_SIZE {
+                nodes[node].start = first as u32;
+                nodes[node].count = items.len() as u32;
+                continue;
+            }
+            let centers = items.iter().fold(Aabb::empty(), |a, &i| {
+                let c = boxes[i as usize].center();
+                a.merge(&Aabb { min: c, max: c })
+            });
+            let axis = (centers.max - centers.min).imax();
+            let mid = items.len() / 2;
+            items.select_nth_unstable_by(mid, |&a, &b| {
+                let ca = boxes[a as usize].center()[axis];
+                let cb = boxes[b as usize].center()[axis];
+                ca.total_cmp(&cb).then(a.cmp(&b))
+            });
+            let left = nodes.len();
+            nodes.push(Node {
+                aabb: Aabb::empty(),
+                start: 0,
+                count: 0,
+            });
+            nodes.push(Node {
+                aabb: Aabb::empty(),
+                start: 0,
+                count: 0,
+            });
+            nodes[node].start = left as u32;
+            work.push((left, first, first + mid));
+            work.push((left + 1, first + mid, end));
+        }
+        let sorted = order.iter().map(|&i| boxes[i as usize]).collect();
+        Bvh { nodes, order, sorted }
+    }
+
+    /// Calls `visit(item)` for every item whose box meets `query` (boxes
+    /// touching count), until
+    /// `visit` returns `false`. Returns `false` when stopped early.
+    #[inline]
+    pub fn for_each_overlap(&self, query: &Aabb, mut visit: impl FnMut(u32) -> bool) -> bool {
+        if self.nodes.is_empty() {
+            return true;
+        }
+        let mut stack = [0u32; STACK];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if !node.aabb.intersects(query) {
+                continue;
+            }
+            if node.count > 0 {
+                let s = node.start as usize;
+                let e = s + node.count as usize;
+                for (item, aabb) in self.order[s..e].iter().zip(&self.sorted[s..e]) {
+                    if aabb.intersects(query) && !visit(*item) {
+                        return false;
+                    }
+                }
+            } else if top + 2 <= STACK {
+                stack[top] = node.start;
+                stack[top + 1] = node.start + 1;
+                top += 2;
+            }
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_tree_reports_exactly_the_boxes_a_brute_force_scan_reports() {
+        // A 10 × 10 × 10 grid of unit boxes with gaps, queried with boxes of
+        // several sizes.
+        let mut boxes = Vec::new();
+        for i in 0..1000 {
+            let c = Vector3::new((i % 10) as f64, ((i / 10) % 10) as f64, (i / 100) as f64) * 1.5;
+            boxes.push(Aabb::around_sphere(&c, 0.5));
+        }
+        let bvh = Bvh::build(&boxes);
+        for (k, r) in [0.1, 0.7, 2.0, 6.0].iter().enumerate() {
+            let q = Aabb::around_sphere(&Vector3::new(3.3 + k as f64, 4.1, 7.9 - k as f64), *r);
+            let mut found = Vec::new();
+            bvh.for_each_overlap(&q, |i| {
+                found.push(i);
+                true
+            });
+            found.sort();
+            let expected: Vec<u32> = (0..1000u32)
+                .filter(|&i| boxes[i as usize].intersects(&q))
+                .collect();
+            assert_eq!(found, expected);
+        }
+    }
+
+    #[test]
+    fn point_to_box_distance_is_euclidean_outside_and_zero_inside() {
+        let b = Aabb {
+            min: Vector3::new(0.0, 0.0, 0.0),
+            max: Vector3::new(1.0, 2.0, 3.0),
+        };
+        assert_eq!(b.distance_squared(&Vector3::new(0.5, 1.0, 1.0)), 0.0);
+        assert!((b.distance_squared(&Vector3::new(4.0, 6.0, 3.0)) - 25.0).abs() < 1e-12);
+    }
+}

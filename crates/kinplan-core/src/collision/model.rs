@@ -1,0 +1,307 @@
+//! The robot as collision bodies: every link's primitives (and meshes given
+//! inline, as convex hulls) in the link frame, plus bodies hanging off the
+//! chain by fixed or locked joints (a gripper's fingers), each with a
+//! bounding sphere for the broad phase. Posed by forward kinematics into a
+//! stack array, so a query allocates nothing.
+
+use std::sync::Arc;
+
+use nalgebra::{Isometry3, Point3, Vector3};
+use parry3d_f64::shape::SharedShape;
+
+use super::convert::{pose_to_parry, vec_to_parry};
+use super::scene::{SceneLimits, validate_mesh};
+use super::world::primitive_shape;
+use super::{CollisionError, Geometry};
+use crate::robot::{Chain, CollisionShape, Shape};
+
+/// Most collision bodies (links with geometry) a model may have.
+pub const MAX_BODIES: usize = 64;
+/// Most links a chain may have to get a collision model.
+pub const MAX_LINKS: usize = 96;
+
+/// Geometry attached rigidly to a chain link but not on the chain itself,
+/// e.g. a finger held at a fixed opening.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AttachedBody {
+    /// Name reported in collisions (the URDF link name).
+    pub name: String,
+    /// The chain link it hangs from.
+    pub parent_link: String,
+    /// Pose of the body frame in the parent link frame.
+    pub offset: Isometry3<f64>,
+    pub shapes: Vec<CollisionShape>,
+}
+
+/// The vertices and triangles of a mesh file a URDF names, supplied by the
+/// caller. Robot meshes are used as their convex hull.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InlineMesh {
+    pub filename: String,
+    pub vertices: Vec<Point3<f64>>,
+    pub indices: Vec<u32>,
+}
+
+/// One shape of a body: shape frame in the body frame (parry's axis
+/// convention folded in).
+#[derive(Clone)]
+pub(crate) struct BodyShape {
+    pub offset: Isometry3<f64>,
+    pub shape: SharedShape,
+}
+
+/// A rigid collision body.
+#[derive(Clone)]
+pub(crate) struct Body {
+    pub name: String,
+    /// Index in [`Chain::links`] of the link that carries it.
+    pub link: usize,
+    /// Body frame in that link's frame.
+    pub offset: Isometry3<f64>,
+    /// The nearest ancestor body in the kinematic tree.
+    pub parent: Option<usize>,
+    pub shapes: Vec<BodyShape>,
+    /// Bounding sphere (body frame): centre and radius, metres.
+    pub center: Vector3<f64>,
+    pub radius: f64,
+}
+
+/// A robot's collision geometry (see the module doc). Immutable; share it
+/// as `Arc<RobotModel>` with the chain.
+#[derive(Clone)]
+pub struct RobotModel {
+    chain: Arc<Chain>,
+    pub(crate) bodies: Vec<Body>,
+}
+
+impl std::fmt::Debug for RobotModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RobotModel")
+            .field("robot", &self.chain.name())
+            .field("bodies", &self.body_names().collect::<Vec<_>>())
+            .finish()
+    }
+}
+
+impl RobotModel {
+    /// The collision model of `chain` alone (URDF primitives; a mesh file
+    /// named by a link is an error, as its geometry is unknown).
+    pub fn new(chain: Arc<Chain>) -> Result<Self, CollisionError> {
+        Self::with_parts(chain, &[], &[])
+    }
+
+    /// The collision model of `chain`, plus `attached` bodies and the
+    /// geometry of mesh files named by links (`meshes`, matched by filename).
+    pub fn with_parts(
+        chain: Arc<Chain>,
+        attached: &[AttachedBody],
+        meshes: &[InlineMesh],
+    ) -> Result<Self, CollisionError> {
+        if chain.links().len() > MAX_LINKS {
+            return Err(CollisionError::TooMany {
+                field: "chain.links".into(),
+                count: chain.links().len(),
+                limit: MAX_LINKS,
+            });
+        }
+        let mut bodies: Vec<Body> = Vec::new();
+        // Body carried by each link, for attached bodies' parents.
+        let mut last_body_at_link: Vec<Option<usize>> = vec![None; chain.links().len()];
+        let mut last: Option<usize> = None;
+        for (li, lc) in chain.collision().iter().enumerate() {
+            let field = format!("links[{}]", lc.link);
+            let shapes = body_shapes(&lc.shapes, meshes, &field)?;
+            if !shapes.is_empty() {
+                bodies.push(make_body(
+                    lc.link.clone(),
+                    li,
+                    Isometry3::identity(),
+                    last,
+                    shapes,
+                ));
+                last = Some(bodies.len() - 1);
+            }
+            last_body_at_link[li] = last;
+        }
+        for (k, a) in attached.iter().enumerate() {
+            let field = format!("attached[{k}]");
+            let li = chain
+                .links()
+                .iter()
+                .position(|l| l.name == a.parent_link)
+                .ok_or_else(|| CollisionError::UnknownName {
+                    field: format!("{field}.parent_link"),
+                    name: a.parent_link.clone(),
+                })?;
+            if !a.offset.translation.vector.iter().all(|v| v.is_finite())
+                || !a.offset.rotation.coords.iter().all(|v| v.is_finite())
+            {
+                return Err(CollisionError::NonFinite {
+                    field: format!("{field}.offset"),
+                });
+            }
+            let shapes = body_shapes(&a.shapes, meshes, &field)?;
+            if !shapes.is_empty() {
+                bodies.push(make_body(
+                    a.name.clone(),
+                    li,
+                    a.offset,
+                    last_body_at_link[li],
+                    shapes,
+                ));
+            }
+        }
+        if bodies.len() > MAX_BODIES {
+            return Err(CollisionError::TooManyBodies {
+                field: "robot".into(),
+                count: bodies.len(),
+                limit: MAX_BODIES,
+            });
+        }
+        Ok(RobotModel { chain, bodies })
+    }
+
+    pub fn chain(&self) -> &Arc<Chain> {
+        &self.chain
+    }
+
+    /// Number of collision bodies.
+    pub fn body_count(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Body names (link names), in body order.
+    pub fn body_names(&self) -> impl Iterator<Item = &str> {
+        self.bodies.iter().map(|b| b.name.as_str())
+    }
+
+    /// True when bodies `a` and `b` are parent and child in the kinematic
+    /// tree (links without geometry skipped).
+    pub fn adjacent(&self, a: usize, b: usize) -> bool {
+        self.bodies[a].parent == Some(b) || self.bodies[b].parent == Some(a)
+    }
+
+    /// Poses (base frame) of every body at `q`, written into `out[..body_count()]`.
+    /// `q` must hold `dof()` values (missing ones read as 0).
+    ///
+    /// Link poses follow [`Chain::link_frames_into`]:
+    /// `T_link = Π_{joints before it} (O_i · M_i(q_i)) · offset_link`; a body's
+    /// pose is `T_link · offset_body`.
+    pub(crate) fn body_poses(&self, q: &[f64], out: &mut [Isometry3<f64>; MAX_BODIES]) {
+        let mut links = [Isometry3::identity(); MAX_LINKS];
+        let joints = self.chain.joints();
+        let mut t = Isometry3::identity();
+        let mut applied = 0;
+        for (li, link) in self.chain.links().iter().enumerate() {
+            if let Some(j) = link.after_joint {
+                while applied <= j && applied < joints.len() {
+                    let joint = &joints[applied];
+                    t = t * joint.origin * joint.motion(q.get(applied).copied().unwrap_or(0.0));
+                    applied += 1;
+                }
+            }
+            links[li] = t * link.offset;
+        }
+        for (b, body) in self.bodies.iter().enumerate() {
+            out[b] = links[body.link] * body.offset;
+        }
+    }
+}
+
+fn make_body(
+    name: String,
+    link: usize,
+    offset: Isometry3<f64>,
+    parent: Option<usize>,
+    shapes: Vec<BodyShape>,
+) -> Body {
+    // Bounding sphere: centred on the box around the shapes' spheres,
+    // radius reaching the farthest of them.
+    let spheres: Vec<(Vector3<f64>, f64)> = shapes
+        .iter()
+        .map(|s| {
+            let bs = s.shape.compute_bounding_sphere(&pose_to_parry(&s.offset));
+            (Vector3::new(bs.center.x, bs.center.y, bs.center.z), bs.radius)
+        })
+        .collect();
+    let (mut lo, mut hi) = (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY));
+    for (c, r) in &spheres {
+        lo = lo.inf(&(c - Vector3::repeat(*r)));
+        hi = hi.sup(&(c + Vector3::repeat(*r)));
+    }
+    let center = 0.5 * (lo + hi);
+    let radius = spheres
+        .iter()
+        .map(|(c, r)| (c - center).norm() + r)
+        .fold(0.0, f64::max);
+    Body {
+        name,
+        link,
+        offset,
+        parent,
+        shapes,
+        center,
+        radius,
+    }
+}
+
+/// parry shapes of URDF collision elements; zero-size primitives (a URDF
+/// may declare them) are skipped.
+fn body_shapes(
+    shapes: &[CollisionShape],
+    meshes: &[InlineMesh],
+    field: &str,
+) -> Result<Vec<BodyShape>, CollisionError> {
+    let mut out = Vec::with_capacity(shapes.len());
+    for (k, cs) in shapes.iter().enumerate() {
+        let field = format!("{field}.collision[{k}]");
+        let geometry = match &cs.shape {
+            Shape::Box { half_extents } => Geometry::Box {
+                half_extents: *half_extents,
+            },
+            Shape::Sphere { radius } => Geometry::Sphere { radius: *radius },
+            Shape::Cylinder { radius, length } => Geometry::Cylinder {
+                radius: *radius,
+                length: *length,
+            },
+            Shape::Capsule { radius, length } => Geometry::Capsule {
+                radius: *radius,
+                length: *length,
+            },
+            Shape::MeshReference { filename } => {
+                let mesh = meshes.iter().find(|m| &m.filename == filename).ok_or_else(|| {
+                    CollisionError::MeshNotInline {
+                        field: field.clone(),
+                        filename: filename.clone(),
+                    }
+                })?;
+                validate_mesh(&mesh.vertices, &mesh.indices, &field, &SceneLimits::default())?;
+                let points: Vec<_> = mesh.vertices.iter().map(|p| vec_to_parry(&p.coords)).collect();
+                let hull = SharedShape::convex_hull(&points).ok_or_else(|| CollisionError::Degenerate {
+                    field: field.clone(),
+                    reason: format!("mesh `{filename}` has no 3-D convex hull"),
+                })?;
+                out.push(BodyShape {
+                    offset: cs.origin,
+                    shape: hull,
+                });
+                continue;
+            }
+        };
+        let degenerate = match &geometry {
+            Geometry::Box { half_extents } => half_extents.min() <= 0.0,
+            Geometry::Sphere { radius } | Geometry::Capsule { radius, .. } => *radius <= 0.0,
+            Geometry::Cylinder { radius, length } => *radius <= 0.0 || *length <= 0.0,
+            _ => false,
+        };
+        if degenerate {
+            continue;
+        }
+        let (shape, fix) = primitive_shape(&geometry).expect("primitive");
+        out.push(BodyShape {
+            offset: cs.origin * fix,
+            shape,
+        });
+    }
+    Ok(out)
+}

@@ -1,0 +1,155 @@
+//! Narrow phase between robot bodies and scene leaves: a bounding-sphere
+//! test first, then parry's exact shape queries on the pairs that survive.
+//! Boolean tests use `intersection_test`; distances use `contact` with a
+//! prediction margin, whose `dist` is the signed distance (negative by the
+//! penetration depth) and whose points are the witnesses.
+//!
+//! A pair parry cannot handle (none among the shapes this room builds) is
+//! reported as colliding: the safe answer for a planner.
+
+use nalgebra::{Isometry3, Point3, Vector3};
+use parry3d_f64::math::Pose;
+use parry3d_f64::query;
+use parry3d_f64::shape::SharedShape;
+
+use super::convert::{point_from_parry, pose_to_parry};
+use super::model::Body;
+use super::world::Leaf;
+
+/// The closest (or deepest) pair of points between two shapes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Witness {
+    /// Signed distance (m), negative when overlapping.
+    pub distance: f64,
+    /// Witness point on the first shape (base frame).
+    pub a: Point3<f64>,
+    /// Witness point on the second shape (base frame).
+    pub b: Point3<f64>,
+}
+
+#[inline]
+fn intersect(p1: &Pose, s1: &SharedShape, p2: &Pose, s2: &SharedShape) -> bool {
+    query::intersection_test(p1, &**s1, p2, &**s2).map_or(true, |i| i.intersecting)
+}
+
+fn contact(p1: &Pose, s1: &SharedShape, p2: &Pose, s2: &SharedShape, margin: f64) -> Option<Witness> {
+    match query::contact(p1, &**s1, p2, &**s2, margin) {
+        Ok(Some(c)) => Some(Witness {
+            distance: c.dist,
+            a: point_from_parry(c.point1),
+            b: point_from_parry(c.point2),
+        }),
+        Ok(None) => None,
+        Err(_) => {
+            let p = point_from_parry(p1.translation);
+            Some(Witness {
+                distance: 0.0,
+                a: p,
+                b: p,
+            })
+        }
+    }
+}
+
+/// World centre of a body's bounding sphere.
+#[inline]
+pub(crate) fn sphere_center(body: &Body, pose: &Isometry3<f64>) -> Vector3<f64> {
+    (pose * Point3::from(body.center)).coords
+}
+
+/// True when body `a` at `pa` and body `b` at `pb` overlap (touching counts).
+pub(crate) fn body_body_intersect(a: &Body, pa: &Isometry3<f64>, b: &Body, pb: &Isometry3<f64>) -> bool {
+    let r = a.radius + b.radius;
+    if (sphere_center(a, pa) - sphere_center(b, pb)).norm_squared() > r * r {
+        return false;
+    }
+    for sa in &a.shapes {
+        let qa = pose_to_parry(&(pa * sa.offset));
+        for sb in &b.shapes {
+            if intersect(&qa, &sa.shape, &pose_to_parry(&(pb * sb.offset)), &sb.shape) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// The smallest signed distance between two bodies when below `margin`.
+pub(crate) fn body_body_contact(
+    a: &Body,
+    pa: &Isometry3<f64>,
+    b: &Body,
+    pb: &Isometry3<f64>,
+    margin: f64,
+) -> Option<Witness> {
+    let r = a.radius + b.radius + margin;
+    if (sphere_center(a, pa) - sphere_center(b, pb)).norm_squared() > r * r {
+        return None;
+    }
+    let mut best: Option<Witness> = None;
+    for sa in &a.shapes {
+        let qa = pose_to_parry(&(pa * sa.offset));
+        for sb in &b.shapes {
+            let found = contact(
+                &qa,
+                &sa.shape,
+                &pose_to_parry(&(pb * sb.offset)),
+                &sb.shape,
+                margin,
+            );
+            best = closer(best, found);
+        }
+    }
+    best
+}
+
+/// True when a body at `pa` overlaps a scene leaf.
+#[inline]
+pub(crate) fn body_leaf_intersect(a: &Body, pa: &Isometry3<f64>, center: &Vector3<f64>, leaf: &Leaf) -> bool {
+    if leaf.aabb.distance_squared(center) > a.radius * a.radius {
+        return false;
+    }
+    a.shapes.iter().any(|sa| {
+        intersect(
+            &pose_to_parry(&(pa * sa.offset)),
+            &sa.shape,
+            &leaf.pose,
+            &leaf.shape,
+        )
+    })
+}
+
+/// The smallest signed distance between a body and a leaf when below `margin`.
+pub(crate) fn body_leaf_contact(
+    a: &Body,
+    pa: &Isometry3<f64>,
+    center: &Vector3<f64>,
+    leaf: &Leaf,
+    margin: f64,
+) -> Option<Witness> {
+    let r = a.radius + margin;
+    if leaf.aabb.distance_squared(center) > r * r {
+        return None;
+    }
+    let mut best: Option<Witness> = None;
+    for sa in &a.shapes {
+        let found = contact(
+            &pose_to_parry(&(pa * sa.offset)),
+            &sa.shape,
+            &leaf.pose,
+            &leaf.shape,
+            margin,
+        );
+        best = closer(best, found);
+    }
+    best
+}
+
+#[inline]
+pub(crate) fn closer(a: Option<Witness>, b: Option<Witness>) -> Option<Witness> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(if y.distance < x.distance { y } else { x }),
+        (x, None) => x,
+        (None, y) => y,
+    }
+}

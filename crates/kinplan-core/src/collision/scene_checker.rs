@@ -1,0 +1,352 @@
+//! [`SceneChecker`]: the [`StateChecker`] of one robot model in one scene.
+//!
+//! A state is valid when every joint is within its limits and no body
+//! overlaps an obstacle or a body it is not allowed to touch (touching
+//! counts as overlap). Per query: forward kinematics into stack arrays;
+//! for each body, the scene BVH is queried with the box around the body's
+//! bounding sphere, leaves are culled by sphere–box distance, and parry's
+//! exact test runs on the survivors; then the checked self pairs, culled by
+//! sphere–sphere distance. Nothing is allocated, so checkers are shared
+//! freely between rayon threads.
+
+use std::sync::Arc;
+
+use nalgebra::{Isometry3, Point3};
+
+use super::acm::AllowedCollisions;
+use super::bvh::Aabb;
+use super::model::{MAX_BODIES, RobotModel};
+use super::narrow::{
+    Witness, body_body_contact, body_body_intersect, body_leaf_contact, body_leaf_intersect, sphere_center,
+};
+use super::world::SceneGeometry;
+use super::{CollisionError, MotionCheck, StateChecker};
+
+/// Options of a [`SceneChecker`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CheckerParams {
+    /// Largest joint step (rad or m) between states checked along a motion
+    /// (default 0.05, the coarsest allowed resolution).
+    pub motion_resolution: f64,
+}
+
+impl Default for CheckerParams {
+    fn default() -> Self {
+        CheckerParams {
+            motion_resolution: 0.05,
+        }
+    }
+}
+
+impl CheckerParams {
+    pub fn validate(&self) -> Result<(), CollisionError> {
+        let r = self.motion_resolution;
+        if !(r.is_finite() && r > 0.0 && r <= 0.05) {
+            return Err(CollisionError::OutOfRange {
+                field: "motion_resolution".into(),
+                value: r,
+                lower: 0.0,
+                upper: 0.05,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// What a robot part touched: another body of the robot or an obstacle.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Part {
+    /// A robot body, by link name.
+    Link(String),
+    /// An obstacle, by index in the scene and name.
+    Obstacle { index: usize, name: String },
+}
+
+impl std::fmt::Display for Part {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Part::Link(name) => write!(f, "link `{name}`"),
+            Part::Obstacle { name, .. } => write!(f, "obstacle `{name}`"),
+        }
+    }
+}
+
+/// The nearest (or deepest) pair between the robot and the rest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Proximity {
+    /// Signed distance (m), negative by the penetration depth.
+    pub distance: f64,
+    /// The robot link.
+    pub link: String,
+    /// What it is nearest to.
+    pub other: Part,
+    /// Witness point on the link (base frame, m).
+    pub point_on_link: Point3<f64>,
+    /// Witness point on the other part (base frame, m).
+    pub point_on_other: Point3<f64>,
+}
+
+/// Everything wrong with one state, for INVALID_START / INVALID_GOAL messages.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct StateReport {
+    /// Joints outside their limits: (index, value, lower, upper).
+    pub out_of_limits: Vec<(usize, f64, f64, f64)>,
+    /// Colliding pairs: a robot link and what it touches.
+    pub collisions: Vec<(String, Part)>,
+}
+
+impl StateReport {
+    pub fn is_valid(&self) -> bool {
+        self.out_of_limits.is_empty() && self.collisions.is_empty()
+    }
+}
+
+impl std::fmt::Display for StateReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.is_valid() {
+            return write!(f, "valid");
+        }
+        let mut parts = Vec::new();
+        for (i, v, lo, hi) in &self.out_of_limits {
+            parts.push(format!("joint {i} = {v} outside [{lo}, {hi}]"));
+        }
+        for (link, other) in &self.collisions {
+            parts.push(format!("link `{link}` collides with {other}"));
+        }
+        write!(f, "{}", parts.join("; "))
+    }
+}
+
+/// Robot model + allowed-collision matrix + scene (see the module doc).
+#[derive(Debug, Clone)]
+pub struct SceneChecker {
+    model: Arc<RobotModel>,
+    world: Arc<SceneGeometry>,
+    /// Body pairs tested for self-collision, `a < b`.
+    self_pairs: Vec<(u16, u16)>,
+    params: CheckerParams,
+}
+
+impl SceneChecker {
+    /// A checker for `model` in `world`; `acm` must be over `model`'s bodies.
+    pub fn new(
+        model: Arc<RobotModel>,
+        acm: &AllowedCollisions,
+        world: Arc<SceneGeometry>,
+        params: CheckerParams,
+    ) -> Result<Self, CollisionError> {
+        params.validate()?;
+        if acm.size() != model.body_count() {
+            return Err(CollisionError::OutOfRange {
+                field: "acm.size".into(),
+                value: acm.size() as f64,
+                lower: model.body_count() as f64,
+                upper: model.body_count() as f64,
+            });
+        }
+        let self_pairs = acm.checked_pairs().map(|(a, b)| (a as u16, b as u16)).collect();
+        Ok(SceneChecker {
+            model,
+            world,
+            self_pairs,
+            params,
+        })
+    }
+
+    pub fn model(&self) -> &Arc<RobotModel> {
+        &self.model
+    }
+
+    pub fn world(&self) -> &Arc<SceneGeometry> {
+        &self.world
+    }
+
+    /// True when `q` has `dof` finite values within the joint limits.
+    pub fn within_limits(&self, q: &[f64]) -> bool {
+        let joints = self.model.chain().joints();
+        q.len() == joints.len()
+            && q.iter()
+                .zip(joints)
+                .all(|(v, j)| v.is_finite() && *v >= j.lower && *v <= j.upper)
+    }
+
+    /// True when some body overlaps an obstacle or a checked body (limits
+    /// not considered). `q` must hold `dof` finite values.
+    pub fn in_collision(&self, q: &[f64]) -> bool {
+        let mut poses = [Isometry3::identity(); MAX_BODIES];
+        self.model.body_poses(q, &mut poses);
+        let bodies = &self.model.bodies;
+        for (b, body) in bodies.iter().enumerate() {
+            let c = sphere_center(body, &poses[b]);
+            let query = Aabb::around_sphere(&c, body.radius);
+            let free = self.world.bvh.for_each_overlap(&query, |leaf| {
+                !body_leaf_intersect(body, &poses[b], &c, &self.world.leaves[leaf as usize])
+            });
+            if !free {
+                return true;
+            }
+        }
+        self.self_pairs.iter().any(|&(a, b)| {
+            let (a, b) = (a as usize, b as usize);
+            body_body_intersect(&bodies[a], &poses[a], &bodies[b], &poses[b])
+        })
+    }
+
+    /// The nearest pair within `max_distance` (m), with witness points, or
+    /// `None` when everything is farther. Bad `q` is an error.
+    pub fn proximity(&self, q: &[f64], max_distance: f64) -> Result<Option<Proximity>, CollisionError> {
+        self.check_q(q)?;
+        if max_distance.is_nan() {
+            return Err(CollisionError::NonFinite {
+                field: "max_distance".into(),
+            });
+        }
+        Ok(self.nearest(q, max_distance).map(|(w, link, other)| Proximity {
+            distance: w.distance,
+            link: self.model.bodies[link].name.clone(),
+            other: self.part(other),
+            point_on_link: w.a,
+            point_on_other: w.b,
+        }))
+    }
+
+    /// Every limit violation and colliding pair of `q`.
+    pub fn report(&self, q: &[f64]) -> Result<StateReport, CollisionError> {
+        self.check_q(q)?;
+        let mut report = StateReport::default();
+        for (i, (v, j)) in q.iter().zip(self.model.chain().joints()).enumerate() {
+            if *v < j.lower || *v > j.upper {
+                report.out_of_limits.push((i, *v, j.lower, j.upper));
+            }
+        }
+        let mut poses = [Isometry3::identity(); MAX_BODIES];
+        self.model.body_poses(q, &mut poses);
+        let bodies = &self.model.bodies;
+        for (b, body) in bodies.iter().enumerate() {
+            let c = sphere_center(body, &poses[b]);
+            let mut hits = Vec::new();
+            self.world
+                .bvh
+                .for_each_overlap(&Aabb::around_sphere(&c, body.radius), |leaf| {
+                    let l = &self.world.leaves[leaf as usize];
+                    if body_leaf_intersect(body, &poses[b], &c, l) {
+                        hits.push(l.obstacle as usize);
+                    }
+                    true
+                });
+            hits.sort_unstable();
+            hits.dedup();
+            for o in hits {
+                report
+                    .collisions
+                    .push((body.name.clone(), self.part(Other::Obstacle(o))));
+            }
+        }
+        for &(a, b) in &self.self_pairs {
+            let (a, b) = (a as usize, b as usize);
+            if body_body_intersect(&bodies[a], &poses[a], &bodies[b], &poses[b]) {
+                report
+                    .collisions
+                    .push((bodies[a].name.clone(), Part::Link(bodies[b].name.clone())));
+            }
+        }
+        Ok(report)
+    }
+
+    fn check_q(&self, q: &[f64]) -> Result<(), CollisionError> {
+        let dof = self.model.chain().dof();
+        if q.len() != dof {
+            return Err(CollisionError::OutOfRange {
+                field: "q.len".into(),
+                value: q.len() as f64,
+                lower: dof as f64,
+                upper: dof as f64,
+            });
+        }
+        match q.iter().position(|v| !v.is_finite()) {
+            Some(i) => Err(CollisionError::NonFinite {
+                field: format!("q[{i}]"),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    fn part(&self, other: Other) -> Part {
+        match other {
+            Other::Body(b) => Part::Link(self.model.bodies[b].name.clone()),
+            Other::Obstacle(index) => Part::Obstacle {
+                index,
+                name: self.world.obstacle_name(index),
+            },
+        }
+    }
+
+    /// Smallest signed distance below `margin`: the witness, the robot body
+    /// and the other part.
+    fn nearest(&self, q: &[f64], margin: f64) -> Option<(Witness, usize, Other)> {
+        let mut poses = [Isometry3::identity(); MAX_BODIES];
+        self.model.body_poses(q, &mut poses);
+        let bodies = &self.model.bodies;
+        let mut best: Option<(Witness, usize, Other)> = None;
+        let consider =
+            |w: Option<Witness>, body: usize, other: Other, best: &mut Option<(Witness, usize, Other)>| {
+                if let Some(w) = w
+                    && best.as_ref().is_none_or(|(bw, _, _)| w.distance < bw.distance)
+                {
+                    *best = Some((w, body, other));
+                }
+            };
+        for (b, body) in bodies.iter().enumerate() {
+            let c = sphere_center(body, &poses[b]);
+            // The search radius shrinks as closer pairs are found.
+            let reach = best.as_ref().map_or(margin, |(w, _, _)| w.distance.min(margin));
+            let query = Aabb::around_sphere(&c, body.radius + reach.max(0.0));
+            self.world.bvh.for_each_overlap(&query, |leaf| {
+                let l = &self.world.leaves[leaf as usize];
+                let m = best.as_ref().map_or(margin, |(w, _, _)| w.distance.min(margin));
+                let w = body_leaf_contact(body, &poses[b], &c, l, m);
+                consider(w, b, Other::Obstacle(l.obstacle as usize), &mut best);
+                true
+            });
+        }
+        for &(a, b) in &self.self_pairs {
+            let (a, b) = (a as usize, b as usize);
+            let m = best.as_ref().map_or(margin, |(w, _, _)| w.distance.min(margin));
+            let w = body_body_contact(&bodies[a], &poses[a], &bodies[b], &poses[b], m);
+            consider(w, a, Other::Body(b), &mut best);
+        }
+        best
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Other {
+    Body(usize),
+    Obstacle(usize),
+}
+
+impl StateChecker for SceneChecker {
+    fn dof(&self) -> usize {
+        self.model.chain().dof()
+    }
+
+    fn is_valid(&self, q: &[f64]) -> bool {
+        self.within_limits(q) && !self.in_collision(q)
+    }
+
+    /// Signed clearance (m), capped at `max_distance`; `-inf` for a `q` of
+    /// the wrong length or with non-finite values.
+    fn clearance(&self, q: &[f64], max_distance: f64) -> f64 {
+        if self.check_q(q).is_err() || max_distance.is_nan() {
+            return f64::NEG_INFINITY;
+        }
+        self.nearest(q, max_distance)
+            .map_or(max_distance, |(w, _, _)| w.distance.min(max_distance))
+    }
+
+    fn motion_check(&self) -> MotionCheck {
+        MotionCheck::Interpolated {
+            resolution: self.params.motion_resolution,
+        }
+    }
+}

@@ -1,0 +1,287 @@
+//! Robot-level cases: adjacency and the sampled ACM, self-collision of the
+//! Panda, malformed meshes, and motion checks.
+
+use std::sync::Arc;
+
+use nalgebra::{Isometry3, Point3, Translation3, Vector3};
+
+use super::super::*;
+use super::{box_mesh, checker, probe_urdf};
+use crate::robot::builtin_chain;
+
+fn panda_checker(acm: impl Fn(&RobotModel) -> AllowedCollisions) -> SceneChecker {
+    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let acm = acm(&model);
+    let world = Arc::new(SceneGeometry::build(&Scene::empty()).unwrap());
+    SceneChecker::new(model, &acm, world, CheckerParams::default()).unwrap()
+}
+
+#[test]
+fn adjacent_links_are_allowed_and_others_are_checked() {
+    let model = RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap();
+    let names: Vec<&str> = model.body_names().collect();
+    assert_eq!(
+        names,
+        [
+            "base_link",
+            "link_1",
+            "link_2",
+            "link_3",
+            "link_4",
+            "link_5",
+            "link_6",
+            "link_7"
+        ]
+    );
+    let acm = AllowedCollisions::adjacent(&model);
+    for a in 0..8usize {
+        for b in 0..8 {
+            let adjacent = a.abs_diff(b) == 1;
+            if a != b {
+                assert_eq!(acm.is_allowed(a, b), adjacent, "{a}–{b}");
+            }
+        }
+    }
+    assert_eq!(acm.reason(2, 3), Some(AllowReason::Adjacent));
+    assert_eq!(acm.checked_pairs().count(), 28 - 7);
+}
+
+#[test]
+fn sampled_acm_keeps_adjacency_is_deterministic_and_keeps_reachable_pairs_checked() {
+    let model = RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap();
+    let params = AcmParams {
+        samples: 2000,
+        ..AcmParams::default()
+    };
+    let a = AllowedCollisions::sampled(&model, &params).unwrap();
+    let b = AllowedCollisions::sampled(&model, &params).unwrap();
+    assert_eq!(a, b);
+    for k in 0..7 {
+        assert_eq!(a.reason(k, k + 1), Some(AllowReason::Adjacent));
+    }
+    // The base sphere and link_1 sphere are adjacent; the base (r 0.12 at
+    // the origin) and link_7 can meet when the arm folds down, so that pair
+    // must stay checked; link_1 and link_3 are 0.316 m apart along the
+    // upper arm and can never meet (radii 0.09 + 0.08): allowed as never.
+    assert_eq!(a.reason(1, 3), Some(AllowReason::Never));
+    assert!(a.reason(0, 7).is_none(), "{:?}", a.reason(0, 7));
+    assert!(AllowedCollisions::sampled(&model, &AcmParams { samples: 0, ..params }).is_err());
+}
+
+#[test]
+fn malformed_meshes_are_rejected_naming_the_field() {
+    let (v, i) = box_mesh(Vector3::new(0.1, 0.1, 0.1));
+    let scene = |vertices: Vec<Point3<f64>>, indices: Vec<u32>| {
+        Scene::new(
+            vec![
+                Obstacle::new("b", Isometry3::identity(), Geometry::Sphere { radius: 0.1 }),
+                Obstacle::new("m", Isometry3::identity(), Geometry::Mesh { vertices, indices }),
+            ],
+            &SceneLimits::default(),
+        )
+    };
+    assert!(scene(v.clone(), i.clone()).is_ok());
+    let mut bad = i.clone();
+    bad[5] = 8;
+    assert_eq!(
+        scene(v.clone(), bad).unwrap_err(),
+        CollisionError::IndexOutOfRange {
+            field: "obstacles[1].indices[5]".into(),
+            index: 8,
+            vertex_count: 8
+        }
+    );
+    let mut nan = v.clone();
+    nan[3].y = f64::NAN;
+    assert_eq!(
+        scene(nan, i.clone()).unwrap_err(),
+        CollisionError::NonFinite {
+            field: "obstacles[1].vertices[3]".into()
+        }
+    );
+    let mut flat = i.clone();
+    flat[4] = flat[3];
+    let err = scene(v.clone(), flat).unwrap_err();
+    assert!(
+        matches!(&err, CollisionError::Degenerate { field, .. } if field == "obstacles[1].indices[3..6]"),
+        "{err}"
+    );
+    // Collinear vertices: zero area.
+    let line = vec![
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(1.0, 0.0, 0.0),
+        Point3::new(2.0, 0.0, 0.0),
+    ];
+    assert!(matches!(
+        scene(line, vec![0, 1, 2]).unwrap_err(),
+        CollisionError::Degenerate { .. }
+    ));
+    assert!(matches!(
+        scene(v.clone(), i[..5].to_vec()).unwrap_err(),
+        CollisionError::Degenerate { .. }
+    ));
+    assert!(matches!(
+        scene(vec![], vec![]).unwrap_err(),
+        CollisionError::Empty { .. }
+    ));
+    let small = SceneLimits {
+        max_mesh_triangles: 11,
+        ..SceneLimits::default()
+    };
+    let err = Scene::new(
+        vec![Obstacle::new(
+            "m",
+            Isometry3::identity(),
+            Geometry::Mesh {
+                vertices: v,
+                indices: i,
+            },
+        )],
+        &small,
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            CollisionError::TooMany {
+                count: 12,
+                limit: 11,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    // Primitives: negative and non-finite sizes, NaN poses.
+    let bad_box = Scene::new(
+        vec![Obstacle::new(
+            "b",
+            Isometry3::identity(),
+            Geometry::Box {
+                half_extents: Vector3::new(0.1, -0.2, 0.1),
+            },
+        )],
+        &SceneLimits::default(),
+    );
+    assert_eq!(
+        bad_box.unwrap_err(),
+        CollisionError::NotPositive {
+            field: "obstacles[0].box.half_extents.y".into(),
+            value: -0.2
+        }
+    );
+    let nan_pose = Scene::new(
+        vec![Obstacle::new(
+            "s",
+            Isometry3::from_parts(Translation3::new(f64::NAN, 0.0, 0.0), Default::default()),
+            Geometry::Sphere { radius: 0.1 },
+        )],
+        &SceneLimits::default(),
+    );
+    assert_eq!(
+        nan_pose.unwrap_err(),
+        CollisionError::NonFinite {
+            field: "obstacles[0].pose".into()
+        }
+    );
+}
+
+#[test]
+fn a_robot_mesh_without_inline_geometry_is_an_error() {
+    let urdf = probe_urdf(r#"<mesh filename="package://x/link.stl"/>"#);
+    let chain = Arc::new(crate::robot::parse_chain(&urdf, &Default::default(), Default::default()).unwrap());
+    assert_eq!(
+        RobotModel::new(chain).unwrap_err(),
+        CollisionError::MeshNotInline {
+            field: "links[probe].collision[0]".into(),
+            filename: "package://x/link.stl".into()
+        }
+    );
+}
+
+#[test]
+fn the_motion_check_finds_a_thin_wall_in_the_middle() {
+    // A 1 cm slab at x = 1 between the probe's start (x = 0) and goal
+    // (x = 2); the probe sphere has radius 2 cm. Each end state is free.
+    let wall = Obstacle::new(
+        "wall",
+        Isometry3::translation(1.0, 0.0, 0.0),
+        Geometry::Box {
+            half_extents: Vector3::new(0.005, 1.0, 1.0),
+        },
+    );
+    let c = checker(&probe_urdf(r#"<sphere radius="0.02"/>"#), &[], vec![wall]);
+    assert!(c.is_valid(&[0.0, 0.0, 0.0]) && c.is_valid(&[2.0, 0.0, 0.0]));
+    assert!(!c.motion_valid(&[0.0, 0.0, 0.0], &[2.0, 0.0, 0.0]));
+    // Beside the wall (y = 1.5) the same motion is free.
+    assert!(c.motion_valid(&[0.0, 1.5, 0.0], &[2.0, 1.5, 0.0]));
+    assert_eq!(c.motion_check(), MotionCheck::Interpolated { resolution: 0.05 });
+}
+
+#[test]
+fn checkers_are_shared_between_threads_and_agree() {
+    use rayon::prelude::*;
+    let c = panda_checker(AllowedCollisions::adjacent);
+    let qs: Vec<[f64; 7]> = (0..64)
+        .map(|k| {
+            let t = k as f64 / 64.0;
+            [2.0 * t - 1.0, 1.5 * t - 0.7, 0.3, -3.0 + 2.5 * t, 0.1, 1.5, 0.0]
+        })
+        .collect();
+    let serial: Vec<bool> = qs.iter().map(|q| c.is_valid(q)).collect();
+    let parallel: Vec<bool> = qs.par_iter().map(|q| c.is_valid(q)).collect();
+    assert_eq!(serial, parallel);
+}
+
+/// Hand derivation in the x–z plane (q1 = q2 = q3 = q5 = q6 = q7 = 0, DH of
+/// `franka_panda.urdf`): the elbow E = (0.0825, 0.649); folding joint 4 by
+/// θ = −q4 swings the forearm vector (−0.0825, +0.384) into
+/// (−0.0825·cos θ + 0.384·sin θ, 0.0825·sin θ + 0.384·cos θ), putting the
+/// wrist W at (0.192, 0.272) for θ = 3.0718. The link_4 capsule (radius 0.08) runs from E to the wrist
+/// W; the link_1 sphere (radius 0.09) sits at C = (0, 0.333). They overlap
+/// when dist(C, EW) < 0.17.
+fn link1_link4_gap(q4: f64) -> f64 {
+    let (s, c) = (-q4).sin_cos();
+    let e = nalgebra::Vector2::new(0.0825, 0.649);
+    // Forearm vector rotated by θ about the joint-4 axis (y pointing into the page).
+    let w = e + nalgebra::Vector2::new(-0.0825 * c + 0.384 * s, 0.0825 * s + 0.384 * c);
+    let center = nalgebra::Vector2::new(0.0, 0.333);
+    let d = w - e;
+    let t = ((center - e).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+    (center - (e + t * d)).norm() - 0.17
+}
+
+#[test]
+fn panda_folded_elbow_self_collides_and_a_less_folded_one_is_free() {
+    // By hand: at q4 = −3.0718 the gap is −3.0 mm; at q4 = −2.8 it is +66 mm.
+    let folded = link1_link4_gap(-3.0718);
+    let open = link1_link4_gap(-2.8);
+    assert!(folded < -0.002 && folded > -0.004, "{folded}");
+    assert!(open > 0.06, "{open}");
+    // The ACM from sampling allows the pairs that overlap everywhere with
+    // these coarse capsules (link_2–link_4 at the elbow, the wrist pairs),
+    // and keeps link_1–link_4 checked.
+    let c = panda_checker(|m| {
+        AllowedCollisions::sampled(
+            m,
+            &AcmParams {
+                samples: 2000,
+                ..AcmParams::default()
+            },
+        )
+        .unwrap()
+    });
+    // q6 = 1.5 swings the hand (link_7) away from the upper arm.
+    let q_folded = [0.0, 0.0, 0.0, -3.0718, 0.0, 1.5, 0.0];
+    let report = c.report(&q_folded).unwrap();
+    assert_eq!(
+        report.collisions,
+        vec![("link_1".to_string(), Part::Link("link_4".into()))],
+        "{report}"
+    );
+    let p = c.proximity(&q_folded, 1.0).unwrap().unwrap();
+    assert!((p.distance - folded).abs() < 1e-6, "{} vs {folded}", p.distance);
+    assert!(!c.is_valid(&q_folded));
+    let q_open = [0.0, 0.0, 0.0, -2.8, 0.0, 1.5, 0.0];
+    assert!(c.is_valid(&q_open), "{}", c.report(&q_open).unwrap());
+    assert!((c.clearance(&q_open, 1.0) - open).abs() < 1e-6);
+}

@@ -1,0 +1,129 @@
+//! A validated [`Scene`] turned into parry shapes with a broad phase: one
+//! leaf per primitive, per mesh (parry's `TriMesh` keeps its own triangle
+//! tree) and per occupied cell, all under one [`Bvh`]. Built once per scene
+//! and shared read-only between threads.
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use parry3d_f64::math::{Pose, Vector};
+use parry3d_f64::shape::SharedShape;
+
+use super::bvh::{Aabb, Bvh};
+use super::convert::{pose_to_parry, vec_to_parry};
+use super::{CollisionError, Geometry, Scene};
+
+/// One broad-phase leaf: a parry shape at a pose (base frame).
+#[derive(Clone)]
+pub(crate) struct Leaf {
+    /// Index of the obstacle in [`Scene::obstacles`].
+    pub obstacle: u32,
+    pub pose: Pose,
+    pub shape: SharedShape,
+    pub aabb: Aabb,
+}
+
+/// The scene ready for queries (see the module doc).
+#[derive(Clone)]
+pub struct SceneGeometry {
+    scene: Scene,
+    pub(crate) leaves: Vec<Leaf>,
+    pub(crate) bvh: Bvh,
+}
+
+impl std::fmt::Debug for SceneGeometry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneGeometry")
+            .field("obstacles", &self.scene.obstacles().len())
+            .field("leaves", &self.leaves.len())
+            .finish()
+    }
+}
+
+/// The parry shape of a z-axis primitive and the correction from the URDF
+/// convention (axis z) to parry's (cylinders along y): `Rx(+90°)` maps
+/// parry's y axis onto z.
+pub(crate) fn primitive_shape(g: &Geometry) -> Option<(SharedShape, Isometry3<f64>)> {
+    let id = Isometry3::identity();
+    Some(match g {
+        Geometry::Box { half_extents: h } => (SharedShape::cuboid(h.x, h.y, h.z), id),
+        Geometry::Sphere { radius } => (SharedShape::ball(*radius), id),
+        Geometry::Capsule { radius, length } => (SharedShape::capsule_z(0.5 * length, *radius), id),
+        Geometry::Cylinder { radius, length } => (
+            SharedShape::cylinder(0.5 * length, *radius),
+            Isometry3::from_parts(
+                Translation3::identity(),
+                UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
+            ),
+        ),
+        Geometry::Mesh { .. } | Geometry::OccupiedCells { .. } => return None,
+    })
+}
+
+pub(crate) fn aabb_of(shape: &SharedShape, pose: &Pose) -> Aabb {
+    let a = shape.compute_aabb(pose);
+    Aabb {
+        min: Vector3::new(a.mins.x, a.mins.y, a.mins.z),
+        max: Vector3::new(a.maxs.x, a.maxs.y, a.maxs.z),
+    }
+}
+
+impl SceneGeometry {
+    /// Builds the shapes and the broad phase of `scene`.
+    pub fn build(scene: &Scene) -> Result<Self, CollisionError> {
+        let mut leaves = Vec::new();
+        for (i, o) in scene.obstacles().iter().enumerate() {
+            let obstacle = i as u32;
+            let mut push = |shape: SharedShape, pose: Isometry3<f64>| {
+                let pose = pose_to_parry(&pose);
+                let aabb = aabb_of(&shape, &pose);
+                leaves.push(Leaf {
+                    obstacle,
+                    pose,
+                    shape,
+                    aabb,
+                });
+            };
+            match &o.geometry {
+                Geometry::Mesh { vertices, indices } => {
+                    let v: Vec<Vector> = vertices.iter().map(|p| vec_to_parry(&p.coords)).collect();
+                    let t: Vec<[u32; 3]> = indices.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+                    let mesh = SharedShape::trimesh(v, t).map_err(|e| CollisionError::Degenerate {
+                        field: format!("obstacles[{i}].mesh"),
+                        reason: e.to_string(),
+                    })?;
+                    push(mesh, o.pose);
+                }
+                Geometry::OccupiedCells { size, centers } => {
+                    let h = 0.5 * size;
+                    let cube = SharedShape::cuboid(h, h, h);
+                    for c in centers {
+                        push(cube.clone(), o.pose * Translation3::from(c.coords));
+                    }
+                }
+                g => {
+                    let (shape, fix) = primitive_shape(g).expect("primitives have a parry shape");
+                    push(shape, o.pose * fix);
+                }
+            }
+        }
+        let boxes: Vec<Aabb> = leaves.iter().map(|l| l.aabb).collect();
+        let bvh = Bvh::build(&boxes);
+        Ok(SceneGeometry {
+            scene: scene.clone(),
+            leaves,
+            bvh,
+        })
+    }
+
+    /// The scene this was built from.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// Name of obstacle `index` (empty names become `obstacles[index]`).
+    pub fn obstacle_name(&self, index: usize) -> String {
+        match self.scene.obstacles().get(index) {
+            Some(o) if !o.name.is_empty() => o.name.clone(),
+            _ => format!("obstacles[{index}]"),
+        }
+    }
+}

@@ -1,0 +1,30 @@
+//! Motion planning in joint space: STOMP and the Cartesian-constrained
+//! CCSTOMP of S0 §3, RRT-Connect with shortcutting, time parameterisation,
+//! and [`plan`], the one entry point a service calls. Planners see the world
+//! only through [`StateChecker`](crate::collision::StateChecker).
+
+mod cartesian;
+mod clock;
+mod costs;
+mod entry;
+mod error;
+mod noise;
+mod params;
+mod rrt_connect;
+mod stomp;
+mod stomp_matrices;
+mod timing;
+
+pub use cartesian::{CartesianLine, Deviation, cartesian_cost, deviation, perturb_pose, violates};
+pub use entry::{Algorithm, Goal, PlanControl, PlanRequest, PlanResult, PlanStatus, Timings, plan};
+pub use error::{PlanError, PlanField};
+pub use params::{CartesianParams, InitialTrajectory, RrtParams, StompParams};
+pub use rrt_connect::{RrtOutcome, RrtStop};
+pub use stomp::{IterationReport, StompOutcome, StompStop};
+pub use stomp_matrices::{ACCELERATION_STENCIL, PADDING, StompMatrices, finite_difference_matrix};
+pub use timing::{MIN_SEGMENT_TIME, TimingParams, time_parameterize};
+
+#[cfg(test)]
+mod tests;
+#[cfg(test)]
+mod toy;

@@ -1,0 +1,465 @@
+//! RRT-Connect (Kuffner & LaValle 2000) in joint space, with shortcutting
+//! and resampling for STOMP's initial trajectory.
+
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+
+use super::RrtParams;
+use super::clock::{Clock, Interrupt};
+use super::costs::{interior_valid, resolution_of};
+use super::noise::stream;
+use crate::collision::StateChecker;
+use crate::robot::{Chain, JointKind};
+
+/// How RRT-Connect ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RrtStop {
+    /// The trees met.
+    Connected,
+    /// `max_samples` samples without a connection.
+    SampleBudget,
+    /// The deadline passed.
+    Deadline,
+    /// The caller's `should_stop` returned true.
+    Cancelled,
+}
+
+/// What [`rrt_connect`](super::rrt_connect) returns.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RrtOutcome {
+    /// Waypoints from start to goal (row-major, `dof` per row), shortcut;
+    /// empty unless `stop` is `Connected`.
+    pub path: Vec<f64>,
+    pub stop: RrtStop,
+    /// Random samples drawn.
+    pub samples: usize,
+    /// Nodes in both trees.
+    pub nodes: usize,
+}
+
+/// A tree of joint states: flat row-major storage and parent indices, so
+/// an extension appends to two `Vec`s and allocates nothing else.
+struct Tree {
+    q: Vec<f64>,
+    parent: Vec<u32>,
+    dof: usize,
+}
+
+enum Extend {
+    Reached(usize),
+    Advanced(usize),
+    Trapped,
+}
+
+impl Tree {
+    fn new(root: &[f64], capacity: usize) -> Self {
+        let mut q = Vec::with_capacity(capacity * root.len());
+        q.extend_from_slice(root);
+        Self {
+            q,
+            parent: vec![u32::MAX],
+            dof: root.len(),
+        }
+    }
+    fn len(&self) -> usize {
+        self.parent.len()
+    }
+    fn node(&self, i: usize) -> &[f64] {
+        &self.q[i * self.dof..(i + 1) * self.dof]
+    }
+    /// Nearest node by Euclidean joint distance: a linear scan over the flat
+    /// array with early exit on partial sums (trees stay small when the
+    /// answer is fast; the scan is cache-friendly and allocation-free).
+    fn nearest(&self, target: &[f64]) -> usize {
+        let mut best = 0;
+        let mut best_d = f64::INFINITY;
+        for (i, row) in self.q.chunks_exact(self.dof).enumerate() {
+            let mut d = 0.0;
+            for (a, b) in row.iter().zip(target) {
+                d += (a - b) * (a - b);
+                if d >= best_d {
+                    break;
+                }
+            }
+            if d < best_d {
+                best_d = d;
+                best = i;
+            }
+        }
+        best
+    }
+}
+
+struct Search<'a, C: ?Sized> {
+    checker: &'a C,
+    range: f64,
+    resolution: f64,
+    q_new: Vec<f64>,
+    buf: Vec<f64>,
+}
+
+impl<C: StateChecker + ?Sized> Search<'_, C> {
+    /// One step of at most `range` from the nearest node towards `target`.
+    fn extend(&mut self, tree: &mut Tree, target: &[f64], clock: &Clock<'_>) -> Extend {
+        let near = tree.nearest(target);
+        let from = tree.node(near);
+        let dist = from
+            .iter()
+            .zip(target)
+            .map(|(a, b)| (b - a) * (b - a))
+            .sum::<f64>()
+            .sqrt();
+        let reached = dist <= self.range;
+        let s = if reached { 1.0 } else { self.range / dist };
+        for ((v, a), b) in self.q_new.iter_mut().zip(from).zip(target) {
+            *v = a + s * (b - a);
+        }
+        if reached {
+            self.q_new.copy_from_slice(target);
+        }
+        if !self.checker.is_valid(&self.q_new)
+            || interior_valid(
+                self.checker,
+                from,
+                &self.q_new,
+                self.resolution,
+                &mut self.buf,
+                clock,
+            ) != Some(true)
+        {
+            return Extend::Trapped;
+        }
+        tree.q.extend_from_slice(&self.q_new);
+        tree.parent.push(near as u32);
+        let i = tree.len() - 1;
+        if reached {
+            Extend::Reached(i)
+        } else {
+            Extend::Advanced(i)
+        }
+    }
+
+    /// Extends repeatedly towards `target` until reached or trapped.
+    fn connect(&mut self, tree: &mut Tree, target: &[f64], clock: &Clock<'_>) -> Extend {
+        loop {
+            match self.extend(tree, target, clock) {
+                Extend::Advanced(_) => {
+                    if clock.interrupted().is_some() {
+                        return Extend::Trapped;
+                    }
+                }
+                other => return other,
+            }
+        }
+    }
+}
+
+/// Sampling box per joint: the limits, or ±π (rotational) / ±1 m
+/// (prismatic) for unlimited joints.
+pub(crate) fn sampling_bounds(chain: &Chain) -> Vec<(f64, f64)> {
+    chain
+        .joints()
+        .iter()
+        .map(|j| {
+            if j.lower.is_finite() && j.upper.is_finite() && j.upper - j.lower < 1e6 {
+                (j.lower, j.upper)
+            } else if j.kind == JointKind::Prismatic {
+                (-1.0, 1.0)
+            } else {
+                (-std::f64::consts::PI, std::f64::consts::PI)
+            }
+        })
+        .collect()
+}
+
+/// RRT-Connect between two valid states, then shortcut.
+///
+/// Trees grow from start and goal; each sample `q_rand` (uniform in the
+/// limits, ChaCha8 stream from `seed`) extends one tree by at most `range`
+/// (Euclidean, rad or m) and the other tree connects greedily towards the
+/// new node; the trees swap roles each sample. Every edge is checked as the
+/// checker's interpolated motion (states ≤ its resolution apart). The
+/// joined path is shortcut by [`shortcut`]. Deadline and `should_stop` are
+/// checked every sample and every connect step. Parameters must be valid.
+pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
+    chain: &Chain,
+    checker: &C,
+    start: &[f64],
+    goal: &[f64],
+    params: &RrtParams,
+    seed: u64,
+    clock: &Clock<'_>,
+) -> RrtOutcome {
+    let dof = start.len();
+    let bounds = sampling_bounds(chain);
+    let mut rng = stream(seed, u64::MAX, 0);
+    let mut search = Search {
+        checker,
+        range: params.range,
+        resolution: resolution_of(checker),
+        q_new: vec![0.0; dof],
+        buf: vec![0.0; dof],
+    };
+    let cap = params.max_samples.min(4096);
+    let mut a = Tree::new(start, cap);
+    let mut b = Tree::new(goal, cap);
+    let mut a_is_start = true;
+    let mut q_rand = vec![0.0; dof];
+    let mut target = vec![0.0; dof];
+    let mut samples = 0;
+    let outcome = |stop, path, a: &Tree, b: &Tree, samples| RrtOutcome {
+        path,
+        stop,
+        samples,
+        nodes: a.len() + b.len(),
+    };
+    // The straight motion first: free problems need no tree.
+    if interior_valid(checker, start, goal, search.resolution, &mut search.buf, clock) == Some(true) {
+        let mut path = start.to_vec();
+        path.extend_from_slice(goal);
+        return outcome(RrtStop::Connected, path, &a, &b, 0);
+    }
+    while samples < params.max_samples {
+        if let Some(i) = clock.interrupted() {
+            let stop = match i {
+                Interrupt::Deadline => RrtStop::Deadline,
+                Interrupt::Cancelled => RrtStop::Cancelled,
+            };
+            return outcome(stop, Vec::new(), &a, &b, samples);
+        }
+        samples += 1;
+        for (v, &(lo, hi)) in q_rand.iter_mut().zip(&bounds) {
+            *v = if hi > lo { rng.random_range(lo..=hi) } else { lo };
+        }
+        let new = match search.extend(&mut a, &q_rand, clock) {
+            Extend::Trapped => None,
+            Extend::Reached(i) | Extend::Advanced(i) => Some(i),
+        };
+        if let Some(ia) = new {
+            target.copy_from_slice(a.node(ia));
+            if let Extend::Reached(ib) = search.connect(&mut b, &target, clock) {
+                let (s_tree, s_end, g_tree, g_end) = if a_is_start {
+                    (&a, ia, &b, ib)
+                } else {
+                    (&b, ib, &a, ia)
+                };
+                let mut path = Vec::new();
+                let mut i = s_end;
+                let mut rows = Vec::new();
+                loop {
+                    rows.push(i);
+                    if s_tree.parent[i] == u32::MAX {
+                        break;
+                    }
+                    i = s_tree.parent[i] as usize;
+                }
+                for &r in rows.iter().rev() {
+                    path.extend_from_slice(s_tree.node(r));
+                }
+                // g_end duplicates s_end's state: start from its parent
+                let mut i = g_end;
+                while g_tree.parent[i] != u32::MAX {
+                    i = g_tree.parent[i] as usize;
+                    path.extend_from_slice(g_tree.node(i));
+                }
+                path[..dof].copy_from_slice(start);
+                let last = path.len() - dof;
+                path[last..].copy_from_slice(goal);
+                let res = search.resolution;
+                shortcut(
+                    checker,
+                    &mut path,
+                    dof,
+                    res,
+                    params.shortcut_attempts,
+                    &mut rng,
+                    clock,
+                );
+                return outcome(RrtStop::Connected, path, &a, &b, samples);
+            }
+        }
+        std::mem::swap(&mut a, &mut b);
+        a_is_start = !a_is_start;
+    }
+    outcome(RrtStop::SampleBudget, Vec::new(), &a, &b, samples)
+}
+
+fn dist(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Greedy vertex shortcut: from each kept vertex, jump to the farthest
+/// later vertex reachable by a valid straight motion.
+fn greedy_pass<C: StateChecker + ?Sized>(
+    checker: &C,
+    path: &mut Vec<f64>,
+    dof: usize,
+    resolution: f64,
+    clock: &Clock<'_>,
+) {
+    let n = path.len() / dof;
+    let mut buf = vec![0.0; dof];
+    let mut out = path[..dof].to_vec();
+    let mut i = 0;
+    while i + 1 < n {
+        let mut j = n - 1;
+        while j > i + 1 {
+            match interior_valid(
+                checker,
+                &path[i * dof..(i + 1) * dof],
+                &path[j * dof..(j + 1) * dof],
+                resolution,
+                &mut buf,
+                clock,
+            ) {
+                None => return,
+                Some(true) => break,
+                Some(false) => j -= 1,
+            }
+        }
+        out.extend_from_slice(&path[j * dof..(j + 1) * dof]);
+        i = j;
+    }
+    *path = out;
+}
+
+/// Shortens a valid path in place: a greedy vertex pass, `attempts` random
+/// partial shortcuts (two points `p1`, `p2` drawn uniformly by arc length on
+/// different segments replace the path between them when the motions
+/// `v_{s1} → p1 → p2 → v_{s2+1}` are valid — the pieces of old segments are
+/// re-checked, since an interpolated check of a piece visits other states),
+/// and a final greedy pass. The ends are kept exactly; every edge of the
+/// result is checked at `resolution`. Stops early when `clock` is
+/// interrupted (the path stays valid).
+pub(crate) fn shortcut<C: StateChecker + ?Sized>(
+    checker: &C,
+    path: &mut Vec<f64>,
+    dof: usize,
+    resolution: f64,
+    attempts: usize,
+    rng: &mut ChaCha8Rng,
+    clock: &Clock<'_>,
+) {
+    greedy_pass(checker, path, dof, resolution, clock);
+    let mut buf = vec![0.0; dof];
+    let mut cum = Vec::new();
+    let mut p1 = vec![0.0; dof];
+    let mut p2 = vec![0.0; dof];
+    for _ in 0..attempts {
+        if clock.interrupted().is_some() {
+            return;
+        }
+        let n = path.len() / dof;
+        if n < 3 {
+            break;
+        }
+        cum.clear();
+        cum.push(0.0);
+        for s in 0..n - 1 {
+            let l = dist(&path[s * dof..(s + 1) * dof], &path[(s + 1) * dof..(s + 2) * dof]);
+            cum.push(cum[s] + l);
+        }
+        let total = cum[n - 1];
+        if total <= 0.0 {
+            break;
+        }
+        let (mut u1, mut u2) = (rng.random::<f64>() * total, rng.random::<f64>() * total);
+        if u1 > u2 {
+            std::mem::swap(&mut u1, &mut u2);
+        }
+        let seg = |u: f64| cum.partition_point(|&c| c <= u).clamp(1, n - 1) - 1;
+        let (s1, s2) = (seg(u1), seg(u2));
+        if s1 == s2 {
+            continue;
+        }
+        let point = |s: usize, u: f64, out: &mut [f64]| {
+            let l = cum[s + 1] - cum[s];
+            let f = if l > 0.0 { (u - cum[s]) / l } else { 0.0 };
+            for (j, v) in out.iter_mut().enumerate() {
+                *v = path[s * dof + j] + f * (path[(s + 1) * dof + j] - path[s * dof + j]);
+            }
+        };
+        point(s1, u1, &mut p1);
+        point(s2, u2, &mut p2);
+        let v1 = &path[s1 * dof..(s1 + 1) * dof];
+        let v2 = &path[(s2 + 1) * dof..(s2 + 2) * dof];
+        let mut ok = checker.is_valid(&p1) && checker.is_valid(&p2);
+        for (x, y) in [(v1, &p1[..]), (&p1[..], &p2[..]), (&p2[..], v2)] {
+            if !ok {
+                break;
+            }
+            match interior_valid(checker, x, y, resolution, &mut buf, clock) {
+                None => return,
+                Some(v) => ok = v,
+            }
+        }
+        if ok {
+            let mut out = Vec::with_capacity(path.len());
+            out.extend_from_slice(&path[..(s1 + 1) * dof]);
+            out.extend_from_slice(&p1);
+            out.extend_from_slice(&p2);
+            out.extend_from_slice(&path[(s2 + 1) * dof..]);
+            *path = out;
+        }
+    }
+    greedy_pass(checker, path, dof, resolution, clock);
+}
+
+/// `n ≥ 2` waypoints on a piecewise-linear path (row-major): every vertex is
+/// kept (so no chord cuts a corner) and the remaining `n − vertices` points
+/// are spread over the segments in proportion to their length. With more
+/// vertices than `n`, points are placed uniformly by arc length instead.
+pub(crate) fn resample(path: &[f64], dof: usize, n: usize) -> Vec<f64> {
+    let v = path.len() / dof;
+    let row = |i: usize| &path[i * dof..(i + 1) * dof];
+    let lens: Vec<f64> = (0..v - 1).map(|s| dist(row(s), row(s + 1))).collect();
+    let total: f64 = lens.iter().sum();
+    let mut out = Vec::with_capacity(n * dof);
+    if v <= n && total > 0.0 {
+        // extra points per segment by largest remainders
+        let extra = n - v;
+        let ideal: Vec<f64> = lens.iter().map(|l| l / total * extra as f64).collect();
+        let mut count: Vec<usize> = ideal.iter().map(|x| x.floor() as usize).collect();
+        let left = extra - count.iter().sum::<usize>();
+        let mut order: Vec<usize> = (0..lens.len()).collect();
+        order.sort_by(|&a, &b| (ideal[b] - ideal[b].floor()).total_cmp(&(ideal[a] - ideal[a].floor())));
+        for &s in order.iter().cycle().take(left) {
+            count[s] += 1;
+        }
+        for (s, &k) in count.iter().enumerate() {
+            out.extend_from_slice(row(s));
+            for i in 1..=k {
+                let f = i as f64 / (k + 1) as f64;
+                out.extend(row(s).iter().zip(row(s + 1)).map(|(a, b)| a + f * (b - a)));
+            }
+        }
+        out.extend_from_slice(row(v - 1));
+        return out;
+    }
+    let mut s = 0;
+    let mut acc = 0.0;
+    for i in 0..n {
+        let u = if total > 0.0 {
+            total * i as f64 / (n - 1) as f64
+        } else {
+            0.0
+        };
+        while s + 1 < v - 1 && acc + lens[s] < u {
+            acc += lens[s];
+            s += 1;
+        }
+        let f = if lens[s] > 0.0 {
+            ((u - acc) / lens[s]).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        out.extend(row(s).iter().zip(row(s + 1)).map(|(a, b)| a + f * (b - a)));
+    }
+    out[..dof].copy_from_slice(row(0));
+    out[(n - 1) * dof..].copy_from_slice(row(v - 1));
+    out
+}

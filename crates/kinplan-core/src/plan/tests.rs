@@ -1,0 +1,420 @@
+//! Planner tests on closed-form toy worlds, each result re-checked by an
+//! independent fine-resolution check.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+use super::toy::{JointBoxes, PlanarWorld, fine_valid};
+use super::*;
+use crate::collision::StateChecker;
+use crate::robot::{Chain, builtin_chain};
+
+fn planar3() -> std::sync::Arc<Chain> {
+    builtin_chain("planar_3").unwrap()
+}
+
+fn blocked_request(algorithm: Algorithm) -> PlanRequest {
+    PlanRequest {
+        start: vec![-1.3, 0.0, 0.0],
+        goal: Goal::Joints(vec![1.3, 0.0, 0.0]),
+        algorithm,
+        seed: 7,
+        ..Default::default()
+    }
+}
+
+fn assert_ends(r: &PlanResult, start: &[f64], goal: &[f64]) {
+    let d = r.dof;
+    assert_eq!(&r.q[..d], start, "start not kept exactly");
+    assert_eq!(&r.q[r.q.len() - d..], goal, "goal not kept exactly");
+}
+
+#[test]
+fn the_toy_world_blocks_the_straight_line() {
+    let w = PlanarWorld::planar3_blocked();
+    assert!(w.is_valid(&[-1.3, 0.0, 0.0]) && w.is_valid(&[1.3, 0.0, 0.0]));
+    assert!(!w.motion_valid(&[-1.3, 0.0, 0.0], &[1.3, 0.0, 0.0]));
+}
+
+#[test]
+fn stomp_from_the_straight_line_goes_around_the_circle() {
+    // A small circle the straight arm's tip sweeps through: STOMP alone
+    // (MoveIt's h = 0.5, no RRT-Connect start) must bend the arm around it.
+    let chain = planar3();
+    let mut w = PlanarWorld::planar3_blocked();
+    w.circles = vec![(0.9, 0.0, 0.06)];
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.stomp.initial = InitialTrajectory::StraightLine;
+    req.stomp.timesteps = 20;
+    req.stomp.max_iterations = 200;
+    req.stomp.noise_stddev = vec![1.0];
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert_eq!(r.status, PlanStatus::Succeeded, "history {:?}", r.cost_history);
+    assert_eq!(r.q.len(), 20 * 3);
+    assert!(
+        fine_valid(&w.shrunk(0.02), &r.q, 3, 0.001),
+        "independent check found a collision"
+    );
+    assert_ends(&r, &[-1.3, 0.0, 0.0], &[1.3, 0.0, 0.0]);
+    // the cost never rises (reverted updates keep the old θ)
+    assert!(r.cost_history.windows(2).all(|c| c[1] <= c[0]));
+    assert!(r.cost_history[0] > *r.cost_history.last().unwrap());
+}
+
+#[test]
+fn stomp_and_rrt_connect_succeed_from_a_blocked_line_and_recheck_clean() {
+    let chain = planar3();
+    let w = PlanarWorld::planar3_blocked();
+    for alg in [Algorithm::Stomp, Algorithm::RrtConnect] {
+        let r = plan(&chain, &w, &blocked_request(alg), PlanControl::default()).unwrap();
+        assert_eq!(r.status, PlanStatus::Succeeded, "{alg:?}");
+        assert!(r.valid);
+        assert!(
+            fine_valid(&w.shrunk(0.02), &r.q, 3, 0.001),
+            "{alg:?}: independent check found a collision"
+        );
+        assert_ends(&r, &[-1.3, 0.0, 0.0], &[1.3, 0.0, 0.0]);
+        assert!(r.criteria.is_some_and(|c| c.jd > 0.0));
+    }
+}
+
+#[test]
+fn rrt_connect_threads_a_narrow_joint_space_passage() {
+    // A wall at 0.4 < q0 < 0.6 with one 0.1-wide hole at 0.5 < q1 < 0.6.
+    let wall = |lo1: f64, hi1: f64| (vec![0.4, lo1, -10.0], vec![0.6, hi1, 10.0]);
+    let w = JointBoxes {
+        dof: 3,
+        limit: std::f64::consts::PI,
+        boxes: vec![wall(-10.0, 0.5), wall(0.6, 10.0)],
+    };
+    let chain = planar3();
+    let req = PlanRequest {
+        start: vec![0.0, -1.0, 0.0],
+        goal: Goal::Joints(vec![1.0, 1.0, 0.3]),
+        algorithm: Algorithm::RrtConnect,
+        seed: 3,
+        ..Default::default()
+    };
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert_eq!(r.status, PlanStatus::Succeeded);
+    assert!(fine_valid(&w.shrunk(0.01), &r.q, 3, 0.001));
+    assert_ends(&r, &[0.0, -1.0, 0.0], &[1.0, 1.0, 0.3]);
+}
+
+#[test]
+fn the_same_seed_gives_the_same_trajectory_on_any_pool() {
+    let chain = planar3();
+    let w = PlanarWorld::planar3_blocked();
+    for alg in [Algorithm::Stomp, Algorithm::RrtConnect] {
+        let req = blocked_request(alg);
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| plan(&chain, &w, &req, PlanControl::default()).unwrap())
+        };
+        let (a, b, c) = (run(1), run(2), run(2));
+        assert_eq!(a.q, b.q, "{alg:?}: 1 vs 2 threads");
+        assert_eq!(b.q, c.q);
+        assert_eq!(a.cost_history, b.cost_history);
+        let mut other = req.clone();
+        other.seed = 8;
+        let d = plan(&chain, &w, &other, PlanControl::default()).unwrap();
+        assert_ne!(a.q, d.q, "{alg:?}: another seed, same answer");
+    }
+}
+
+#[test]
+fn a_10_ms_budget_answers_within_about_10_ms() {
+    let chain = planar3();
+    let mut w = PlanarWorld::planar3_blocked();
+    w.spin = 2_000; // ~tens of µs per state check
+    for alg in [Algorithm::Stomp, Algorithm::RrtConnect] {
+        let mut req = blocked_request(alg);
+        req.stomp.initial = InitialTrajectory::StraightLine;
+        let t0 = Instant::now();
+        let ctl = PlanControl {
+            deadline: Some(t0 + Duration::from_millis(10)),
+            ..Default::default()
+        };
+        let r = plan(&chain, &w, &req, ctl).unwrap();
+        let took = t0.elapsed();
+        // the re-check and timing after the deadline cost a few state checks
+        assert!(took < Duration::from_millis(40), "{alg:?} took {took:?}");
+        assert!(
+            matches!(r.status, PlanStatus::Timeout | PlanStatus::Succeeded),
+            "{alg:?}: {:?}",
+            r.status
+        );
+    }
+}
+
+#[test]
+fn cancellation_is_a_status() {
+    let chain = planar3();
+    let w = PlanarWorld::planar3_blocked();
+    let calls = AtomicUsize::new(0);
+    let stop = || calls.fetch_add(1, Ordering::Relaxed) > 3;
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.stomp.initial = InitialTrajectory::StraightLine;
+    let ctl = PlanControl {
+        should_stop: &stop,
+        ..Default::default()
+    };
+    let r = plan(&chain, &w, &req, ctl).unwrap();
+    assert_eq!(r.status, PlanStatus::Cancelled);
+    assert_eq!(r.q.len(), 40 * 3, "best so far returned");
+}
+
+#[test]
+fn invalid_start_and_goal_are_statuses_and_bad_parameters_errors() {
+    let chain = planar3();
+    let w = PlanarWorld::planar3_blocked();
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.start = vec![0.0, 0.0, 0.0]; // straight arm through the circle
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert_eq!(r.status, PlanStatus::InvalidStart);
+    assert!(r.q.is_empty());
+    let mut req = blocked_request(Algorithm::RrtConnect);
+    req.goal = Goal::Joints(vec![0.0, 0.0, 0.0]);
+    assert_eq!(
+        plan(&chain, &w, &req, PlanControl::default()).unwrap().status,
+        PlanStatus::InvalidGoal
+    );
+    // goal outside the limits
+    req.goal = Goal::Joints(vec![4.0, 0.0, 0.0]);
+    assert_eq!(
+        plan(&chain, &w, &req, PlanControl::default()).unwrap().status,
+        PlanStatus::InvalidGoal
+    );
+
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.stomp.timesteps = 2;
+    let e = plan(&chain, &w, &req, PlanControl::default()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PlanError::InvalidParam {
+                field: PlanField::Timesteps,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.start = vec![0.0, f64::NAN, 0.0];
+    let e = plan(&chain, &w, &req, PlanControl::default()).unwrap_err();
+    assert_eq!(
+        e,
+        PlanError::NonFinite {
+            field: PlanField::Start,
+            index: 1
+        }
+    );
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.goal = Goal::Joints(vec![0.0]);
+    let e = plan(&chain, &w, &req, PlanControl::default()).unwrap_err();
+    assert!(matches!(
+        e,
+        PlanError::WrongLength {
+            field: PlanField::GoalJoints,
+            ..
+        }
+    ));
+    let mut req = blocked_request(Algorithm::Ccstomp);
+    req.cartesian.rotation_tolerance = -1.0;
+    let e = plan(&chain, &w, &req, PlanControl::default()).unwrap_err();
+    assert!(matches!(
+        e,
+        PlanError::InvalidParam {
+            field: PlanField::RotationTolerance,
+            ..
+        }
+    ));
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.stomp.max_rollouts = 3;
+    assert!(plan(&chain, &w, &req, PlanControl::default()).is_err());
+}
+
+#[test]
+fn progress_sees_every_iteration_with_a_never_rising_cost() {
+    let chain = planar3();
+    let w = PlanarWorld::planar3_blocked();
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.stomp.initial = InitialTrajectory::StraightLine;
+    req.stomp.max_iterations = 20;
+    req.stomp.iterations_after_valid = 100;
+    let mut seen = Vec::new();
+    let mut cb = |it: &IterationReport<'_>| seen.push((it.iteration, it.cost, it.trajectory.len()));
+    let ctl = PlanControl {
+        progress: Some(&mut cb),
+        ..Default::default()
+    };
+    let r = plan(&chain, &w, &req, ctl).unwrap();
+    assert_eq!(seen.len(), 20);
+    assert_eq!(r.iterations, 20);
+    assert!(seen.iter().enumerate().all(|(i, s)| s.0 == i && s.2 == 120));
+    assert!(seen.windows(2).all(|p| p[1].1 <= p[0].1));
+}
+
+/// Velocity and acceleration of a timed piecewise-linear path, computed
+/// here from the definitions (not with the planner's code).
+fn worst_rates(q: &[f64], t: &[f64], dof: usize, v: &[f64], a: &[f64]) -> (f64, f64) {
+    let n = t.len();
+    let vel = |s: usize, j: usize| (q[(s + 1) * dof + j] - q[s * dof + j]) / (t[s + 1] - t[s]);
+    let mut worst_v: f64 = 0.0;
+    let mut worst_a: f64 = 0.0;
+    for j in 0..dof {
+        for s in 0..n - 1 {
+            worst_v = worst_v.max(vel(s, j).abs() / v[j]);
+        }
+        for i in 0..n {
+            let vin = if i > 0 { vel(i - 1, j) } else { 0.0 };
+            let vout = if i + 1 < n { vel(i, j) } else { 0.0 };
+            let span = match i {
+                0 => (t[1] - t[0]) / 2.0,
+                _ if i + 1 == n => (t[n - 1] - t[n - 2]) / 2.0,
+                _ => (t[i + 1] - t[i - 1]) / 2.0,
+            };
+            worst_a = worst_a.max((vout - vin).abs() / span / a[j]);
+        }
+    }
+    (worst_v, worst_a)
+}
+
+#[test]
+fn time_parameterisation_never_exceeds_the_limits() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+    for case in 0..200 {
+        let dof = rng.random_range(1..7);
+        let n = rng.random_range(2..30);
+        let q: Vec<f64> = (0..n * dof).map(|_| rng.random_range(-2.0..2.0)).collect();
+        let v: Vec<f64> = (0..dof).map(|_| rng.random_range(0.2..3.0)).collect();
+        let a: Vec<f64> = (0..dof).map(|_| rng.random_range(0.5..10.0)).collect();
+        let t = time_parameterize(&q, dof, &v, None);
+        assert!(t.windows(2).all(|w| w[1] > w[0]));
+        assert!(
+            worst_rates(&q, &t, dof, &v, &[f64::INFINITY; 6]).0 <= 1.0 + 1e-9,
+            "case {case}"
+        );
+        // some segment runs a joint at its limit: no slower than needed
+        let (wv, _) = worst_rates(&q, &t, dof, &v, &[f64::INFINITY; 6]);
+        assert!(wv > 1.0 - 1e-9 || t[n - 1] <= MIN_SEGMENT_TIME * n as f64);
+        let t = time_parameterize(&q, dof, &v, Some(&a));
+        let (wv, wa) = worst_rates(&q, &t, dof, &v, &a);
+        assert!(wv <= 1.0 + 1e-9 && wa <= 1.0 + 1e-9, "case {case}: v {wv} a {wa}");
+    }
+}
+
+#[test]
+fn returned_trajectories_are_timed_within_the_chain_velocity_limits() {
+    let chain = planar3();
+    let w = PlanarWorld::planar3_blocked();
+    let r = plan(
+        &chain,
+        &w,
+        &blocked_request(Algorithm::Stomp),
+        PlanControl::default(),
+    )
+    .unwrap();
+    let v: Vec<f64> = chain.joints().iter().map(|j| j.max_velocity.unwrap()).collect();
+    let (wv, _) = worst_rates(&r.q, &r.time_from_start, 3, &v, &[f64::INFINITY; 3]);
+    assert!(wv <= 1.0 + 1e-9 && wv > 0.99, "{wv}");
+}
+
+#[test]
+fn ccstomp_keeps_every_waypoint_within_the_tolerances() {
+    // UR5 in free space (limits only), S0's noise and tolerances, tighter t_r.
+    let chain = builtin_chain("ur5").unwrap();
+    struct Free(Vec<(f64, f64)>);
+    impl StateChecker for Free {
+        fn dof(&self) -> usize {
+            self.0.len()
+        }
+        fn is_valid(&self, q: &[f64]) -> bool {
+            q.iter().zip(&self.0).all(|(v, (lo, hi))| v >= lo && v <= hi)
+        }
+        fn clearance(&self, _: &[f64], d: f64) -> f64 {
+            d
+        }
+    }
+    let w = Free(chain.limits().collect());
+    let mut req = PlanRequest {
+        start: vec![0.0, -1.2, 1.4, -0.8, 1.1, 0.2],
+        goal: Goal::Joints(vec![1.2, -1.0, 1.0, -1.2, 1.3, -0.4]),
+        algorithm: Algorithm::Ccstomp,
+        seed: 5,
+        ..Default::default()
+    };
+    req.stomp.timesteps = 10;
+    req.cartesian.translation_tolerance = 0.08;
+    req.cartesian.rotation_tolerance = 0.1;
+    // noise scaled to these tighter tolerances (S0's 0.5 m suits t_t = 1 m)
+    req.cartesian.translation_stddev = 0.05;
+    req.cartesian.rotation_stddev = 0.05;
+    req.stomp.max_iterations = 100;
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert_eq!(r.status, PlanStatus::Succeeded, "history {:?}", r.cost_history);
+    let line = CartesianLine::between(&chain, &req.start, &[1.2, -1.0, 1.0, -1.2, 1.3, -0.4]);
+    for (i, q) in r.q.chunks_exact(6).enumerate() {
+        // independent: the reference pose and the deviation by matrices
+        let pl = line.pose_at(i as f64 / 9.0).to_homogeneous();
+        let pr = chain.fk(q).to_homogeneous();
+        let diff = pl.try_inverse().unwrap() * pr;
+        let et = diff.fixed_view::<3, 1>(0, 3).norm();
+        let tr = diff.fixed_view::<3, 3>(0, 0).trace();
+        let er = ((tr - 1.0) / 2.0).clamp(-1.0, 1.0).acos();
+        assert!(et <= 0.08 && er <= 0.1, "waypoint {i}: {et} m, {er} rad");
+        assert!(
+            (r.deviation[i].translation - et).abs() < 1e-9 && (r.deviation[i].rotation - er).abs() < 1e-6
+        );
+    }
+    // the straight joint line itself leaves the tolerance, so CCSTOMP did work
+    let mut straight = req.clone();
+    straight.algorithm = Algorithm::RrtConnect;
+    let s = plan(&chain, &w, &straight, PlanControl::default()).unwrap();
+    assert_eq!(
+        s.q.len(),
+        12,
+        "free space: RRT-Connect returns the straight motion"
+    );
+    let mut mid = vec![0.0; 6];
+    for (j, m) in mid.iter_mut().enumerate() {
+        *m = 0.5 * (s.q[j] + s.q[6 + j]);
+    }
+    let d = deviation(&line.pose_at(0.5), &chain.fk(&mid));
+    assert!(d.translation > 0.08 || d.rotation > 0.1, "{d:?}");
+}
+
+#[test]
+fn a_pose_goal_is_solved_by_ik_and_reached() {
+    let chain = builtin_chain("ur5").unwrap();
+    let w = JointBoxes {
+        dof: 6,
+        limit: 2.0 * std::f64::consts::PI,
+        boxes: vec![],
+    };
+    let target = chain.fk(&[0.8, -1.0, 1.2, -1.0, 1.2, 0.1]);
+    let req = PlanRequest {
+        start: vec![0.0, -1.2, 1.4, -0.8, 1.1, 0.2],
+        goal: Goal::Pose(target),
+        algorithm: Algorithm::RrtConnect,
+        ..Default::default()
+    };
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert_eq!(r.status, PlanStatus::Succeeded);
+    let end = chain.fk(&r.q[r.q.len() - 6..]);
+    let d = deviation(&target, &end);
+    assert!(d.translation < 1e-4 && d.rotation < 1e-3);
+    assert_eq!(r.goal.as_deref(), Some(&r.q[r.q.len() - 6..]));
+    // unreachable pose
+    let mut far = req.clone();
+    far.goal = Goal::Pose(nalgebra::Isometry3::translation(5.0, 0.0, 0.0));
+    far.goal_ik.max_restarts = 3;
+    assert_eq!(
+        plan(&chain, &w, &far, PlanControl::default()).unwrap().status,
+        PlanStatus::GoalUnreachable
+    );
+}
