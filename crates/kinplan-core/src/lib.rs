@@ -10,5 +10,6 @@ pub mod collision;
 pub mod ik;
 pub mod linalg;
 pub mod mobile;
+pub mod octree;
 pub mod robot;
 pub mod score;
