@@ -7,8 +7,12 @@ mod io;
 mod key;
 mod params;
 mod query;
+mod ray;
+mod scan;
 mod tree;
 
+#[cfg(test)]
+mod ray_tests;
 #[cfg(test)]
 mod tests;
 
@@ -20,4 +24,6 @@ pub use key::{
 };
 pub use params::{LogOddsModel, OctreeLimits, SensorModel};
 pub use query::{BoxVolumes, CellVisit, StateFilter};
+pub use ray::{RayHit, RayParams, RayStop};
+pub use scan::{PinholeIntrinsics, ScanParams, ScanStats, ScanStatus, depth_image_points};
 pub use tree::{CellState, Octree};
