@@ -1,0 +1,134 @@
+//! OctoMap's discrete addressing: keys, child indices and key ↔ coordinate maps
+//! (ALGORITHMS.md §5, "OctoMap interoperability").
+
+/// Levels below the root; a key has 16 bits per axis.
+pub const TREE_DEPTH: u8 = 16;
+/// Key of the cell whose lower corner is the origin: `2^15`.
+pub const TREE_MAX_VAL: i32 = 32768;
+
+/// A cell address at depth 16: one `u16` per axis, `k = ⌊c · (1/res)⌋ + 32768`.
+pub type OcKey = [u16; 3];
+
+/// Index (0–7) of the child containing `key` below a node at depth `depth` (0 = root):
+/// bit `15 − depth` of the x, y, z keys gives `x + 2y + 4z`.
+#[inline]
+pub fn child_index(key: &OcKey, depth: u8) -> usize {
+    let bit = 15 - depth as u32;
+    (((key[0] >> bit) & 1) | (((key[1] >> bit) & 1) << 1) | (((key[2] >> bit) & 1) << 2)) as usize
+}
+
+/// Key of one axis as OctoMap's `coordToKeyChecked` computes it: `⌊c · f⌋ + 32768`
+/// with `f = 1/res` in f64; `None` outside `[0, 65536)`.
+#[inline]
+pub fn coord_to_key_axis(c: f64, resolution_factor: f64) -> Option<u16> {
+    let s = (c * resolution_factor).floor();
+    if !(s >= -(TREE_MAX_VAL as f64) && s < TREE_MAX_VAL as f64) {
+        return None;
+    }
+    Some((s as i32 + TREE_MAX_VAL) as u16)
+}
+
+/// Centre of a depth-16 key along one axis (m): `(k − 32768 + ½) · res`.
+#[inline]
+pub fn key_to_coord_axis(k: u16, resolution: f64) -> f64 {
+    ((k as i32 - TREE_MAX_VAL) as f64 + 0.5) * resolution
+}
+
+/// Centre of the depth-`depth` cell containing key `k` along one axis (m), as
+/// OctoMap's `keyToCoord(key, depth)`: the cell spans `2^(16−depth)` keys.
+#[inline]
+pub fn key_to_coord_axis_at(k: u16, depth: u8, resolution: f64) -> f64 {
+    if depth == 0 {
+        return 0.0;
+    }
+    if depth >= TREE_DEPTH {
+        return key_to_coord_axis(k, resolution);
+    }
+    let shift = (TREE_DEPTH - depth) as u32;
+    let base = ((k as i32) >> shift) << shift;
+    let half = 1i32 << (shift - 1);
+    ((base + half - TREE_MAX_VAL) as f64) * resolution
+}
+
+/// `key` with its lowest `16 − depth` bits cleared: the smallest key of the
+/// depth-`depth` cell containing it.
+#[inline]
+pub fn key_at_depth(key: &OcKey, depth: u8) -> OcKey {
+    if depth >= TREE_DEPTH {
+        return *key;
+    }
+    let shift = (TREE_DEPTH - depth) as u32;
+    let mask = if shift >= 16 {
+        0
+    } else {
+        (0xffffu32 << shift) as u16
+    };
+    [key[0] & mask, key[1] & mask, key[2] & mask]
+}
+
+/// Key of the child `i` of the cell with smallest key `base` at depth `depth`.
+#[inline]
+pub fn child_key(base: &OcKey, depth: u8, i: usize) -> OcKey {
+    let bit = 1u16 << (15 - depth as u32);
+    [
+        base[0] | if i & 1 != 0 { bit } else { 0 },
+        base[1] | if i & 2 != 0 { bit } else { 0 },
+        base[2] | if i & 4 != 0 { bit } else { 0 },
+    ]
+}
+
+/// Probability → log-odds `ln(p / (1 − p))`, as OctoMap computes it (f32).
+#[inline]
+pub fn logodds(p: f64) -> f32 {
+    (p / (1.0 - p)).ln() as f32
+}
+
+/// Log-odds → probability `1 − 1/(1 + eˡ)`.
+#[inline]
+pub fn probability(l: f32) -> f64 {
+    1.0 - 1.0 / (1.0 + (l as f64).exp())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_follow_octomap_formula() {
+        let f = 1.0 / 0.1;
+        // ⌊0.05·10⌋ = 0 → 32768; ⌊−0.05·10⌋ = −1 → 32767; ⌊1.23·10⌋ = 12 → 32780
+        assert_eq!(coord_to_key_axis(0.05, f), Some(32768));
+        assert_eq!(coord_to_key_axis(-0.05, f), Some(32767));
+        assert_eq!(coord_to_key_axis(1.23, f), Some(32780));
+        assert_eq!(coord_to_key_axis(-3276.8, f), Some(0));
+        assert_eq!(coord_to_key_axis(3276.8, f), None);
+        assert_eq!(coord_to_key_axis(f64::NAN, f), None);
+        assert!((key_to_coord_axis(32780, 0.1) - 1.25).abs() < 1e-12);
+        assert!((key_to_coord_axis(32767, 0.1) + 0.05).abs() < 1e-12);
+    }
+
+    #[test]
+    fn child_index_reads_bit_15_minus_depth() {
+        // key x = 32768 (bit 15 set), y = 0, z = 32768 + 1 (bits 15 and 0)
+        let k = [32768u16, 0, 32769];
+        assert_eq!(child_index(&k, 0), 1 + 4);
+        assert_eq!(child_index(&k, 15), 4);
+        assert_eq!(child_index(&k, 7), 0);
+    }
+
+    #[test]
+    fn coarse_cell_centres() {
+        // depth 15 cell of key 32768 spans keys 32768–32769: centre at 1 · res
+        assert!((key_to_coord_axis_at(32769, 15, 0.1) - 0.1).abs() < 1e-12);
+        // depth 1 cell of key 40000 spans keys 32768–65535: centre at 16384 · res
+        assert!((key_to_coord_axis_at(40000, 1, 0.1) - 1638.4).abs() < 1e-9);
+        assert_eq!(key_at_depth(&[40001, 7, 65535], 14), [40000, 4, 65532]);
+        assert_eq!(child_key(&[40000, 4, 65532], 14, 5), [40002, 4, 65534]);
+    }
+
+    #[test]
+    fn logodds_of_defaults() {
+        assert!((logodds(0.7) - 0.847_297_9).abs() < 1e-6);
+        assert!((probability(logodds(0.4)) - 0.4).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,29 @@
+//! OctoMap-compatible occupancy octree: keys, arena nodes, `.bt`/`.ot`/ROS-message IO,
+//! queries, ray casting and scan integration (ALGORITHMS.md §5).
+
+mod error;
+mod header;
+mod io;
+mod key;
+mod params;
+mod query;
+mod ray;
+mod scan;
+mod tree;
+
+#[cfg(test)]
+mod ray_tests;
+#[cfg(test)]
+mod tests;
+
+pub use error::OctreeError;
+pub use header::{BT_FIRST_LINE, OT_FIRST_LINE};
+pub use key::{
+    OcKey, TREE_DEPTH, TREE_MAX_VAL, child_index, child_key, coord_to_key_axis, key_at_depth,
+    key_to_coord_axis, key_to_coord_axis_at, logodds, probability,
+};
+pub use params::{LogOddsModel, OctreeLimits, SensorModel};
+pub use query::{BoxVolumes, CellVisit, StateFilter};
+pub use ray::{RayHit, RayParams, RayStop};
+pub use scan::{PinholeIntrinsics, ScanParams, ScanStats, ScanStatus, depth_image_points};
+pub use tree::{CellState, Octree};

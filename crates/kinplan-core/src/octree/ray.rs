@@ -1,0 +1,267 @@
+//! Ray casting over keys: the 3-D DDA of Amanatides & Woo with OctoMap's
+//! `computeRayKeys` and `castRay` semantics, in OctoMap's f32/f64 arithmetic so the same
+//! cells come out (ALGORITHMS.md §5).
+
+use nalgebra::{Point3, Vector3};
+use rayon::prelude::*;
+
+use super::key::{OcKey, TREE_DEPTH, coord_to_key_axis, key_to_coord_axis};
+use super::{Octree, OctreeError};
+
+/// Options of [`Octree::cast_ray`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayParams {
+    /// Treat unknown cells as free and go on (`true`) or stop there (`false`, OctoMap's
+    /// default: a ray ends at the first unknown cell, reported as not hitting).
+    pub ignore_unknown: bool,
+    /// Stop once the centre of the current cell is farther than this from the origin
+    /// (m); ≤ 0 means no limit. Default −1.
+    pub max_range: f64,
+}
+
+impl Default for RayParams {
+    fn default() -> Self {
+        Self {
+            ignore_unknown: false,
+            max_range: -1.0,
+        }
+    }
+}
+
+/// Why a cast ray stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum RayStop {
+    /// An occupied cell (the only outcome OctoMap reports as `true`).
+    Occupied,
+    /// An unknown cell while `ignore_unknown` is false.
+    Unknown,
+    /// The next cell lies beyond `max_range`.
+    MaxRange,
+    /// The ray reached the border of the tree's cube.
+    Bounds,
+}
+
+/// Result of one cast.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayHit {
+    /// True when an occupied cell stopped the ray (OctoMap's return value).
+    pub hit: bool,
+    pub stop: RayStop,
+    /// Centre of the cell where the ray stopped (m), as OctoMap's `end`.
+    pub end: Point3<f64>,
+    /// Its key.
+    pub key: OcKey,
+    /// Cells stepped through (DDA steps).
+    pub steps: u32,
+}
+
+/// The per-axis DDA state of OctoMap: step sign, parameter of the next border,
+/// parameter increment per cell.
+struct Dda {
+    step: [i32; 3],
+    t_max: [f64; 3],
+    t_delta: [f64; 3],
+}
+
+impl Dda {
+    /// `float_border`: `computeRayKeys` rounds the half cell to f32, `castRay` does not.
+    fn new(key: &OcKey, origin: &[f32; 3], dir: &[f32; 3], res: f64, float_border: bool) -> Self {
+        let mut d = Dda {
+            step: [0; 3],
+            t_max: [f64::MAX; 3],
+            t_delta: [f64::MAX; 3],
+        };
+        for i in 0..3 {
+            d.step[i] = if dir[i] > 0.0 {
+                1
+            } else if dir[i] < 0.0 {
+                -1
+            } else {
+                0
+            };
+            if d.step[i] != 0 {
+                let half = d.step[i] as f64 * res * 0.5;
+                let border =
+                    key_to_coord_axis(key[i], res) + if float_border { half as f32 as f64 } else { half };
+                d.t_max[i] = (border - origin[i] as f64) / dir[i] as f64;
+                d.t_delta[i] = res / (dir[i].abs() as f64);
+            }
+        }
+        d
+    }
+
+    /// Axis of the smallest `t_max`, ties resolved as OctoMap does.
+    #[inline]
+    fn axis(&self) -> usize {
+        let t = &self.t_max;
+        if t[0] < t[1] {
+            if t[0] < t[2] { 0 } else { 2 }
+        } else if t[1] < t[2] {
+            1
+        } else {
+            2
+        }
+    }
+}
+
+#[inline]
+fn f32_norm(v: &[f32; 3]) -> f64 {
+    ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) as f64).sqrt()
+}
+
+impl Octree {
+    /// Key of an f32 point (OctoMap's `coordToKeyChecked(point3d)`).
+    #[inline]
+    pub(crate) fn key_of_f32(&self, p: &[f32; 3]) -> Option<OcKey> {
+        let f = self.resolution_factor;
+        Some([
+            coord_to_key_axis(p[0] as f64, f)?,
+            coord_to_key_axis(p[1] as f64, f)?,
+            coord_to_key_axis(p[2] as f64, f)?,
+        ])
+    }
+
+    /// The cells a beam from `origin` to `end` (m, map frame, rounded to f32 as OctoMap's
+    /// `point3d`) passes through, end cell excluded, origin cell first — OctoMap's
+    /// `computeRayKeys`: DDA with `t_max_i = (border_i − o_i)/d_i`,
+    /// `t_delta_i = res/|d_i|`, stopping at the end key or once `min t_max > ‖end − o‖`.
+    /// `out` is cleared and filled (no other allocation). Returns false (and leaves
+    /// `out` empty) when either point is outside the tree's cube.
+    pub fn compute_ray_keys(&self, origin: &[f32; 3], end: &[f32; 3], out: &mut Vec<OcKey>) -> bool {
+        out.clear();
+        let (Some(ko), Some(ke)) = (self.key_of_f32(origin), self.key_of_f32(end)) else {
+            return false;
+        };
+        if ko == ke {
+            return true;
+        }
+        out.push(ko);
+        let mut dir = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
+        let length = f32_norm(&dir) as f32;
+        for v in dir.iter_mut() {
+            *v /= length;
+        }
+        let mut dda = Dda::new(&ko, origin, &dir, self.resolution, true);
+        let mut k = ko;
+        let length = length as f64;
+        // a beam between two keys in the cube crosses at most 3 · 65536 borders
+        for _ in 0..3 * 65536 {
+            let a = dda.axis();
+            k[a] = (k[a] as i32 + dda.step[a]) as u16;
+            dda.t_max[a] += dda.t_delta[a];
+            if k == ke {
+                break;
+            }
+            let dist = dda.t_max[0].min(dda.t_max[1]).min(dda.t_max[2]);
+            if dist > length {
+                break;
+            }
+            out.push(k);
+        }
+        true
+    }
+
+    /// Casts a ray from `origin` along `direction` (m, map frame; both rounded to f32)
+    /// and stops at the first occupied cell — OctoMap's `castRay`: an occupied origin
+    /// cell is a hit at once; an unknown origin (unless `ignore_unknown`) stops with
+    /// `Unknown`; the cube's border stops with `Bounds`; with `max_range > 0` a cell whose
+    /// centre is farther stops with `MaxRange`. Errors: origin outside the cube, zero or
+    /// non-finite direction.
+    pub fn cast_ray(
+        &self,
+        origin: &Point3<f64>,
+        direction: &Vector3<f64>,
+        params: &RayParams,
+    ) -> Result<RayHit, OctreeError> {
+        let o = [origin.x as f32, origin.y as f32, origin.z as f32];
+        let d = [direction.x as f32, direction.y as f32, direction.z as f32];
+        if o.iter().any(|v| !v.is_finite()) {
+            return Err(OctreeError::NonFinite { field: "origin" });
+        }
+        if d.iter().any(|v| !v.is_finite()) {
+            return Err(OctreeError::NonFinite { field: "direction" });
+        }
+        let ko = self
+            .key_of_f32(&o)
+            .ok_or(OctreeError::OutOfBounds { field: "origin" })?;
+        self.cast_ray_f32(&o, &d, &ko, params)
+    }
+
+    pub(crate) fn cast_ray_f32(
+        &self,
+        o: &[f32; 3],
+        d: &[f32; 3],
+        ko: &OcKey,
+        params: &RayParams,
+    ) -> Result<RayHit, OctreeError> {
+        let res = self.resolution;
+        let center = |k: &OcKey| [0, 1, 2].map(|i| key_to_coord_axis(k[i], res) as f32);
+        let finish = |k: OcKey, hit, stop, steps| RayHit {
+            hit,
+            stop,
+            end: Point3::from(center(&k).map(|v| v as f64)),
+            key: k,
+            steps,
+        };
+        match self.search_key(ko, TREE_DEPTH) {
+            Some((v, _)) if self.is_occupied_value(v) => return Ok(finish(*ko, true, RayStop::Occupied, 0)),
+            None if !params.ignore_unknown => return Ok(finish(*ko, false, RayStop::Unknown, 0)),
+            _ => {}
+        }
+        let len = f32_norm(d);
+        if len <= 0.0 {
+            return Err(OctreeError::InvalidParam {
+                field: "direction",
+                value: 0.0,
+                reason: "must not be zero",
+            });
+        }
+        let lenf = len as f32;
+        let dir = [d[0] / lenf, d[1] / lenf, d[2] / lenf];
+        let mut dda = Dda::new(ko, o, &dir, res, false);
+        let limit = params.max_range > 0.0;
+        let range_sq = params.max_range * params.max_range;
+        let mut k = *ko;
+        let mut steps = 0u32;
+        loop {
+            let a = dda.axis();
+            if (dda.step[a] < 0 && k[a] == 0) || (dda.step[a] > 0 && k[a] == u16::MAX) {
+                return Ok(finish(k, false, RayStop::Bounds, steps));
+            }
+            k[a] = (k[a] as i32 + dda.step[a]) as u16;
+            dda.t_max[a] += dda.t_delta[a];
+            steps += 1;
+            if limit {
+                let c = center(&k);
+                let mut sq = 0.0f64;
+                for j in 0..3 {
+                    let e = c[j] - o[j];
+                    sq += (e * e) as f64;
+                }
+                if sq > range_sq {
+                    return Ok(finish(k, false, RayStop::MaxRange, steps));
+                }
+            }
+            match self.search_key(&k, TREE_DEPTH) {
+                Some((v, _)) if self.is_occupied_value(v) => {
+                    return Ok(finish(k, true, RayStop::Occupied, steps));
+                }
+                None if !params.ignore_unknown => return Ok(finish(k, false, RayStop::Unknown, steps)),
+                _ => {}
+            }
+        }
+    }
+
+    /// Casts many rays `(origin, direction)` in parallel on the rayon pool; one result
+    /// per ray, in order.
+    pub fn cast_rays(
+        &self,
+        rays: &[(Point3<f64>, Vector3<f64>)],
+        params: &RayParams,
+    ) -> Vec<Result<RayHit, OctreeError>> {
+        rays.par_iter()
+            .with_min_len(256)
+            .map(|(o, d)| self.cast_ray(o, d, params))
+            .collect()
+    }
+}
