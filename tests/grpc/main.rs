@@ -4,6 +4,7 @@
 mod kinematics;
 mod loadtest;
 mod mobile;
+mod planning;
 mod robot;
 mod scoring;
 

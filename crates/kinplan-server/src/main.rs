@@ -67,6 +67,10 @@ struct ServeArgs {
     /// Parsed robot models kept in the cache.
     #[arg(long, env = "KINPLAN_MODEL_CACHE", default_value_t = 256)]
     model_cache: usize,
+    /// Random states sampled for each robot's allowed-collision matrix
+    /// (computed once per model).
+    #[arg(long, env = "KINPLAN_ACM_SAMPLES", default_value_t = 10_000)]
+    acm_samples: usize,
 }
 
 fn main() {
@@ -143,6 +147,7 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
         concurrency_limit: args.concurrency_limit,
         max_urdf_bytes: args.max_urdf_bytes,
         model_cache_entries: args.model_cache,
+        acm_samples: args.acm_samples,
         drain_delay: seconds(args.drain_delay_secs, "--drain-delay-secs")?,
     };
     runtime.block_on(async move {

@@ -438,7 +438,7 @@ fn linear_solver_in(field: &str, value: i32) -> Result<Option<RlxaVariant>, Stat
 /// The request's deadline less a reply reserve (a tenth of the remaining
 /// time, 0.2–100 ms, at most half of it), so that an answer cut by the budget
 /// still reaches the caller before its deadline.
-fn soft_deadline(deadline: Option<Instant>) -> Option<Instant> {
+pub(super) fn soft_deadline(deadline: Option<Instant>) -> Option<Instant> {
     let deadline = deadline?;
     let remaining = deadline.saturating_duration_since(Instant::now());
     let reserve = (remaining / 10)

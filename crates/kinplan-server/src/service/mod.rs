@@ -4,13 +4,17 @@
 
 pub mod pb;
 
+mod collision_models;
 mod compute;
 mod convert;
 mod kinematics;
 mod metrics;
 mod mobile;
 mod models;
+mod planning;
+mod planning_convert;
 mod robot;
+mod scene;
 mod scoring;
 mod server;
 mod status;

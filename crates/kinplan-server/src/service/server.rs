@@ -11,15 +11,18 @@ use tonic::transport::Server;
 use tonic::transport::server::TcpIncoming;
 use tonic_health::ServingStatus;
 
+use super::collision_models::CollisionModels;
 use super::kinematics::KinematicsApi;
 use super::metrics::MetricsLayer;
 use super::mobile::MobileApi;
 use super::models::Resolved;
 use super::pb::kinematics_service_server::KinematicsServiceServer;
 use super::pb::mobile_service_server::MobileServiceServer;
+use super::pb::planning_service_server::PlanningServiceServer;
 use super::pb::{
     self, robot_service_server::RobotServiceServer, scoring_service_server::ScoringServiceServer,
 };
+use super::planning::PlanningApi;
 use super::robot::RobotApi;
 use super::scoring::ScoringApi;
 use super::{Budget, Compute, ModelStore};
@@ -41,6 +44,9 @@ pub struct ServerConfig {
     pub max_urdf_bytes: usize,
     /// Parsed models kept in the cache.
     pub model_cache_entries: usize,
+    /// Random states sampled for a robot's allowed-collision matrix (once
+    /// per model; MoveIt's setup assistant samples 10,000).
+    pub acm_samples: usize,
     /// Time between reporting NOT_SERVING and closing the listener on
     /// shutdown, so load balancers stop sending new calls first.
     pub drain_delay: Duration,
@@ -55,6 +61,7 @@ impl Default for ServerConfig {
             concurrency_limit: 256,
             max_urdf_bytes: 2 * 1024 * 1024,
             model_cache_entries: 256,
+            acm_samples: 10_000,
             drain_delay: Duration::ZERO,
         }
     }
@@ -81,7 +88,15 @@ pub async fn serve(
         },
         config.model_cache_entries,
     ));
-    let shared = Shared { models, compute };
+    let collision = Arc::new(CollisionModels::new(
+        config.model_cache_entries,
+        config.acm_samples,
+    ));
+    let shared = Shared {
+        models,
+        compute,
+        collision,
+    };
     let limit = config.max_message_bytes;
     // Each kinplan service: its adapter, with the message size limits.
     macro_rules! service {
@@ -95,12 +110,14 @@ pub async fn serve(
     let scoring = service!(ScoringServiceServer, ScoringApi::new(shared.clone()));
     let mobile = service!(MobileServiceServer, MobileApi::new(shared.clone()));
     let kinematics = service!(KinematicsServiceServer, KinematicsApi::new(shared.clone()));
+    let planning = service!(PlanningServiceServer, PlanningApi::new(shared.clone()));
 
     let services = [
         name_of(&robot),
         name_of(&scoring),
         name_of(&mobile),
         name_of(&kinematics),
+        name_of(&planning),
     ];
     let (health, health_service) = tonic_health::server::health_reporter();
     for name in services {
@@ -135,6 +152,7 @@ pub async fn serve(
         .add_service(scoring)
         .add_service(mobile)
         .add_service(kinematics)
+        .add_service(planning)
         .serve_with_incoming_shutdown(
             // Small replies must not wait for Nagle + delayed ACK (40 ms on loopback).
             TcpIncoming::from(listener)
@@ -151,6 +169,7 @@ pub async fn serve(
 pub struct Shared {
     pub models: Arc<ModelStore>,
     pub compute: Arc<Compute>,
+    pub collision: Arc<CollisionModels>,
 }
 
 impl Shared {

@@ -1,0 +1,102 @@
+//! Collision models per robot chain: the bodies of its URDF `<collision>`
+//! primitives and the allowed-collision matrix sampled as MoveIt's setup
+//! assistant does (10 000 states by default, a fraction of a second), built
+//! once per parsed chain and kept in a small bounded cache beside the model
+//! cache. Only an optimisation: a miss rebuilds, so every replica answers.
+
+use std::sync::{Arc, Mutex, Weak};
+
+use kinplan_core::collision::{AcmParams, AllowedCollisions, CollisionError, RobotModel};
+use kinplan_core::robot::Chain;
+
+/// A chain's collision bodies and the body pairs never checked.
+pub struct CollisionSetup {
+    pub model: Arc<RobotModel>,
+    pub acm: AllowedCollisions,
+}
+
+impl CollisionSetup {
+    /// Builds the model and samples the matrix (`acm_samples` states).
+    pub fn build(chain: Arc<Chain>, acm_samples: usize) -> Result<Self, CollisionError> {
+        let model = Arc::new(RobotModel::new(chain)?);
+        let acm = AllowedCollisions::sampled(
+            &model,
+            &AcmParams {
+                samples: acm_samples,
+                ..AcmParams::default()
+            },
+        )?;
+        Ok(Self { model, acm })
+    }
+}
+
+/// Setups keyed by the identity of the cached chain they were built for (a
+/// weak reference, so an evicted chain's setup is never returned for another).
+pub struct CollisionModels {
+    entries: Mutex<Vec<(Weak<Chain>, Arc<CollisionSetup>)>>,
+    capacity: usize,
+    /// States sampled for each allowed-collision matrix.
+    pub acm_samples: usize,
+}
+
+impl CollisionModels {
+    pub fn new(capacity: usize, acm_samples: usize) -> Self {
+        Self {
+            entries: Mutex::new(Vec::new()),
+            capacity: capacity.max(1),
+            acm_samples,
+        }
+    }
+
+    /// The setup built for this very chain, if cached.
+    pub fn get(&self, chain: &Arc<Chain>) -> Option<Arc<CollisionSetup>> {
+        let entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+        entries
+            .iter()
+            .find(|(w, _)| w.upgrade().is_some_and(|c| Arc::ptr_eq(&c, chain)))
+            .map(|(_, s)| s.clone())
+    }
+
+    /// Keeps `setup` for `chain`, dropping entries whose chain is gone and then
+    /// the oldest beyond the capacity.
+    pub fn insert(&self, chain: &Arc<Chain>, setup: Arc<CollisionSetup>) {
+        let mut entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+        entries.retain(|(w, _)| w.strong_count() > 0);
+        if !entries
+            .iter()
+            .any(|(w, _)| w.upgrade().is_some_and(|c| Arc::ptr_eq(&c, chain)))
+        {
+            entries.push((Arc::downgrade(chain), setup));
+        }
+        while entries.len() > self.capacity {
+            entries.remove(0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kinplan_core::robot::builtin_chain;
+
+    #[test]
+    fn a_setup_is_found_only_for_its_own_chain_and_dropped_with_it() {
+        let cache = CollisionModels::new(4, 50);
+        let ur5 = builtin_chain("ur5").unwrap();
+        let setup = Arc::new(CollisionSetup::build(ur5.clone(), 50).unwrap());
+        cache.insert(&ur5, setup.clone());
+        assert!(Arc::ptr_eq(&cache.get(&ur5).unwrap(), &setup));
+        // An equal chain in another allocation is another model.
+        let copy = Arc::new((*ur5).clone());
+        assert!(cache.get(&copy).is_none());
+        cache.insert(&copy, Arc::new(CollisionSetup::build(copy.clone(), 50).unwrap()));
+        drop(copy);
+        // The dead entry is dropped on the next insert; capacity holds.
+        let panda = builtin_chain("franka_panda").unwrap();
+        cache.insert(
+            &panda,
+            Arc::new(CollisionSetup::build(panda.clone(), 50).unwrap()),
+        );
+        assert_eq!(cache.entries.lock().unwrap().len(), 2);
+    }
+}

@@ -1,0 +1,534 @@
+//! PlanningService end to end: plans around obstacles re-checked by the
+//! server's CheckState at a finer resolution, limits and timing checked
+//! against DescribeRobot, pose goals against forward kinematics, witness
+//! points against the sphere they lie on, and bad input named by field.
+
+use std::time::{Duration, Instant};
+
+use kinplan_server::service::ServerConfig;
+use kinplan_server::service::pb::{
+    self, collision_object::Shape, plan_request::Goal, planning_service_client::PlanningServiceClient,
+    robot_service_client::RobotServiceClient,
+};
+use tonic::Code;
+
+use crate::{named, start};
+
+const ROBOT: &str = "ur5";
+const START: [f64; 6] = [-1.2, -1.3, 1.4, -1.6, -1.57, 0.0];
+const GOAL: [f64; 6] = [1.2, -1.3, 1.4, -1.6, -1.57, 0.0];
+
+fn config() -> ServerConfig {
+    ServerConfig {
+        acm_samples: 300,
+        ..ServerConfig::default()
+    }
+}
+
+fn sphere(id: &str, centre: [f64; 3], radius: f64) -> pb::CollisionObject {
+    pb::CollisionObject {
+        id: id.into(),
+        pose: Some(pb::Pose {
+            position: Some(pb::Vec3 {
+                x: centre[0],
+                y: centre[1],
+                z: centre[2],
+            }),
+            orientation: None,
+        }),
+        shape: Some(Shape::Sphere(pb::Sphere { radius })),
+        unknown_as_obstacle: false,
+    }
+}
+
+fn request(algorithm: pb::PlanAlgorithm, scene: Vec<pb::CollisionObject>) -> pb::PlanRequest {
+    pb::PlanRequest {
+        robot: named(ROBOT),
+        start: START.to_vec(),
+        goal: Some(Goal::GoalJoints(pb::JointState {
+            positions: GOAL.to_vec(),
+        })),
+        scene: Some(pb::Scene { objects: scene }),
+        algorithm: algorithm as i32,
+        options: None,
+        seed: 7,
+    }
+}
+
+async fn tool_position(robots: &mut RobotServiceClient<tonic::transport::Channel>, q: &[f64]) -> [f64; 3] {
+    let p = robots
+        .forward_kinematics(pb::ForwardKinematicsRequest {
+            robot: named(ROBOT),
+            joint_positions: q.to_vec(),
+            include_links: false,
+        })
+        .await
+        .unwrap()
+        .into_inner()
+        .tool_pose
+        .unwrap()
+        .position
+        .unwrap();
+    [p.x, p.y, p.z]
+}
+
+/// A sphere where the tool passes at the middle of the straight joint-space
+/// line, so the line is blocked and the planner must go around it.
+async fn blocking_sphere(robots: &mut RobotServiceClient<tonic::transport::Channel>) -> pb::CollisionObject {
+    let mid: Vec<f64> = START.iter().zip(GOAL).map(|(a, b)| (a + b) / 2.0).collect();
+    sphere("ball", tool_position(robots, &mid).await, 0.12)
+}
+
+/// States along every segment, at most `step` rad apart, all valid per CheckState.
+async fn assert_path_valid(
+    planning: &mut PlanningServiceClient<tonic::transport::Channel>,
+    scene: &[pb::CollisionObject],
+    traj: &pb::JointTrajectory,
+    step: f64,
+) {
+    let mut states = Vec::new();
+    for w in traj.points.windows(2) {
+        let (a, b) = (&w[0].positions, &w[1].positions);
+        let span = a.iter().zip(b).map(|(x, y)| (y - x).abs()).fold(0.0, f64::max);
+        let n = (span / step).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            let t = k as f64 / n as f64;
+            states.push(pb::JointState {
+                positions: a.iter().zip(b).map(|(x, y)| x + t * (y - x)).collect(),
+            });
+        }
+    }
+    let count = states.len();
+    let checks = planning
+        .check_state(pb::CheckStateRequest {
+            robot: named(ROBOT),
+            states,
+            scene: Some(pb::Scene {
+                objects: scene.to_vec(),
+            }),
+            max_distance: None,
+        })
+        .await
+        .unwrap()
+        .into_inner()
+        .states;
+    assert_eq!(checks.len(), count);
+    if let Some(bad) = checks.iter().position(|c| !c.valid) {
+        panic!(
+            "state {bad} of {count} on the path is invalid: {:?}",
+            checks[bad].colliding
+        );
+    }
+}
+
+#[tokio::test]
+async fn every_planner_goes_around_a_blocking_sphere_within_the_speed_limits() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let ball = blocking_sphere(&mut robots).await;
+    // The straight line is blocked, the ends are free.
+    let mid: Vec<f64> = START.iter().zip(GOAL).map(|(a, b)| (a + b) / 2.0).collect();
+    let ends = planning
+        .check_state(pb::CheckStateRequest {
+            robot: named(ROBOT),
+            states: [START.to_vec(), mid, GOAL.to_vec()]
+                .into_iter()
+                .map(|positions| pb::JointState { positions })
+                .collect(),
+            scene: Some(pb::Scene {
+                objects: vec![ball.clone()],
+            }),
+            max_distance: None,
+        })
+        .await
+        .unwrap()
+        .into_inner()
+        .states;
+    assert!(ends[0].valid && ends[2].valid && !ends[1].valid, "{ends:?}");
+    assert!(
+        ends[1].colliding.iter().any(|c| c.ends_with(":ball")),
+        "{:?}",
+        ends[1].colliding
+    );
+
+    let limits: Vec<f64> = robots
+        .describe_robot(pb::DescribeRobotRequest { robot: named(ROBOT) })
+        .await
+        .unwrap()
+        .into_inner()
+        .joints
+        .iter()
+        .map(|j| j.max_velocity)
+        .collect();
+    for algorithm in [
+        pb::PlanAlgorithm::RrtConnect,
+        pb::PlanAlgorithm::Stomp,
+        pb::PlanAlgorithm::Ccstomp,
+    ] {
+        let reply = planning
+            .plan(request(algorithm, vec![ball.clone()]))
+            .await
+            .unwrap()
+            .into_inner();
+        assert_eq!(
+            reply.status,
+            pb::PlanStatus::Succeeded as i32,
+            "{algorithm:?}: {}",
+            reply.message
+        );
+        assert!(reply.valid);
+        let traj = reply.trajectory.unwrap();
+        let (first, last) = (&traj.points[0], traj.points.last().unwrap());
+        assert_eq!(
+            first.positions,
+            START.to_vec(),
+            "{algorithm:?}: start kept exactly"
+        );
+        assert_eq!(last.positions, GOAL.to_vec(), "{algorithm:?}: goal kept exactly");
+        assert_eq!(first.time_from_start, 0.0);
+        for w in traj.points.windows(2) {
+            let dt = w[1].time_from_start - w[0].time_from_start;
+            assert!(dt > 0.0, "{algorithm:?}: times increase");
+            for (j, v) in limits.iter().enumerate() {
+                let speed = (w[1].positions[j] - w[0].positions[j]).abs() / dt;
+                assert!(
+                    speed <= v * (1.0 + 1e-9),
+                    "{algorithm:?}: joint {j} at {speed} rad/s > {v}"
+                );
+            }
+        }
+        assert!((reply.duration - last.time_from_start).abs() < 1e-12);
+        assert_path_valid(&mut planning, std::slice::from_ref(&ball), &traj, 0.01).await;
+        // JD of the reply against the trajectory it carries.
+        let jd: f64 = traj
+            .points
+            .windows(2)
+            .map(|w| {
+                w[0].positions
+                    .iter()
+                    .zip(&w[1].positions)
+                    .map(|(a, b)| (b - a).abs())
+                    .sum::<f64>()
+            })
+            .sum();
+        assert!(
+            (reply.criteria["JD"] - jd).abs() < 1e-9 * jd.max(1.0),
+            "{algorithm:?}"
+        );
+        if algorithm == pb::PlanAlgorithm::Ccstomp {
+            let dev = reply.deviation.unwrap();
+            assert!(!dev.violates_tolerance);
+            assert!(dev.translation.iter().all(|&t| t <= 1.0) && dev.rotation.iter().all(|&r| r <= 0.2));
+        }
+    }
+}
+
+#[tokio::test]
+async fn the_same_seed_gives_the_same_trajectory_and_another_seed_may_not() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let ball = blocking_sphere(&mut robots).await;
+    for algorithm in [pb::PlanAlgorithm::RrtConnect, pb::PlanAlgorithm::Stomp] {
+        let a = planning
+            .plan(request(algorithm, vec![ball.clone()]))
+            .await
+            .unwrap()
+            .into_inner();
+        let b = planning
+            .plan(request(algorithm, vec![ball.clone()]))
+            .await
+            .unwrap()
+            .into_inner();
+        assert_eq!(a.trajectory, b.trajectory, "{algorithm:?}");
+    }
+}
+
+#[tokio::test]
+async fn a_pose_goal_ends_at_that_pose() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let target = robots
+        .forward_kinematics(pb::ForwardKinematicsRequest {
+            robot: named(ROBOT),
+            joint_positions: GOAL.to_vec(),
+            include_links: false,
+        })
+        .await
+        .unwrap()
+        .into_inner()
+        .tool_pose
+        .unwrap();
+    let mut req = request(pb::PlanAlgorithm::RrtConnect, Vec::new());
+    req.goal = Some(Goal::GoalPose(target));
+    let reply = planning.plan(req).await.unwrap().into_inner();
+    assert_eq!(
+        reply.status,
+        pb::PlanStatus::Succeeded as i32,
+        "{}",
+        reply.message
+    );
+    let end = reply.trajectory.unwrap().points.last().unwrap().positions.clone();
+    assert_eq!(end, reply.goal);
+    let reached = tool_position(&mut robots, &end).await;
+    let p = target.position.unwrap();
+    let err = ((reached[0] - p.x).powi(2) + (reached[1] - p.y).powi(2) + (reached[2] - p.z).powi(2)).sqrt();
+    assert!(err < 1e-4, "tool {err} m from the goal pose");
+}
+
+#[tokio::test]
+async fn a_start_inside_an_obstacle_is_reported_with_the_colliding_pair() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let at_tool = tool_position(&mut robots, &START).await;
+    let reply = planning
+        .plan(request(
+            pb::PlanAlgorithm::RrtConnect,
+            vec![sphere("crate", at_tool, 0.05)],
+        ))
+        .await
+        .unwrap()
+        .into_inner();
+    assert_eq!(reply.status, pb::PlanStatus::InvalidStart as i32);
+    assert!(
+        reply.colliding.iter().any(|c| c.ends_with(":crate")),
+        "{:?}",
+        reply.colliding
+    );
+    assert!(reply.message.contains("crate"), "{}", reply.message);
+    // Out of limits is invalid too.
+    let mut req = request(pb::PlanAlgorithm::RrtConnect, Vec::new());
+    req.start[1] = 10.0;
+    let reply = planning.plan(req).await.unwrap().into_inner();
+    assert_eq!(reply.status, pb::PlanStatus::InvalidStart as i32);
+    assert!(
+        reply.colliding.contains(&"joint 1".to_string()),
+        "{:?}",
+        reply.colliding
+    );
+}
+
+#[tokio::test]
+async fn a_short_budget_ends_in_time_with_timeout() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let ball = blocking_sphere(&mut robots).await;
+    let mut req = request(pb::PlanAlgorithm::Stomp, vec![ball]);
+    req.options = Some(pb::PlanOptions {
+        stomp: Some(pb::StompOptions {
+            max_iterations: Some(1_000_000),
+            iterations_after_valid: Some(1_000_000),
+            straight_line_start: true,
+            ..Default::default()
+        }),
+        time_budget: Some(0.05),
+        ..Default::default()
+    });
+    // Warm the collision setup first: its one-off sampling is not the budget's.
+    planning
+        .plan(request(pb::PlanAlgorithm::RrtConnect, Vec::new()))
+        .await
+        .unwrap();
+    let started = Instant::now();
+    let reply = planning.plan(req).await.unwrap().into_inner();
+    let took = started.elapsed();
+    assert_eq!(reply.status, pb::PlanStatus::Timeout as i32, "{}", reply.message);
+    assert!(took < Duration::from_millis(500), "answered after {took:?}");
+}
+
+#[tokio::test]
+async fn plan_stream_sends_iterations_then_the_result() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let ball = blocking_sphere(&mut robots).await;
+    let mut stream = planning
+        .plan_stream(request(pb::PlanAlgorithm::Stomp, vec![ball]))
+        .await
+        .unwrap()
+        .into_inner();
+    let mut messages = Vec::new();
+    while let Some(m) = stream.message().await.unwrap() {
+        messages.push(m);
+    }
+    let (last, iterations) = messages.split_last().unwrap();
+    let result = last.result.as_ref().expect("the last message carries the result");
+    assert_eq!(result.status, pb::PlanStatus::Succeeded as i32);
+    assert!(!iterations.is_empty());
+    for (k, m) in iterations.iter().enumerate() {
+        assert!(m.result.is_none());
+        assert_eq!(m.trajectory.as_ref().unwrap().points.len(), 40, "message {k}");
+    }
+}
+
+#[tokio::test]
+async fn witness_points_lie_on_the_sphere_at_the_reported_clearance() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    // A ball 0.25 m above the tool: nearer than any other robot part.
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let tool = tool_position(&mut robots, &START).await;
+    let centre = [tool[0], tool[1], tool[2] + 0.25];
+    let r = 0.1;
+    let check = planning
+        .check_state(pb::CheckStateRequest {
+            robot: named(ROBOT),
+            states: vec![pb::JointState {
+                positions: START.to_vec(),
+            }],
+            scene: Some(pb::Scene {
+                objects: vec![sphere("s", centre, r)],
+            }),
+            max_distance: Some(5.0),
+        })
+        .await
+        .unwrap()
+        .into_inner()
+        .states
+        .remove(0);
+    assert!(check.valid && check.within_limits);
+    assert!(check.closest_pair.ends_with(":s"), "{}", check.closest_pair);
+    let (a, b) = (check.robot_point.unwrap(), check.obstacle_point.unwrap());
+    let on_sphere =
+        ((b.x - centre[0]).powi(2) + (b.y - centre[1]).powi(2) + (b.z - centre[2]).powi(2)).sqrt();
+    assert!(
+        (on_sphere - r).abs() < 1e-6,
+        "obstacle witness {on_sphere} m from the centre"
+    );
+    let gap = ((a.x - b.x).powi(2) + (a.y - b.y).powi(2) + (a.z - b.z).powi(2)).sqrt();
+    assert!(
+        (gap - check.clearance).abs() < 1e-6,
+        "{gap} vs {}",
+        check.clearance
+    );
+    assert!(check.clearance > 0.0);
+}
+
+#[tokio::test]
+async fn bad_input_is_named_by_field() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let cases: Vec<(pb::PlanRequest, &str)> = vec![
+        (
+            {
+                let mut r = request(pb::PlanAlgorithm::RrtConnect, Vec::new());
+                r.start[2] = f64::NAN;
+                r
+            },
+            "start[2]",
+        ),
+        (
+            {
+                let mut r = request(pb::PlanAlgorithm::RrtConnect, Vec::new());
+                r.start.pop();
+                r
+            },
+            "start",
+        ),
+        (
+            {
+                let mut r = request(pb::PlanAlgorithm::RrtConnect, Vec::new());
+                r.goal = None;
+                r
+            },
+            "goal",
+        ),
+        (
+            {
+                let mut r = request(pb::PlanAlgorithm::RrtConnect, Vec::new());
+                r.goal = Some(Goal::GoalPose(pb::Pose {
+                    position: Some(pb::Vec3 {
+                        x: f64::INFINITY,
+                        y: 0.0,
+                        z: 0.0,
+                    }),
+                    orientation: None,
+                }));
+                r
+            },
+            "goal_pose.position.x",
+        ),
+        (
+            request(
+                pb::PlanAlgorithm::RrtConnect,
+                vec![pb::CollisionObject {
+                    id: "m".into(),
+                    pose: None,
+                    shape: Some(Shape::Mesh(pb::TriangleMesh {
+                        vertices: vec![
+                            pb::Vec3 {
+                                x: 0.0,
+                                y: 0.0,
+                                z: 0.0
+                            };
+                            3
+                        ],
+                        indices: vec![0, 1, 7],
+                    })),
+                    unknown_as_obstacle: false,
+                }],
+            ),
+            "scene.objects[0].mesh.indices[2]",
+        ),
+        (
+            request(
+                pb::PlanAlgorithm::RrtConnect,
+                vec![sphere("s", [0.0, 0.0, 0.0], -1.0)],
+            ),
+            "scene.objects[0].sphere.radius",
+        ),
+        (
+            {
+                let mut r = request(pb::PlanAlgorithm::Stomp, Vec::new());
+                r.options = Some(pb::PlanOptions {
+                    stomp: Some(pb::StompOptions {
+                        cost_sensitivity: Some(-1.0),
+                        ..Default::default()
+                    }),
+                    ..Default::default()
+                });
+                r
+            },
+            "options.stomp.cost_sensitivity",
+        ),
+        (
+            {
+                let mut r = request(pb::PlanAlgorithm::Stomp, Vec::new());
+                r.options = Some(pb::PlanOptions {
+                    stomp: Some(pb::StompOptions {
+                        timesteps: Some(10_000),
+                        max_rollouts: Some(10_000),
+                        ..Default::default()
+                    }),
+                    ..Default::default()
+                });
+                r
+            },
+            "options.stomp",
+        ),
+        (
+            {
+                let mut r = request(pb::PlanAlgorithm::RrtConnect, Vec::new());
+                r.options = Some(pb::PlanOptions {
+                    motion_resolution: Some(0.5),
+                    ..Default::default()
+                });
+                r
+            },
+            "options.motion_resolution",
+        ),
+    ];
+    for (req, field) in cases {
+        let err = planning.plan(req).await.unwrap_err();
+        assert_eq!(err.code(), Code::InvalidArgument, "{field}: {}", err.message());
+        assert!(
+            err.message().starts_with(&format!("{field}:")),
+            "{field}: {}",
+            err.message()
+        );
+    }
+}
