@@ -53,6 +53,9 @@ impl Drop for CancelOnDrop {
     }
 }
 
+/// Stack of each CPU-pool thread, bytes.
+pub const CPU_STACK_BYTES: usize = 8 * 1024 * 1024;
+
 /// The server's CPU pool and admission limit.
 pub struct Compute {
     pool: rayon::ThreadPool,
@@ -68,6 +71,8 @@ impl Compute {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("kinplan-cpu-{i}"))
+            // Explicit, so recursion depth never depends on the platform default.
+            .stack_size(CPU_STACK_BYTES)
             .build()
             .expect("the CPU pool starts");
         let limit = concurrency.max(1);
