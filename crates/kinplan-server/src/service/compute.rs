@@ -11,6 +11,8 @@ use std::time::{Duration, Instant};
 use tokio::sync::{OwnedSemaphorePermit, Semaphore, oneshot};
 use tonic::Status;
 
+use super::guard::{RequestDeadline, deadline_after, effective_timeout};
+
 /// What a running computation may spend: a deadline and a cancellation flag
 /// raised when the caller goes away.
 #[derive(Debug, Clone)]
@@ -93,11 +95,18 @@ impl Compute {
                 self.limit
             ))
         })?;
-        let timeout = match (grpc_timeout(request.metadata()), self.default_timeout) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        };
-        Ok((permit, Budget::new(timeout.map(|t| Instant::now() + t))))
+        Ok((permit, Budget::new(self.deadline_of(request))))
+    }
+
+    /// The request's deadline: the one the guard layer set, or (outside a
+    /// server) the shorter of `grpc-timeout` and the default, from now. Never
+    /// overflows: a timeout too large for `Instant` means no deadline.
+    pub fn deadline_of<T>(&self, request: &tonic::Request<T>) -> Option<Instant> {
+        if let Some(RequestDeadline(deadline)) = request.extensions().get::<RequestDeadline>() {
+            return *deadline;
+        }
+        let header = grpc_timeout(request.metadata().as_ref());
+        effective_timeout(header, self.default_timeout).and_then(deadline_after)
     }
 
     /// Runs `work` on the CPU pool. Answers DEADLINE_EXCEEDED when the
@@ -146,9 +155,10 @@ fn deadline_exceeded() -> Status {
     Status::deadline_exceeded("the request's deadline passed before the work finished")
 }
 
-/// Parses the `grpc-timeout` header: up to 8 digits and a unit (H M S m u n).
-pub(crate) fn grpc_timeout(metadata: &tonic::metadata::MetadataMap) -> Option<Duration> {
-    let value = metadata.get("grpc-timeout")?.to_str().ok()?;
+/// Parses the `grpc-timeout` header: digits and a unit (H M S m u n),
+/// saturating (the spec allows 8 digits; more are read, not trusted).
+pub(crate) fn grpc_timeout(headers: &http::HeaderMap) -> Option<Duration> {
+    let value = headers.get("grpc-timeout")?.to_str().ok()?;
     let (digits, unit) = value.split_at(value.len().checked_sub(1)?);
     let n: u64 = digits.parse().ok()?;
     Some(match unit {
@@ -168,13 +178,23 @@ mod tests {
 
     #[test]
     fn grpc_timeout_units() {
-        let mut md = tonic::metadata::MetadataMap::new();
+        let mut md = http::HeaderMap::new();
         md.insert("grpc-timeout", "250m".parse().unwrap());
         assert_eq!(grpc_timeout(&md), Some(Duration::from_millis(250)));
         md.insert("grpc-timeout", "3S".parse().unwrap());
         assert_eq!(grpc_timeout(&md), Some(Duration::from_secs(3)));
         md.insert("grpc-timeout", "x".parse().unwrap());
         assert_eq!(grpc_timeout(&md), None);
+        // Regression: the legal-looking maximum overflowed `Instant` arithmetic.
+        md.insert("grpc-timeout", "18446744073709551615S".parse().unwrap());
+        assert_eq!(grpc_timeout(&md), Some(Duration::from_secs(u64::MAX)));
+        let compute = Compute::new(1, 1, None);
+        let mut req = tonic::Request::new(());
+        req.metadata_mut()
+            .insert("grpc-timeout", "18446744073709551615S".parse().unwrap());
+        assert_eq!(compute.deadline_of(&req), None);
+        let compute = Compute::new(1, 1, Some(Duration::from_secs(1)));
+        assert!(compute.deadline_of(&req).is_some());
     }
 
     #[tokio::test]

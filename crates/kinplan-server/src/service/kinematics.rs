@@ -235,7 +235,8 @@ impl KinematicsService for KinematicsApi {
         let (permit, _) = self.shared.compute.admit(&request)?;
         // A controller's stream lives as long as the controller runs: only a
         // deadline the client sets bounds it, not the server's default.
-        let deadline = super::compute::grpc_timeout(request.metadata()).map(|t| Instant::now() + t);
+        let deadline =
+            super::compute::grpc_timeout(request.metadata().as_ref()).and_then(super::guard::deadline_after);
         let inbound = request.into_inner();
         let (tx, rx) = tokio::sync::mpsc::channel(4);
         let models = self.shared.models.clone();

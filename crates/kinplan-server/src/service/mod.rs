@@ -6,8 +6,8 @@ pub mod pb;
 
 mod compute;
 mod convert;
+mod guard;
 mod kinematics;
-mod metrics;
 mod mobile;
 mod models;
 mod robot;
@@ -16,5 +16,6 @@ mod server;
 mod status;
 
 pub use compute::{Budget, Compute};
+pub use guard::HANDLING_BUCKETS;
 pub use models::ModelStore;
-pub use server::{HANDLING_BUCKETS, ServerConfig, serve};
+pub use server::{ServerConfig, serve};
