@@ -111,6 +111,7 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
         drain_delay: seconds(args.drain_delay_secs, "--drain-delay-secs")?,
         drain_timeout: seconds(args.drain_timeout_secs, "--drain-timeout-secs")?,
         stream_idle_timeout: seconds(args.stream_idle_timeout_secs, "--stream-idle-timeout-secs")?,
+        ..ServerConfig::default()
     };
     runtime.block_on(async move {
         if let Some(addr) = args.metrics_listen {

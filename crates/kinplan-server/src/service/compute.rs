@@ -5,7 +5,7 @@
 
 use std::panic::AssertUnwindSafe;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use tokio::sync::{OwnedSemaphorePermit, Semaphore, oneshot};
@@ -64,6 +64,28 @@ pub struct Compute {
     admitted: Arc<Semaphore>,
     limit: usize,
     default_timeout: Option<Duration>,
+    /// Open `StreamIk` streams (each message's work is admitted separately).
+    streams: Arc<Semaphore>,
+    /// How long a stream may stay silent.
+    pub stream_idle_timeout: Duration,
+    /// Jobs running on the pool now (tests read it to see work stop).
+    running: Arc<AtomicUsize>,
+}
+
+/// Counts a job while it runs.
+struct Running(Arc<AtomicUsize>);
+
+impl Running {
+    fn start(counter: &Arc<AtomicUsize>) -> Self {
+        counter.fetch_add(1, Ordering::SeqCst);
+        Self(counter.clone())
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
 }
 
 impl Compute {
@@ -83,18 +105,49 @@ impl Compute {
             admitted: Arc::new(Semaphore::new(limit)),
             limit,
             default_timeout,
+            streams: Arc::new(Semaphore::new(limit)),
+            stream_idle_timeout: Duration::from_secs(60),
+            running: Arc::new(AtomicUsize::new(0)),
         }
     }
 
-    /// Admits a request or sheds it; the permit is held until the reply.
-    pub fn admit<T>(&self, request: &tonic::Request<T>) -> Result<(OwnedSemaphorePermit, Budget), Status> {
-        let permit = self.admitted.clone().try_acquire_owned().map_err(|_| {
+    /// Counts running jobs in `counter` (shared with whoever watches it).
+    pub fn with_running_counter(mut self, counter: Arc<AtomicUsize>) -> Self {
+        self.running = counter;
+        self
+    }
+
+    /// Jobs running on the CPU pool now.
+    pub fn running_jobs(&self) -> usize {
+        self.running.load(Ordering::SeqCst)
+    }
+
+    /// Admits a new stream (at most the concurrency limit open at once); its
+    /// messages' work is admitted one by one with [`Compute::admit_work`].
+    pub fn admit_stream(&self) -> Result<OwnedSemaphorePermit, Status> {
+        self.streams.clone().try_acquire_owned().map_err(|_| {
+            metrics::counter!("kinplan_requests_shed_total").increment(1);
+            Status::resource_exhausted(format!(
+                "server busy: {} streams open; retry with backoff",
+                self.limit
+            ))
+        })
+    }
+
+    /// Admits one piece of work (a stream message) or sheds it.
+    pub fn admit_work(&self) -> Result<OwnedSemaphorePermit, Status> {
+        self.admitted.clone().try_acquire_owned().map_err(|_| {
             metrics::counter!("kinplan_requests_shed_total").increment(1);
             Status::resource_exhausted(format!(
                 "server busy: {} requests in flight; retry with backoff",
                 self.limit
             ))
-        })?;
+        })
+    }
+
+    /// Admits a request or sheds it; the permit is held until the reply.
+    pub fn admit<T>(&self, request: &tonic::Request<T>) -> Result<(OwnedSemaphorePermit, Budget), Status> {
+        let permit = self.admit_work()?;
         Ok((permit, Budget::new(self.deadline_of(request))))
     }
 
@@ -126,10 +179,12 @@ impl Compute {
         };
         let (tx, rx) = oneshot::channel();
         let inner = budget.clone();
+        let running = self.running.clone();
         self.pool.spawn(move || {
             if inner.should_stop() {
                 return;
             }
+            let _running = Running::start(&running);
             let out = std::panic::catch_unwind(AssertUnwindSafe(|| work(&inner)));
             let _ = tx.send(out);
         });

@@ -219,6 +219,13 @@ fn observe(
     http::Response::from_parts(parts, Body::new(body))
 }
 
+/// `future`, with a panic while polling it returned as `Err`.
+pub fn catch_unwind<F: Future>(
+    future: F,
+) -> impl Future<Output = Result<F::Output, Box<dyn std::any::Any + Send>>> {
+    CatchUnwind(Box::pin(future))
+}
+
 /// Polls a future inside `catch_unwind`.
 struct CatchUnwind<F>(Pin<Box<F>>);
 

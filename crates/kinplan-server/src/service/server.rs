@@ -3,6 +3,7 @@
 
 use std::future::Future;
 use std::sync::Arc;
+use std::sync::atomic::AtomicUsize;
 use std::time::Duration;
 
 use tokio::net::TcpListener;
@@ -50,6 +51,8 @@ pub struct ServerConfig {
     /// A `StreamIk` stream that sends no message for this long is ended
     /// (UNAVAILABLE), so idle streams cannot pile up.
     pub stream_idle_timeout: Duration,
+    /// Counts jobs running on the CPU pool (tests watch it to see work stop).
+    pub running_jobs: Arc<AtomicUsize>,
 }
 
 impl Default for ServerConfig {
@@ -64,6 +67,7 @@ impl Default for ServerConfig {
             drain_delay: Duration::ZERO,
             drain_timeout: Duration::from_secs(10),
             stream_idle_timeout: Duration::from_secs(60),
+            running_jobs: Arc::default(),
         }
     }
 }
@@ -77,11 +81,14 @@ pub async fn serve(
     listener: TcpListener,
     shutdown: impl Future<Output = ()> + Send + 'static,
 ) -> Result<(), BoxError> {
-    let compute = Arc::new(Compute::new(
+    let mut compute = Compute::new(
         config.cpu_threads,
         config.concurrency_limit,
         config.request_timeout,
-    ));
+    )
+    .with_running_counter(config.running_jobs.clone());
+    compute.stream_idle_timeout = config.stream_idle_timeout;
+    let compute = Arc::new(compute);
     let models = Arc::new(ModelStore::new(
         UrdfLimits {
             max_bytes: config.max_urdf_bytes,
