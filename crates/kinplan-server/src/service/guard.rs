@@ -155,6 +155,7 @@ where
         let deadline = effective_timeout(header, self.default_timeout).and_then(deadline_after);
         request.extensions_mut().insert(RequestDeadline(deadline));
         let cut = self.cut.clone();
+        let reply_type = super::finite::reply_type(request.uri().path());
         let call = std::panic::catch_unwind(AssertUnwindSafe(|| self.inner.call(request)));
         Box::pin(async move {
             let future = match call {
@@ -176,7 +177,7 @@ where
                 Some(Ok(result)) => result,
             };
             match response {
-                Ok(response) => Ok(observe(response, labels, cut)),
+                Ok(response) => Ok(observe(response, labels, cut, reply_type)),
                 Err(e) => {
                     labels.record("UNKNOWN");
                     Err(e)
@@ -192,6 +193,7 @@ fn observe(
     response: http::Response<Body>,
     labels: CallLabels,
     cut: watch::Receiver<bool>,
+    reply_type: Option<&'static str>,
 ) -> http::Response<Body> {
     if let Some(code) = response
         .headers()
@@ -215,6 +217,8 @@ fn observe(
         labels: Some(labels),
         cut,
         done: false,
+        reply_type,
+        pending: bytes::BytesMut::new(),
     };
     http::Response::from_parts(parts, Body::new(body))
 }
@@ -250,6 +254,10 @@ struct GuardedBody {
     labels: Option<CallLabels>,
     cut: Pin<Box<dyn Future<Output = ()> + Send>>,
     done: bool,
+    /// The reply's message type, when its numbers are checked ([`super::finite`]).
+    reply_type: Option<&'static str>,
+    /// Bytes of a reply message not yet complete (held until checked).
+    pending: bytes::BytesMut,
 }
 
 impl GuardedBody {
@@ -261,6 +269,47 @@ impl GuardedBody {
         let mut trailers = http::HeaderMap::new();
         let _ = status.add_header(&mut trailers);
         Poll::Ready(Some(Ok(Frame::trailers(trailers))))
+    }
+}
+
+impl GuardedBody {
+    /// Adds `data` to the pending bytes and releases the complete gRPC
+    /// messages (5-byte prefix + body) whose numbers are all finite; `None`
+    /// while no message is complete; INTERNAL for a reply that carries a
+    /// non-finite number.
+    fn checked(&mut self, reply_type: &'static str, data: Bytes) -> Result<Option<Bytes>, Status> {
+        self.pending.extend_from_slice(&data);
+        let mut complete = 0;
+        while let Some(header) = self.pending.get(complete..complete + 5) {
+            let len = u32::from_be_bytes([header[1], header[2], header[3], header[4]]) as usize;
+            let Some(message) = self.pending.get(complete + 5..complete + 5 + len) else {
+                break;
+            };
+            // Compressed messages (flag 1) are not inspected; kinplan sends none.
+            if header[0] == 0
+                && let Err(at) = super::finite::check(reply_type, message)
+            {
+                let (service, method) = self
+                    .labels
+                    .as_ref()
+                    .map_or(("?", "?"), |l| (l.service.as_str(), l.method.as_str()));
+                tracing::error!(
+                    service,
+                    method,
+                    field_numbers = ?at.0,
+                    "an OK reply carried a non-finite number; answering INTERNAL"
+                );
+                self.pending.clear();
+                return Err(Status::internal(
+                    "the server computed a non-finite number; this is a bug",
+                ));
+            }
+            complete += 5 + len;
+        }
+        if complete == 0 {
+            return Ok(None);
+        }
+        Ok(Some(self.pending.split_to(complete).freeze()))
     }
 }
 
@@ -289,47 +338,59 @@ impl http_body::Body for GuardedBody {
                 "the server is shutting down; the stream was ended after the drain timeout",
             ));
         }
-        let this = &mut *self;
-        let polled = std::panic::catch_unwind(AssertUnwindSafe(|| Pin::new(&mut this.inner).poll_frame(cx)));
-        match polled {
-            Err(panic) => {
-                let labels = self.labels.clone().unwrap_or(CallLabels {
-                    service: "unknown".into(),
-                    method: "unknown".into(),
-                    started: Instant::now(),
-                });
-                let status = panic_status(&labels, &*panic);
-                self.finish(status)
-            }
-            Ok(Poll::Pending) => Poll::Pending,
-            Ok(Poll::Ready(None)) => {
-                self.done = true;
-                if let Some(labels) = self.labels.take() {
-                    labels.record("OK");
+        loop {
+            let this = &mut *self;
+            let polled =
+                std::panic::catch_unwind(AssertUnwindSafe(|| Pin::new(&mut this.inner).poll_frame(cx)));
+            return match polled {
+                Err(panic) => {
+                    let labels = self.labels.clone().unwrap_or(CallLabels {
+                        service: "unknown".into(),
+                        method: "unknown".into(),
+                        started: Instant::now(),
+                    });
+                    let status = panic_status(&labels, &*panic);
+                    self.finish(status)
                 }
-                Poll::Ready(None)
-            }
-            Ok(Poll::Ready(Some(Err(e)))) => {
-                self.done = true;
-                if let Some(labels) = self.labels.take() {
-                    labels.record(code_name(e.code() as i32));
-                }
-                Poll::Ready(Some(Err(e)))
-            }
-            Ok(Poll::Ready(Some(Ok(frame)))) => {
-                if let Some(trailers) = frame.trailers_ref() {
+                Ok(Poll::Pending) => Poll::Pending,
+                Ok(Poll::Ready(None)) => {
                     self.done = true;
-                    let code = trailers
-                        .get("grpc-status")
-                        .and_then(|v| v.to_str().ok())
-                        .and_then(|v| v.parse::<i32>().ok())
-                        .unwrap_or(0);
                     if let Some(labels) = self.labels.take() {
-                        labels.record(code_name(code));
+                        labels.record("OK");
                     }
+                    Poll::Ready(None)
                 }
-                Poll::Ready(Some(Ok(frame)))
-            }
+                Ok(Poll::Ready(Some(Err(e)))) => {
+                    self.done = true;
+                    if let Some(labels) = self.labels.take() {
+                        labels.record(code_name(e.code() as i32));
+                    }
+                    Poll::Ready(Some(Err(e)))
+                }
+                Ok(Poll::Ready(Some(Ok(frame)))) => {
+                    let frame = match (frame.into_data(), self.reply_type) {
+                        (Ok(data), Some(reply_type)) => match self.checked(reply_type, data) {
+                            Ok(Some(ready)) => Frame::data(ready),
+                            Ok(None) => continue, // a message not yet complete
+                            Err(status) => return self.finish(status),
+                        },
+                        (Ok(data), None) => Frame::data(data),
+                        (Err(frame), _) => frame,
+                    };
+                    if let Some(trailers) = frame.trailers_ref() {
+                        self.done = true;
+                        let code = trailers
+                            .get("grpc-status")
+                            .and_then(|v| v.to_str().ok())
+                            .and_then(|v| v.parse::<i32>().ok())
+                            .unwrap_or(0);
+                        if let Some(labels) = self.labels.take() {
+                            labels.record(code_name(code));
+                        }
+                    }
+                    Poll::Ready(Some(Ok(frame)))
+                }
+            };
         }
     }
 
@@ -466,5 +527,119 @@ mod tests {
             .headers_mut()
             .insert("grpc-timeout", "18446744073709551615S".parse().unwrap());
         svc.oneshot(request).await.unwrap();
+    }
+
+    fn framed(message: &impl prost::Message) -> Bytes {
+        let body = message.encode_to_vec();
+        let mut out = vec![0u8];
+        out.extend_from_slice(&(body.len() as u32).to_be_bytes());
+        out.extend_from_slice(&body);
+        Bytes::from(out)
+    }
+
+    /// A reply body of data frames then OK trailers.
+    struct Reply(Vec<Bytes>, Option<http::HeaderMap>);
+    impl http_body::Body for Reply {
+        type Data = Bytes;
+        type Error = Status;
+        fn poll_frame(
+            mut self: Pin<&mut Self>,
+            _: &mut Context<'_>,
+        ) -> Poll<Option<Result<Frame<Bytes>, Status>>> {
+            if !self.0.is_empty() {
+                let data = self.0.remove(0);
+                return Poll::Ready(Some(Ok(Frame::data(data))));
+            }
+            Poll::Ready(self.1.take().map(|t| Ok(Frame::trailers(t))))
+        }
+    }
+
+    fn trailers(code: i32) -> http::HeaderMap {
+        let mut t = http::HeaderMap::new();
+        t.insert("grpc-status", code.to_string().parse().unwrap());
+        t
+    }
+
+    async fn call_with(path: &str, frames: Vec<Bytes>, code: i32) -> http_body_util::Collected<Bytes> {
+        let (_tx, layer) = layer();
+        let reply = std::sync::Mutex::new(Some(Reply(frames, Some(trailers(code)))));
+        let svc = layer.layer(tower::service_fn(move |_req: http::Request<Body>| {
+            let body = reply.lock().unwrap().take().unwrap();
+            async move { Ok::<_, std::convert::Infallible>(http::Response::new(Body::new(body))) }
+        }));
+        let request = http::Request::builder().uri(path).body(Body::empty()).unwrap();
+        let response = svc.oneshot(request).await.unwrap();
+        response.into_body().collect().await.unwrap()
+    }
+
+    /// The one reply check: an OK reply with a non-finite number becomes
+    /// INTERNAL; a finite one passes unchanged, even split across frames.
+    #[tokio::test]
+    async fn non_finite_replies_become_internal() {
+        use super::super::pb;
+        let path = "/kinplan.v1.RobotService/ForwardKinematics";
+        let mut reply = pb::ForwardKinematicsResponse {
+            tool_pose: Some(pb::Pose {
+                position: Some(pb::Vec3 {
+                    x: 1.0,
+                    y: 2.0,
+                    z: 3.0,
+                }),
+                orientation: None,
+            }),
+            ..Default::default()
+        };
+        let good = framed(&reply);
+        let (a, b) = (good.slice(..7), good.slice(7..));
+        let collected = call_with(path, vec![a, b], 0).await;
+        assert_eq!(collected.trailers().unwrap().get("grpc-status").unwrap(), "0");
+        assert_eq!(collected.to_bytes(), good);
+        reply.tool_pose.as_mut().unwrap().position.as_mut().unwrap().z = f64::INFINITY;
+        let collected = call_with(path, vec![framed(&reply)], 0).await;
+        assert_eq!(collected.trailers().unwrap().get("grpc-status").unwrap(), "13");
+        assert!(collected.to_bytes().is_empty());
+    }
+
+    /// Metrics count the status the client sees: a stream's trailers, and a
+    /// deadline this layer answered.
+    #[test]
+    fn metrics_count_the_final_status() {
+        let recorder = metrics_exporter_prometheus::PrometheusBuilder::new().build_recorder();
+        let handle = recorder.handle();
+        let runtime = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .unwrap();
+        metrics::with_local_recorder(&recorder, || {
+            runtime.block_on(async {
+                call_with("/kinplan.v1.KinematicsService/StreamIk", vec![], 3).await;
+                let (_tx, layer) = layer();
+                let svc = layer.layer(tower::service_fn(|_req: http::Request<Body>| async {
+                    tokio::time::sleep(Duration::from_secs(30)).await;
+                    Ok::<_, std::convert::Infallible>(http::Response::new(Body::empty()))
+                }));
+                let mut request = http::Request::builder()
+                    .uri("/kinplan.v1.KinematicsService/SolveIkBatch")
+                    .body(Body::empty())
+                    .unwrap();
+                request
+                    .headers_mut()
+                    .insert("grpc-timeout", "10m".parse().unwrap());
+                svc.oneshot(request).await.unwrap();
+            })
+        });
+        let text = handle.render();
+        assert!(
+            text.lines().any(|l| l.starts_with("grpc_server_handled_total")
+                && l.contains("grpc_method=\"StreamIk\"")
+                && l.contains("grpc_code=\"INVALID_ARGUMENT\"")),
+            "{text}"
+        );
+        assert!(
+            text.lines().any(|l| l.starts_with("grpc_server_handled_total")
+                && l.contains("grpc_method=\"SolveIkBatch\"")
+                && l.contains("grpc_code=\"DEADLINE_EXCEEDED\"")),
+            "{text}"
+        );
     }
 }

@@ -6,6 +6,7 @@ pub mod pb;
 
 mod compute;
 mod convert;
+mod finite;
 mod guard;
 mod kinematics;
 mod mobile;
