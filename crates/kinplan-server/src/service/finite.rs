@@ -17,6 +17,8 @@ use super::pb;
 #[derive(Debug, Clone)]
 enum Kind {
     Double,
+    /// A double whose documentation gives ±inf a meaning (unlimited joints).
+    DoubleOrInfinite,
     Float,
     Message(String),
     Other,
@@ -28,6 +30,10 @@ struct Schema {
     messages: HashMap<String, HashMap<u64, Kind>>,
     replies: HashMap<String, String>,
 }
+
+/// `(message, field)` pairs whose proto documentation gives ±inf a meaning;
+/// NaN is refused everywhere.
+const INFINITE_ALLOWED: &[(&str, &str)] = &[("JointInfo", "lower"), ("JointInfo", "upper")];
 
 fn schema() -> &'static Schema {
     static SCHEMA: OnceLock<Schema> = OnceLock::new();
@@ -47,6 +53,9 @@ fn schema() -> &'static Schema {
                 .iter()
                 .map(|f| {
                     let kind = match f.r#type() {
+                        Type::Double if INFINITE_ALLOWED.contains(&(m.name(), f.name())) => {
+                            Kind::DoubleOrInfinite
+                        }
                         Type::Double => Kind::Double,
                         Type::Float => Kind::Float,
                         Type::Message => Kind::Message(f.type_name().to_string()),
@@ -107,6 +116,14 @@ fn varint(bytes: &[u8], at: &mut usize) -> Option<u64> {
     None
 }
 
+fn double_ok(kind: &Kind, v: f64) -> bool {
+    match kind {
+        Kind::Double => v.is_finite(),
+        Kind::DoubleOrInfinite => !v.is_nan(),
+        _ => true,
+    }
+}
+
 fn walk(
     schema: &Schema,
     type_name: &str,
@@ -142,9 +159,7 @@ fn walk(
                     return Ok(());
                 };
                 at += 8;
-                if matches!(kind, Kind::Double)
-                    && !f64::from_le_bytes(b.try_into().expect("8 bytes")).is_finite()
-                {
+                if !double_ok(kind, f64::from_le_bytes(b.try_into().expect("8 bytes"))) {
                     return bad(path);
                 }
             }
@@ -171,10 +186,10 @@ fn walk(
                 };
                 at += body.len();
                 match kind {
-                    Kind::Double => {
+                    Kind::Double | Kind::DoubleOrInfinite => {
                         if body
                             .chunks_exact(8)
-                            .any(|c| !f64::from_le_bytes(c.try_into().expect("8 bytes")).is_finite())
+                            .any(|c| !double_ok(kind, f64::from_le_bytes(c.try_into().expect("8 bytes"))))
                         {
                             return bad(path);
                         }
@@ -238,5 +253,18 @@ mod tests {
         };
         assert!(check(name, &lin.encode_to_vec()).is_ok());
         assert_eq!(reply_type("/grpc.health.v1.Health/Check"), None);
+        // Documented infinities pass; NaN never does.
+        let mut joint = pb::DescribeRobotResponse {
+            joints: vec![pb::JointInfo {
+                lower: f64::NEG_INFINITY,
+                upper: f64::INFINITY,
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        let name = reply_type("/kinplan.v1.RobotService/DescribeRobot").unwrap();
+        assert!(check(name, &joint.encode_to_vec()).is_ok());
+        joint.joints[0].lower = f64::NAN;
+        assert!(check(name, &joint.encode_to_vec()).is_err());
     }
 }

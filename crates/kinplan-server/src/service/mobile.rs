@@ -721,7 +721,8 @@ fn run_out(run: SimRun) -> pb::MobileRun {
         metrics: Some(pb::RunMetrics {
             path_length: run.metrics.path_length,
             time: run.metrics.time,
-            min_clearance: run.metrics.min_clearance,
+            // unset without obstacles (the domain says +inf)
+            min_clearance: run.metrics.min_clearance.filter(|c| c.is_finite()),
             steps: run.metrics.steps as u32,
         }),
     }
