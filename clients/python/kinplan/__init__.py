@@ -9,10 +9,19 @@ from .client import Client, Robot, RobotDescription
 from .errors import KinplanError
 from .kinematics import IkBatchResult, IkResult, IkSolution, IkStream, LinearSolution, TrackResult
 from .mobile import Mobile, MobileRun, StepResult, WheelKinematics
+from .planning import Box, Capsule, Cylinder, Mesh, OctreeObstacle, Plan, Sphere, StateChecks
 from .scoring import Comparison, Scores
 
 __all__ = [
+    "Box",
+    "Capsule",
     "Client",
+    "Cylinder",
+    "Mesh",
+    "OctreeObstacle",
+    "Plan",
+    "Sphere",
+    "StateChecks",
     "Comparison",
     "IkBatchResult",
     "IkResult",

@@ -61,6 +61,13 @@ struct ServeArgs {
     /// Seconds between reporting NOT_SERVING and closing the listener.
     #[arg(long, env = "KINPLAN_DRAIN_DELAY_SECS", default_value_t = 0.0)]
     drain_delay_secs: f64,
+    /// Seconds calls in flight may take to finish after the listener closes;
+    /// then open streams end with UNAVAILABLE and the server exits.
+    #[arg(long, env = "KINPLAN_DRAIN_TIMEOUT_SECS", default_value_t = 10.0)]
+    drain_timeout_secs: f64,
+    /// Seconds a `StreamIk` stream may stay silent before it is ended.
+    #[arg(long, env = "KINPLAN_STREAM_IDLE_TIMEOUT_SECS", default_value_t = 60.0)]
+    stream_idle_timeout_secs: f64,
     /// Largest inline URDF, bytes.
     #[arg(long, env = "KINPLAN_MAX_URDF_BYTES", default_value_t = 2 * 1024 * 1024)]
     max_urdf_bytes: usize,
@@ -149,6 +156,9 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
         model_cache_entries: args.model_cache,
         acm_samples: args.acm_samples,
         drain_delay: seconds(args.drain_delay_secs, "--drain-delay-secs")?,
+        drain_timeout: seconds(args.drain_timeout_secs, "--drain-timeout-secs")?,
+        stream_idle_timeout: seconds(args.stream_idle_timeout_secs, "--stream-idle-timeout-secs")?,
+        ..ServerConfig::default()
     };
     runtime.block_on(async move {
         if let Some(addr) = args.metrics_listen {

@@ -125,7 +125,7 @@ class Octree(_message.Message):
     def __init__(self, id: _Optional[str] = ..., resolution: _Optional[float] = ..., binary: _Optional[bool] = ..., data: _Optional[bytes] = ...) -> None: ...
 
 class CollisionObject(_message.Message):
-    __slots__ = ("id", "pose", "box", "sphere", "cylinder", "capsule", "mesh", "octree")
+    __slots__ = ("id", "pose", "box", "sphere", "cylinder", "capsule", "mesh", "octree", "unknown_as_obstacle")
     ID_FIELD_NUMBER: _ClassVar[int]
     POSE_FIELD_NUMBER: _ClassVar[int]
     BOX_FIELD_NUMBER: _ClassVar[int]
@@ -134,6 +134,7 @@ class CollisionObject(_message.Message):
     CAPSULE_FIELD_NUMBER: _ClassVar[int]
     MESH_FIELD_NUMBER: _ClassVar[int]
     OCTREE_FIELD_NUMBER: _ClassVar[int]
+    UNKNOWN_AS_OBSTACLE_FIELD_NUMBER: _ClassVar[int]
     id: str
     pose: Pose
     box: Box
@@ -142,7 +143,8 @@ class CollisionObject(_message.Message):
     capsule: Capsule
     mesh: TriangleMesh
     octree: Octree
-    def __init__(self, id: _Optional[str] = ..., pose: _Optional[_Union[Pose, _Mapping]] = ..., box: _Optional[_Union[Box, _Mapping]] = ..., sphere: _Optional[_Union[Sphere, _Mapping]] = ..., cylinder: _Optional[_Union[Cylinder, _Mapping]] = ..., capsule: _Optional[_Union[Capsule, _Mapping]] = ..., mesh: _Optional[_Union[TriangleMesh, _Mapping]] = ..., octree: _Optional[_Union[Octree, _Mapping]] = ...) -> None: ...
+    unknown_as_obstacle: bool
+    def __init__(self, id: _Optional[str] = ..., pose: _Optional[_Union[Pose, _Mapping]] = ..., box: _Optional[_Union[Box, _Mapping]] = ..., sphere: _Optional[_Union[Sphere, _Mapping]] = ..., cylinder: _Optional[_Union[Cylinder, _Mapping]] = ..., capsule: _Optional[_Union[Capsule, _Mapping]] = ..., mesh: _Optional[_Union[TriangleMesh, _Mapping]] = ..., octree: _Optional[_Union[Octree, _Mapping]] = ..., unknown_as_obstacle: _Optional[bool] = ...) -> None: ...
 
 class Scene(_message.Message):
     __slots__ = ("objects",)

@@ -127,16 +127,20 @@ pub fn plan_grid_astar(
     let res = params.resolution;
     let x0 = lo.x - params.padding;
     let y0 = lo.y - params.padding;
-    let nx = ((hi.x + params.padding - x0) / res).ceil() as usize + 1;
-    let ny = ((hi.y + params.padding - y0) / res).ceil() as usize + 1;
-    if nx.saturating_mul(ny) > params.max_cells {
+    // Sized in floating point first: a far-away point (1e308) would otherwise
+    // saturate or wrap the cast and leave a grid too small for its indices.
+    let nxf = ((hi.x + params.padding - x0) / res).ceil() + 1.0;
+    let nyf = ((hi.y + params.padding - y0) / res).ceil() + 1.0;
+    let cells = nxf * nyf;
+    if !(cells <= params.max_cells as f64) {
         return Err(MobileError::OutOfRange {
             field: "astar grid cells".into(),
-            value: (nx as f64) * (ny as f64),
+            value: cells,
             min: 4.0,
             max: params.max_cells as f64,
         });
     }
+    let (nx, ny) = (nxf as usize, nyf as usize);
     let mut g = Grid {
         x0,
         y0,
@@ -288,6 +292,18 @@ mod tests {
                 assert!(w.distance(q).0 > 0.25);
             }
         }
+    }
+
+    #[test]
+    fn far_points_never_index_out_of_bounds() {
+        // Regression: start.x = 1e308 sized the grid by a saturated cast and
+        // indexed out of bounds.
+        let w = World::new(vec![Obstacle::circle(2.0, 0.0, 0.5)]).unwrap();
+        let p = GridAstarParams::default();
+        assert!(plan_grid_astar(&w, Point2::new(1e308, 0.0), Point2::new(4.0, 0.0), &p).is_err());
+        // Far but in-world points: a grid too large is refused, never allocated.
+        let far = plan_grid_astar(&w, Point2::new(-9e5, -9e5), Point2::new(9e5, 9e5), &p);
+        assert!(matches!(far, Err(MobileError::OutOfRange { .. })), "{far:?}");
     }
 
     #[test]

@@ -29,7 +29,7 @@ pub use path_follow::{
     ControllerKind, PathFollowParams, PathFollowState, PathFollowStep, PathNode, path_follow_step,
     validate_path,
 };
-pub use pose::{Point2, Pose, Twist, integrate_twist};
+pub use pose::{MAX_COORDINATE, MAX_RATE, Point2, Pose, Twist, integrate_twist};
 pub use pure_pursuit::{PurePursuitCommand, PurePursuitParams, pure_pursuit_step};
 pub use sensors::{RangeSensorParams, RangeSensors};
 pub use shortest_path::shortest_path_step;

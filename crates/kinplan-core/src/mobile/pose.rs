@@ -3,7 +3,17 @@
 use serde::{Deserialize, Serialize};
 
 use super::angle::{sinc, versinc, wrap_angle};
-use super::error::{MobileError, check_finite};
+use super::error::{MobileError, check_range};
+
+/// Largest magnitude of a world coordinate, m: bounded so that distances,
+/// grids and control laws stay finite (a 1e308 coordinate overflowed them).
+pub const MAX_COORDINATE: f64 = 1e6;
+/// Largest magnitude of a heading (rad) or a twist component (m/s, rad/s).
+pub const MAX_RATE: f64 = 1e6;
+
+fn bounded(field: &str, value: f64, bound: f64) -> Result<(), MobileError> {
+    check_range(field, value, -bound, bound)
+}
 
 /// A point in the world frame, m.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -25,13 +35,13 @@ impl Point2 {
         (self.x - other.x).hypot(self.y - other.y)
     }
 
-    /// Rejects NaN or infinite coordinates.
+    /// Rejects NaN, infinite or out-of-world (beyond [`MAX_COORDINATE`]) coordinates.
     pub fn validate(&self, field: &str) -> Result<(), MobileError> {
-        if self.x.is_finite() && self.y.is_finite() {
+        if self.x.abs() <= MAX_COORDINATE && self.y.abs() <= MAX_COORDINATE {
             return Ok(());
         }
-        check_finite(&format!("{field}.x"), self.x)?;
-        check_finite(&format!("{field}.y"), self.y)
+        bounded(&format!("{field}.x"), self.x, MAX_COORDINATE)?;
+        bounded(&format!("{field}.y"), self.y, MAX_COORDINATE)
     }
 }
 
@@ -58,14 +68,15 @@ impl Pose {
         Point2::new(self.x, self.y)
     }
 
-    /// Rejects NaN or infinite components.
+    /// Rejects NaN, infinite or out-of-world components (coordinates beyond
+    /// [`MAX_COORDINATE`], headings beyond [`MAX_RATE`]).
     pub fn validate(&self, field: &str) -> Result<(), MobileError> {
-        if self.x.is_finite() && self.y.is_finite() && self.theta.is_finite() {
+        if self.x.abs() <= MAX_COORDINATE && self.y.abs() <= MAX_COORDINATE && self.theta.abs() <= MAX_RATE {
             return Ok(());
         }
-        check_finite(&format!("{field}.x"), self.x)?;
-        check_finite(&format!("{field}.y"), self.y)?;
-        check_finite(&format!("{field}.theta"), self.theta)
+        bounded(&format!("{field}.x"), self.x, MAX_COORDINATE)?;
+        bounded(&format!("{field}.y"), self.y, MAX_COORDINATE)?;
+        bounded(&format!("{field}.theta"), self.theta, MAX_RATE)
     }
 }
 
@@ -107,14 +118,14 @@ impl Twist {
         }
     }
 
-    /// Rejects NaN or infinite components.
+    /// Rejects NaN, infinite or absurd (beyond [`MAX_RATE`]) components.
     pub fn validate(&self, field: &str) -> Result<(), MobileError> {
-        if self.vx.is_finite() && self.vy.is_finite() && self.omega.is_finite() {
+        if self.vx.abs() <= MAX_RATE && self.vy.abs() <= MAX_RATE && self.omega.abs() <= MAX_RATE {
             return Ok(());
         }
-        check_finite(&format!("{field}.vx"), self.vx)?;
-        check_finite(&format!("{field}.vy"), self.vy)?;
-        check_finite(&format!("{field}.omega"), self.omega)
+        bounded(&format!("{field}.vx"), self.vx, MAX_RATE)?;
+        bounded(&format!("{field}.vy"), self.vy, MAX_RATE)?;
+        bounded(&format!("{field}.omega"), self.omega, MAX_RATE)
     }
 }
 

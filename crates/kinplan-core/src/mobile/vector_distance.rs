@@ -9,7 +9,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
 
 use super::angle::wrap_angle;
 use super::error::{MobileError, check_count, check_finite, check_positive, check_range};
-use super::pose::{Point2, Pose, Twist};
+use super::pose::{MAX_COORDINATE, MAX_RATE, Point2, Pose, Twist};
 use super::sensors::RangeSensorParams;
 
 /// Navigation mode (S1 §3.5).
@@ -201,35 +201,60 @@ pub struct VdfState {
 }
 
 const MAX_TOKEN_HISTORY: usize = 100_000;
+/// Largest step counter a token may carry: counters saturate, and a forged
+/// `u64::MAX` is refused rather than trusted.
+pub const MAX_TOKEN_STEPS: u64 = 1 << 40;
 
 impl VdfState {
-    /// Serialises to an opaque token (JSON bytes).
-    pub fn to_token(&self) -> Vec<u8> {
-        serde_json::to_vec(self).unwrap_or_default()
+    /// Serialises to an opaque token (JSON bytes). Fails (never an empty
+    /// token) if the state holds a value a token cannot carry.
+    pub fn to_token(&self) -> Result<Vec<u8>, MobileError> {
+        self.check()?;
+        serde_json::to_vec(self).map_err(|e| MobileError::BadToken {
+            reason: format!("the state could not be encoded: {e}"),
+        })
     }
 
-    /// Decodes and checks a token produced by [`VdfState::to_token`].
+    /// Decodes and checks a token produced by [`VdfState::to_token`]: every
+    /// field within its bounds (finite angles and distances within the world,
+    /// non-negative distances, counters at most [`MAX_TOKEN_STEPS`]).
     pub fn from_token(token: &[u8]) -> Result<Self, MobileError> {
         if token.is_empty() {
             return Ok(Self::default());
         }
         let s: Self = serde_json::from_slice(token).map_err(|e| MobileError::BadToken {
-            reason: e.to_string(),
+            reason: e.to_string().chars().take(128).collect(),
         })?;
-        let bad = |r: &str| MobileError::BadToken { reason: r.to_owned() };
-        if !s.locked_direction.is_finite() || !s.hit_distance.is_finite() {
-            return Err(bad("non-finite angle or distance"));
-        }
-        if s.hit_point.is_some_and(|h| !(h.x.is_finite() && h.y.is_finite())) {
-            return Err(bad("non-finite hit point"));
-        }
-        if s.history.len() > MAX_TOKEN_HISTORY || s.history.iter().any(|d| !d.is_finite()) {
-            return Err(bad("history too long or not finite"));
-        }
-        if s.best_distance.is_some_and(|d| !d.is_finite()) {
-            return Err(bad("non-finite best distance"));
-        }
+        s.check()?;
         Ok(s)
+    }
+
+    fn check(&self) -> Result<(), MobileError> {
+        let bad = |r: &str| MobileError::BadToken { reason: r.to_owned() };
+        // Distances in a world of coordinates within ±MAX_COORDINATE.
+        let max_distance = 4.0 * MAX_COORDINATE;
+        let distance_ok = |d: f64| d.is_finite() && (0.0..=max_distance).contains(&d);
+        if !(self.locked_direction.is_finite() && self.locked_direction.abs() <= MAX_RATE) {
+            return Err(bad("locked direction not finite or out of range"));
+        }
+        if !distance_ok(self.hit_distance) {
+            return Err(bad("hit distance not finite, negative or out of range"));
+        }
+        if self.hit_point.is_some_and(|h| h.validate("hit_point").is_err()) {
+            return Err(bad("hit point not finite or out of the world"));
+        }
+        if self.history.len() > MAX_TOKEN_HISTORY || !self.history.iter().all(|d| distance_ok(*d)) {
+            return Err(bad(
+                "history too long, or a distance not finite, negative or out of range",
+            ));
+        }
+        if self.best_distance.is_some_and(|d| !distance_ok(d)) {
+            return Err(bad("best distance not finite, negative or out of range"));
+        }
+        if self.steps_in_mode > MAX_TOKEN_STEPS || self.steps_since_progress > MAX_TOKEN_STEPS {
+            return Err(bad("step counter out of range"));
+        }
+        Ok(())
     }
 }
 
@@ -303,7 +328,7 @@ fn reading_at(readings: &[f64], theta: f64, beta: f64) -> f64 {
 /// assert_eq!(next.mode, NavMode::Rotate);
 /// assert!((out.twist.vx - 0.5).abs() < 1e-12 && out.twist.omega.abs() < 1e-12);
 /// // The state travels as an opaque token.
-/// assert_eq!(VdfState::from_token(&next.to_token()).unwrap(), next);
+/// assert_eq!(VdfState::from_token(&next.to_token().unwrap()).unwrap(), next);
 /// ```
 pub fn vdf_step(
     state: &VdfState,
@@ -362,7 +387,7 @@ pub(crate) fn vdf_step_mut(
     while s.history.len() > p.progress_steps + 1 {
         s.history.pop_front();
     }
-    s.steps_in_mode += 1;
+    s.steps_in_mode = s.steps_in_mode.saturating_add(1);
     let stalled = s.history.len() == p.progress_steps + 1 && s.history[0] - z < p.progress_min;
     let mut event = None;
     match s.mode {
@@ -430,7 +455,7 @@ pub(crate) fn vdf_step_mut(
             s.best_distance = Some(z);
             s.steps_since_progress = 0;
         } else {
-            s.steps_since_progress += 1;
+            s.steps_since_progress = s.steps_since_progress.saturating_add(1);
         }
         let give_up = if z < s.hit_distance - p.no_path_min - 3.0 * p.hit_radius {
             // Clearly past the obstacle of H: forget it.
@@ -733,7 +758,8 @@ mod tests {
     /// Tokens written before `side_retried` existed still decode.
     #[test]
     fn token_without_side_retried_decodes() {
-        let mut v: serde_json::Value = serde_json::from_slice(&VdfState::default().to_token()).unwrap();
+        let mut v: serde_json::Value =
+            serde_json::from_slice(&VdfState::default().to_token().unwrap()).unwrap();
         v.as_object_mut().unwrap().remove("side_retried");
         let s = VdfState::from_token(&serde_json::to_vec(&v).unwrap()).unwrap();
         assert!(!s.side_retried);
@@ -748,12 +774,65 @@ mod tests {
             best_distance: Some(2.5),
             ..VdfState::default()
         };
-        assert_eq!(VdfState::from_token(&s.to_token()).unwrap(), s);
+        assert_eq!(VdfState::from_token(&s.to_token().unwrap()).unwrap(), s);
         assert!(matches!(
             VdfState::from_token(b"{not json"),
             Err(MobileError::BadToken { .. })
         ));
         assert_eq!(VdfState::from_token(b"").unwrap(), VdfState::default());
+    }
+
+    /// Regression: a client-forged token with `steps_in_mode = u64::MAX`
+    /// overflowed the step counter (a panic in debug builds, a wrap in release).
+    #[test]
+    fn forged_token_counters_are_refused_or_saturate() {
+        let mut v: serde_json::Value =
+            serde_json::from_slice(&VdfState::default().to_token().unwrap()).unwrap();
+        v["steps_in_mode"] = serde_json::json!(u64::MAX);
+        assert!(matches!(
+            VdfState::from_token(&serde_json::to_vec(&v).unwrap()),
+            Err(MobileError::BadToken { .. })
+        ));
+        for (field, value) in [
+            ("steps_since_progress", serde_json::json!(u64::MAX)),
+            ("hit_distance", serde_json::json!(-1.0)),
+            ("hit_distance", serde_json::json!(1e308)),
+            ("locked_direction", serde_json::json!(1e308)),
+            ("hit_point", serde_json::json!({"x": 1e308, "y": 0.0})),
+            ("best_distance", serde_json::json!(-3.0)),
+            ("history", serde_json::json!([1.0, -2.0])),
+        ] {
+            let mut v: serde_json::Value =
+                serde_json::from_slice(&VdfState::default().to_token().unwrap()).unwrap();
+            v[field] = value;
+            assert!(
+                VdfState::from_token(&serde_json::to_vec(&v).unwrap()).is_err(),
+                "{field}"
+            );
+        }
+        // The largest accepted counters step without overflow.
+        let s = VdfState {
+            steps_in_mode: MAX_TOKEN_STEPS,
+            steps_since_progress: MAX_TOKEN_STEPS,
+            ..VdfState::default()
+        };
+        let s = VdfState::from_token(&s.to_token().unwrap()).unwrap();
+        let (next, _) = vdf_step(
+            &s,
+            Pose::default(),
+            Point2::new(3.0, 0.0),
+            &[5.0; 8],
+            &sensors(),
+            &VdfParams::default(),
+        )
+        .unwrap();
+        assert!(next.steps_in_mode <= MAX_TOKEN_STEPS + 1);
+        // A state a token cannot carry is an error, never an empty token.
+        let nan = VdfState {
+            hit_distance: f64::NAN,
+            ..VdfState::default()
+        };
+        assert!(nan.to_token().is_err());
     }
 
     #[test]

@@ -49,7 +49,7 @@ pub fn builtin_urdf(name: &str) -> Result<&'static str, RobotError> {
         .position(|n| *n == name)
         .map(|i| BUILTIN_URDFS[i])
         .ok_or_else(|| RobotError::UnknownRobot {
-            name: name.into(),
+            name: super::urdf::clip(name),
             known: BUILTIN_NAMES.join(", "),
         })
 }
@@ -61,7 +61,7 @@ pub fn builtin_chain(name: &str) -> Result<Arc<Chain>, RobotError> {
         .iter()
         .position(|n| *n == name)
         .ok_or_else(|| RobotError::UnknownRobot {
-            name: name.into(),
+            name: super::urdf::clip(name),
             known: BUILTIN_NAMES.join(", "),
         })?;
     let cells = CHAINS.get_or_init(|| BUILTIN_NAMES.iter().map(|_| OnceLock::new()).collect());

@@ -127,8 +127,17 @@ impl Chain {
                 got: q.len(),
             });
         }
-        match q.iter().position(|v| !v.is_finite()) {
-            Some(index) => Err(RobotError::NonFiniteJoint { index }),
+        if let Some(index) = q.iter().position(|v| !v.is_finite()) {
+            return Err(RobotError::NonFiniteJoint { index });
+        }
+        // Bounded joint values (and bounded origins, see `parse_chain`) keep
+        // forward kinematics finite.
+        match q.iter().position(|v| v.abs() > super::urdf::MAX_LIMIT) {
+            Some(index) => Err(RobotError::JointOutOfRange {
+                index,
+                value: q[index],
+                limit: super::urdf::MAX_LIMIT,
+            }),
             None => Ok(()),
         }
     }

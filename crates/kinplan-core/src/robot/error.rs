@@ -15,6 +15,8 @@ pub enum RobotError {
     },
     #[error("URDF value {field} is not finite")]
     NonFiniteValue { field: String },
+    #[error("URDF value {field} is out of range: {reason}")]
+    ValueOutOfRange { field: String, reason: &'static str },
     #[error("unknown link `{link}`")]
     UnknownLink { link: String },
     #[error("unknown robot `{name}`; built-in robots: {known}")]
@@ -35,4 +37,6 @@ pub enum RobotError {
     WrongJointCount { expected: usize, got: usize },
     #[error("joint value {index} is not finite")]
     NonFiniteJoint { index: usize },
+    #[error("joint value {index} is {value}, beyond the accepted magnitude {limit}")]
+    JointOutOfRange { index: usize, value: f64, limit: f64 },
 }

@@ -287,6 +287,7 @@ fn bad_urdfs_are_rejected_with_reasons() {
     let small = UrdfLimits {
         max_bytes: 10,
         max_elements: 5,
+        ..UrdfLimits::default()
     };
     assert!(matches!(
         parse_chain(nan, &spec, small).unwrap_err(),
@@ -339,4 +340,161 @@ fn every_arm_name_is_a_built_in_with_six_or_seven_joints() {
         let dof = builtin_chain(name).unwrap().dof();
         assert!(dof == 6 || dof == 7, "{name}: {dof} joints");
     }
+}
+
+fn two_links(joint_body: &str) -> String {
+    format!(
+        r#"<robot name="r"><link name="a"/><link name="b"/>
+      <joint name="j" type="revolute"><parent link="a"/><child link="b"/>{joint_body}</joint></robot>"#
+    )
+}
+
+/// Regression: 3,500 nested elements overflowed a pool thread's stack in the
+/// recursive XML parser and aborted the server.
+#[test]
+fn deeply_nested_urdf_is_rejected_before_parsing() {
+    let text = format!(
+        r#"<robot name="r"><link name="a"/>{}{}</robot>"#,
+        "<x>".repeat(3500),
+        "</x>".repeat(3500)
+    );
+    let err = parse_chain(&text, &ChainSpec::default(), UrdfLimits::default()).unwrap_err();
+    assert!(err.to_string().contains("nested more than 64 deep"), "{err}");
+    // 64 levels are fine for the scan (the parser then decides).
+    let ok = format!(
+        r#"<robot name="r"><link name="a"/>{}{}</robot>"#,
+        "<x>".repeat(62),
+        "</x>".repeat(62)
+    );
+    parse_chain(&ok, &ChainSpec::default(), UrdfLimits::default()).unwrap();
+}
+
+/// Regression: 840 KB of unclosed `<x>` cost the parser 30–42 s of CPU. The
+/// bound below is a regression guard two orders of magnitude under that, not a
+/// performance claim (the pre-scan rejects it in well under a millisecond in a
+/// release build).
+#[test]
+fn unclosed_elements_at_the_size_limit_fail_fast() {
+    let text = format!(r#"<robot name="r"><link name="a"/>{}"#, "<x>".repeat(280_000));
+    let started = std::time::Instant::now();
+    assert!(parse_chain(&text, &ChainSpec::default(), UrdfLimits::default()).is_err());
+    assert!(
+        started.elapsed() < std::time::Duration::from_millis(500),
+        "{:?}",
+        started.elapsed()
+    );
+    // Many siblings, quoted `>` and comments are scanned, not mistaken for depth.
+    let siblings = format!(
+        r#"<robot name="r"><!-- <a><b> --><link name="a"><collision name="v>x"><geometry><box size="1 1 1"/></geometry></collision></link>{}</robot>"#,
+        "<material name=\"m\"/>".repeat(15_000)
+    );
+    let started = std::time::Instant::now();
+    parse_chain(&siblings, &ChainSpec::default(), UrdfLimits::default()).unwrap();
+    eprintln!("15,000 siblings: {:?}", started.elapsed());
+    let too_many = format!(r#"<robot name="r">{}</robot>"#, "<x/>".repeat(25_000));
+    assert!(matches!(
+        parse_chain(&too_many, &ChainSpec::default(), UrdfLimits::default()).unwrap_err(),
+        RobotError::TooManyElements {
+            what: "XML elements",
+            ..
+        }
+    ));
+    let doctype = r#"<!DOCTYPE r [<!ENTITY a "aaaa">]><robot name="r"><link name="a"/></robot>"#;
+    assert!(parse_chain(doctype, &ChainSpec::default(), UrdfLimits::default()).is_err());
+}
+
+/// Regression: an axis of (1e308, 1e308, 0) overflowed normalisation, origins of
+/// 1e308 gave non-finite FK, and velocity limits of −5 or NaN were accepted.
+#[test]
+fn extreme_urdf_values_are_rejected_or_normalised() {
+    let spec = ChainSpec::default();
+    let limits = UrdfLimits::default();
+    let lim = r#"<limit lower="-1" upper="1" effort="1" velocity="1"/>"#;
+    let huge_axis = two_links(&format!(r#"<axis xyz="1e308 1e308 0"/>{lim}"#));
+    let chain = parse_chain(&huge_axis, &spec, limits).unwrap();
+    let axis = chain.joints()[0].axis;
+    assert!(
+        (axis.x - std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-12,
+        "{axis:?}"
+    );
+    let zero_axis = two_links(&format!(r#"<axis xyz="0 0 1e-300"/>{lim}"#));
+    assert!(matches!(
+        parse_chain(&zero_axis, &spec, limits).unwrap_err(),
+        RobotError::ZeroAxis { .. }
+    ));
+    let far = two_links(&format!(r#"<origin xyz="1e308 0 0"/>{lim}"#));
+    assert!(matches!(
+        parse_chain(&far, &spec, limits).unwrap_err(),
+        RobotError::ValueOutOfRange { .. }
+    ));
+    for velocity in ["-5", "NaN", "5e-324"] {
+        let v = two_links(&format!(
+            r#"<limit lower="-1" upper="1" effort="1" velocity="{velocity}"/>"#
+        ));
+        assert!(
+            matches!(
+                parse_chain(&v, &spec, limits).unwrap_err(),
+                RobotError::ValueOutOfRange { .. }
+            ),
+            "velocity {velocity}"
+        );
+    }
+    let effort = two_links(r#"<limit lower="-1" upper="1" effort="-1" velocity="1"/>"#);
+    assert!(parse_chain(&effort, &spec, limits).is_err());
+    // Joint values are bounded too, so FK stays finite.
+    let slide = r#"<robot name="s"><link name="a"/><link name="b"/>
+      <joint name="j" type="prismatic"><parent link="a"/><child link="b"/>
+      <limit lower="-1e300" upper="1e300" effort="1" velocity="1"/></joint></robot>"#;
+    let chain = parse_chain(slide, &spec, limits).unwrap();
+    assert!(matches!(
+        chain.check_joints(&[1e308]).unwrap_err(),
+        RobotError::JointOutOfRange { .. }
+    ));
+    chain.check_joints(&[1e6]).unwrap();
+    assert!(chain.fk(&[1e6]).translation.vector.iter().all(|v| v.is_finite()));
+}
+
+/// Regression: duplicate joint names and a cycle detached from the root were accepted.
+#[test]
+fn duplicate_joints_and_detached_cycles_are_rejected() {
+    let spec = ChainSpec::default();
+    let limits = UrdfLimits::default();
+    let dup = r#"<robot name="d"><link name="a"/><link name="b"/><link name="c"/>
+      <joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>
+      <joint name="j" type="fixed"><parent link="b"/><child link="c"/></joint></robot>"#;
+    let err = parse_chain(dup, &spec, limits).unwrap_err();
+    assert!(err.to_string().contains("two joints share the name `j`"), "{err}");
+    let cycle = r#"<robot name="c"><link name="a"/><link name="b"/><link name="x"/><link name="y"/>
+      <joint name="j1" type="fixed"><parent link="a"/><child link="b"/></joint>
+      <joint name="j2" type="fixed"><parent link="x"/><child link="y"/></joint>
+      <joint name="j3" type="fixed"><parent link="y"/><child link="x"/></joint></robot>"#;
+    let err = parse_chain(cycle, &spec, limits).unwrap_err();
+    assert!(
+        err.to_string().contains("cycle of joints detached from the root"),
+        "{err}"
+    );
+}
+
+/// Regression: 25,000 collision boxes in a 1.7 MB URDF were accepted, and scoring
+/// with collision-vertex points then used gigabytes.
+#[test]
+fn collision_shapes_per_model_are_limited() {
+    let boxes = r#"<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>"#.repeat(1001);
+    let text = format!(r#"<robot name="b"><link name="a">{boxes}</link></robot>"#);
+    assert!(matches!(
+        parse_chain(&text, &ChainSpec::default(), UrdfLimits::default()).unwrap_err(),
+        RobotError::TooManyElements {
+            what: "collision shapes",
+            ..
+        }
+    ));
+}
+
+/// Names echoed in errors are clipped, so a 3,000-character name cannot blow up
+/// a reply's metadata.
+#[test]
+fn echoed_names_are_clipped() {
+    let long = "n".repeat(3000);
+    let err = builtin_chain(&long).unwrap_err().to_string();
+    assert!(err.len() < 400 && err.contains('…'), "{}", err.len());
 }

@@ -30,8 +30,10 @@ impl CollisionSetup {
     }
 }
 
-/// Setups keyed by the identity of the cached chain they were built for (a
-/// weak reference, so an evicted chain's setup is never returned for another).
+/// Setups keyed by the identity of the chain they were built for. A setup
+/// holds its chain (the robot model owns it), so the chain's address cannot
+/// be reused by another chain while the entry lives; the capacity bounds the
+/// cache (oldest entry out first).
 pub struct CollisionModels {
     entries: Mutex<Vec<(Weak<Chain>, Arc<CollisionSetup>)>>,
     capacity: usize,
@@ -57,11 +59,9 @@ impl CollisionModels {
             .map(|(_, s)| s.clone())
     }
 
-    /// Keeps `setup` for `chain`, dropping entries whose chain is gone and then
-    /// the oldest beyond the capacity.
+    /// Keeps `setup` for `chain`, dropping the oldest entries beyond the capacity.
     pub fn insert(&self, chain: &Arc<Chain>, setup: Arc<CollisionSetup>) {
         let mut entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
-        entries.retain(|(w, _)| w.strong_count() > 0);
         if !entries
             .iter()
             .any(|(w, _)| w.upgrade().is_some_and(|c| Arc::ptr_eq(&c, chain)))
@@ -80,8 +80,8 @@ mod tests {
     use kinplan_core::robot::builtin_chain;
 
     #[test]
-    fn a_setup_is_found_only_for_its_own_chain_and_dropped_with_it() {
-        let cache = CollisionModels::new(4, 50);
+    fn a_setup_is_found_only_for_its_own_chain_and_the_capacity_holds() {
+        let cache = CollisionModels::new(2, 50);
         let ur5 = builtin_chain("ur5").unwrap();
         let setup = Arc::new(CollisionSetup::build(ur5.clone(), 50).unwrap());
         cache.insert(&ur5, setup.clone());

@@ -5,11 +5,13 @@
 
 use std::panic::AssertUnwindSafe;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use tokio::sync::{OwnedSemaphorePermit, Semaphore, oneshot};
 use tonic::Status;
+
+use super::guard::{RequestDeadline, deadline_after, effective_timeout};
 
 /// What a running computation may spend: a deadline and a cancellation flag
 /// raised when the caller goes away.
@@ -53,12 +55,37 @@ impl Drop for CancelOnDrop {
     }
 }
 
+/// Stack of each CPU-pool thread, bytes.
+pub const CPU_STACK_BYTES: usize = 8 * 1024 * 1024;
+
 /// The server's CPU pool and admission limit.
 pub struct Compute {
     pool: rayon::ThreadPool,
     admitted: Arc<Semaphore>,
     limit: usize,
     default_timeout: Option<Duration>,
+    /// Open `StreamIk` streams (each message's work is admitted separately).
+    streams: Arc<Semaphore>,
+    /// How long a stream may stay silent.
+    pub stream_idle_timeout: Duration,
+    /// Jobs running on the pool now (tests read it to see work stop).
+    running: Arc<AtomicUsize>,
+}
+
+/// Counts a job while it runs.
+struct Running(Arc<AtomicUsize>);
+
+impl Running {
+    fn start(counter: &Arc<AtomicUsize>) -> Self {
+        counter.fetch_add(1, Ordering::SeqCst);
+        Self(counter.clone())
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::SeqCst);
+    }
 }
 
 impl Compute {
@@ -68,6 +95,8 @@ impl Compute {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("kinplan-cpu-{i}"))
+            // Explicit, so recursion depth never depends on the platform default.
+            .stack_size(CPU_STACK_BYTES)
             .build()
             .expect("the CPU pool starts");
         let limit = concurrency.max(1);
@@ -76,23 +105,61 @@ impl Compute {
             admitted: Arc::new(Semaphore::new(limit)),
             limit,
             default_timeout,
+            streams: Arc::new(Semaphore::new(limit)),
+            stream_idle_timeout: Duration::from_secs(60),
+            running: Arc::new(AtomicUsize::new(0)),
         }
     }
 
-    /// Admits a request or sheds it; the permit is held until the reply.
-    pub fn admit<T>(&self, request: &tonic::Request<T>) -> Result<(OwnedSemaphorePermit, Budget), Status> {
-        let permit = self.admitted.clone().try_acquire_owned().map_err(|_| {
+    /// Counts running jobs in `counter` (shared with whoever watches it).
+    pub fn with_running_counter(mut self, counter: Arc<AtomicUsize>) -> Self {
+        self.running = counter;
+        self
+    }
+
+    /// Jobs running on the CPU pool now.
+    pub fn running_jobs(&self) -> usize {
+        self.running.load(Ordering::SeqCst)
+    }
+
+    /// Admits a new stream (at most the concurrency limit open at once); its
+    /// messages' work is admitted one by one with [`Compute::admit_work`].
+    pub fn admit_stream(&self) -> Result<OwnedSemaphorePermit, Status> {
+        self.streams.clone().try_acquire_owned().map_err(|_| {
+            metrics::counter!("kinplan_requests_shed_total").increment(1);
+            Status::resource_exhausted(format!(
+                "server busy: {} streams open; retry with backoff",
+                self.limit
+            ))
+        })
+    }
+
+    /// Admits one piece of work (a stream message) or sheds it.
+    pub fn admit_work(&self) -> Result<OwnedSemaphorePermit, Status> {
+        self.admitted.clone().try_acquire_owned().map_err(|_| {
             metrics::counter!("kinplan_requests_shed_total").increment(1);
             Status::resource_exhausted(format!(
                 "server busy: {} requests in flight; retry with backoff",
                 self.limit
             ))
-        })?;
-        let timeout = match (grpc_timeout(request.metadata()), self.default_timeout) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        };
-        Ok((permit, Budget::new(timeout.map(|t| Instant::now() + t))))
+        })
+    }
+
+    /// Admits a request or sheds it; the permit is held until the reply.
+    pub fn admit<T>(&self, request: &tonic::Request<T>) -> Result<(OwnedSemaphorePermit, Budget), Status> {
+        let permit = self.admit_work()?;
+        Ok((permit, Budget::new(self.deadline_of(request))))
+    }
+
+    /// The request's deadline: the one the guard layer set, or (outside a
+    /// server) the shorter of `grpc-timeout` and the default, from now. Never
+    /// overflows: a timeout too large for `Instant` means no deadline.
+    pub fn deadline_of<T>(&self, request: &tonic::Request<T>) -> Option<Instant> {
+        if let Some(RequestDeadline(deadline)) = request.extensions().get::<RequestDeadline>() {
+            return *deadline;
+        }
+        let header = grpc_timeout(request.metadata().as_ref());
+        effective_timeout(header, self.default_timeout).and_then(deadline_after)
     }
 
     /// Runs `work` on the CPU pool. Answers DEADLINE_EXCEEDED when the
@@ -112,10 +179,12 @@ impl Compute {
         };
         let (tx, rx) = oneshot::channel();
         let inner = budget.clone();
+        let running = self.running.clone();
         self.pool.spawn(move || {
             if inner.should_stop() {
                 return;
             }
+            let _running = Running::start(&running);
             let out = std::panic::catch_unwind(AssertUnwindSafe(|| work(&inner)));
             let _ = tx.send(out);
         });
@@ -141,9 +210,10 @@ fn deadline_exceeded() -> Status {
     Status::deadline_exceeded("the request's deadline passed before the work finished")
 }
 
-/// Parses the `grpc-timeout` header: up to 8 digits and a unit (H M S m u n).
-pub(crate) fn grpc_timeout(metadata: &tonic::metadata::MetadataMap) -> Option<Duration> {
-    let value = metadata.get("grpc-timeout")?.to_str().ok()?;
+/// Parses the `grpc-timeout` header: digits and a unit (H M S m u n),
+/// saturating (the spec allows 8 digits; more are read, not trusted).
+pub(crate) fn grpc_timeout(headers: &http::HeaderMap) -> Option<Duration> {
+    let value = headers.get("grpc-timeout")?.to_str().ok()?;
     let (digits, unit) = value.split_at(value.len().checked_sub(1)?);
     let n: u64 = digits.parse().ok()?;
     Some(match unit {
@@ -163,13 +233,23 @@ mod tests {
 
     #[test]
     fn grpc_timeout_units() {
-        let mut md = tonic::metadata::MetadataMap::new();
+        let mut md = http::HeaderMap::new();
         md.insert("grpc-timeout", "250m".parse().unwrap());
         assert_eq!(grpc_timeout(&md), Some(Duration::from_millis(250)));
         md.insert("grpc-timeout", "3S".parse().unwrap());
         assert_eq!(grpc_timeout(&md), Some(Duration::from_secs(3)));
         md.insert("grpc-timeout", "x".parse().unwrap());
         assert_eq!(grpc_timeout(&md), None);
+        // Regression: the legal-looking maximum overflowed `Instant` arithmetic.
+        md.insert("grpc-timeout", "18446744073709551615S".parse().unwrap());
+        assert_eq!(grpc_timeout(&md), Some(Duration::from_secs(u64::MAX)));
+        let compute = Compute::new(1, 1, None);
+        let mut req = tonic::Request::new(());
+        req.metadata_mut()
+            .insert("grpc-timeout", "18446744073709551615S".parse().unwrap());
+        assert_eq!(compute.deadline_of(&req), None);
+        let compute = Compute::new(1, 1, Some(Duration::from_secs(1)));
+        assert!(compute.deadline_of(&req).is_some());
     }
 
     #[tokio::test]

@@ -232,17 +232,28 @@ impl KinematicsService for KinematicsApi {
         &self,
         request: Request<Streaming<pb::StreamIkRequest>>,
     ) -> Result<Response<Self::StreamIkStream>, Status> {
-        let (permit, _) = self.shared.compute.admit(&request)?;
+        // An open stream holds a stream slot, not an admission permit: each
+        // message's work is admitted on its own (idle streams block no one).
+        let permit = self.shared.compute.admit_stream()?;
         // A controller's stream lives as long as the controller runs: only a
         // deadline the client sets bounds it, not the server's default.
-        let deadline = super::compute::grpc_timeout(request.metadata()).map(|t| Instant::now() + t);
+        let deadline =
+            super::compute::grpc_timeout(request.metadata().as_ref()).and_then(super::guard::deadline_after);
         let inbound = request.into_inner();
         let (tx, rx) = tokio::sync::mpsc::channel(4);
         let models = self.shared.models.clone();
         let compute = self.shared.compute.clone();
         tokio::spawn(async move {
             let _permit = permit;
-            if let Err(status) = stream_loop(inbound, &tx, &models, &compute, deadline).await {
+            let looped =
+                super::guard::catch_unwind(stream_loop(inbound, &tx, &models, &compute, deadline)).await;
+            let outcome = looped.unwrap_or_else(|_panic| {
+                tracing::error!("a StreamIk stream panicked; answering INTERNAL");
+                Err(Status::internal(
+                    "the server failed unexpectedly while handling this stream",
+                ))
+            });
+            if let Err(status) = outcome {
                 let _ = tx.send(Err(status)).await;
             }
         });
@@ -562,9 +573,18 @@ async fn stream_loop(
         workspace: Option<IkWorkspace>,
     }
     let mut session: Option<Session> = None;
-    while let Some(msg) = inbound.message().await? {
+    let idle = compute.stream_idle_timeout;
+    loop {
+        let Ok(next) = tokio::time::timeout(idle, inbound.message()).await else {
+            return Err(Status::unavailable(format!(
+                "no message for {} s: the stream was ended; open a new one",
+                idle.as_secs_f64()
+            )));
+        };
+        let Some(msg) = next? else { break };
         let seq = msg.sequence;
         let at = |s: Status| with_sequence(s, seq);
+        let _admitted = compute.admit_work().map_err(at)?;
         let mut model_id = Vec::new();
         let st = match session.as_mut() {
             None => {

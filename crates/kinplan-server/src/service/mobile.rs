@@ -234,7 +234,7 @@ fn control_step(req: pb::ControlStepRequest) -> Result<pb::ControlStepResponse, 
             applied: Some(twist_out(applied)),
             saturation: Some(saturation_out(sat)),
             reached,
-            state_token: next.to_token(),
+            state_token: next.to_token().map_err(token_failure)?,
             target_node: 0,
             mode: mode_out(out.mode) as i32,
             readings,
@@ -270,10 +270,21 @@ fn control_step(req: pb::ControlStepRequest) -> Result<pb::ControlStepResponse, 
         applied: Some(twist_out(applied)),
         saturation: Some(saturation_out(sat)),
         reached: s.reached,
-        state_token: serde_json::to_vec(&s.next).unwrap_or_default(),
+        state_token: serde_json::to_vec(&s.next).map_err(|e| {
+            token_failure(MobileError::BadToken {
+                reason: e.to_string(),
+            })
+        })?,
         target_node: s.next.target as u32,
         ..Default::default()
     })
+}
+
+/// A controller state the server could not encode: a server bug, never an
+/// empty token the client would take for a fresh start.
+fn token_failure(err: MobileError) -> Status {
+    tracing::error!(%err, "a controller state could not be encoded");
+    Status::internal("the controller state could not be encoded")
 }
 
 /// INVALID_ARGUMENT naming the request field that a [`MobileError`] is about.
@@ -710,7 +721,8 @@ fn run_out(run: SimRun) -> pb::MobileRun {
         metrics: Some(pb::RunMetrics {
             path_length: run.metrics.path_length,
             time: run.metrics.time,
-            min_clearance: run.metrics.min_clearance,
+            // unset without obstacles (the domain says +inf)
+            min_clearance: run.metrics.min_clearance.filter(|c| c.is_finite()),
             steps: run.metrics.steps as u32,
         }),
     }

@@ -1,8 +1,9 @@
-//! Assembles the gRPC server: kinplan services, health, reflection, metrics
-//! layer, message limits and graceful shutdown.
+//! Assembles the gRPC server: kinplan services, health, reflection, the guard
+//! layer (deadlines, panics, metrics), message limits and graceful shutdown.
 
 use std::future::Future;
 use std::sync::Arc;
+use std::sync::atomic::AtomicUsize;
 use std::time::Duration;
 
 use tokio::net::TcpListener;
@@ -12,8 +13,8 @@ use tonic::transport::server::TcpIncoming;
 use tonic_health::ServingStatus;
 
 use super::collision_models::CollisionModels;
+use super::guard::GuardLayer;
 use super::kinematics::KinematicsApi;
-use super::metrics::MetricsLayer;
 use super::mobile::MobileApi;
 use super::models::Resolved;
 use super::pb::kinematics_service_server::KinematicsServiceServer;
@@ -50,6 +51,14 @@ pub struct ServerConfig {
     /// Time between reporting NOT_SERVING and closing the listener on
     /// shutdown, so load balancers stop sending new calls first.
     pub drain_delay: Duration,
+    /// After the listener closes, how long calls in flight may finish; then
+    /// open streams (`Health.Watch`, `StreamIk`) end with UNAVAILABLE.
+    pub drain_timeout: Duration,
+    /// A `StreamIk` stream that sends no message for this long is ended
+    /// (UNAVAILABLE), so idle streams cannot pile up.
+    pub stream_idle_timeout: Duration,
+    /// Counts jobs running on the CPU pool (tests watch it to see work stop).
+    pub running_jobs: Arc<AtomicUsize>,
 }
 
 impl Default for ServerConfig {
@@ -63,6 +72,9 @@ impl Default for ServerConfig {
             model_cache_entries: 256,
             acm_samples: 10_000,
             drain_delay: Duration::ZERO,
+            drain_timeout: Duration::from_secs(10),
+            stream_idle_timeout: Duration::from_secs(60),
+            running_jobs: Arc::default(),
         }
     }
 }
@@ -76,11 +88,14 @@ pub async fn serve(
     listener: TcpListener,
     shutdown: impl Future<Output = ()> + Send + 'static,
 ) -> Result<(), BoxError> {
-    let compute = Arc::new(Compute::new(
+    let mut compute = Compute::new(
         config.cpu_threads,
         config.concurrency_limit,
         config.request_timeout,
-    ));
+    )
+    .with_running_counter(config.running_jobs.clone());
+    compute.stream_idle_timeout = config.stream_idle_timeout;
+    let compute = Arc::new(compute);
     let models = Arc::new(ModelStore::new(
         UrdfLimits {
             max_bytes: config.max_urdf_bytes,
@@ -133,6 +148,11 @@ pub async fn serve(
         .build_v1alpha()?;
 
     let drain_delay = config.drain_delay;
+    let drain_timeout = config.drain_timeout;
+    // `cut` turns true when the drain timeout has passed: the guard then ends
+    // every open reply stream with UNAVAILABLE, so shutdown cannot hang on them.
+    let (cut_tx, cut_rx) = tokio::sync::watch::channel(false);
+    let (closed_tx, closed_rx) = tokio::sync::oneshot::channel::<()>();
     let drain = async move {
         shutdown.await;
         tracing::info!(?drain_delay, "shutting down: reporting NOT_SERVING");
@@ -140,11 +160,23 @@ pub async fn serve(
             health.set_service_status(name, ServingStatus::NotServing).await;
         }
         tokio::time::sleep(drain_delay).await;
-        tracing::info!("closing the listener; finishing calls in flight");
+        tracing::info!(?drain_timeout, "closing the listener; finishing calls in flight");
+        let _ = closed_tx.send(());
+    };
+    let cutter = async move {
+        if closed_rx.await.is_err() {
+            return std::future::pending().await;
+        }
+        tokio::time::sleep(drain_timeout).await;
+        tracing::warn!("drain timeout passed: ending open streams with UNAVAILABLE");
+        let _ = cut_tx.send(true);
+        // A last resort if a connection still does not close.
+        tokio::time::sleep(Duration::from_secs(2)).await;
+        tracing::warn!("connections still open after the drain timeout; stopping anyway");
     };
     tracing::info!(addr = ?listener.local_addr().ok(), "kinplan serving");
-    Server::builder()
-        .layer(MetricsLayer)
+    let server = Server::builder()
+        .layer(GuardLayer::new(cut_rx, config.request_timeout))
         .add_service(health_service)
         .add_service(reflection_v1)
         .add_service(reflection_v1alpha)
@@ -159,8 +191,11 @@ pub async fn serve(
                 .with_nodelay(Some(true))
                 .with_keepalive(Some(Duration::from_secs(60))),
             drain,
-        )
-        .await?;
+        );
+    tokio::select! {
+        served = server => served?,
+        () = cutter => {}
+    }
     Ok(())
 }
 
@@ -190,5 +225,3 @@ impl Shared {
 fn name_of<S: tonic::server::NamedService>(_: &S) -> &'static str {
     S::NAME
 }
-
-pub use super::metrics::HANDLING_BUCKETS;

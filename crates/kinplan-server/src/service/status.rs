@@ -16,9 +16,21 @@ pub fn not_found(field: impl Into<String>, description: impl Into<String>) -> St
     field_status(Code::NotFound, field, description)
 }
 
+/// Longest description a status carries: values echoed from a request are
+/// clipped so a reply never outgrows the client's metadata limit.
+pub const MAX_DESCRIPTION_CHARS: usize = 256;
+
+/// At most `max` characters of `text`, with `…` when clipped.
+pub fn clip(text: &str, max: usize) -> String {
+    match text.char_indices().nth(max) {
+        Some((at, _)) => format!("{}…", &text[..at]),
+        None => text.to_string(),
+    }
+}
+
 fn field_status(code: Code, field: impl Into<String>, description: impl Into<String>) -> Status {
-    let field = field.into();
-    let description = description.into();
+    let field = clip(&field.into(), 64);
+    let description = clip(&description.into(), MAX_DESCRIPTION_CHARS);
     let message = format!("{field}: {description}");
     Status::with_error_details(
         code,
@@ -38,11 +50,14 @@ pub fn robot_error(err: RobotError, joints_field: &str) -> Status {
             invalid("robot.tip_link", text)
         }
         RobotError::WrongJointCount { .. } => invalid(joints_field, text),
-        RobotError::NonFiniteJoint { index } => invalid(format!("{joints_field}[{index}]"), text),
+        RobotError::NonFiniteJoint { index } | RobotError::JointOutOfRange { index, .. } => {
+            invalid(format!("{joints_field}[{index}]"), text)
+        }
         RobotError::MalformedUrdf(_)
         | RobotError::UrdfTooLarge { .. }
         | RobotError::TooManyElements { .. }
         | RobotError::NonFiniteValue { .. }
+        | RobotError::ValueOutOfRange { .. }
         | RobotError::NoSingleRoot { .. }
         | RobotError::UnsupportedJoint { .. }
         | RobotError::ZeroAxis { .. }

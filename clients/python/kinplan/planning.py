@@ -1,0 +1,440 @@
+"""Motion planning in a collision scene: STOMP, CCSTOMP (S0's Cartesian-
+constrained STOMP) and RRT-Connect, and validity checks of joint states.
+
+``Client.plan(robot, start=q0, goal=q1 | pose=T, algorithm="ccstomp",
+scene=[kinplan.Box(...), ...])`` returns a :class:`Plan`; ``Client.check_states
+(robot, qs, scene)`` a :class:`StateChecks`. Obstacles are placed in the
+robot's base frame; units are metres and radians (proto/kinplan/v1/planning.proto).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from ._convert import joints, matrix_to_pose
+from .v1 import common_pb2, planning_pb2, planning_pb2_grpc
+
+#: Planner names accepted by ``algorithm=``.
+ALGORITHMS = {
+    "rrt_connect": planning_pb2.PLAN_ALGORITHM_RRT_CONNECT,
+    "stomp": planning_pb2.PLAN_ALGORITHM_STOMP,
+    "ccstomp": planning_pb2.PLAN_ALGORITHM_CCSTOMP,
+}
+
+PoseLike = Union[None, np.ndarray, Sequence[float]]
+
+
+def _pose(pose: PoseLike) -> common_pb2.Pose:
+    """A 4x4 matrix, a 3-vector position (identity rotation) or None (identity)."""
+    if pose is None:
+        return common_pb2.Pose()
+    arr = np.asarray(pose, dtype=float)
+    if arr.shape == (3,):
+        return common_pb2.Pose(position=common_pb2.Vec3(x=arr[0], y=arr[1], z=arr[2]))
+    if arr.shape == (4, 4):
+        return matrix_to_pose(arr)
+    raise ValueError(f"pose must be a 4x4 matrix or a 3-vector position, got shape {arr.shape}")
+
+
+@dataclass
+class Box:
+    """A box with full edge lengths ``size`` (x, y, z), metres, centred on ``pose``."""
+
+    size: Sequence[float]
+    pose: PoseLike = None
+    id: str = ""
+
+    def to_proto(self) -> common_pb2.CollisionObject:
+        x, y, z = (float(v) for v in self.size)
+        return common_pb2.CollisionObject(
+            id=self.id, pose=_pose(self.pose), box=common_pb2.Box(size=common_pb2.Vec3(x=x, y=y, z=z))
+        )
+
+
+@dataclass
+class Sphere:
+    """A sphere of ``radius`` metres centred at ``pose`` (a 3-vector or 4x4)."""
+
+    radius: float
+    pose: PoseLike = None
+    id: str = ""
+
+    def to_proto(self) -> common_pb2.CollisionObject:
+        return common_pb2.CollisionObject(
+            id=self.id, pose=_pose(self.pose), sphere=common_pb2.Sphere(radius=float(self.radius))
+        )
+
+
+@dataclass
+class Cylinder:
+    """A cylinder along the z axis of ``pose``: radius and full length, metres."""
+
+    radius: float
+    length: float
+    pose: PoseLike = None
+    id: str = ""
+
+    def to_proto(self) -> common_pb2.CollisionObject:
+        return common_pb2.CollisionObject(
+            id=self.id,
+            pose=_pose(self.pose),
+            cylinder=common_pb2.Cylinder(radius=float(self.radius), length=float(self.length)),
+        )
+
+
+@dataclass
+class Capsule:
+    """A capsule along z: radius and the distance between its cap centres, metres."""
+
+    radius: float
+    length: float
+    pose: PoseLike = None
+    id: str = ""
+
+    def to_proto(self) -> common_pb2.CollisionObject:
+        return common_pb2.CollisionObject(
+            id=self.id,
+            pose=_pose(self.pose),
+            capsule=common_pb2.Capsule(radius=float(self.radius), length=float(self.length)),
+        )
+
+
+@dataclass
+class Mesh:
+    """A triangle mesh: ``vertices`` (n x 3, metres) and ``faces`` (m x 3 vertex indices)."""
+
+    vertices: Any
+    faces: Any
+    pose: PoseLike = None
+    id: str = ""
+
+    def to_proto(self) -> common_pb2.CollisionObject:
+        v = np.asarray(self.vertices, dtype=float)
+        f = np.asarray(self.faces)
+        if v.ndim != 2 or v.shape[1] != 3:
+            raise ValueError(f"vertices must be n x 3, got shape {v.shape}")
+        if f.ndim != 2 or f.shape[1] != 3:
+            raise ValueError(f"faces must be m x 3, got shape {f.shape}")
+        if f.size and (f.min() < 0 or f.max() >= len(v)):
+            raise ValueError(f"faces index vertices 0..{len(v) - 1}, got {f.min()}..{f.max()}")
+        mesh = common_pb2.TriangleMesh(
+            vertices=[common_pb2.Vec3(x=a, y=b, z=c) for a, b, c in v.tolist()],
+            indices=f.astype(np.uint32).ravel().tolist(),
+        )
+        return common_pb2.CollisionObject(id=self.id, pose=_pose(self.pose), mesh=mesh)
+
+
+@dataclass
+class OctreeObstacle:
+    """An OctoMap tree as an obstacle: the node bytes of a ``.bt`` file (or of
+    a ``.ot`` file with ``binary=False``) without its text header, as ROS
+    ``octomap_msgs/Octomap.data`` carries them; or a whole ``.bt`` file via
+    :meth:`from_bt_file_bytes`. Occupied leaves are obstacles; with
+    ``unknown_as_obstacle`` so are the unknown cells inside its known bounds."""
+
+    data: bytes
+    resolution: float
+    binary: bool = True
+    tree_id: str = "OcTree"
+    pose: PoseLike = None
+    unknown_as_obstacle: bool = False
+    id: str = ""
+
+    @classmethod
+    def from_bt_file_bytes(cls, content: bytes, **kwargs: Any) -> "OctreeObstacle":
+        """Splits a ``.bt`` file's header (``id``, ``res``, ``data`` lines) from its nodes."""
+        tree_id, resolution, offset = "OcTree", None, 0
+        while True:
+            end = content.index(b"\n", offset)
+            line = content[offset:end].decode("ascii", "replace").strip()
+            offset = end + 1
+            if line.startswith("id "):
+                tree_id = line[3:].strip()
+            elif line.startswith("res "):
+                resolution = float(line[4:])
+            elif line == "data":
+                break
+        if resolution is None:
+            raise ValueError("the .bt header has no 'res' line")
+        return cls(data=content[offset:], resolution=resolution, tree_id=tree_id, binary=True, **kwargs)
+
+    def to_proto(self) -> common_pb2.CollisionObject:
+        return common_pb2.CollisionObject(
+            id=self.id,
+            pose=_pose(self.pose),
+            octree=common_pb2.Octree(
+                id=self.tree_id, resolution=float(self.resolution), binary=self.binary, data=bytes(self.data)
+            ),
+            unknown_as_obstacle=self.unknown_as_obstacle,
+        )
+
+
+Obstacle = Union[Box, Sphere, Cylinder, Capsule, Mesh, OctreeObstacle, common_pb2.CollisionObject]
+
+
+def scene_to_proto(scene: Optional[Sequence[Obstacle]]) -> common_pb2.Scene:
+    objects = []
+    for k, o in enumerate(scene or []):
+        if isinstance(o, common_pb2.CollisionObject):
+            objects.append(o)
+        elif hasattr(o, "to_proto"):
+            p = o.to_proto()
+            if not p.id:
+                p.id = f"{type(o).__name__.lower()}_{k}"
+            objects.append(p)
+        else:
+            raise TypeError(f"scene[{k}] is a {type(o).__name__}, not a kinplan obstacle")
+    return common_pb2.Scene(objects=objects)
+
+
+@dataclass
+class Plan:
+    """A planned trajectory. ``q`` is n x dof (rad, or m for prismatic
+    joints), ``t`` the time of each waypoint (s) within the velocity limits.
+    ``status`` is one of SUCCEEDED, NO_VALID_TRAJECTORY, INVALID_START,
+    INVALID_GOAL, GOAL_UNREACHABLE, TIMEOUT, CANCELLED; ``valid`` says the
+    trajectory is collision-free (and, for CCSTOMP, within the Cartesian
+    tolerances). ``deviation`` is n x 2: the tool's translation (m) and
+    rotation (rad) from the straight Cartesian line between the start and goal
+    tool poses. ``scores`` holds the S0 criteria (see ``Client.score``)."""
+
+    status: str
+    message: str
+    q: np.ndarray
+    t: np.ndarray
+    valid: bool
+    cost_history: np.ndarray
+    deviation: np.ndarray
+    violates_tolerance: bool
+    scores: Dict[str, float]
+    colliding: List[str]
+    goal: np.ndarray
+    iterations: int
+    duration: float
+    timings: Dict[str, float]
+    raw: Any = field(default=None, repr=False)
+
+    @property
+    def success(self) -> bool:
+        return self.status == "SUCCEEDED"
+
+    def __repr__(self) -> str:
+        return (
+            f"Plan(status={self.status}, waypoints={len(self.q)}, valid={self.valid}, "
+            f"duration={self.duration:.3f} s, planning={self.timings.get('total', 0.0) * 1e3:.1f} ms)"
+        )
+
+    @classmethod
+    def from_proto(cls, r: planning_pb2.PlanResponse) -> "Plan":
+        points = r.trajectory.points
+        q = np.array([list(p.positions) for p in points], dtype=float) if points else np.zeros((0, 0))
+        return cls(
+            status=planning_pb2.PlanStatus.Name(r.status).removeprefix("PLAN_STATUS_"),
+            message=r.message,
+            q=q,
+            t=np.array([p.time_from_start for p in points], dtype=float),
+            valid=r.valid,
+            cost_history=np.array(r.cost_history, dtype=float),
+            deviation=np.column_stack(
+                [np.array(r.deviation.translation, dtype=float), np.array(r.deviation.rotation, dtype=float)]
+            )
+            if len(r.deviation.translation)
+            else np.zeros((0, 2)),
+            violates_tolerance=r.deviation.violates_tolerance,
+            scores=dict(r.criteria),
+            colliding=list(r.colliding),
+            goal=np.array(r.goal, dtype=float),
+            iterations=r.iterations,
+            duration=r.duration,
+            timings={
+                "goal_ik": r.timings.goal_ik,
+                "rrt_connect": r.timings.rrt_connect,
+                "stomp": r.timings.stomp,
+                "verify": r.timings.verify,
+                "total": r.timings.total,
+            },
+            raw=r,
+        )
+
+
+@dataclass
+class StateChecks:
+    """Per state: ``valid``, ``within_limits``, ``clearance`` (m, negative when
+    penetrating, capped at max_distance), the colliding pairs, the closest
+    pair and its witness points (n x 3, NaN where nothing was within reach)."""
+
+    valid: np.ndarray
+    within_limits: np.ndarray
+    clearance: np.ndarray
+    colliding: List[List[str]]
+    closest_pair: List[str]
+    robot_points: np.ndarray
+    obstacle_points: np.ndarray
+
+    def __repr__(self) -> str:
+        return f"StateChecks({int(self.valid.sum())}/{len(self.valid)} valid, min clearance {self.clearance.min(initial=np.inf):.4f} m)"
+
+
+def _vec(v: Any, present: bool) -> List[float]:
+    return [v.x, v.y, v.z] if present else [np.nan] * 3
+
+
+class PlanningMixin:
+    """``Client.plan``, ``Client.plan_stream`` and ``Client.check_states``."""
+
+    def _planning(self) -> planning_pb2_grpc.PlanningServiceStub:
+        stub = getattr(self, "_planning_stub", None)
+        if stub is None:
+            stub = planning_pb2_grpc.PlanningServiceStub(self._channel)  # type: ignore[attr-defined]
+            self._planning_stub = stub
+        return stub
+
+    def _plan_request(
+        self,
+        robot: Any,
+        start: Any,
+        goal: Any,
+        pose: Any,
+        algorithm: str,
+        scene: Optional[Sequence[Obstacle]],
+        seed: int,
+        time_budget: Optional[float],
+        motion_resolution: Optional[float],
+        return_cost_history: bool,
+        stomp: Optional[Mapping[str, Any]],
+        cartesian: Optional[Mapping[str, Any]],
+        rrt_connect: Optional[Mapping[str, Any]],
+        timing: Optional[Mapping[str, Any]],
+    ) -> Any:
+        if (goal is None) == (pose is None):
+            raise ValueError("give exactly one of goal= (joints) or pose= (4x4 tool pose)")
+        if algorithm not in ALGORITHMS:
+            raise ValueError(f"algorithm must be one of {sorted(ALGORITHMS)}, got {algorithm!r}")
+        options = planning_pb2.PlanOptions(
+            stomp=planning_pb2.StompOptions(**dict(stomp or {})),
+            cartesian=planning_pb2.CartesianOptions(**dict(cartesian or {})),
+            rrt_connect=planning_pb2.RrtConnectOptions(**dict(rrt_connect or {})),
+            timing=planning_pb2.TimingOptions(**dict(timing or {})),
+            return_cost_history=return_cost_history,
+        )
+        if time_budget is not None:
+            options.time_budget = float(time_budget)
+        if motion_resolution is not None:
+            options.motion_resolution = float(motion_resolution)
+        proto_scene = scene_to_proto(scene)
+
+        def build(ref: common_pb2.RobotRef) -> planning_pb2.PlanRequest:
+            req = planning_pb2.PlanRequest(
+                robot=ref,
+                start=joints(start, "start"),
+                scene=proto_scene,
+                algorithm=ALGORITHMS[algorithm],
+                options=options,
+                seed=int(seed),
+            )
+            if goal is not None:
+                req.goal_joints.positions.extend(joints(goal, "goal"))
+            else:
+                req.goal_pose.CopyFrom(_pose(pose))
+            return req
+
+        return build
+
+    def plan(
+        self,
+        robot: Any,
+        *,
+        start: Any,
+        goal: Any = None,
+        pose: Any = None,
+        algorithm: str = "rrt_connect",
+        scene: Optional[Sequence[Obstacle]] = None,
+        seed: int = 0,
+        time_budget: Optional[float] = None,
+        motion_resolution: Optional[float] = None,
+        return_cost_history: bool = True,
+        stomp: Optional[Mapping[str, Any]] = None,
+        cartesian: Optional[Mapping[str, Any]] = None,
+        rrt_connect: Optional[Mapping[str, Any]] = None,
+        timing: Optional[Mapping[str, Any]] = None,
+        timeout: Optional[float] = None,
+    ) -> Plan:
+        """Plans from ``start`` to ``goal`` (joints) or ``pose`` (4x4 tool pose)
+        among ``scene``'s obstacles. ``algorithm``: "rrt_connect", "stomp" or
+        "ccstomp". ``stomp``, ``cartesian``, ``rrt_connect`` and ``timing`` take
+        the fields of the proto messages of those names (e.g.
+        ``stomp={"timesteps": 10}``, ``cartesian={"translation_tolerance": 1.0}``);
+        unset fields take the documented defaults. The same ``seed`` gives the
+        same answer."""
+        build = self._plan_request(
+            robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution,
+            return_cost_history, stomp, cartesian, rrt_connect, timing,
+        )
+        reply = robot._call(self._planning().Plan, build, timeout)
+        return Plan.from_proto(reply)
+
+    def plan_stream(self, robot: Any, *, start: Any, goal: Any = None, pose: Any = None,
+                    algorithm: str = "stomp", scene: Optional[Sequence[Obstacle]] = None, seed: int = 0,
+                    timeout: Optional[float] = None, **options: Any) -> Iterator[Union[np.ndarray, Plan]]:
+        """Yields the trajectory (waypoints x dof) after every STOMP / CCSTOMP
+        iteration, then the final :class:`Plan` (for animations). ``options``
+        are those of :meth:`plan`."""
+        build = self._plan_request(
+            robot, start, goal, pose, algorithm, scene, seed, options.pop("time_budget", None),
+            options.pop("motion_resolution", None), options.pop("return_cost_history", True),
+            options.pop("stomp", None), options.pop("cartesian", None), options.pop("rrt_connect", None),
+            options.pop("timing", None),
+        )
+        if options:
+            raise TypeError(f"unknown options: {sorted(options)}")
+        from .errors import KinplanError
+        import grpc
+
+        t = self.timeout if timeout is None else timeout  # type: ignore[attr-defined]
+        try:
+            for m in self._planning().PlanStream(build(robot._ref()), timeout=t):
+                if m.HasField("result"):
+                    yield Plan.from_proto(m.result)
+                else:
+                    yield np.array([list(p.positions) for p in m.trajectory.points], dtype=float)
+        except grpc.RpcError as err:
+            raise KinplanError.from_rpc_error(err) from None
+
+    def check_states(
+        self,
+        robot: Any,
+        qs: Any,
+        scene: Optional[Sequence[Obstacle]] = None,
+        *,
+        max_distance: float = 1.0,
+        timeout: Optional[float] = None,
+    ) -> StateChecks:
+        """Validity and clearance of each row of ``qs`` (n x dof) in ``scene``."""
+        arr = np.asarray(qs, dtype=float)
+        if arr.ndim == 1:
+            arr = arr[None, :]
+        if arr.ndim != 2:
+            raise ValueError(f"qs must be n x dof, got shape {arr.shape}")
+        proto_scene = scene_to_proto(scene)
+
+        def build(ref: common_pb2.RobotRef) -> planning_pb2.CheckStateRequest:
+            return planning_pb2.CheckStateRequest(
+                robot=ref,
+                states=[planning_pb2.JointState(positions=row) for row in arr.tolist()],
+                scene=proto_scene,
+                max_distance=float(max_distance),
+            )
+
+        reply = robot._call(self._planning().CheckState, build, timeout)
+        s = reply.states
+        return StateChecks(
+            valid=np.array([c.valid for c in s], dtype=bool),
+            within_limits=np.array([c.within_limits for c in s], dtype=bool),
+            clearance=np.array([c.clearance for c in s], dtype=float),
+            colliding=[list(c.colliding) for c in s],
+            closest_pair=[c.closest_pair for c in s],
+            robot_points=np.array([_vec(c.robot_point, c.HasField("robot_point")) for c in s]).reshape(-1, 3),
+            obstacle_points=np.array([_vec(c.obstacle_point, c.HasField("obstacle_point")) for c in s]).reshape(-1, 3),
+        )

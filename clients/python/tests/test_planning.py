@@ -1,0 +1,102 @@
+"""c.plan / c.plan_stream / c.check_states against a real server: paths
+re-checked at a finer resolution, speeds against the model's limits, pose goals
+against FK, an OctoMap tree built by hand as an obstacle, errors by field."""
+import numpy as np
+import pytest
+
+import kinplan
+
+START = np.array([-1.2, -1.3, 1.4, -1.6, -1.57, 0.0])
+GOAL = np.array([1.2, -1.3, 1.4, -1.6, -1.57, 0.0])
+
+
+@pytest.fixture()
+def ur5(client):
+    return client.robot("ur5")
+
+
+def blocking_ball(ur5):
+    """A ball where the tool passes halfway along the straight joint-space line."""
+    return kinplan.Sphere(0.12, ur5.fk((START + GOAL) / 2)[:3, 3], id="ball")
+
+
+def interpolate(q, step):
+    out = []
+    for a, b in zip(q[:-1], q[1:]):
+        n = max(1, int(np.ceil(np.abs(b - a).max() / step)))
+        out.extend(a + (b - a) * k / n for k in range(n + 1))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("algorithm", ["rrt_connect", "stomp"])
+def test_a_plan_goes_around_the_ball_within_the_speed_limits(client, ur5, algorithm):
+    ball = blocking_ball(ur5)
+    line = client.check_states(ur5, [START, (START + GOAL) / 2, GOAL], [ball])
+    assert list(line.valid) == [True, False, True]
+
+    plan = client.plan(ur5, start=START, goal=GOAL, algorithm=algorithm, scene=[ball], seed=3)
+    assert plan.success and plan.valid, plan.message
+    np.testing.assert_array_equal(plan.q[0], START)
+    np.testing.assert_array_equal(plan.q[-1], GOAL)
+    assert plan.t[0] == 0 and np.all(np.diff(plan.t) > 0)
+    vmax = ur5.describe().max_velocity
+    speeds = np.abs(np.diff(plan.q, axis=0)) / np.diff(plan.t)[:, None]
+    assert np.all(speeds <= vmax * (1 + 1e-9))
+    assert client.check_states(ur5, interpolate(plan.q, 0.01), [ball]).valid.all()
+    assert plan.scores["JD"] == pytest.approx(np.abs(np.diff(plan.q, axis=0)).sum())
+    assert "SUCCEEDED" in repr(plan)
+
+
+def test_a_pose_goal_ends_at_the_pose(client, ur5):
+    T = ur5.fk(GOAL)
+    plan = client.plan(ur5, start=START, pose=T, algorithm="rrt_connect")
+    assert plan.success, plan.message
+    np.testing.assert_allclose(ur5.fk(plan.q[-1]), T, atol=1e-5)
+
+
+def test_invalid_start_names_the_obstacle(client, ur5):
+    crate = kinplan.Box((0.2, 0.2, 0.2), ur5.fk(START)[:3, 3], id="crate")
+    plan = client.plan(ur5, start=START, goal=GOAL, scene=[crate])
+    assert plan.status == "INVALID_START"
+    assert any(c.endswith(":crate") for c in plan.colliding), plan.colliding
+
+
+def test_plan_stream_yields_iterations_then_the_plan(client, ur5):
+    items = list(client.plan_stream(ur5, start=START, goal=GOAL, algorithm="stomp", scene=[blocking_ball(ur5)]))
+    *frames, final = items
+    assert isinstance(final, kinplan.Plan) and final.success
+    assert frames and all(f.shape == (40, 6) for f in frames)
+
+
+def hand_made_bt(resolution):
+    """A .bt file with one occupied cell at key (32768, 32768, 32768), the cube
+    [0, res)^3: child 7 at depth 0, child 0 down to depth 15, an occupied leaf."""
+    nodes = bytes([0x00, 0xC0]) + bytes([0x03, 0x00]) * 14 + bytes([0x02, 0x00])
+    header = f"# Octomap OcTree binary file\nid OcTree\nsize 16\nres {resolution}\ndata\n".encode()
+    return header + nodes
+
+
+def test_an_octree_cell_is_an_obstacle_where_the_pose_puts_it(client, ur5):
+    res = 0.1
+    tool = ur5.fk(START)[:3, 3]
+    # The cube [0, res)^3 moved so that its centre is the tool point.
+    cell = kinplan.OctreeObstacle.from_bt_file_bytes(hand_made_bt(res), pose=tool - res / 2)
+    assert cell.resolution == res and len(cell.data) == 32
+    hit = client.check_states(ur5, [START], [cell])
+    assert not hit.valid[0] and any(c.endswith(":octreeobstacle_0") for c in hit.colliding[0])
+    # 0.5 m above the tool, the same cell is clear by about 0.5 - 0.05 m less the tool's size.
+    away = kinplan.OctreeObstacle.from_bt_file_bytes(hand_made_bt(res), pose=tool + [0, 0, 0.5] - res / 2)
+    clear = client.check_states(ur5, [START], [away], max_distance=2.0)
+    assert clear.valid[0] and 0.0 < clear.clearance[0] < 0.45
+
+
+def test_bad_input_is_named(client, ur5):
+    with pytest.raises(kinplan.KinplanError) as e:
+        client.plan(ur5, start=[0, 0, np.nan, 0, 0, 0], goal=GOAL)
+    assert "start[2]" in str(e.value)
+    with pytest.raises(ValueError):
+        kinplan.Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 5]]).to_proto()
+    with pytest.raises(ValueError):
+        client.plan(ur5, start=START)
+    with pytest.raises(ValueError):
+        client.plan(ur5, start=START, goal=GOAL, algorithm="prm")
