@@ -132,7 +132,8 @@ pub fn plan_grid_astar(
     let nxf = ((hi.x + params.padding - x0) / res).ceil() + 1.0;
     let nyf = ((hi.y + params.padding - y0) / res).ceil() + 1.0;
     let cells = nxf * nyf;
-    if !(cells <= params.max_cells as f64) {
+    // NaN (from infinite inputs) is refused too.
+    if cells.is_nan() || cells > params.max_cells as f64 {
         return Err(MobileError::OutOfRange {
             field: "astar grid cells".into(),
             value: cells,
