@@ -16,20 +16,24 @@
 //! (the queries).
 
 mod acm;
+mod attach;
 mod bvh;
 mod checker;
 mod convert;
 mod error;
 mod model;
+mod moveit;
 mod narrow;
 mod scene;
 mod scene_checker;
 mod world;
 
 pub use acm::{AcmParams, AllowReason, AllowedCollisions};
+pub use attach::attached_bodies;
 pub use checker::{MotionCheck, StateChecker, interpolate_motion_valid};
 pub use error::CollisionError;
 pub use model::{AttachedBody, InlineMesh, MAX_BODIES, MAX_LINKS, RobotModel};
+pub use moveit::{JointRequest, MAX_YAML_BYTES, parse_joint_request, parse_planning_scene};
 pub use scene::{Geometry, Obstacle, Scene, SceneLimits};
 pub use scene_checker::{CheckerParams, Part, Proximity, SceneChecker, StateReport};
 pub use world::SceneGeometry;

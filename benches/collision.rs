@@ -1,0 +1,163 @@
+//! State checks of the Franka Panda (7 joints, 8 collision bodies) against
+//! 50 random primitives (boxes, spheres, cylinders, capsules), seeded.
+//! `cargo bench -p kinplan-core --bench collision`; figures go to
+//! benches/COLLISION_RESULTS.md.
+//!
+//! Side effect: writes the scene, the robot's shapes, the world pose of
+//! every robot shape at each benchmark state, the self-collision pairs and
+//! our verdicts to `target/collision_bench/scene.json`, which
+//! `benches/collision_coal.py` reads to time coal on the same shapes.
+
+use std::hint::black_box;
+use std::sync::Arc;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use kinplan_core::collision::{
+    AcmParams, AllowedCollisions, CheckerParams, Geometry, Obstacle, RobotModel, Scene, SceneChecker,
+    SceneGeometry, SceneLimits, StateChecker,
+};
+use kinplan_core::robot::{Shape, builtin_chain};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde_json::{Value, json};
+
+const OBSTACLES: usize = 50;
+const STATES: usize = 1024;
+
+/// 50 primitives of 3–10 cm half size, centres 0.3–0.9 m from the base at
+/// heights 0–1 m, random orientation.
+fn scene(rng: &mut ChaCha8Rng) -> Vec<Obstacle> {
+    (0..OBSTACLES)
+        .map(|i| {
+            let r = rng.random_range(0.3..0.9);
+            let a = rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+            let z = rng.random_range(0.0..1.0);
+            let rot = UnitQuaternion::from_euler_angles(
+                rng.random_range(-3.1..3.1),
+                rng.random_range(-3.1..3.1),
+                rng.random_range(-3.1..3.1),
+            );
+            let pose = Isometry3::from_parts(Translation3::new(r * a.cos(), r * a.sin(), z), rot);
+            let s = |rng: &mut ChaCha8Rng| rng.random_range(0.03..0.1);
+            let g = match i % 4 {
+                0 => Geometry::Box {
+                    half_extents: Vector3::new(s(rng), s(rng), s(rng)),
+                },
+                1 => Geometry::Sphere { radius: s(rng) },
+                2 => Geometry::Cylinder {
+                    radius: s(rng),
+                    length: 2.0 * s(rng),
+                },
+                _ => Geometry::Capsule {
+                    radius: s(rng),
+                    length: 2.0 * s(rng),
+                },
+            };
+            Obstacle::new(format!("o{i}"), pose, g)
+        })
+        .collect()
+}
+
+fn pose_json(p: &Isometry3<f64>) -> Value {
+    let q = p.rotation.quaternion().coords;
+    json!({"t": p.translation.vector.as_slice(), "q_xyzw": [q.x, q.y, q.z, q.w]})
+}
+
+fn geometry_json(g: &Geometry) -> Value {
+    match g {
+        Geometry::Box { half_extents } => json!({"box": half_extents.as_slice()}),
+        Geometry::Sphere { radius } => json!({"sphere": radius}),
+        Geometry::Cylinder { radius, length } => json!({"cylinder": [radius, length]}),
+        Geometry::Capsule { radius, length } => json!({"capsule": [radius, length]}),
+        _ => unreachable!("the bench scene has primitives only"),
+    }
+}
+
+fn setup() -> (SceneChecker, Vec<Vec<f64>>) {
+    let chain = builtin_chain("franka_panda").unwrap();
+    let model = Arc::new(RobotModel::new(chain.clone()).unwrap());
+    let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let obstacles = scene(&mut rng);
+    let scene = Scene::new(obstacles.clone(), &SceneLimits::default()).unwrap();
+    let world = Arc::new(SceneGeometry::build(&scene).unwrap());
+    let checker = SceneChecker::new(model.clone(), &acm, world, CheckerParams::default()).unwrap();
+    let states: Vec<Vec<f64>> = (0..STATES)
+        .map(|_| chain.limits().map(|(lo, hi)| rng.random_range(lo..=hi)).collect())
+        .collect();
+
+    // Dump for the coal comparison.
+    let names: Vec<&str> = model.body_names().collect();
+    let mut frames = Vec::new();
+    let shapes: Vec<Value> = chain
+        .collision()
+        .iter()
+        .flat_map(|lc| {
+            lc.shapes.iter().map(move |s| {
+                let g = match &s.shape {
+                    Shape::Box { half_extents } => json!({"box": half_extents.as_slice()}),
+                    Shape::Sphere { radius } => json!({"sphere": radius}),
+                    Shape::Cylinder { radius, length } => json!({"cylinder": [radius, length]}),
+                    Shape::Capsule { radius, length } => json!({"capsule": [radius, length]}),
+                    Shape::MeshReference { .. } => unreachable!("built-in Panda has primitives"),
+                };
+                json!({"link": lc.link, "geometry": g, "origin": pose_json(&s.origin)})
+            })
+        })
+        .collect();
+    let poses: Vec<Value> = states
+        .iter()
+        .map(|q| {
+            chain.link_frames_into(q, &mut frames);
+            let links: serde_json::Map<String, Value> = chain
+                .links()
+                .iter()
+                .zip(&frames)
+                .map(|(l, f)| (l.name.clone(), pose_json(f)))
+                .collect();
+            json!({"q": q, "links": links, "valid": checker.is_valid(q)})
+        })
+        .collect();
+    let pairs: Vec<[&str; 2]> = acm.checked_pairs().map(|(a, b)| [names[a], names[b]]).collect();
+    let dump = json!({
+        "obstacles": obstacles.iter().map(|o| json!({"name": o.name, "pose": pose_json(&o.pose), "geometry": geometry_json(&o.geometry)})).collect::<Vec<_>>(),
+        "robot_shapes": shapes,
+        "self_pairs": pairs,
+        "states": poses,
+    });
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/collision_bench");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("scene.json"), serde_json::to_string(&dump).unwrap()).unwrap();
+    (checker, states)
+}
+
+fn state_checks(c: &mut Criterion) {
+    let (checker, states) = setup();
+    let valid = states.iter().filter(|q| checker.is_valid(q)).count();
+    eprintln!("{valid} of {STATES} benchmark states are valid");
+    let mut i = 0;
+    c.bench_function("is_valid/panda_50_primitives", |b| {
+        b.iter(|| {
+            i = (i + 1) % STATES;
+            checker.is_valid(black_box(&states[i]))
+        })
+    });
+    let mut i = 0;
+    c.bench_function("clearance/panda_50_primitives", |b| {
+        b.iter(|| {
+            i = (i + 1) % STATES;
+            checker.clearance(black_box(&states[i]), 0.5)
+        })
+    });
+    let mut i = 0;
+    c.bench_function("motion_valid/panda_50_primitives", |b| {
+        b.iter(|| {
+            i = (i + 1) % STATES;
+            checker.motion_valid(black_box(&states[i]), black_box(&states[(i + 1) % STATES]))
+        })
+    });
+}
+
+criterion_group!(benches, state_checks);
+criterion_main!(benches);
