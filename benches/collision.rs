@@ -13,8 +13,8 @@ use std::sync::Arc;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use kinplan_core::collision::{
-    AcmParams, AllowedCollisions, CheckerParams, Geometry, Obstacle, RobotModel, Scene, SceneChecker,
-    SceneGeometry, SceneLimits, StateChecker,
+    AcmParams, AllowReason, AllowedCollisions, CheckerParams, Geometry, Obstacle, RobotModel, Scene,
+    SceneChecker, SceneGeometry, SceneLimits, StateChecker,
 };
 use kinplan_core::robot::{Shape, builtin_chain};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
@@ -74,7 +74,9 @@ fn geometry_json(g: &Geometry) -> Value {
     }
 }
 
-fn setup() -> (SceneChecker, Vec<Vec<f64>>) {
+/// The full checker (scene + self pairs of the sampled ACM), the scene-only
+/// checker (every robot pair allowed, as in the coal comparison) and the states.
+fn setup() -> (SceneChecker, SceneChecker, Vec<Vec<f64>>) {
     let chain = builtin_chain("franka_panda").unwrap();
     let model = Arc::new(RobotModel::new(chain.clone()).unwrap());
     let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
@@ -82,7 +84,14 @@ fn setup() -> (SceneChecker, Vec<Vec<f64>>) {
     let obstacles = scene(&mut rng);
     let scene = Scene::new(obstacles.clone(), &SceneLimits::default()).unwrap();
     let world = Arc::new(SceneGeometry::build(&scene).unwrap());
-    let checker = SceneChecker::new(model.clone(), &acm, world, CheckerParams::default()).unwrap();
+    let checker = SceneChecker::new(model.clone(), &acm, world.clone(), CheckerParams::default()).unwrap();
+    let mut all = AllowedCollisions::adjacent(&model);
+    for a in 0..model.body_count() {
+        for b in 0..model.body_count() {
+            all.allow(a, b, AllowReason::User);
+        }
+    }
+    let scene_only = SceneChecker::new(model.clone(), &all, world, CheckerParams::default()).unwrap();
     let states: Vec<Vec<f64>> = (0..STATES)
         .map(|_| chain.limits().map(|(lo, hi)| rng.random_range(lo..=hi)).collect())
         .collect();
@@ -116,7 +125,7 @@ fn setup() -> (SceneChecker, Vec<Vec<f64>>) {
                 .zip(&frames)
                 .map(|(l, f)| (l.name.clone(), pose_json(f)))
                 .collect();
-            json!({"q": q, "links": links, "valid": checker.is_valid(q)})
+            json!({"q": q, "links": links, "valid": checker.is_valid(q), "scene_valid": scene_only.is_valid(q)})
         })
         .collect();
     let pairs: Vec<[&str; 2]> = acm.checked_pairs().map(|(a, b)| [names[a], names[b]]).collect();
@@ -129,18 +138,58 @@ fn setup() -> (SceneChecker, Vec<Vec<f64>>) {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/collision_bench");
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("scene.json"), serde_json::to_string(&dump).unwrap()).unwrap();
-    (checker, states)
+    (checker, scene_only, states)
+}
+
+/// CPU time this thread has run (ns), from `/proc/thread-self/schedstat`:
+/// unlike wall time it excludes time spent descheduled on a loaded machine.
+fn thread_cpu_ns() -> Option<u64> {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
+/// Mean CPU time per call of `f` over `n` calls (ns), when schedstat exists.
+fn cpu_per_call(n: usize, mut f: impl FnMut(usize) -> bool) -> Option<f64> {
+    let t0 = thread_cpu_ns()?;
+    let mut hits = 0;
+    for i in 0..n {
+        hits += f(i) as usize;
+    }
+    black_box(hits);
+    Some((thread_cpu_ns()? - t0) as f64 / n as f64)
 }
 
 fn state_checks(c: &mut Criterion) {
-    let (checker, states) = setup();
+    let (checker, scene_only, states) = setup();
     let valid = states.iter().filter(|q| checker.is_valid(q)).count();
-    eprintln!("{valid} of {STATES} benchmark states are valid");
+    let scene_valid = states.iter().filter(|q| scene_only.is_valid(q)).count();
+    eprintln!("{valid} of {STATES} benchmark states are valid ({scene_valid} free of the scene)");
+    let n = 400_000;
+    let full = cpu_per_call(n, |i| checker.is_valid(black_box(&states[i % STATES])));
+    let only = cpu_per_call(n, |i| scene_only.is_valid(black_box(&states[i % STATES])));
+    if let (Some(full), Some(only)) = (full, only) {
+        eprintln!(
+            "thread CPU time per is_valid over {n} calls: {:.3} µs (scene + self), {:.3} µs (scene only)",
+            full / 1e3,
+            only / 1e3
+        );
+    }
     let mut i = 0;
     c.bench_function("is_valid/panda_50_primitives", |b| {
         b.iter(|| {
             i = (i + 1) % STATES;
             checker.is_valid(black_box(&states[i]))
+        })
+    });
+    let mut i = 0;
+    c.bench_function("is_valid_scene_only/panda_50_primitives", |b| {
+        b.iter(|| {
+            i = (i + 1) % STATES;
+            scene_only.is_valid(black_box(&states[i]))
         })
     });
     let mut i = 0;

@@ -21,6 +21,7 @@ mod bvh;
 mod checker;
 mod convert;
 mod error;
+mod fast;
 mod model;
 mod moveit;
 mod narrow;

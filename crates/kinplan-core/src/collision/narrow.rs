@@ -4,6 +4,9 @@
 //! prediction margin, whose `dist` is the signed distance (negative by the
 //! penetration depth) and whose points are the witnesses.
 //!
+//! Boolean tests between a robot sphere or capsule and an obstacle sphere,
+//! capsule, box or cell use the closed forms of `fast` instead of parry.
+//!
 //! A pair parry cannot handle (none among the shapes this room builds) is
 //! reported as colliding: the safe answer for a planner.
 
@@ -13,6 +16,7 @@ use parry3d_f64::query;
 use parry3d_f64::shape::SharedShape;
 
 use super::convert::{point_from_parry, pose_to_parry};
+use super::fast::{overlap, overlap_robot};
 use super::model::Body;
 use super::world::Leaf;
 
@@ -64,9 +68,17 @@ pub(crate) fn body_body_intersect(a: &Body, pa: &Isometry3<f64>, b: &Body, pb: &
         return false;
     }
     for sa in &a.shapes {
-        let qa = pose_to_parry(&(pa * sa.offset));
         for sb in &b.shapes {
-            if intersect(&qa, &sa.shape, &pose_to_parry(&(pb * sb.offset)), &sb.shape) {
+            let hit = match overlap_robot(&sa.fast, pa, &sb.fast, pb) {
+                Some(hit) => hit,
+                None => intersect(
+                    &pose_to_parry(&(pa * sa.offset)),
+                    &sa.shape,
+                    &pose_to_parry(&(pb * sb.offset)),
+                    &sb.shape,
+                ),
+            };
+            if hit {
                 return true;
             }
         }
@@ -109,13 +121,14 @@ pub(crate) fn body_leaf_intersect(a: &Body, pa: &Isometry3<f64>, center: &Vector
     if leaf.aabb.distance_squared(center) > a.radius * a.radius {
         return false;
     }
-    a.shapes.iter().any(|sa| {
-        intersect(
+    a.shapes.iter().any(|sa| match overlap(&sa.fast, pa, &leaf.fast) {
+        Some(hit) => hit,
+        None => intersect(
             &pose_to_parry(&(pa * sa.offset)),
             &sa.shape,
             &leaf.pose,
             &leaf.shape,
-        )
+        ),
     })
 }
 

@@ -176,7 +176,8 @@ impl SceneChecker {
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
         let bodies = &self.model.bodies;
-        for (b, body) in bodies.iter().enumerate() {
+        // Distal bodies first: they are the likeliest to hit something.
+        for (b, body) in bodies.iter().enumerate().rev() {
             let c = sphere_center(body, &poses[b]);
             let query = Aabb::around_sphere(&c, body.radius);
             let free = self.world.bvh.for_each_overlap(&query, |leaf| {
