@@ -9,8 +9,10 @@
 //! cargo run --release -p kinplan-core --example mbm_validity -- target/mbm/problems
 //! ```
 //!
-//! Fingers: each request's `panda_finger_joint1/2` start positions, clamped
-//! into the URDF limit [0, 0.04] m (MotionBenchMaker's requests say 0.065).
+//! Fingers: each request's `panda_finger_joint1/2` start positions as given
+//! (MotionBenchMaker's requests say 0.065 m, past the 0.04 m limit of the
+//! URDF; MoveIt checked the states with that value). `--clamp-fingers`
+//! clamps them into [0, 0.04] instead.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -71,16 +73,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = PathBuf::from(
         std::env::args()
             .nth(1)
-            .ok_or("usage: mbm_validity <problems dir>")?,
+            .ok_or("usage: mbm_validity <problems dir> [--clamp-fingers]")?,
     );
+    let clamp = std::env::args().any(|a| a == "--clamp-fingers");
     let mut cache = BTreeMap::new();
-    println!("| set | problems | invalid starts | invalid goals | colliding pairs (count) |");
-    println!("|---|---|---|---|---|");
+    println!(
+        "| set | problems | invalid starts | invalid goals | depth median / max (mm) | colliding pairs (count) |"
+    );
+    println!("|---|---|---|---|---|---|");
     let (mut checks, mut check_time) = (0usize, 0.0f64);
     for set in SETS {
         let dir = root.join(format!("{set}_panda"));
         let (mut n, mut bad_start, mut bad_goal) = (0, 0, 0);
         let mut pairs: BTreeMap<String, usize> = BTreeMap::new();
+        let mut depths: Vec<f64> = Vec::new();
         for k in 1..=100 {
             let scene_path = dir.join(format!("scene{k:04}.yaml"));
             let request_path = dir.join(format!("request{k:04}.yaml"));
@@ -95,8 +101,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .start
                 .iter()
                 .find(|(n, _)| n == "panda_finger_joint1")
-                .map_or(0.04, |(_, v)| *v)
-                .clamp(0.0, 0.04);
+                .map_or(0.04, |(_, v)| *v);
+            let opening = if clamp { opening.clamp(0.0, 0.04) } else { opening };
             let (model, acm) = model(opening, &mut cache);
             let world = Arc::new(SceneGeometry::build(&scene)?);
             let checker = SceneChecker::new(model, &acm, world, CheckerParams::default())?;
@@ -111,6 +117,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         bad_start += 1;
                     } else {
                         bad_goal += 1;
+                    }
+                    if let Some(p) = checker.proximity(&q, 0.0)? {
+                        depths.push(-p.distance);
                     }
                     let report = checker.report(&q)?;
                     for (link, other) in &report.collisions {
@@ -129,7 +138,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut top: Vec<_> = pairs.into_iter().collect();
         top.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
         let top: Vec<String> = top.iter().take(4).map(|(p, c)| format!("{p} ({c})")).collect();
-        println!("| {set} | {n} | {bad_start} | {bad_goal} | {} |", top.join(", "));
+        depths.sort_by(f64::total_cmp);
+        let depth = match depths.len() {
+            0 => "–".to_string(),
+            k => format!("{:.1} / {:.1}", 1e3 * depths[k / 2], 1e3 * depths[k - 1]),
+        };
+        println!(
+            "| {set} | {n} | {bad_start} | {bad_goal} | {depth} | {} |",
+            top.join(", ")
+        );
     }
     println!(
         "\n{checks} start/goal checks, mean {:.2} µs per is_valid (cold caches, scenes of 10–30 primitives)",

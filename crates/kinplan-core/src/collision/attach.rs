@@ -16,8 +16,9 @@ const MAX_URDF_BYTES: usize = 4 << 20;
 
 /// The attached bodies of `chain` in the URDF `urdf` (the text the chain
 /// was parsed from). Off-chain moving joints take their value from
-/// `locked` (by joint name, rad or m), else 0; either is clamped into the
-/// joint's limits. Joint transform: `origin · motion(value)`, composed from
+/// `locked` (by joint name, rad or m), used as given even outside the
+/// joint's limits (a recorded state is reproduced as it was), else 0
+/// clamped into the limits. Joint transform: `origin · motion(value)`, composed from
 /// the chain link down to the body.
 pub fn attached_bodies(
     urdf: &str,
@@ -70,13 +71,10 @@ pub fn attached_bodies(
                         field: format!("{field}.axis"),
                         reason: "zero-length axis".into(),
                     })?;
-                    let value = locked
-                        .iter()
-                        .find(|(n, _)| *n == joint.name)
-                        .map_or(0.0, |(_, v)| *v);
-                    let value = match joint.joint_type {
-                        urdf_rs::JointType::Continuous => value,
-                        _ => value.clamp(
+                    let value = match locked.iter().find(|(n, _)| *n == joint.name) {
+                        Some((_, v)) => *v,
+                        None if matches!(joint.joint_type, urdf_rs::JointType::Continuous) => 0.0,
+                        None => 0.0_f64.clamp(
                             joint.limit.lower.min(joint.limit.upper),
                             joint.limit.upper.max(joint.limit.lower),
                         ),

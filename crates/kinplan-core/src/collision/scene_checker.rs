@@ -179,8 +179,7 @@ impl SceneChecker {
         // Distal bodies first: they are the likeliest to hit something.
         for (b, body) in bodies.iter().enumerate().rev() {
             let c = sphere_center(body, &poses[b]);
-            let query = Aabb::around_sphere(&c, body.radius);
-            let free = self.world.bvh.for_each_overlap(&query, |leaf| {
+            let free = self.world.bvh.for_each_near(&c, body.radius, |leaf| {
                 !body_leaf_intersect(body, &poses[b], &c, &self.world.leaves[leaf as usize])
             });
             if !free {

@@ -138,7 +138,8 @@ def panda_hand():
     hand housing, a box 0.065 x 0.205 x 0.070 from z = 0 to 0.07;
     each finger, a box 0.021 x 0.025 x 0.054 whose inner face is at the
     finger frame's origin plane (y = 0), so the fingers meet at opening 0.
-    A tool-centre frame `panda_hand_tcp` sits 0.1034 m along the hand's z."""
+    A tool-centre frame `panda_hand_tcp` sits 0.1034 m along the hand's z.
+    link_4 gets a forearm that follows the elbow offset (see below)."""
     with open(os.path.join(OUT, "franka_panda.urdf")) as f:
         text = f.read()
     def box_link(name, size, xyz):
@@ -160,6 +161,28 @@ def panda_hand():
                        [0, 0, 0.0584], [0, 0, 0], [0, 1, 0], (0.0, 0.04, 0.2))
     extra += joint_xml("panda_finger_joint2", "prismatic", "panda_hand", "panda_rightfinger",
                        [0, 0, 0.0584], [0, 0, 0], [0, -1, 0], (0.0, 0.04, 0.2))
+    # The forearm: franka_panda's single link_4 capsule runs diagonally from
+    # the elbow to the wrist and cuts across the elbow offset; the real
+    # forearm runs parallel to y4 at x4 = -0.0825 (the offset a = -82.5 mm)
+    # from the elbow housing to the wrist. Two capsules follow that shape:
+    # the elbow crossing (0,0,0)-(-0.0825,0,0), r 0.07, and the forearm
+    # (-0.0825,0,0)-(-0.0825,0.31,0), r 0.065 (the wrist housing is link_5's
+    # sphere, r 0.07, at (-0.0825, 0.384, 0)).
+    start = text.index('  <link name="link_4">')
+    end = text.index("</link>\n", start) + len("</link>\n")
+    def capsule(p0, p1, r):
+        xyz, rpy, length = capsule_origin(p0, p1)
+        return (
+            f"    <collision>\n"
+            f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
+            f'      <geometry><capsule radius="{float(r)!r}" length="{float(length)!r}"/></geometry>\n'
+            f"    </collision>\n"
+        )
+    link4 = '  <link name="link_4">\n'
+    link4 += capsule([0, 0, 0], [-0.0825, 0, 0], 0.07)
+    link4 += capsule([-0.0825, 0, 0], [-0.0825, 0.31, 0], 0.065)
+    link4 += "  </link>\n"
+    text = text[:start] + link4 + text[end:]
     text = text.replace('<robot name="franka_panda">', '<robot name="franka_panda_hand">')
     text = text.replace("-->", "+ Franka Hand (panda_hand, two fingers; see generate.py panda_hand) -->", 1)
     text = text.replace("</robot>\n", extra + "</robot>\n")
