@@ -10,6 +10,14 @@
 //! stay nalgebra 0.35; the conversion lives in one private module
 //! (`convert`), called right before parry queries.
 //!
+//! Semantics: touching counts as collision; scene meshes are surfaces
+//! (a robot part wholly inside a closed mesh does not touch it); robot
+//! meshes are used as convex hulls; motions are checked at interpolated
+//! states at most 0.05 rad apart (not conservative between states).
+//! Narrow phase: closed forms for robot spheres/capsules against spheres,
+//! capsules, boxes and cells (cylinders bracketed by capsules), parry for
+//! the rest and for every distance query.
+//!
 //! Pieces: [`Scene`] (validated obstacles) → [`SceneGeometry`] (parry
 //! shapes and a BVH, built once per scene); [`RobotModel`] (bodies from a
 //! chain) and [`AllowedCollisions`] (once per model); [`SceneChecker`]

@@ -4,8 +4,10 @@
 //! prediction margin, whose `dist` is the signed distance (negative by the
 //! penetration depth) and whose points are the witnesses.
 //!
-//! Boolean tests between a robot sphere or capsule and an obstacle sphere,
-//! capsule, box or cell use the closed forms of `fast` instead of parry.
+//! Boolean tests and distances between a robot sphere or capsule and an
+//! obstacle sphere, capsule, box or cell (or another robot sphere or
+//! capsule) use the closed forms of `fast` instead of parry; penetration
+//! into a box and every other pair go to parry.
 //!
 //! A pair parry cannot handle (none among the shapes this room builds) is
 //! reported as colliding: the safe answer for a planner.
@@ -16,7 +18,7 @@ use parry3d_f64::query;
 use parry3d_f64::shape::SharedShape;
 
 use super::convert::{point_from_parry, pose_to_parry};
-use super::fast::{overlap, overlap_robot};
+use super::fast::{distance, distance_robot, overlap, overlap_robot};
 use super::model::Body;
 use super::world::Leaf;
 
@@ -102,13 +104,20 @@ pub(crate) fn body_body_contact(
     for sa in &a.shapes {
         let qa = pose_to_parry(&(pa * sa.offset));
         for sb in &b.shapes {
-            let found = contact(
-                &qa,
-                &sa.shape,
-                &pose_to_parry(&(pb * sb.offset)),
-                &sb.shape,
-                margin,
-            );
+            let found = match distance_robot(&sa.fast, pa, &sb.fast, pb) {
+                Some((d, x, y)) => (d < margin).then_some(Witness {
+                    distance: d,
+                    a: x,
+                    b: y,
+                }),
+                None => contact(
+                    &qa,
+                    &sa.shape,
+                    &pose_to_parry(&(pb * sb.offset)),
+                    &sb.shape,
+                    margin,
+                ),
+            };
             best = closer(best, found);
         }
     }
@@ -146,13 +155,20 @@ pub(crate) fn body_leaf_contact(
     }
     let mut best: Option<Witness> = None;
     for sa in &a.shapes {
-        let found = contact(
-            &pose_to_parry(&(pa * sa.offset)),
-            &sa.shape,
-            &leaf.pose,
-            &leaf.shape,
-            margin,
-        );
+        let found = match distance(&sa.fast, pa, &leaf.fast) {
+            Some((d, x, y)) => (d < margin).then_some(Witness {
+                distance: d,
+                a: x,
+                b: y,
+            }),
+            None => contact(
+                &pose_to_parry(&(pa * sa.offset)),
+                &sa.shape,
+                &leaf.pose,
+                &leaf.shape,
+                margin,
+            ),
+        };
         best = closer(best, found);
     }
     best
