@@ -8,8 +8,10 @@
 //! our verdicts to `target/collision_bench/scene.json`, which
 //! `benches/collision_coal.py` reads to time coal on the same shapes.
 
+use std::alloc::{GlobalAlloc, Layout, System};
 use std::hint::black_box;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use kinplan_core::collision::{
@@ -21,6 +23,23 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::{Value, json};
+
+/// Counts heap allocations, to show that the queries allocate nothing.
+struct Counting;
+static ALLOCS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCS.fetch_add(1, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
 
 const OBSTACLES: usize = 50;
 const STATES: usize = 1024;
@@ -168,6 +187,28 @@ fn state_checks(c: &mut Criterion) {
     let valid = states.iter().filter(|q| checker.is_valid(q)).count();
     let scene_valid = states.iter().filter(|q| scene_only.is_valid(q)).count();
     eprintln!("{valid} of {STATES} benchmark states are valid ({scene_valid} free of the scene)");
+    let count = |f: &dyn Fn(usize)| {
+        let before = ALLOCS.load(Ordering::Relaxed);
+        (0..STATES).for_each(f);
+        ALLOCS.load(Ordering::Relaxed) - before
+    };
+    eprintln!(
+        "heap allocations over {STATES} states: is_valid {}, clearance {} (on the valid states only: {}), motion_valid {}",
+        count(&|i| {
+            black_box(checker.is_valid(&states[i]));
+        }),
+        count(&|i| {
+            black_box(checker.clearance(&states[i], 0.5));
+        }),
+        count(&|i| {
+            if checker.is_valid(&states[i]) {
+                black_box(checker.clearance(&states[i], 0.5));
+            }
+        }),
+        count(&|i| {
+            black_box(checker.motion_valid(&states[i], &states[(i + 1) % STATES]));
+        }),
+    );
     let n = 400_000;
     let full = cpu_per_call(n, |i| checker.is_valid(black_box(&states[i % STATES])));
     let only = cpu_per_call(n, |i| scene_only.is_valid(black_box(&states[i % STATES])));
