@@ -10,7 +10,7 @@
 use nalgebra::Vector3;
 
 /// Items per leaf.
-const LEAF_SIZE: usize = 2;
+const LEAF_SIZE: usize = 4;
 /// Traversal stack depth.
 const STACK: usize = 64;
 
@@ -166,6 +166,47 @@ impl Bvh {
                 let e = s + node.count as usize;
                 for (item, aabb) in self.order[s..e].iter().zip(&self.sorted[s..e]) {
                     if aabb.intersects(query) && !visit(*item) {
+                        return false;
+                    }
+                }
+            } else if top + 2 <= STACK {
+                stack[top] = node.start;
+                stack[top + 1] = node.start + 1;
+                top += 2;
+            }
+        }
+        true
+    }
+}
+
+impl Bvh {
+    /// Calls `visit(item)` for every item whose box lies within `radius` of
+    /// `center` (the sphere test is tighter than its bounding box at the
+    /// corners), until `visit` returns `false`. Returns `false` when stopped.
+    #[inline]
+    pub fn for_each_near(
+        &self,
+        center: &Vector3<f64>,
+        radius: f64,
+        mut visit: impl FnMut(u32) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return true;
+        }
+        let r2 = radius * radius;
+        let mut stack = [0u32; STACK];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if node.aabb.distance_squared(center) > r2 {
+                continue;
+            }
+            if node.count > 0 {
+                let s = node.start as usize;
+                let e = s + node.count as usize;
+                for (item, aabb) in self.order[s..e].iter().zip(&self.sorted[s..e]) {
+                    if aabb.distance_squared(center) <= r2 && !visit(*item) {
                         return false;
                     }
                 }

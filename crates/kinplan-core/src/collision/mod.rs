@@ -10,26 +10,39 @@
 //! stay nalgebra 0.35; the conversion lives in one private module
 //! (`convert`), called right before parry queries.
 //!
+//! Semantics: touching counts as collision; scene meshes are surfaces
+//! (a robot part wholly inside a closed mesh does not touch it); robot
+//! meshes are used as convex hulls; motions are checked at interpolated
+//! states at most 0.05 rad apart (not conservative between states).
+//! Narrow phase: closed forms for robot spheres/capsules against spheres,
+//! capsules, boxes and cells (cylinders bracketed by capsules), parry for
+//! the rest and for every distance query.
+//!
 //! Pieces: [`Scene`] (validated obstacles) → [`SceneGeometry`] (parry
 //! shapes and a BVH, built once per scene); [`RobotModel`] (bodies from a
 //! chain) and [`AllowedCollisions`] (once per model); [`SceneChecker`]
 //! (the queries).
 
 mod acm;
+mod attach;
 mod bvh;
 mod checker;
 mod convert;
 mod error;
+mod fast;
 mod model;
+mod moveit;
 mod narrow;
 mod scene;
 mod scene_checker;
 mod world;
 
 pub use acm::{AcmParams, AllowReason, AllowedCollisions};
+pub use attach::attached_bodies;
 pub use checker::{MotionCheck, StateChecker, interpolate_motion_valid};
 pub use error::CollisionError;
 pub use model::{AttachedBody, InlineMesh, MAX_BODIES, MAX_LINKS, RobotModel};
+pub use moveit::{JointRequest, MAX_YAML_BYTES, parse_joint_request, parse_planning_scene};
 pub use scene::{Geometry, Obstacle, Scene, SceneLimits};
 pub use scene_checker::{CheckerParams, Part, Proximity, SceneChecker, StateReport};
 pub use world::SceneGeometry;

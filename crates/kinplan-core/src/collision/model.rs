@@ -10,13 +10,14 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use parry3d_f64::shape::SharedShape;
 
 use super::convert::{pose_to_parry, vec_to_parry};
+use super::fast::RobotFast;
 use super::scene::{SceneLimits, validate_mesh};
 use super::world::primitive_shape;
 use super::{CollisionError, Geometry};
 use crate::robot::{Chain, CollisionShape, Shape};
 
 /// Most collision bodies (links with geometry) a model may have.
-pub const MAX_BODIES: usize = 64;
+pub const MAX_BODIES: usize = 32;
 /// Most links a chain may have to get a collision model.
 pub const MAX_LINKS: usize = 96;
 
@@ -48,6 +49,8 @@ pub struct InlineMesh {
 pub(crate) struct BodyShape {
     pub offset: Isometry3<f64>,
     pub shape: SharedShape,
+    /// The closed-form description in the body frame (spheres, capsules).
+    pub fast: RobotFast,
 }
 
 /// A rigid collision body.
@@ -72,6 +75,8 @@ pub(crate) struct Body {
 pub struct RobotModel {
     chain: Arc<Chain>,
     pub(crate) bodies: Vec<Body>,
+    /// Body indices ordered by carrying link (stable).
+    by_link: Vec<usize>,
 }
 
 impl std::fmt::Debug for RobotModel {
@@ -158,7 +163,13 @@ impl RobotModel {
                 limit: MAX_BODIES,
             });
         }
-        Ok(RobotModel { chain, bodies })
+        let mut by_link: Vec<usize> = (0..bodies.len()).collect();
+        by_link.sort_by_key(|&b| bodies[b].link);
+        Ok(RobotModel {
+            chain,
+            bodies,
+            by_link,
+        })
     }
 
     pub fn chain(&self) -> &Arc<Chain> {
@@ -188,11 +199,17 @@ impl RobotModel {
     /// `T_link = Π_{joints before it} (O_i · M_i(q_i)) · offset_link`; a body's
     /// pose is `T_link · offset_body`.
     pub(crate) fn body_poses(&self, q: &[f64], out: &mut [Isometry3<f64>; MAX_BODIES]) {
-        let mut links = [Isometry3::identity(); MAX_LINKS];
         let joints = self.chain.joints();
+        let links = self.chain.links();
         let mut t = Isometry3::identity();
         let mut applied = 0;
-        for (li, link) in self.chain.links().iter().enumerate() {
+        // `by_link` lists bodies by carrying link, so one pass down the
+        // chain poses them all without storing every link frame.
+        let mut next = 0;
+        for (li, link) in links.iter().enumerate() {
+            if next == self.by_link.len() {
+                break;
+            }
             if let Some(j) = link.after_joint {
                 while applied <= j && applied < joints.len() {
                     let joint = &joints[applied];
@@ -200,10 +217,11 @@ impl RobotModel {
                     applied += 1;
                 }
             }
-            links[li] = t * link.offset;
-        }
-        for (b, body) in self.bodies.iter().enumerate() {
-            out[b] = links[body.link] * body.offset;
+            while next < self.by_link.len() && self.bodies[self.by_link[next]].link == li {
+                let b = self.by_link[next];
+                out[b] = t * link.offset * self.bodies[b].offset;
+                next += 1;
+            }
         }
     }
 }
@@ -284,6 +302,7 @@ fn body_shapes(
                 out.push(BodyShape {
                     offset: cs.origin,
                     shape: hull,
+                    fast: RobotFast::None,
                 });
                 continue;
             }
@@ -298,9 +317,26 @@ fn body_shapes(
             continue;
         }
         let (shape, fix) = primitive_shape(&geometry).expect("primitive");
+        let fast = match geometry {
+            Geometry::Sphere { radius } => {
+                let c = Point3::from(cs.origin.translation.vector);
+                RobotFast::Swept {
+                    a: c,
+                    b: c,
+                    r: radius,
+                }
+            }
+            Geometry::Capsule { radius, length } => RobotFast::Swept {
+                a: cs.origin * Point3::new(0.0, 0.0, -0.5 * length),
+                b: cs.origin * Point3::new(0.0, 0.0, 0.5 * length),
+                r: radius,
+            },
+            _ => RobotFast::None,
+        };
         out.push(BodyShape {
             offset: cs.origin * fix,
             shape,
+            fast,
         });
     }
     Ok(out)

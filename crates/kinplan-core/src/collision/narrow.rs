@@ -4,6 +4,11 @@
 //! prediction margin, whose `dist` is the signed distance (negative by the
 //! penetration depth) and whose points are the witnesses.
 //!
+//! Boolean tests and distances between a robot sphere or capsule and an
+//! obstacle sphere, capsule, box or cell (or another robot sphere or
+//! capsule) use the closed forms of `fast` instead of parry; penetration
+//! into a box and every other pair go to parry.
+//!
 //! A pair parry cannot handle (none among the shapes this room builds) is
 //! reported as colliding: the safe answer for a planner.
 
@@ -13,6 +18,7 @@ use parry3d_f64::query;
 use parry3d_f64::shape::SharedShape;
 
 use super::convert::{point_from_parry, pose_to_parry};
+use super::fast::{distance, distance_robot, overlap, overlap_robot};
 use super::model::Body;
 use super::world::Leaf;
 
@@ -64,9 +70,17 @@ pub(crate) fn body_body_intersect(a: &Body, pa: &Isometry3<f64>, b: &Body, pb: &
         return false;
     }
     for sa in &a.shapes {
-        let qa = pose_to_parry(&(pa * sa.offset));
         for sb in &b.shapes {
-            if intersect(&qa, &sa.shape, &pose_to_parry(&(pb * sb.offset)), &sb.shape) {
+            let hit = match overlap_robot(&sa.fast, pa, &sb.fast, pb) {
+                Some(hit) => hit,
+                None => intersect(
+                    &pose_to_parry(&(pa * sa.offset)),
+                    &sa.shape,
+                    &pose_to_parry(&(pb * sb.offset)),
+                    &sb.shape,
+                ),
+            };
+            if hit {
                 return true;
             }
         }
@@ -90,13 +104,20 @@ pub(crate) fn body_body_contact(
     for sa in &a.shapes {
         let qa = pose_to_parry(&(pa * sa.offset));
         for sb in &b.shapes {
-            let found = contact(
-                &qa,
-                &sa.shape,
-                &pose_to_parry(&(pb * sb.offset)),
-                &sb.shape,
-                margin,
-            );
+            let found = match distance_robot(&sa.fast, pa, &sb.fast, pb) {
+                Some((d, x, y)) => (d < margin).then_some(Witness {
+                    distance: d,
+                    a: x,
+                    b: y,
+                }),
+                None => contact(
+                    &qa,
+                    &sa.shape,
+                    &pose_to_parry(&(pb * sb.offset)),
+                    &sb.shape,
+                    margin,
+                ),
+            };
             best = closer(best, found);
         }
     }
@@ -109,13 +130,14 @@ pub(crate) fn body_leaf_intersect(a: &Body, pa: &Isometry3<f64>, center: &Vector
     if leaf.aabb.distance_squared(center) > a.radius * a.radius {
         return false;
     }
-    a.shapes.iter().any(|sa| {
-        intersect(
+    a.shapes.iter().any(|sa| match overlap(&sa.fast, pa, &leaf.fast) {
+        Some(hit) => hit,
+        None => intersect(
             &pose_to_parry(&(pa * sa.offset)),
             &sa.shape,
             &leaf.pose,
             &leaf.shape,
-        )
+        ),
     })
 }
 
@@ -133,13 +155,20 @@ pub(crate) fn body_leaf_contact(
     }
     let mut best: Option<Witness> = None;
     for sa in &a.shapes {
-        let found = contact(
-            &pose_to_parry(&(pa * sa.offset)),
-            &sa.shape,
-            &leaf.pose,
-            &leaf.shape,
-            margin,
-        );
+        let found = match distance(&sa.fast, pa, &leaf.fast) {
+            Some((d, x, y)) => (d < margin).then_some(Witness {
+                distance: d,
+                a: x,
+                b: y,
+            }),
+            None => contact(
+                &pose_to_parry(&(pa * sa.offset)),
+                &sa.shape,
+                &leaf.pose,
+                &leaf.shape,
+                margin,
+            ),
+        };
         best = closer(best, found);
     }
     best

@@ -118,6 +118,30 @@ impl std::fmt::Display for StateReport {
 }
 
 /// Robot model + allowed-collision matrix + scene (see the module doc).
+///
+/// ```
+/// use std::sync::Arc;
+/// use kinplan_core::collision::*;
+/// use nalgebra::{Isometry3, Vector3};
+///
+/// let chain = kinplan_core::robot::builtin_chain("planar_2").unwrap();
+/// let model = Arc::new(RobotModel::new(chain).unwrap());
+/// let acm = AllowedCollisions::adjacent(&model);
+/// // A 10 cm cube 0.8 m along x: the stretched arm (reach 1 m) hits it,
+/// // the arm turned to +y misses it.
+/// let cube = Obstacle::new(
+///     "cube",
+///     Isometry3::translation(0.8, 0.0, 0.0),
+///     Geometry::Box { half_extents: Vector3::repeat(0.05) },
+/// );
+/// let scene = Scene::new(vec![cube], &SceneLimits::default()).unwrap();
+/// let world = Arc::new(SceneGeometry::build(&scene).unwrap());
+/// let checker = SceneChecker::new(model, &acm, world, CheckerParams::default()).unwrap();
+/// assert!(!checker.is_valid(&[0.0, 0.0]));
+/// assert!(checker.is_valid(&[std::f64::consts::FRAC_PI_2, 0.0]));
+/// let report = checker.report(&[0.0, 0.0]).unwrap();
+/// assert!(report.to_string().contains("obstacle `cube`"));
+/// ```
 #[derive(Debug, Clone)]
 pub struct SceneChecker {
     model: Arc<RobotModel>,
@@ -176,10 +200,10 @@ impl SceneChecker {
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
         let bodies = &self.model.bodies;
-        for (b, body) in bodies.iter().enumerate() {
+        // Distal bodies first: they are the likeliest to hit something.
+        for (b, body) in bodies.iter().enumerate().rev() {
             let c = sphere_center(body, &poses[b]);
-            let query = Aabb::around_sphere(&c, body.radius);
-            let free = self.world.bvh.for_each_overlap(&query, |leaf| {
+            let free = self.world.bvh.for_each_near(&c, body.radius, |leaf| {
                 !body_leaf_intersect(body, &poses[b], &c, &self.world.leaves[leaf as usize])
             });
             if !free {

@@ -3,12 +3,13 @@
 //! tree) and per occupied cell, all under one [`Bvh`]. Built once per scene
 //! and shared read-only between threads.
 
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::shape::SharedShape;
 
 use super::bvh::{Aabb, Bvh};
 use super::convert::{pose_to_parry, vec_to_parry};
+use super::fast::LeafFast;
 use super::{CollisionError, Geometry, Scene};
 
 /// One broad-phase leaf: a parry shape at a pose (base frame).
@@ -19,6 +20,8 @@ pub(crate) struct Leaf {
     pub pose: Pose,
     pub shape: SharedShape,
     pub aabb: Aabb,
+    /// The closed-form description (spheres, capsules, boxes, cells).
+    pub fast: LeafFast,
 }
 
 /// The scene ready for queries (see the module doc).
@@ -72,7 +75,7 @@ impl SceneGeometry {
         let mut leaves = Vec::new();
         for (i, o) in scene.obstacles().iter().enumerate() {
             let obstacle = i as u32;
-            let mut push = |shape: SharedShape, pose: Isometry3<f64>| {
+            let mut push = |shape: SharedShape, pose: Isometry3<f64>, fast: LeafFast| {
                 let pose = pose_to_parry(&pose);
                 let aabb = aabb_of(&shape, &pose);
                 leaves.push(Leaf {
@@ -80,6 +83,7 @@ impl SceneGeometry {
                     pose,
                     shape,
                     aabb,
+                    fast,
                 });
             };
             match &o.geometry {
@@ -90,18 +94,52 @@ impl SceneGeometry {
                         field: format!("obstacles[{i}].mesh"),
                         reason: e.to_string(),
                     })?;
-                    push(mesh, o.pose);
+                    push(mesh, o.pose, LeafFast::None);
                 }
                 Geometry::OccupiedCells { size, centers } => {
                     let h = 0.5 * size;
                     let cube = SharedShape::cuboid(h, h, h);
                     for c in centers {
-                        push(cube.clone(), o.pose * Translation3::from(c.coords));
+                        let pose = o.pose * Translation3::from(c.coords);
+                        let fast = LeafFast::Box {
+                            pose,
+                            half: Vector3::repeat(h),
+                        };
+                        push(cube.clone(), pose, fast);
                     }
                 }
                 g => {
                     let (shape, fix) = primitive_shape(g).expect("primitives have a parry shape");
-                    push(shape, o.pose * fix);
+                    let fast = match g {
+                        Geometry::Box { half_extents } => LeafFast::Box {
+                            pose: o.pose,
+                            half: *half_extents,
+                        },
+                        Geometry::Sphere { radius } => {
+                            let c = Point3::from(o.pose.translation.vector);
+                            LeafFast::Swept {
+                                a: c,
+                                b: c,
+                                r: *radius,
+                            }
+                        }
+                        Geometry::Capsule { radius, length } => LeafFast::Swept {
+                            a: o.pose * Point3::new(0.0, 0.0, -0.5 * length),
+                            b: o.pose * Point3::new(0.0, 0.0, 0.5 * length),
+                            r: *radius,
+                        },
+                        Geometry::Cylinder { radius, length } => {
+                            let h = 0.5 * length;
+                            let rho = radius.min(h);
+                            let at = |z: f64| o.pose * Point3::new(0.0, 0.0, z);
+                            LeafFast::Cylinder {
+                                outer: (at(-h), at(h), *radius),
+                                inner: (at(-h + rho), at(h - rho), rho),
+                            }
+                        }
+                        _ => LeafFast::None,
+                    };
+                    push(shape, o.pose * fix, fast);
                 }
             }
         }

@@ -30,6 +30,7 @@ builtins!(
     "abb_irb4600_60_205",
     "ur5",
     "franka_panda",
+    "franka_panda_hand",
     "kuka_lbr_iiwa14_r820",
     "planar_2",
     "planar_3",
@@ -41,6 +42,10 @@ builtins!(
     "planar_9",
     "planar_10",
 );
+
+/// Tip links of built-in robots whose URDF tree has several leaves (a
+/// gripper's fingers); the others end in their single leaf.
+const BUILTIN_TIPS: &[(&str, &str)] = &[("franka_panda_hand", "panda_hand_tcp")];
 
 /// The URDF text of a built-in robot.
 pub fn builtin_urdf(name: &str) -> Result<&'static str, RobotError> {
@@ -66,7 +71,14 @@ pub fn builtin_chain(name: &str) -> Result<Arc<Chain>, RobotError> {
         })?;
     let cells = CHAINS.get_or_init(|| BUILTIN_NAMES.iter().map(|_| OnceLock::new()).collect());
     let chain = cells[index].get_or_init(|| {
-        let chain = parse_chain(BUILTIN_URDFS[index], &ChainSpec::default(), UrdfLimits::default())
+        let spec = ChainSpec {
+            base_link: None,
+            tip_link: BUILTIN_TIPS
+                .iter()
+                .find(|(n, _)| *n == BUILTIN_NAMES[index])
+                .map(|(_, tip)| tip.to_string()),
+        };
+        let chain = parse_chain(BUILTIN_URDFS[index], &spec, UrdfLimits::default())
             .expect("built-in URDFs are valid (checked by tests)");
         Arc::new(chain)
     });

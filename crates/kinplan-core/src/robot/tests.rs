@@ -137,6 +137,11 @@ fn reference(name: &str, q: &[f64]) -> Matrix4<f64> {
         "abb_irb4600_60_205" => abb_dh(q),
         "ur5" => ur5_dh(q),
         "franka_panda" => panda_craig(q),
+        // The Franka Hand turns −45° about the flange z; its TCP is 103.4 mm out.
+        "franka_panda_hand" => {
+            let hand = nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), -PI / 4.0).to_homogeneous();
+            panda_craig(q) * hand * Matrix4::new_translation(&Vector3::new(0.0, 0.0, 0.1034))
+        }
         "kuka_lbr_iiwa14_r820" => iiwa_dh(q),
         planar_n => planar(planar_n["planar_".len()..].parse().unwrap(), q),
     }

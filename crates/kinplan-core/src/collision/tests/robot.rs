@@ -285,3 +285,66 @@ fn panda_folded_elbow_self_collides_and_a_less_folded_one_is_free() {
     assert!(c.is_valid(&q_open), "{}", c.report(&q_open).unwrap());
     assert!((c.clearance(&q_open, 1.0) - open).abs() < 1e-6);
 }
+
+fn panda_hand_checker(opening: f64, obstacles: Vec<Obstacle>) -> SceneChecker {
+    let chain = builtin_chain("franka_panda_hand").unwrap();
+    let urdf = crate::robot::builtin_urdf("franka_panda_hand").unwrap();
+    let fingers = [("panda_finger_joint1", opening), ("panda_finger_joint2", opening)];
+    let attached = attached_bodies(urdf, &chain, &fingers).unwrap();
+    let model = Arc::new(RobotModel::with_parts(chain, &attached, &[]).unwrap());
+    // Scene contacts only: every robot pair allowed.
+    let mut acm = AllowedCollisions::adjacent(&model);
+    for a in 0..model.body_count() {
+        for b in 0..model.body_count() {
+            acm.allow(a, b, AllowReason::User);
+        }
+    }
+    let world =
+        Arc::new(SceneGeometry::build(&Scene::new(obstacles, &SceneLimits::default()).unwrap()).unwrap());
+    SceneChecker::new(model, &acm, world, CheckerParams::default()).unwrap()
+}
+
+#[test]
+fn the_panda_hand_carries_two_fingers_at_the_requested_opening() {
+    let c = panda_hand_checker(0.04, vec![]);
+    let names: Vec<&str> = c.model().body_names().collect();
+    assert_eq!(
+        &names[7..],
+        ["link_7", "panda_hand", "panda_leftfinger", "panda_rightfinger"]
+    );
+    // link_7 and the hand are adjacent through the flange (no geometry);
+    // each finger is adjacent to the hand, the fingers are not adjacent.
+    assert!(c.model().adjacent(7, 8) && c.model().adjacent(8, 9) && c.model().adjacent(8, 10));
+    assert!(!c.model().adjacent(9, 10) && !c.model().adjacent(7, 9));
+
+    // A 5 mm sphere between the fingertips, 90 mm out along the hand's z.
+    let chain = builtin_chain("franka_panda_hand").unwrap();
+    let q = [0.0, 0.3, 0.0, -2.0, 0.0, 2.3, 0.785];
+    let mut frames = Vec::new();
+    chain.link_frames_into(&q, &mut frames);
+    let hand = chain.links().iter().position(|l| l.name == "panda_hand").unwrap();
+    let at = frames[hand] * Point3::new(0.0, 0.0, 0.09);
+    let ball = || {
+        vec![Obstacle::new(
+            "ball",
+            Isometry3::translation(at.x, at.y, at.z),
+            Geometry::Sphere { radius: 0.005 },
+        )]
+    };
+    // Open 40 mm per finger: the nearest part is the housing top (z = 0.07),
+    // 20 mm − 5 mm away; the finger faces are 40 mm − 5 mm away.
+    let open = panda_hand_checker(0.04, ball());
+    assert!(open.is_valid(&q));
+    let p = open.proximity(&q, 1.0).unwrap().unwrap();
+    assert_eq!(p.link, "panda_hand");
+    assert!((p.distance - 0.015).abs() < 1e-9, "{}", p.distance);
+    // Closed: both fingers enclose the ball.
+    let closed = panda_hand_checker(0.0, ball());
+    let report = closed.report(&q).unwrap();
+    let links: Vec<&str> = report.collisions.iter().map(|(l, _)| l.as_str()).collect();
+    assert_eq!(links, ["panda_leftfinger", "panda_rightfinger"], "{report}");
+    // An opening past the 40 mm limit is used as given: the fingers move
+    // farther out and the housing stays the nearest part.
+    let wide = panda_hand_checker(0.065, ball());
+    assert!((wide.proximity(&q, 1.0).unwrap().unwrap().distance - 0.015).abs() < 1e-9);
+}

@@ -130,6 +130,66 @@ def craig_dh(name, comment, d, a, alpha, flange, limits, speeds, radii):
     write_robot(name, comment, joints, tool, radii, 0.12)
 
 
+def panda_hand():
+    """franka_panda plus the Franka Hand: `panda_hand` fixed to the flange,
+    turned -45 deg about z (as Franka mounts it), and two prismatic fingers
+    0.0584 m above the hand frame, opening along +y / -y (0 to 0.04 m each).
+    Collision shapes enclose the real parts (dimensions in metres):
+    hand housing, a box 0.065 x 0.205 x 0.070 from z = 0 to 0.07;
+    each finger, a box 0.021 x 0.025 x 0.054 whose inner face is at the
+    finger frame's origin plane (y = 0), so the fingers meet at opening 0.
+    A tool-centre frame `panda_hand_tcp` sits 0.1034 m along the hand's z.
+    link_4 gets a forearm that follows the elbow offset (see below)."""
+    with open(os.path.join(OUT, "franka_panda.urdf")) as f:
+        text = f.read()
+    def box_link(name, size, xyz):
+        return (
+            f'  <link name="{name}">\n'
+            f"    <collision>\n"
+            f'      <origin xyz="{fmt(xyz)}" rpy="0.0 0.0 0.0"/>\n'
+            f'      <geometry><box size="{fmt(size)}"/></geometry>\n'
+            f"    </collision>\n"
+            f"  </link>\n"
+        )
+    extra = box_link("panda_hand", [0.065, 0.205, 0.070], [0, 0, 0.035])
+    extra += box_link("panda_leftfinger", [0.021, 0.025, 0.054], [0, 0.0125, 0.027])
+    extra += box_link("panda_rightfinger", [0.021, 0.025, 0.054], [0, -0.0125, 0.027])
+    extra += '  <link name="panda_hand_tcp"/>\n'
+    extra += joint_xml("flange-panda_hand", "fixed", "flange", "panda_hand", [0, 0, 0], [0, 0, -math.pi / 4])
+    extra += joint_xml("panda_hand-panda_hand_tcp", "fixed", "panda_hand", "panda_hand_tcp", [0, 0, 0.1034], [0, 0, 0])
+    extra += joint_xml("panda_finger_joint1", "prismatic", "panda_hand", "panda_leftfinger",
+                       [0, 0, 0.0584], [0, 0, 0], [0, 1, 0], (0.0, 0.04, 0.2))
+    extra += joint_xml("panda_finger_joint2", "prismatic", "panda_hand", "panda_rightfinger",
+                       [0, 0, 0.0584], [0, 0, 0], [0, -1, 0], (0.0, 0.04, 0.2))
+    # The forearm: franka_panda's single link_4 capsule runs diagonally from
+    # the elbow to the wrist and cuts across the elbow offset; the real
+    # forearm runs parallel to y4 at x4 = -0.0825 (the offset a = -82.5 mm)
+    # from the elbow housing to the wrist. Two capsules follow that shape:
+    # the elbow crossing (0,0,0)-(-0.0825,0,0), r 0.07, and the forearm
+    # (-0.0825,0,0)-(-0.0825,0.31,0), r 0.065 (the wrist housing is link_5's
+    # sphere, r 0.07, at (-0.0825, 0.384, 0)).
+    start = text.index('  <link name="link_4">')
+    end = text.index("</link>\n", start) + len("</link>\n")
+    def capsule(p0, p1, r):
+        xyz, rpy, length = capsule_origin(p0, p1)
+        return (
+            f"    <collision>\n"
+            f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
+            f'      <geometry><capsule radius="{float(r)!r}" length="{float(length)!r}"/></geometry>\n'
+            f"    </collision>\n"
+        )
+    link4 = '  <link name="link_4">\n'
+    link4 += capsule([0, 0, 0], [-0.0825, 0, 0], 0.07)
+    link4 += capsule([-0.0825, 0, 0], [-0.0825, 0.31, 0], 0.065)
+    link4 += "  </link>\n"
+    text = text[:start] + link4 + text[end:]
+    text = text.replace('<robot name="franka_panda">', '<robot name="franka_panda_hand">')
+    text = text.replace("-->", "+ Franka Hand (panda_hand, two fingers; see generate.py panda_hand) -->", 1)
+    text = text.replace("</robot>\n", extra + "</robot>\n")
+    with open(os.path.join(OUT, "franka_panda_hand.urdf"), "w") as f:
+        f.write(text)
+
+
 def main():
     os.makedirs(OUT, exist_ok=True)
     kuka_signs = [-1, 1, 1, -1, 1, -1]
@@ -182,6 +242,7 @@ def main():
         [r2d(2.175)] * 4 + [r2d(2.61)] * 3,
         [0.09, 0.09, 0.08, 0.08, 0.07, 0.06, 0.05],
     )
+    panda_hand()
     standard_dh(
         "kuka_lbr_iiwa14_r820",
         "KUKA LBR iiwa 14 R820, standard DH: d1 360, d3 420, d5 400, d7 81 mm, "
