@@ -251,7 +251,11 @@ fn progress_sees_every_iteration_with_a_never_rising_cost() {
     req.stomp.max_iterations = 20;
     req.stomp.iterations_after_valid = 100;
     let mut seen = Vec::new();
-    let mut cb = |it: &IterationReport<'_>| seen.push((it.iteration, it.cost, it.trajectory.len()));
+    let mut valid = Vec::new();
+    let mut cb = |it: &IterationReport<'_>| {
+        seen.push((it.iteration, it.cost, it.trajectory.len()));
+        valid.push(it.valid);
+    };
     let ctl = PlanControl {
         progress: Some(&mut cb),
         ..Default::default()
@@ -261,6 +265,8 @@ fn progress_sees_every_iteration_with_a_never_rising_cost() {
     assert_eq!(r.iterations, 20);
     assert!(seen.iter().enumerate().all(|(i, s)| s.0 == i && s.2 == 120));
     assert!(seen.windows(2).all(|p| p[1].1 <= p[0].1));
+    // once valid, never invalid again
+    assert!(valid.windows(2).all(|v| !v[0] || v[1]), "{valid:?}");
 }
 
 /// Velocity and acceleration of a timed piecewise-linear path, computed
