@@ -7,12 +7,13 @@ use nalgebra::Isometry3;
 
 use super::cartesian::{CartesianLine, Deviation, deviation, violates};
 use super::clock::{Clock, Interrupt};
-use super::costs::{interior_valid, path_valid, resolution_of};
+use super::costs::{path_valid, resolution_of};
 use super::error::{PlanError, PlanField, check_vector};
-use super::rrt_connect::{RrtStop, resample, rrt_connect_path};
-use super::stomp::{IterationReport, StompStop, stomp_optimize, straight_line};
+use super::initial::initial_trajectory;
+use super::rrt_connect::{RrtStop, rrt_connect_path};
+use super::stomp::{IterationReport, StompStop, stomp_optimize};
 use super::timing::{TimingParams, time_parameterize};
-use super::{CartesianParams, InitialTrajectory, RrtParams, StompParams};
+use super::{CartesianParams, RrtParams, StompParams};
 use crate::collision::StateChecker;
 use crate::ik::{IkParams, IkTarget, solve_ik};
 use crate::robot::Chain;
@@ -193,9 +194,10 @@ fn validate(chain: &Chain, checker_dof: usize, req: &PlanRequest) -> Result<(), 
 /// 2. Start (and a joint goal) checked with `checker.is_valid`. A pose goal is
 ///    solved by IK (`goal_ik.num_solutions` distinct solutions seeded at the
 ///    start); the valid one nearest the start (Euclidean) is used.
-/// 3. RRT-Connect: the path, shortcut. STOMP/CCSTOMP: the straight line (or,
-///    with [`InitialTrajectory::RrtConnectIfBlocked`] and a blocked line, the
-///    resampled RRT-Connect path) optimised by STOMP.
+/// 3. RRT-Connect: the path, shortcut. STOMP/CCSTOMP: the initial trajectory
+///    chosen by [`InitialTrajectory`](super::InitialTrajectory) (straight
+///    joint line; Cartesian line by IK; RRT-Connect when the line is blocked)
+///    optimised by STOMP.
 /// 4. The result is re-checked state by state and motion by motion at the
 ///    checker's resolution (skipped after an interruption),
 ///    timed by [`time_parameterize`] and scored (S0 criteria, unit joint
@@ -314,19 +316,18 @@ pub fn plan<C: StateChecker + ?Sized>(
         }
         Algorithm::Stomp | Algorithm::Ccstomp => {
             let n = req.stomp.timesteps;
-            let mut initial = straight_line(start, &goal, n);
-            let line_free = || {
-                let mut buf = vec![0.0; dof];
-                interior_valid(checker, start, &goal, resolution_of(checker), &mut buf, &clock) == Some(true)
-            };
-            if req.stomp.initial == InitialTrajectory::RrtConnectIfBlocked && !line_free() {
-                let t0 = Instant::now();
-                let out = rrt_connect_path(chain, checker, start, &goal, &req.rrt, req.seed, &clock);
-                timings.rrt_us = t0.elapsed().as_micros() as u64;
-                if out.stop == RrtStop::Connected {
-                    initial = resample(&out.path, dof, n);
-                }
-            }
+            let (initial, rrt_us) = initial_trajectory(
+                chain,
+                checker,
+                start,
+                &goal,
+                n,
+                req.stomp.initial,
+                &req.rrt,
+                req.seed,
+                &clock,
+            );
+            timings.rrt_us = rrt_us;
             let t0 = Instant::now();
             let cart = (req.algorithm == Algorithm::Ccstomp).then_some(&req.cartesian);
             let out = stomp_optimize(

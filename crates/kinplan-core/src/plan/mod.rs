@@ -8,6 +8,7 @@ mod clock;
 mod costs;
 mod entry;
 mod error;
+mod initial;
 mod noise;
 mod params;
 mod rrt_connect;

@@ -12,6 +12,12 @@ pub enum InitialTrajectory {
     /// finds nothing within its sample budget.
     #[default]
     RrtConnectIfBlocked,
+    /// The tool's straight Cartesian line (lerp/slerp between the end poses)
+    /// solved by IK waypoint after waypoint, warm-started, when that succeeds
+    /// without a branch jump (> 0.5 rad) and is valid; otherwise as
+    /// `RrtConnectIfBlocked`. Suits CCSTOMP, whose cost is measured against
+    /// that line.
+    CartesianLine,
 }
 
 /// Options of STOMP (ALGORITHMS.md §4). Defaults follow MoveIt 2's STOMP

@@ -84,7 +84,7 @@ struct Rollout<'c> {
 /// `S_k(t)` per timestep; `P_k(t) = e^{−h(S_k(t) − min S(t))/(max S(t) − min S(t))}`
 /// normalised over k (uniform when all are equal); `δθ(t) = Σ_k P_k(t) ε_k(t)`;
 /// `θ' = θ + M δθ` per joint, clamped into the joint limits; `θ'` replaces `θ`
-/// unless its total cost is higher. Rollouts are drawn and evaluated on the
+/// unless its total cost is higher or `θ` is valid and `θ'` is not. Rollouts are drawn and evaluated on the
 /// rayon pool; rollout k of iteration i draws from its own stream
 /// (seed, i, k), so a seed fixes the result.
 ///
@@ -265,7 +265,10 @@ pub(crate) fn stomp_optimize<C: StateChecker + ?Sized>(
             stop = interrupt_stop(clock.interrupted().unwrap_or(Interrupt::Deadline));
             break;
         }
-        let accepted = cand.total <= cur.total;
+        // Revert on a cost rise, and never trade a valid trajectory for an
+        // invalid one (a lower distance cost can outweigh a small collision
+        // penalty).
+        let accepted = cand.total <= cur.total && (cand.valid() || !cur.valid());
         if accepted {
             std::mem::swap(&mut theta, &mut cand_q);
             std::mem::swap(&mut cur, &mut cand);

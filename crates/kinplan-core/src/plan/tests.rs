@@ -134,11 +134,16 @@ fn a_10_ms_budget_answers_within_about_10_ms() {
         let mut req = blocked_request(alg);
         req.stomp.initial = InitialTrajectory::StraightLine;
         let t0 = Instant::now();
-        let ctl = PlanControl {
-            deadline: Some(t0 + Duration::from_millis(10)),
-            ..Default::default()
-        };
-        let r = plan(&chain, &w, &req, ctl).unwrap();
+        // an own pool: rollouts of tests running beside this one on the
+        // global pool would otherwise delay ours
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let r = pool.install(|| {
+            let ctl = PlanControl {
+                deadline: Some(t0 + Duration::from_millis(10)),
+                ..Default::default()
+            };
+            plan(&chain, &w, &req, ctl).unwrap()
+        });
         let took = t0.elapsed();
         // the re-check and timing after the deadline cost a few state checks
         assert!(took < Duration::from_millis(40), "{alg:?} took {took:?}");
@@ -246,7 +251,11 @@ fn progress_sees_every_iteration_with_a_never_rising_cost() {
     req.stomp.max_iterations = 20;
     req.stomp.iterations_after_valid = 100;
     let mut seen = Vec::new();
-    let mut cb = |it: &IterationReport<'_>| seen.push((it.iteration, it.cost, it.trajectory.len()));
+    let mut valid = Vec::new();
+    let mut cb = |it: &IterationReport<'_>| {
+        seen.push((it.iteration, it.cost, it.trajectory.len()));
+        valid.push(it.valid);
+    };
     let ctl = PlanControl {
         progress: Some(&mut cb),
         ..Default::default()
@@ -256,6 +265,8 @@ fn progress_sees_every_iteration_with_a_never_rising_cost() {
     assert_eq!(r.iterations, 20);
     assert!(seen.iter().enumerate().all(|(i, s)| s.0 == i && s.2 == 120));
     assert!(seen.windows(2).all(|p| p[1].1 <= p[0].1));
+    // once valid, never invalid again
+    assert!(valid.windows(2).all(|v| !v[0] || v[1]), "{valid:?}");
 }
 
 /// Velocity and acceleration of a timed piecewise-linear path, computed
@@ -416,5 +427,56 @@ fn a_pose_goal_is_solved_by_ik_and_reached() {
     assert_eq!(
         plan(&chain, &w, &far, PlanControl::default()).unwrap().status,
         PlanStatus::GoalUnreachable
+    );
+}
+
+#[test]
+fn resampling_keeps_every_vertex_and_the_count() {
+    let path = [0.0, 0.0, 1.0, 0.0, 1.0, 3.0];
+    let q = super::rrt_connect::resample(&path, 2, 8);
+    assert_eq!(q.len(), 16);
+    let rows: Vec<&[f64]> = q.chunks_exact(2).collect();
+    assert_eq!(rows[0], &[0.0, 0.0]);
+    assert!(rows.contains(&&[1.0, 0.0][..]), "corner kept");
+    assert_eq!(rows[7], &[1.0, 3.0]);
+    // the 3 m segment gets three times the points of the 1 m one
+    let on_first = rows
+        .iter()
+        .filter(|r| r[1] == 0.0 && r[0] > 0.0 && r[0] < 1.0)
+        .count();
+    let on_second = rows
+        .iter()
+        .filter(|r| r[0] == 1.0 && r[1] > 0.0 && r[1] < 3.0)
+        .count();
+    assert_eq!((on_first, on_second), (1, 4));
+}
+
+#[test]
+fn ccstomp_from_the_cartesian_line_stays_on_it() {
+    let chain = builtin_chain("ur5").unwrap();
+    let w = JointBoxes {
+        dof: 6,
+        limit: 2.0 * std::f64::consts::PI,
+        boxes: vec![],
+    };
+    let goal = vec![0.6, -1.0, 1.2, -1.0, 1.3, 0.0];
+    let mut req = PlanRequest {
+        start: vec![0.0, -1.2, 1.4, -0.8, 1.1, 0.2],
+        goal: Goal::Joints(goal.clone()),
+        algorithm: Algorithm::Ccstomp,
+        seed: 2,
+        ..Default::default()
+    };
+    req.stomp.timesteps = 12;
+    req.stomp.initial = InitialTrajectory::CartesianLine;
+    req.cartesian.translation_tolerance = 0.02;
+    req.cartesian.rotation_tolerance = 0.02;
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert_eq!(r.status, PlanStatus::Succeeded);
+    assert_ends(&r, &req.start, &goal);
+    assert!(
+        r.deviation
+            .iter()
+            .all(|d| d.translation <= 0.02 && d.rotation <= 0.02)
     );
 }
