@@ -37,6 +37,11 @@ pub(crate) struct Block {
 /// Where a node lives: `ROOT`, or `block · 8 + slot`.
 pub(crate) type Loc = u32;
 
+/// A read-only handle to one node, for traversals outside the room (copied out of the
+/// arena; valid until the tree is next changed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeRef(pub(crate) Node);
+
 /// Occupancy of a cell as OctoMap classifies it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum CellState {
@@ -101,6 +106,40 @@ impl Octree {
     /// The sensor model used by updates and by the occupancy threshold.
     pub fn sensor_model(&self) -> &SensorModel {
         &self.sensor
+    }
+
+    /// The root, if the tree has nodes.
+    #[inline]
+    pub fn root_ref(&self) -> Option<NodeRef> {
+        self.root.map(NodeRef)
+    }
+
+    /// True when the node has children (else it is a leaf, possibly a pruned cube).
+    #[inline]
+    pub fn has_children(&self, n: NodeRef) -> bool {
+        n.0.has_children()
+    }
+
+    /// Child `i` (0–7, `x + 2y + 4z`) of `n`, if it exists.
+    #[inline]
+    pub fn child_ref(&self, n: NodeRef, i: usize) -> Option<NodeRef> {
+        if !n.0.has_children() || i >= 8 {
+            return None;
+        }
+        let b = &self.blocks[n.0.block as usize];
+        (b.mask & (1 << i) != 0).then(|| NodeRef(b.nodes[i]))
+    }
+
+    /// Log-odds of a node.
+    #[inline]
+    pub fn log_odds_of(&self, n: NodeRef) -> f32 {
+        n.0.value
+    }
+
+    /// The occupancy threshold as log-odds (a node is occupied above it).
+    #[inline]
+    pub fn threshold_log_odds(&self) -> f32 {
+        self.model.threshold
     }
 
     /// Nodes, inner and leaves (OctoMap's `size()`).
