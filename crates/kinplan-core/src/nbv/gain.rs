@@ -4,7 +4,7 @@
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::camera::{CameraModel, Frustum};
-use crate::octree::{CellState, OcKey, Octree, TREE_DEPTH};
+use crate::octree::{CellState, OcKey, Octree, SearchCache, TREE_DEPTH};
 
 /// How the gain of a view is computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -244,9 +244,10 @@ pub fn walk(
         }
     }
     let mut steps = 0u64;
+    let mut cache = SearchCache::default();
     loop {
         steps += 1;
-        let (state, v) = match tree.search_key(&k, TREE_DEPTH) {
+        let (state, v) = match tree.search_key_cached(&k, &mut cache) {
             None => (CellState::Unknown, None),
             Some((v, _)) => (
                 if v > tree.threshold_log_odds() {

@@ -6,7 +6,7 @@ use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use super::key::{OcKey, TREE_DEPTH, coord_to_key_axis, key_to_coord_axis};
-use super::{Octree, OctreeError};
+use super::{Octree, OctreeError, SearchCache};
 
 /// Options of [`Octree::cast_ray`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -223,6 +223,7 @@ impl Octree {
         let range_sq = params.max_range * params.max_range;
         let mut k = *ko;
         let mut steps = 0u32;
+        let mut cache = SearchCache::default();
         loop {
             let a = dda.axis();
             if (dda.step[a] < 0 && k[a] == 0) || (dda.step[a] > 0 && k[a] == u16::MAX) {
@@ -242,7 +243,7 @@ impl Octree {
                     return Ok(finish(k, false, RayStop::MaxRange, steps));
                 }
             }
-            match self.search_key(&k, TREE_DEPTH) {
+            match self.search_key_cached(&k, &mut cache) {
                 Some((v, _)) if self.is_occupied_value(v) => {
                     return Ok(finish(k, true, RayStop::Occupied, steps));
                 }

@@ -42,6 +42,19 @@ pub(crate) type Loc = u32;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NodeRef(pub(crate) Node);
 
+/// The path of the last lookup, so that a lookup of a nearby key (the next DDA step)
+/// resumes at the deepest ancestor both keys share instead of at the root. Valid for
+/// one tree while it is not changed; [`SearchCache::default`] starts empty.
+#[derive(Debug, Clone, Default)]
+pub struct SearchCache {
+    key: OcKey,
+    nodes: [Option<Node>; TREE_DEPTH as usize + 1],
+    /// Depth at which the last lookup ended: the node found, or the missing child.
+    end: u8,
+    result: Option<(f32, u8)>,
+    valid: bool,
+}
+
 /// Occupancy of a cell as OctoMap classifies it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum CellState {
@@ -214,6 +227,52 @@ impl Octree {
             node = &b.nodes[i];
         }
         Some((node.value, depth))
+    }
+
+    /// [`search_key`](Self::search_key) at depth 16 resuming from `cache`: keys sharing
+    /// their top `c` bits share the path down to depth `c`, and a key inside the cube
+    /// where the last lookup ended gets the same answer without any descent.
+    #[inline]
+    pub fn search_key_cached(&self, key: &OcKey, cache: &mut SearchCache) -> Option<(f32, u8)> {
+        let root = self.root.as_ref()?;
+        let mut start = 0u8;
+        if cache.valid {
+            let c = cache
+                .key
+                .iter()
+                .zip(key)
+                .map(|(a, b)| (a ^ b).leading_zeros() as u8)
+                .fold(TREE_DEPTH, u8::min);
+            if c >= cache.end {
+                cache.key = *key;
+                return cache.result;
+            }
+            start = c;
+        } else {
+            cache.nodes[0] = Some(*root);
+        }
+        cache.valid = true;
+        cache.key = *key;
+        let mut node = cache.nodes[start as usize].expect("cached path node");
+        for d in start..TREE_DEPTH {
+            if !node.has_children() {
+                cache.end = d;
+                cache.result = Some((node.value, d));
+                return cache.result;
+            }
+            let b = &self.blocks[node.block as usize];
+            let i = child_index(key, d);
+            if b.mask & (1 << i) == 0 {
+                cache.end = d + 1;
+                cache.result = None;
+                return None;
+            }
+            node = b.nodes[i];
+            cache.nodes[d as usize + 1] = Some(node);
+        }
+        cache.end = TREE_DEPTH;
+        cache.result = Some((node.value, TREE_DEPTH));
+        cache.result
     }
 
     /// State of the cell with `key` at depth 16.
