@@ -4,7 +4,7 @@
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::camera::look_along;
-use crate::octree::{CellState, OcKey, Octree, StateFilter, TREE_DEPTH};
+use crate::octree::{CellState, OcKey, Octree, SearchCache, StateFilter, TREE_DEPTH};
 
 /// One frontier cell: a known-free depth-16 cell with enough unknown neighbours.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,8 +41,26 @@ pub fn frontier_cells(
         if (0..3).any(|i| k[i] < kmin[i] || k[i] > kmax[i]) {
             return;
         }
-        let nb = tree.neighbors(&k, TREE_DEPTH, true);
-        let unknown = nb.iter().filter(|(_, s)| *s == CellState::Unknown).count();
+        // the 26 neighbours, looked up through one path cache (no allocation)
+        let mut cache = SearchCache::default();
+        let mut unknown = 0usize;
+        for dz in -1..=1i32 {
+            for dy in -1..=1i32 {
+                for dx in -1..=1i32 {
+                    if dx == 0 && dy == 0 && dz == 0 {
+                        continue;
+                    }
+                    let n = [k[0] as i32 + dx, k[1] as i32 + dy, k[2] as i32 + dz];
+                    if n.iter().any(|v| !(0..65536).contains(v)) {
+                        continue;
+                    }
+                    let n = [n[0] as u16, n[1] as u16, n[2] as u16];
+                    if tree.search_key_cached(&n, &mut cache).is_none() {
+                        unknown += 1;
+                    }
+                }
+            }
+        }
         let ratio = unknown as f64 / 26.0;
         if unknown > 0 && ratio >= min_unknown_ratio {
             out.push(Frontier {

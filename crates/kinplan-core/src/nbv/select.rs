@@ -148,8 +148,7 @@ pub fn estimate_reach(chain: &Chain) -> f64 {
 ///    `base⁻¹ · pose · mount⁻¹`; unreachable ones are dropped (or, with
 ///    `count_failures`, kept with `f − failure_penalty · failures`).
 ///
-/// Deadline and `should_stop` are polled between candidates (every 16 in the field
-/// stage, per candidate elsewhere); on either the result ranks what was evaluated.
+/// Deadline and `should_stop` are polled per candidate in every stage; on either the result ranks what was evaluated.
 pub fn next_best_view(
     tree: &Octree,
     params: &NbvParams,
@@ -185,19 +184,32 @@ pub fn next_best_view(
     }
     st.frontier_us = us(t);
     let t = Instant::now();
-    let mut cands: Vec<(Isometry3<f64>, Option<Point3<f64>>)> = Vec::with_capacity(frontier.len());
-    for (i, f) in frontier.iter().enumerate() {
-        if i.is_multiple_of(16)
-            && let Some(s) = clock.interrupted()
-        {
-            status = s;
-            break;
-        }
-        let field = potential_field(tree, &f.center, params.field_radius)?;
-        if let Some(p) = candidate_pose(&f.center, &field, params.standoff, camera.near) {
-            cands.push((p, Some(f.center)));
-        }
+    // potential fields in parallel; the clock is polled per frontier cell
+    let fields: Vec<Option<Option<Isometry3<f64>>>> = frontier
+        .par_iter()
+        .map(|f| {
+            if clock.interrupted().is_some() {
+                return Ok(None);
+            }
+            let field = potential_field(tree, &f.center, params.field_radius)?;
+            Ok(Some(candidate_pose(
+                &f.center,
+                &field,
+                params.standoff,
+                camera.near,
+            )))
+        })
+        .collect::<Result<_, crate::octree::OctreeError>>()?;
+    if fields.iter().any(Option::is_none)
+        && let Some(s) = clock.interrupted()
+    {
+        status = s;
     }
+    let mut cands: Vec<(Isometry3<f64>, Option<Point3<f64>>)> = fields
+        .into_iter()
+        .zip(&frontier)
+        .filter_map(|(p, f)| p.flatten().map(|p| (p, Some(f.center))))
+        .collect();
     st.frontier_candidates = cands.len();
     st.caller_candidates = params.extra_candidates.len();
     cands.extend(params.extra_candidates.iter().map(|p| (*p, None)));
