@@ -57,6 +57,18 @@ pub struct GainWorkspace {
 /// whose cell centres are all outside one plane is dropped, a cube with all centres
 /// inside every plane adds `8^(16−d)` if unknown, a known leaf adds nothing, anything
 /// else is split (absent space virtually) down to single cells.
+///
+/// ```
+/// use kinplan_core::nbv::{CameraModel, Frustum, frustum_unknown_count, look_along};
+/// use kinplan_core::octree::Octree;
+/// use nalgebra::{Point3, Vector3};
+/// let cam = CameraModel { near: 0.2, far: 1.0, ..CameraModel::default() };
+/// let pose = look_along(&Point3::new(0.01, 0.02, 0.03), &Vector3::x()).unwrap();
+/// // an empty tree is all unknown: the count approaches volume / res³
+/// let c = frustum_unknown_count(&Octree::new(0.05).unwrap(), &Frustum::new(&cam, &pose)) as f64;
+/// let v = cam.frustum_volume() / 0.05f64.powi(3);
+/// assert!((c / v - 1.0).abs() < 0.1);
+/// ```
 pub fn frustum_unknown_count(tree: &Octree, frustum: &Frustum) -> u64 {
     let res = tree.resolution();
     let planes = &frustum.planes;

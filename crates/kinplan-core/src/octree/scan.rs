@@ -128,6 +128,17 @@ impl Octree {
     ///
     /// Beams are traced in parallel (rayon) into dense bitsets over the scan's key box\n    /// (or, beyond `dense_limit_cells`, sorted Morton-code vectors).
     /// `should_stop` is polled every 1,024 beams; when it fires the tree is left unchanged.
+    ///
+    /// ```
+    /// use kinplan_core::octree::{CellState, Octree, ScanParams};
+    /// let mut t = Octree::new(0.1).unwrap();
+    /// // one beam along +x from the centre of cell 32768 to x = 0.45 (cell 32772)
+    /// let s = t.insert_scan(&[[0.45, 0.05, 0.05]], &[0.05, 0.05, 0.05], &ScanParams::default(), &|| false).unwrap();
+    /// assert_eq!((s.free_cells, s.occupied_cells), (4, 1));
+    /// assert_eq!(t.state_of_key(&[32771, 32768, 32768]), CellState::Free);
+    /// assert_eq!(t.state_of_key(&[32772, 32768, 32768]), CellState::Occupied);
+    /// assert_eq!(t.state_of_key(&[32773, 32768, 32768]), CellState::Unknown);
+    /// ```
     pub fn insert_scan(
         &mut self,
         points: &[[f32; 3]],
