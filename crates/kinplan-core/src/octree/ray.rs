@@ -129,13 +129,25 @@ impl Octree {
     /// `out` empty) when either point is outside the tree's cube.
     pub fn compute_ray_keys(&self, origin: &[f32; 3], end: &[f32; 3], out: &mut Vec<OcKey>) -> bool {
         out.clear();
+        self.visit_ray_keys(origin, end, |k| out.push(*k))
+    }
+
+    /// [`compute_ray_keys`](Self::compute_ray_keys) handing each key to `visit` in order
+    /// instead of collecting them.
+    #[inline]
+    pub(crate) fn visit_ray_keys(
+        &self,
+        origin: &[f32; 3],
+        end: &[f32; 3],
+        mut visit: impl FnMut(&OcKey),
+    ) -> bool {
         let (Some(ko), Some(ke)) = (self.key_of_f32(origin), self.key_of_f32(end)) else {
             return false;
         };
         if ko == ke {
             return true;
         }
-        out.push(ko);
+        visit(&ko);
         let mut dir = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
         let length = f32_norm(&dir) as f32;
         for v in dir.iter_mut() {
@@ -156,7 +168,7 @@ impl Octree {
             if dist > length {
                 break;
             }
-            out.push(k);
+            visit(&k);
         }
         true
     }

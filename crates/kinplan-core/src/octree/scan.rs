@@ -309,7 +309,6 @@ impl Octree {
                     acc.3 = true;
                     return acc;
                 }
-                let mut ray = Vec::with_capacity(512);
                 for p in chunk {
                     if p.iter().any(|v| !v.is_finite()) {
                         acc.2 += 1;
@@ -317,7 +316,13 @@ impl Octree {
                     }
                     let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
                     let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
-                    let ok = if max_range < 0.0 || norm <= max_range {
+                    let free = &mut acc.0;
+                    let mut mark = |k: &OcKey| {
+                        let i = index(k);
+                        free[i >> 6] |= 1 << (i & 63);
+                    };
+                    if max_range < 0.0 || norm <= max_range {
+                        this.visit_ray_keys(origin, p, &mut mark);
                         match this.key_of_f32(p) {
                             Some(k) => {
                                 let i = index(&k);
@@ -325,17 +330,10 @@ impl Octree {
                             }
                             None => acc.2 += 1,
                         }
-                        this.compute_ray_keys(origin, p, &mut ray)
                     } else {
                         let (n, m) = (norm as f32, max_range as f32);
                         let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                        this.compute_ray_keys(origin, &e, &mut ray)
-                    };
-                    if ok {
-                        for k in &ray {
-                            let i = index(k);
-                            acc.0[i >> 6] |= 1 << (i & 63);
-                        }
+                        this.visit_ray_keys(origin, &e, &mut mark);
                     }
                 }
                 acc
