@@ -253,8 +253,8 @@ fn insert_scan_gives_octomaps_tree_byte_for_byte() {
     for (origin, max_range, pts) in fixture_scans() {
         let p = ScanParams {
             max_range,
-            discretize: false,
             dense_limit_cells: 0,
+            ..ScanParams::default()
         };
         t2.insert_scan(&pts, &origin, &p, &|| false).unwrap();
     }

@@ -23,6 +23,11 @@ pub struct ScanParams {
     /// per worker); larger scans fall back to sorted key vectors. Default 2^27
     /// (16 MiB per bitset).
     pub dense_limit_cells: usize,
+    /// Above `dense_limit_cells` the beams' keys are collected in vectors; a scan whose
+    /// beams could cross more cells than this (upper bound `Σ (‖Δkey‖₁ + 1)`) is refused
+    /// with [`OctreeError::ScanTooLarge`] instead of allocating without bound.
+    /// Default 2^26 (512 MiB of keys at most).
+    pub max_sorted_keys: usize,
 }
 
 impl Default for ScanParams {
@@ -31,6 +36,7 @@ impl Default for ScanParams {
             max_range: -1.0,
             discretize: false,
             dense_limit_cells: 1 << 27,
+            max_sorted_keys: 1 << 26,
         }
     }
 }
@@ -127,7 +133,8 @@ impl Octree {
     /// clamped) — the same tree as OctoMap's `insertPointCloud(…, lazy_eval = false)`.
     ///
     /// Beams are traced in parallel (rayon) into dense bitsets over the scan's key box\n    /// (or, beyond `dense_limit_cells`, sorted Morton-code vectors).
-    /// `should_stop` is polled every 1,024 beams; when it fires the tree is left unchanged.
+    /// `should_stop` is polled per chunk of 4,096 beams (1,024 on the sorted path); when
+    /// it fires the tree is left unchanged.
     ///
     /// ```
     /// use kinplan_core::octree::{CellState, Octree, ScanParams};
@@ -193,6 +200,32 @@ impl Octree {
         let cells = dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]);
         if cells <= params.dense_limit_cells {
             return Ok(self.insert_dense(pts, origin, max_range, lo, dims, points.len(), t0, should_stop));
+        }
+        // bound the keys the sorted path could collect before allocating for them
+        let cut_bound = if max_range > 0.0 {
+            3 * (max_range * self.resolution_factor) as u64 + 4
+        } else {
+            u64::MAX
+        };
+        let mut bound = 0u64;
+        for p in pts {
+            if let Some(k) = p
+                .iter()
+                .all(|v| v.is_finite())
+                .then(|| self.key_of_f32(p))
+                .flatten()
+            {
+                let l1: u64 = (0..3).map(|i| (k[i] as i64 - ko[i] as i64).unsigned_abs()).sum();
+                bound = bound.saturating_add((l1 + 1).min(cut_bound));
+            } else if max_range > 0.0 && p.iter().all(|v| v.is_finite()) {
+                bound = bound.saturating_add(cut_bound);
+            }
+        }
+        if bound > params.max_sorted_keys as u64 {
+            return Err(OctreeError::ScanTooLarge {
+                cells: bound,
+                limit: params.max_sorted_keys,
+            });
         }
         let chunks: Vec<Option<ChunkKeys>> = pts
             .par_chunks(1024)
