@@ -72,20 +72,37 @@ pub fn frontier_cells(
     };
     'cubes: for (base, depth) in cubes {
         let n = 1u32 << (TREE_DEPTH - depth);
+        // offsets of the cube clipped to the region's keys
+        let lo = [0, 1, 2].map(|i| (kmin[i] as u32).saturating_sub(base[i] as u32));
+        let hi = [0, 1, 2].map(|i| (n - 1).min((kmax[i] as u32).saturating_sub(base[i] as u32)));
+        if (0..3).any(|i| lo[i] > hi[i] || base[i] as u32 > kmax[i] as u32) {
+            continue;
+        }
         // only cells on the cube's surface can border anything but the cube itself
-        for dz in 0..n {
-            for dy in 0..n {
+        for dz in lo[2]..=hi[2] {
+            for dy in lo[1]..=hi[1] {
                 let surface_yz = dz == 0 || dz == n - 1 || dy == 0 || dy == n - 1;
-                let stride = if surface_yz || n == 1 { 1 } else { n - 1 };
-                let mut dx = 0;
-                while dx < n {
+                let mut visit = |dx: u32, out: &mut Vec<Frontier>| {
                     polled += 1;
-                    if polled.is_multiple_of(256) && should_stop() {
-                        break 'cubes;
-                    }
                     let k = [base[0] + dx as u16, base[1] + dy as u16, base[2] + dz as u16];
-                    test(k, &mut out);
-                    dx += stride;
+                    test(k, out);
+                    polled.is_multiple_of(256) && should_stop()
+                };
+                if surface_yz {
+                    for dx in lo[0]..=hi[0] {
+                        if visit(dx, &mut out) {
+                            break 'cubes;
+                        }
+                    }
+                } else {
+                    for dx in [0, n - 1] {
+                        if (lo[0]..=hi[0]).contains(&dx) && visit(dx, &mut out) {
+                            break 'cubes;
+                        }
+                        if n == 1 {
+                            break;
+                        }
+                    }
                 }
             }
         }

@@ -166,16 +166,31 @@ pub fn next_best_view(
     };
     let mut st = StageStats::default();
     let mut status = NbvStatus::Complete;
-    let region = params.region.or_else(|| tree.known_bounds());
+    // default region: the known leaves' bounds, moved in by half a cell to the centres of
+    // the outermost cells (the upper bound may be the tree cube's exclusive edge)
+    let half = tree.resolution() / 2.0;
+    let region = params.region.or_else(|| {
+        tree.known_bounds().map(|(a, b)| {
+            (
+                a + nalgebra::Vector3::repeat(half),
+                b - nalgebra::Vector3::repeat(half),
+            )
+        })
+    });
+    // deadline or cancellation, for the loops that take a closure
+    let stop = || clock.interrupted().is_some();
 
     // 1. candidates
     let t = Instant::now();
     let mut frontier = match &region {
         Some((a, b)) if params.max_frontier_candidates > 0 => {
-            frontier_cells(tree, a, b, params.frontier_unknown_ratio, should_stop)?
+            frontier_cells(tree, a, b, params.frontier_unknown_ratio, &stop)?
         }
         _ => Vec::new(),
     };
+    if let Some(s) = clock.interrupted() {
+        status = s; // the frontier scan was cut short
+    }
     st.frontier_cells = frontier.len();
     if frontier.len() > params.max_frontier_candidates {
         let n = frontier.len();
@@ -261,7 +276,7 @@ pub fn next_best_view(
                     (c, c / c_max, 0)
                 }
                 m => {
-                    let g = ray_gain(tree, camera, pose, m, ws, should_stop);
+                    let g = ray_gain(tree, camera, pose, m, ws, &stop);
                     (g.cells, g.ig, g.ray_steps)
                 }
             })

@@ -253,3 +253,35 @@ fn next_best_view_ranks_filters_and_checks_reach() {
     };
     assert!(next_best_view(&t, &bad, &cam, &current, None, &|| false).is_err());
 }
+
+#[test]
+fn huge_free_cubes_from_a_hostile_tree_stop_at_the_deadline() {
+    use crate::octree::OctreeLimits;
+    // two node bytes: the root's eight children are free leaves, each 32768 cells wide
+    let t = Octree::from_message_data(true, "OcTree", 0.1, &[0x55, 0x55], &OctreeLimits::default()).unwrap();
+    assert_eq!(t.num_nodes(), 9);
+    let cam = small_camera();
+    let current = look_along(&Point3::new(0.0, 0.0, 1.0), &Vector3::x()).unwrap();
+    let params = NbvParams {
+        time_budget: Some(std::time::Duration::from_millis(50)),
+        ..NbvParams::default()
+    };
+    let start = std::time::Instant::now();
+    let r = next_best_view(&t, &params, &cam, &current, None, &|| false).unwrap();
+    assert_eq!(r.status, NbvStatus::TimeBudget);
+    assert!(
+        start.elapsed() < std::time::Duration::from_secs(5),
+        "{:?}",
+        start.elapsed()
+    );
+    // a small region clips the scan: done at once, and no frontier (nothing unknown)
+    let f = frontier_cells(
+        &t,
+        &Point3::new(-1.0, -1.0, -1.0),
+        &Point3::new(1.0, 1.0, 1.0),
+        0.25,
+        &|| false,
+    )
+    .unwrap();
+    assert!(f.is_empty());
+}
