@@ -10,6 +10,7 @@ pub mod collision;
 pub mod ik;
 pub mod linalg;
 pub mod mobile;
+pub mod nbv;
 pub mod octree;
 pub mod plan;
 pub mod robot;

@@ -32,6 +32,8 @@ pub enum OctreeError {
     OutOfBounds { field: &'static str },
     #[error("{field} is not finite")]
     NonFinite { field: &'static str },
+    #[error("scan beams could cross {cells} cells, more than the limit {limit}")]
+    ScanTooLarge { cells: u64, limit: usize },
     #[error("{field}: expected {expected} values, got {got}")]
     WrongLength {
         field: &'static str,

@@ -19,6 +19,23 @@ impl Octree {
     /// inner nodes the maximum of their children (OctoMap's `readBinary`; a root without
     /// children reads as an occupied leaf, as in OctoMap). The header's `size` must equal
     /// the nodes read and stay within `limits.max_nodes`; nothing follows the last node.
+    ///
+    /// ```
+    /// use kinplan_core::octree::{CellState, Octree, OctreeError, OctreeLimits};
+    /// use nalgebra::Point3;
+    /// let mut t = Octree::new(0.1).unwrap();
+    /// let k = t.key_of(&Point3::new(0.25, 0.0, 1.0)).unwrap();
+    /// assert_eq!(k, [32770, 32768, 32778]); // ⌊c/0.1⌋ + 32768
+    /// t.update_key(&k, t.sensor_model().log_odds().hit);
+    /// let bytes = t.write_bt();
+    /// assert!(bytes.starts_with(b"# Octomap OcTree binary file\n"));
+    /// let back = Octree::read_bt(&bytes, &OctreeLimits::default()).unwrap();
+    /// assert_eq!(back.state_of_key(&k), CellState::Occupied);
+    /// assert_eq!(back.num_nodes(), 17); // root + one node per level
+    /// // a truncated stream is an error naming the offset, not a panic
+    /// let cut = Octree::read_bt(&bytes[..bytes.len() - 1], &OctreeLimits::default());
+    /// assert!(matches!(cut, Err(OctreeError::Truncated { .. })));
+    /// ```
     pub fn read_bt(bytes: &[u8], limits: &OctreeLimits) -> Result<Octree, OctreeError> {
         let h = parse_header(bytes, BT_FIRST_LINE)?;
         if h.id != "OcTree" && h.id != "ColorOcTree" {

@@ -26,4 +26,4 @@ pub use params::{LogOddsModel, OctreeLimits, SensorModel};
 pub use query::{BoxVolumes, CellVisit, StateFilter};
 pub use ray::{RayHit, RayParams, RayStop};
 pub use scan::{PinholeIntrinsics, ScanParams, ScanStats, ScanStatus, depth_image_points};
-pub use tree::{CellState, Octree};
+pub use tree::{CellState, NodeRef, Octree, SearchCache};

@@ -6,7 +6,7 @@ use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
 use super::key::{OcKey, TREE_DEPTH, coord_to_key_axis, key_to_coord_axis};
-use super::{Octree, OctreeError};
+use super::{Octree, OctreeError, SearchCache};
 
 /// Options of [`Octree::cast_ray`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -129,13 +129,25 @@ impl Octree {
     /// `out` empty) when either point is outside the tree's cube.
     pub fn compute_ray_keys(&self, origin: &[f32; 3], end: &[f32; 3], out: &mut Vec<OcKey>) -> bool {
         out.clear();
+        self.visit_ray_keys(origin, end, |k| out.push(*k))
+    }
+
+    /// [`compute_ray_keys`](Self::compute_ray_keys) handing each key to `visit` in order
+    /// instead of collecting them.
+    #[inline]
+    pub(crate) fn visit_ray_keys(
+        &self,
+        origin: &[f32; 3],
+        end: &[f32; 3],
+        mut visit: impl FnMut(&OcKey),
+    ) -> bool {
         let (Some(ko), Some(ke)) = (self.key_of_f32(origin), self.key_of_f32(end)) else {
             return false;
         };
         if ko == ke {
             return true;
         }
-        out.push(ko);
+        visit(&ko);
         let mut dir = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
         let length = f32_norm(&dir) as f32;
         for v in dir.iter_mut() {
@@ -156,7 +168,7 @@ impl Octree {
             if dist > length {
                 break;
             }
-            out.push(k);
+            visit(&k);
         }
         true
     }
@@ -223,6 +235,7 @@ impl Octree {
         let range_sq = params.max_range * params.max_range;
         let mut k = *ko;
         let mut steps = 0u32;
+        let mut cache = SearchCache::default();
         loop {
             let a = dda.axis();
             if (dda.step[a] < 0 && k[a] == 0) || (dda.step[a] > 0 && k[a] == u16::MAX) {
@@ -242,7 +255,7 @@ impl Octree {
                     return Ok(finish(k, false, RayStop::MaxRange, steps));
                 }
             }
-            match self.search_key(&k, TREE_DEPTH) {
+            match self.search_key_cached(&k, &mut cache) {
                 Some((v, _)) if self.is_occupied_value(v) => {
                     return Ok(finish(k, true, RayStop::Occupied, steps));
                 }

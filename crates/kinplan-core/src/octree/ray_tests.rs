@@ -177,7 +177,7 @@ fn insert_of_a_tiny_scan_by_hand() {
     let mut t2 = Octree::new(0.1).unwrap();
     let p = ScanParams {
         max_range: 0.2,
-        discretize: false,
+        ..ScanParams::default()
     };
     let s = t2
         .insert_scan(&pts[..1], &[0.05, 0.05, 0.05], &p, &|| false)
@@ -242,12 +242,23 @@ fn insert_scan_gives_octomaps_tree_byte_for_byte() {
     for (origin, max_range, pts) in fixture_scans() {
         let p = ScanParams {
             max_range,
-            discretize: false,
+            ..ScanParams::default()
         };
         let s = t.insert_scan(&pts, &origin, &p, &|| false).unwrap();
         assert_eq!(s.status, ScanStatus::Inserted);
     }
     let ours = t.write_ot();
+    // the sorted-vector path (no dense grid) builds the same tree
+    let mut t2 = Octree::new(0.1).unwrap();
+    for (origin, max_range, pts) in fixture_scans() {
+        let p = ScanParams {
+            max_range,
+            dense_limit_cells: 0,
+            ..ScanParams::default()
+        };
+        t2.insert_scan(&pts, &origin, &p, &|| false).unwrap();
+    }
+    assert!(t2.write_ot() == expected, "sorted path differs from OctoMap's");
     assert_eq!(ours.len(), expected.len());
     assert!(ours == expected, "tree differs from OctoMap's");
     // and OctoMap's file reads back into the same tree

@@ -19,6 +19,15 @@ pub struct ScanParams {
     /// Merge end points falling into the same cell first and cast from its centre
     /// (OctoMap's `discretize`). Default false.
     pub discretize: bool,
+    /// Largest key box (cells) traced into dense bitsets (one bit per cell and set,
+    /// per worker); larger scans fall back to sorted key vectors. Default 2^27
+    /// (16 MiB per bitset).
+    pub dense_limit_cells: usize,
+    /// Above `dense_limit_cells` the beams' keys are collected in vectors; a scan whose
+    /// beams could cross more cells than this (upper bound `Σ (‖Δkey‖₁ + 1)`) is refused
+    /// with [`OctreeError::ScanTooLarge`] instead of allocating without bound.
+    /// Default 2^26 (512 MiB of keys at most).
+    pub max_sorted_keys: usize,
 }
 
 impl Default for ScanParams {
@@ -26,6 +35,8 @@ impl Default for ScanParams {
         Self {
             max_range: -1.0,
             discretize: false,
+            dense_limit_cells: 1 << 27,
+            max_sorted_keys: 1 << 26,
         }
     }
 }
@@ -121,8 +132,20 @@ impl Octree {
     /// occupied only, and each set element gets one update (`+hit` or `+miss` log-odds,
     /// clamped) — the same tree as OctoMap's `insertPointCloud(…, lazy_eval = false)`.
     ///
-    /// Beams are traced in parallel (rayon); the sets are sorted Morton-code vectors.
-    /// `should_stop` is polled every 1,024 beams; when it fires the tree is left unchanged.
+    /// Beams are traced in parallel (rayon) into dense bitsets over the scan's key box\n    /// (or, beyond `dense_limit_cells`, sorted Morton-code vectors).
+    /// `should_stop` is polled per chunk of 4,096 beams (1,024 on the sorted path); when
+    /// it fires the tree is left unchanged.
+    ///
+    /// ```
+    /// use kinplan_core::octree::{CellState, Octree, ScanParams};
+    /// let mut t = Octree::new(0.1).unwrap();
+    /// // one beam along +x from the centre of cell 32768 to x = 0.45 (cell 32772)
+    /// let s = t.insert_scan(&[[0.45, 0.05, 0.05]], &[0.05, 0.05, 0.05], &ScanParams::default(), &|| false).unwrap();
+    /// assert_eq!((s.free_cells, s.occupied_cells), (4, 1));
+    /// assert_eq!(t.state_of_key(&[32771, 32768, 32768]), CellState::Free);
+    /// assert_eq!(t.state_of_key(&[32772, 32768, 32768]), CellState::Occupied);
+    /// assert_eq!(t.state_of_key(&[32773, 32768, 32768]), CellState::Unknown);
+    /// ```
     pub fn insert_scan(
         &mut self,
         points: &[[f32; 3]],
@@ -157,6 +180,53 @@ impl Octree {
             points
         };
         let max_range = params.max_range;
+        // key box of the origin and every usable point: all beams lie inside it
+        let ko = self.key_of_f32(origin).expect("checked above");
+        let (mut lo, mut hi) = (ko, ko);
+        for p in pts {
+            if let Some(k) = p
+                .iter()
+                .all(|v| v.is_finite())
+                .then(|| self.key_of_f32(p))
+                .flatten()
+            {
+                for i in 0..3 {
+                    lo[i] = lo[i].min(k[i]);
+                    hi[i] = hi[i].max(k[i]);
+                }
+            }
+        }
+        let dims = [0, 1, 2].map(|i| (hi[i] - lo[i]) as usize + 1);
+        let cells = dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]);
+        if cells <= params.dense_limit_cells {
+            return Ok(self.insert_dense(pts, origin, max_range, lo, dims, points.len(), t0, should_stop));
+        }
+        // bound the keys the sorted path could collect before allocating for them
+        let cut_bound = if max_range > 0.0 {
+            3 * (max_range * self.resolution_factor) as u64 + 4
+        } else {
+            u64::MAX
+        };
+        let mut bound = 0u64;
+        for p in pts {
+            if let Some(k) = p
+                .iter()
+                .all(|v| v.is_finite())
+                .then(|| self.key_of_f32(p))
+                .flatten()
+            {
+                let l1: u64 = (0..3).map(|i| (k[i] as i64 - ko[i] as i64).unsigned_abs()).sum();
+                bound = bound.saturating_add((l1 + 1).min(cut_bound));
+            } else if max_range > 0.0 && p.iter().all(|v| v.is_finite()) {
+                bound = bound.saturating_add(cut_bound);
+            }
+        }
+        if bound > params.max_sorted_keys as u64 {
+            return Err(OctreeError::ScanTooLarge {
+                cells: bound,
+                limit: params.max_sorted_keys,
+            });
+        }
         let chunks: Vec<Option<ChunkKeys>> = pts
             .par_chunks(1024)
             .map(|chunk| {
@@ -241,6 +311,119 @@ impl Octree {
         stats.nodes = self.num_nodes;
         stats.status = ScanStatus::Inserted;
         Ok(stats)
+    }
+
+    /// Traces every beam into two bitsets over the key box (free, end points), merges
+    /// the workers' sets by OR, clears free bits that are end points, and updates the
+    /// cells in x-fastest order — the same sets, so the same tree, as the sorted path.
+    #[allow(clippy::too_many_arguments)]
+    fn insert_dense(
+        &mut self,
+        pts: &[[f32; 3]],
+        origin: &[f32; 3],
+        max_range: f64,
+        lo: OcKey,
+        dims: [usize; 3],
+        given: usize,
+        t0: Instant,
+        should_stop: &(dyn Fn() -> bool + Sync),
+    ) -> ScanStats {
+        let words = (dims[0] * dims[1] * dims[2]).div_ceil(64);
+        let index = |k: &OcKey| {
+            ((k[2] - lo[2]) as usize * dims[1] + (k[1] - lo[1]) as usize) * dims[0] + (k[0] - lo[0]) as usize
+        };
+        let this = &*self;
+        type Acc = (Vec<u64>, Vec<u64>, usize, bool);
+        let empty = || -> Acc { (vec![0u64; words], vec![0u64; words], 0, false) };
+        let (mut free, occ, skipped, stopped) = pts
+            .par_chunks(4096)
+            .fold(empty, |mut acc, chunk| {
+                if acc.3 || should_stop() {
+                    acc.3 = true;
+                    return acc;
+                }
+                for p in chunk {
+                    if p.iter().any(|v| !v.is_finite()) {
+                        acc.2 += 1;
+                        continue;
+                    }
+                    let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+                    let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
+                    let free = &mut acc.0;
+                    let mut mark = |k: &OcKey| {
+                        let i = index(k);
+                        free[i >> 6] |= 1 << (i & 63);
+                    };
+                    if max_range < 0.0 || norm <= max_range {
+                        this.visit_ray_keys(origin, p, &mut mark);
+                        match this.key_of_f32(p) {
+                            Some(k) => {
+                                let i = index(&k);
+                                acc.1[i >> 6] |= 1 << (i & 63);
+                            }
+                            None => acc.2 += 1,
+                        }
+                    } else {
+                        let (n, m) = (norm as f32, max_range as f32);
+                        let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
+                        this.visit_ray_keys(origin, &e, &mut mark);
+                    }
+                }
+                acc
+            })
+            .reduce(empty, |mut a, b| {
+                for (x, y) in a.0.iter_mut().zip(&b.0) {
+                    *x |= y;
+                }
+                for (x, y) in a.1.iter_mut().zip(&b.1) {
+                    *x |= y;
+                }
+                (a.0, a.1, a.2 + b.2, a.3 || b.3)
+            });
+        let mut stats = ScanStats {
+            status: ScanStatus::Cancelled,
+            points: given,
+            skipped_points: skipped,
+            free_cells: 0,
+            occupied_cells: 0,
+            nodes: self.num_nodes,
+            trace_us: 0,
+            update_us: 0,
+        };
+        if stopped {
+            stats.trace_us = t0.elapsed().as_micros() as u64;
+            return stats;
+        }
+        for (f, o) in free.iter_mut().zip(&occ) {
+            *f &= !o;
+        }
+        stats.trace_us = t0.elapsed().as_micros() as u64;
+        let t1 = Instant::now();
+        let key_of = |i: usize| {
+            let x = i % dims[0];
+            let y = (i / dims[0]) % dims[1];
+            let z = i / (dims[0] * dims[1]);
+            [lo[0] + x as u16, lo[1] + y as u16, lo[2] + z as u16]
+        };
+        let (hit, miss) = (self.model.hit, self.model.miss);
+        for (bits, delta, count) in [
+            (&free, miss, &mut stats.free_cells),
+            (&occ, hit, &mut stats.occupied_cells),
+        ] {
+            for (w, &word) in bits.iter().enumerate() {
+                let mut b = word;
+                while b != 0 {
+                    let i = w * 64 + b.trailing_zeros() as usize;
+                    b &= b - 1;
+                    self.update_key(&key_of(i), delta);
+                    *count += 1;
+                }
+            }
+        }
+        stats.update_us = t1.elapsed().as_micros() as u64;
+        stats.nodes = self.num_nodes;
+        stats.status = ScanStatus::Inserted;
+        stats
     }
 
     /// Inserts a depth image: pixel `(u, v)` (row-major, `width` per row) with depth

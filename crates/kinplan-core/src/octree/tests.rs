@@ -307,3 +307,26 @@ fn state_at_point_and_neighbours_on_a_hand_built_tree() {
     let (lo, hi) = t.known_bounds().unwrap();
     assert_eq!((lo, hi), (Point3::new(0.0, 0.0, 0.0), Point3::new(1.0, 0.5, 0.5)));
 }
+
+#[test]
+fn cached_search_agrees_with_search_from_the_root() {
+    use rand::{Rng, SeedableRng};
+    let t = random_tree(21, 5000, 0.1);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
+    let mut cache = SearchCache::default();
+    let mut k = [32768u16; 3];
+    for _ in 0..20000 {
+        // unit steps (as a DDA takes) mixed with jumps
+        if rng.random_bool(0.05) {
+            k = [0; 3].map(|_| 32768 - 24 + rng.random_range(0..48u16));
+        } else {
+            let a = rng.random_range(0..3);
+            k[a] = if rng.random_bool(0.5) {
+                k[a].wrapping_add(1)
+            } else {
+                k[a].wrapping_sub(1)
+            };
+        }
+        assert_eq!(t.search_key_cached(&k, &mut cache), t.search_key(&k, 16), "{k:?}");
+    }
+}

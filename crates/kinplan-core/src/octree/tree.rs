@@ -37,6 +37,24 @@ pub(crate) struct Block {
 /// Where a node lives: `ROOT`, or `block · 8 + slot`.
 pub(crate) type Loc = u32;
 
+/// A read-only handle to one node, for traversals outside the room (copied out of the
+/// arena; valid until the tree is next changed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeRef(pub(crate) Node);
+
+/// The path of the last lookup, so that a lookup of a nearby key (the next DDA step)
+/// resumes at the deepest ancestor both keys share instead of at the root. Valid for
+/// one tree while it is not changed; [`SearchCache::default`] starts empty.
+#[derive(Debug, Clone, Default)]
+pub struct SearchCache {
+    key: OcKey,
+    nodes: [Option<Node>; TREE_DEPTH as usize + 1],
+    /// Depth at which the last lookup ended: the node found, or the missing child.
+    end: u8,
+    result: Option<(f32, u8)>,
+    valid: bool,
+}
+
 /// Occupancy of a cell as OctoMap classifies it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum CellState {
@@ -101,6 +119,40 @@ impl Octree {
     /// The sensor model used by updates and by the occupancy threshold.
     pub fn sensor_model(&self) -> &SensorModel {
         &self.sensor
+    }
+
+    /// The root, if the tree has nodes.
+    #[inline]
+    pub fn root_ref(&self) -> Option<NodeRef> {
+        self.root.map(NodeRef)
+    }
+
+    /// True when the node has children (else it is a leaf, possibly a pruned cube).
+    #[inline]
+    pub fn has_children(&self, n: NodeRef) -> bool {
+        n.0.has_children()
+    }
+
+    /// Child `i` (0–7, `x + 2y + 4z`) of `n`, if it exists.
+    #[inline]
+    pub fn child_ref(&self, n: NodeRef, i: usize) -> Option<NodeRef> {
+        if !n.0.has_children() || i >= 8 {
+            return None;
+        }
+        let b = &self.blocks[n.0.block as usize];
+        (b.mask & (1 << i) != 0).then(|| NodeRef(b.nodes[i]))
+    }
+
+    /// Log-odds of a node.
+    #[inline]
+    pub fn log_odds_of(&self, n: NodeRef) -> f32 {
+        n.0.value
+    }
+
+    /// The occupancy threshold as log-odds (a node is occupied above it).
+    #[inline]
+    pub fn threshold_log_odds(&self) -> f32 {
+        self.model.threshold
     }
 
     /// Nodes, inner and leaves (OctoMap's `size()`).
@@ -175,6 +227,52 @@ impl Octree {
             node = &b.nodes[i];
         }
         Some((node.value, depth))
+    }
+
+    /// [`search_key`](Self::search_key) at depth 16 resuming from `cache`: keys sharing
+    /// their top `c` bits share the path down to depth `c`, and a key inside the cube
+    /// where the last lookup ended gets the same answer without any descent.
+    #[inline]
+    pub fn search_key_cached(&self, key: &OcKey, cache: &mut SearchCache) -> Option<(f32, u8)> {
+        let root = self.root.as_ref()?;
+        let mut start = 0u8;
+        if cache.valid {
+            let c = cache
+                .key
+                .iter()
+                .zip(key)
+                .map(|(a, b)| (a ^ b).leading_zeros() as u8)
+                .fold(TREE_DEPTH, u8::min);
+            if c >= cache.end {
+                cache.key = *key;
+                return cache.result;
+            }
+            start = c;
+        } else {
+            cache.nodes[0] = Some(*root);
+        }
+        cache.valid = true;
+        cache.key = *key;
+        let mut node = cache.nodes[start as usize].expect("cached path node");
+        for d in start..TREE_DEPTH {
+            if !node.has_children() {
+                cache.end = d;
+                cache.result = Some((node.value, d));
+                return cache.result;
+            }
+            let b = &self.blocks[node.block as usize];
+            let i = child_index(key, d);
+            if b.mask & (1 << i) == 0 {
+                cache.end = d + 1;
+                cache.result = None;
+                return None;
+            }
+            node = b.nodes[i];
+            cache.nodes[d as usize + 1] = Some(node);
+        }
+        cache.end = TREE_DEPTH;
+        cache.result = Some((node.value, TREE_DEPTH));
+        cache.result
     }
 
     /// State of the cell with `key` at depth 16.

@@ -1,0 +1,166 @@
+//! Candidate views from frontier cells and the potential field (ALGORITHMS.md §5
+//! step 1, S0 §4.1 eq. 4.1).
+
+use nalgebra::{Isometry3, Point3, Vector3};
+
+use super::camera::look_along;
+use crate::octree::{CellState, OcKey, Octree, SearchCache, StateFilter, TREE_DEPTH};
+
+/// One frontier cell: a known-free depth-16 cell with enough unknown neighbours.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frontier {
+    pub key: OcKey,
+    /// Centre (m, map frame).
+    pub center: Point3<f64>,
+    /// Unknown share of its 26 neighbours (0–1).
+    pub unknown_ratio: f64,
+}
+
+/// Frontier cells inside the box `[min, max]` (m): free depth-16 cells (including the
+/// surface cells of pruned free cubes) whose 26 neighbours are unknown in a share of at
+/// least `min_unknown_ratio`. Sorted by key (x fastest) so the result is deterministic.
+/// `should_stop` is polled every 256 cells; the cells found so far are returned.
+pub fn frontier_cells(
+    tree: &Octree,
+    min: &Point3<f64>,
+    max: &Point3<f64>,
+    min_unknown_ratio: f64,
+    should_stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<Frontier>, crate::octree::OctreeError> {
+    let mut cubes = Vec::new();
+    let free = StateFilter {
+        free: true,
+        occupied: false,
+        unknown: false,
+    };
+    tree.for_each_in_box(min, max, TREE_DEPTH, free, |c| cubes.push((c.key, c.depth)))?;
+    let (kmin, kmax) = (tree.key_of(min)?, tree.key_of(max)?);
+    let mut out = Vec::new();
+    let mut polled = 0usize;
+    let test = |k: OcKey, out: &mut Vec<Frontier>| {
+        if (0..3).any(|i| k[i] < kmin[i] || k[i] > kmax[i]) {
+            return;
+        }
+        // the 26 neighbours, looked up through one path cache (no allocation)
+        let mut cache = SearchCache::default();
+        let mut unknown = 0usize;
+        for dz in -1..=1i32 {
+            for dy in -1..=1i32 {
+                for dx in -1..=1i32 {
+                    if dx == 0 && dy == 0 && dz == 0 {
+                        continue;
+                    }
+                    let n = [k[0] as i32 + dx, k[1] as i32 + dy, k[2] as i32 + dz];
+                    if n.iter().any(|v| !(0..65536).contains(v)) {
+                        continue;
+                    }
+                    let n = [n[0] as u16, n[1] as u16, n[2] as u16];
+                    if tree.search_key_cached(&n, &mut cache).is_none() {
+                        unknown += 1;
+                    }
+                }
+            }
+        }
+        let ratio = unknown as f64 / 26.0;
+        if unknown > 0 && ratio >= min_unknown_ratio {
+            out.push(Frontier {
+                key: k,
+                center: tree.key_center(&k, TREE_DEPTH),
+                unknown_ratio: ratio,
+            });
+        }
+    };
+    'cubes: for (base, depth) in cubes {
+        let n = 1u32 << (TREE_DEPTH - depth);
+        // offsets of the cube clipped to the region's keys
+        let lo = [0, 1, 2].map(|i| (kmin[i] as u32).saturating_sub(base[i] as u32));
+        let hi = [0, 1, 2].map(|i| (n - 1).min((kmax[i] as u32).saturating_sub(base[i] as u32)));
+        if (0..3).any(|i| lo[i] > hi[i] || base[i] as u32 > kmax[i] as u32) {
+            continue;
+        }
+        // only cells on the cube's surface can border anything but the cube itself
+        for dz in lo[2]..=hi[2] {
+            for dy in lo[1]..=hi[1] {
+                let surface_yz = dz == 0 || dz == n - 1 || dy == 0 || dy == n - 1;
+                let mut visit = |dx: u32, out: &mut Vec<Frontier>| {
+                    polled += 1;
+                    let k = [base[0] + dx as u16, base[1] + dy as u16, base[2] + dz as u16];
+                    test(k, out);
+                    polled.is_multiple_of(256) && should_stop()
+                };
+                if surface_yz {
+                    for dx in lo[0]..=hi[0] {
+                        if visit(dx, &mut out) {
+                            break 'cubes;
+                        }
+                    }
+                } else {
+                    for dx in [0, n - 1] {
+                        if (lo[0]..=hi[0]).contains(&dx) && visit(dx, &mut out) {
+                            break 'cubes;
+                        }
+                        if n == 1 {
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out.sort_by_key(|f| (f.key[2], f.key[1], f.key[0]));
+    Ok(out)
+}
+
+/// Potential field at `p` (S0 eq. 4.1): `F = Σ F_p − Σ F_o` over the space within
+/// `radius` (m): every unknown cell attracts and every known (free or occupied) cell
+/// repels with `(c − p)/‖c − p‖²` (unit direction over distance, so closer cells weigh
+/// more). Octree cubes are taken whole (their centre, clipped to the radius' box,
+/// weighted by the cells they hold), so the cost follows the tree, not the radius³.
+pub fn potential_field(
+    tree: &Octree,
+    p: &Point3<f64>,
+    radius: f64,
+) -> Result<Vector3<f64>, crate::octree::OctreeError> {
+    let r = Vector3::repeat(radius);
+    let (bmin, bmax) = (p - r, p + r);
+    let res = tree.resolution();
+    let mut f = Vector3::zeros();
+    tree.for_each_in_box(&bmin, &bmax, TREE_DEPTH, StateFilter::ALL, |c| {
+        let h = c.size / 2.0;
+        let lo = (c.center - Vector3::repeat(h)).coords.sup(&bmin.coords);
+        let hi = (c.center + Vector3::repeat(h)).coords.inf(&bmax.coords);
+        let ext = hi - lo;
+        if ext.iter().any(|&e| e <= 0.0) {
+            return;
+        }
+        let centre = (lo + hi) / 2.0;
+        let d = centre - p.coords;
+        let dist = d.norm();
+        if dist > radius || dist < 1e-9 {
+            return;
+        }
+        let weight =
+            (ext.x / res).round().max(1.0) * (ext.y / res).round().max(1.0) * (ext.z / res).round().max(1.0);
+        let term = d / (dist * dist) * weight;
+        if c.state == CellState::Unknown {
+            f += term;
+        } else {
+            f -= term;
+        }
+    })?;
+    Ok(f)
+}
+
+/// A camera pose for a frontier cell: looking along `F̂` from `P_c − s·F̂`, with the
+/// stand-off `s = max(standoff, near)` so the frontier is not closer than the sensor's
+/// near range. `None` when `F` vanishes.
+pub fn candidate_pose(
+    frontier: &Point3<f64>,
+    field: &Vector3<f64>,
+    standoff: f64,
+    near: f64,
+) -> Option<Isometry3<f64>> {
+    let dir = field.try_normalize(1e-12)?;
+    let s = standoff.max(near);
+    look_along(&(frontier - dir * s), &dir)
+}

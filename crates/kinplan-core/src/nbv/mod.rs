@@ -1,0 +1,20 @@
+//! Next-best-view selection on occupancy octrees: frontier candidates with a potential
+//! field, ORF → PTF → IGF filters, information gain by frustum intersection or ray
+//! casting, utility and IK reachability (ALGORITHMS.md §5, S0 §4).
+
+mod camera;
+mod error;
+mod frontier;
+mod gain;
+mod params;
+mod select;
+
+#[cfg(test)]
+mod tests;
+
+pub use camera::{CameraModel, Frustum, look_along};
+pub use error::NbvError;
+pub use frontier::{Frontier, candidate_pose, frontier_cells, potential_field};
+pub use gain::{GainMethod, GainWorkspace, ViewGain, frustum_unknown_count, ray_gain, walk};
+pub use params::{NbvParams, Weights};
+pub use select::{NbvCandidate, NbvResult, NbvStatus, StageStats, estimate_reach, next_best_view};

@@ -1,0 +1,408 @@
+//! The NBV pipeline: candidates, ORF → PTF → IGF, utility, IK reachability
+//! (ALGORITHMS.md §5, S0 §4).
+
+use std::time::Instant;
+
+use kiddo::{KdTree, SquaredEuclidean};
+use nalgebra::{Isometry3, Point3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+use super::camera::{CameraModel, Frustum};
+use super::frontier::{candidate_pose, frontier_cells, potential_field};
+use super::gain::{GainMethod, GainWorkspace, frustum_unknown_count, ray_gain};
+use super::{NbvError, NbvParams, Weights};
+use crate::ik::{IkTarget, solve_ik};
+use crate::octree::Octree;
+use crate::robot::Chain;
+
+/// How the request ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum NbvStatus {
+    /// Every stage ran to the end.
+    Complete,
+    /// The time budget ran out; the result ranks what was evaluated by then.
+    TimeBudget,
+    /// `should_stop` fired; likewise partial.
+    Cancelled,
+}
+
+/// One ranked view.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NbvCandidate {
+    /// Camera pose (optical frame → map; +z is the view direction).
+    pub pose: Isometry3<f64>,
+    /// The frontier cell it looks at (None for caller-given poses).
+    pub frontier: Option<Point3<f64>>,
+    /// D = 1 − ‖p_c − p'‖ / (2·d_max).
+    pub distance_term: f64,
+    /// R = 1 − Δr/π.
+    pub rotation_term: f64,
+    /// Ig = c / c_max.
+    pub ig: f64,
+    /// c, the unknown cells counted (weighted sum for occlusion-aware gain).
+    pub unknown_cells: f64,
+    /// f = w_d·D + w_r·R + w_i·Ig (minus the failure penalty when counting failures).
+    pub utility: f64,
+    /// Some(true/false) once checked by IK, None when not checked.
+    pub reachable: Option<bool>,
+    /// IK joints (rad/m, chain order) reaching the camera pose, when reachable.
+    pub joints: Option<Vec<f64>>,
+    /// Planning failures: prior ones matched by position plus this call's.
+    pub failures: u32,
+}
+
+/// Per-stage counts and times (µs) of one request.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StageStats {
+    pub frontier_cells: usize,
+    pub frontier_candidates: usize,
+    pub caller_candidates: usize,
+    pub after_orf: usize,
+    pub after_ptf: usize,
+    pub after_igf: usize,
+    pub ik_checked: usize,
+    pub ik_failed: usize,
+    pub frontier_us: u64,
+    pub field_us: u64,
+    pub orf_us: u64,
+    pub ptf_us: u64,
+    pub igf_us: u64,
+    pub ik_us: u64,
+    /// DDA steps of ray gains.
+    pub ray_steps: u64,
+}
+
+/// Result of [`next_best_view`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct NbvResult {
+    /// Best first, at most `max_results`.
+    pub candidates: Vec<NbvCandidate>,
+    pub stages: StageStats,
+    pub status: NbvStatus,
+    /// Weights used (after adaptation).
+    pub weights: Weights,
+    /// Reach used by ORF (m), if any.
+    pub reach: Option<f64>,
+    pub elapsed_us: u64,
+}
+
+struct Clock<'a> {
+    deadline: Option<Instant>,
+    should_stop: &'a (dyn Fn() -> bool + Sync),
+}
+
+impl Clock<'_> {
+    fn interrupted(&self) -> Option<NbvStatus> {
+        if let Some(d) = self.deadline
+            && Instant::now() >= d
+        {
+            return Some(NbvStatus::TimeBudget);
+        }
+        (self.should_stop)().then_some(NbvStatus::Cancelled)
+    }
+}
+
+fn us(t: Instant) -> u64 {
+    t.elapsed().as_micros() as u64
+}
+
+/// Largest tool distance from the base over 2,000 seeded joint samples inside the
+/// limits (unlimited revolute joints in [−π, π]), plus 5 % (m).
+pub fn estimate_reach(chain: &Chain) -> f64 {
+    let mut rng = ChaCha8Rng::seed_from_u64(0x5eed);
+    let lim: Vec<(f64, f64)> = chain
+        .limits()
+        .map(|(lo, hi)| {
+            if lo.is_finite() && hi.is_finite() && hi > lo {
+                (lo, hi)
+            } else {
+                (-3.2, 3.2)
+            }
+        })
+        .collect();
+    let mut q = vec![0.0; lim.len()];
+    let mut best: f64 = 0.0;
+    for _ in 0..2000 {
+        for (v, &(lo, hi)) in q.iter_mut().zip(&lim) {
+            *v = rng.random_range(lo..=hi);
+        }
+        best = best.max(chain.fk(&q).translation.vector.norm());
+    }
+    best * 1.05
+}
+
+/// Ranks candidate views of `tree` for `camera` now at `current_pose` (optical frame →
+/// map) — ALGORITHMS.md §5 / S0 §4:
+/// 1. candidates: frontier cells (free, ≥ `frontier_unknown_ratio` unknown
+///    neighbours), each looking along its potential field `F = ΣF_p − ΣF_o` from a
+///    stand-off, plus `extra_candidates`;
+/// 2. ORF: `‖p' − base‖ > reach` dropped; PTF: dropped when a kept candidate is within
+///    `position_threshold` (k-d tree) and `orientation_threshold`; IGF: `Ig <
+///    gain_threshold` dropped (gains computed in parallel);
+/// 3. `f = w_d·D + w_r·R + w_i·Ig`, `D = 1 − ‖p_c − p'‖/(2·d_max)` (d_max the largest
+///    distance among the survivors), `R = 1 − Δr/π` (Δr the rotation angle between the
+///    current and the candidate orientation);
+/// 4. the best `ik_check` are checked by IK on `robot` for the tip pose
+///    `base⁻¹ · pose · mount⁻¹`; unreachable ones are dropped (or, with
+///    `count_failures`, kept with `f − failure_penalty · failures`).
+///
+/// Deadline and `should_stop` are polled per candidate in every stage; on either the result ranks what was evaluated.
+pub fn next_best_view(
+    tree: &Octree,
+    params: &NbvParams,
+    camera: &CameraModel,
+    current_pose: &Isometry3<f64>,
+    robot: Option<&Chain>,
+    should_stop: &(dyn Fn() -> bool + Sync),
+) -> Result<NbvResult, NbvError> {
+    params.validate()?;
+    camera.validate()?;
+    let start = Instant::now();
+    let clock = Clock {
+        deadline: params.time_budget.map(|b| start + b),
+        should_stop,
+    };
+    let mut st = StageStats::default();
+    let mut status = NbvStatus::Complete;
+    // default region: the known leaves' bounds, moved in by half a cell to the centres of
+    // the outermost cells (the upper bound may be the tree cube's exclusive edge)
+    let half = tree.resolution() / 2.0;
+    let region = params.region.or_else(|| {
+        tree.known_bounds().map(|(a, b)| {
+            (
+                a + nalgebra::Vector3::repeat(half),
+                b - nalgebra::Vector3::repeat(half),
+            )
+        })
+    });
+    // deadline or cancellation, for the loops that take a closure
+    let stop = || clock.interrupted().is_some();
+
+    // 1. candidates
+    let t = Instant::now();
+    let mut frontier = match &region {
+        Some((a, b)) if params.max_frontier_candidates > 0 => {
+            frontier_cells(tree, a, b, params.frontier_unknown_ratio, &stop)?
+        }
+        _ => Vec::new(),
+    };
+    if let Some(s) = clock.interrupted() {
+        status = s; // the frontier scan was cut short
+    }
+    st.frontier_cells = frontier.len();
+    if frontier.len() > params.max_frontier_candidates {
+        let n = frontier.len();
+        let m = params.max_frontier_candidates;
+        frontier = (0..m).map(|i| frontier[i * n / m]).collect();
+    }
+    st.frontier_us = us(t);
+    let t = Instant::now();
+    // potential fields in parallel; the clock is polled per frontier cell
+    let fields: Vec<Option<Option<Isometry3<f64>>>> = frontier
+        .par_iter()
+        .map(|f| {
+            if clock.interrupted().is_some() {
+                return Ok(None);
+            }
+            let field = potential_field(tree, &f.center, params.field_radius)?;
+            Ok(Some(candidate_pose(
+                &f.center,
+                &field,
+                params.standoff,
+                camera.near,
+            )))
+        })
+        .collect::<Result<_, crate::octree::OctreeError>>()?;
+    if fields.iter().any(Option::is_none)
+        && let Some(s) = clock.interrupted()
+    {
+        status = s;
+    }
+    let mut cands: Vec<(Isometry3<f64>, Option<Point3<f64>>)> = fields
+        .into_iter()
+        .zip(&frontier)
+        .filter_map(|(p, f)| p.flatten().map(|p| (p, Some(f.center))))
+        .collect();
+    st.frontier_candidates = cands.len();
+    st.caller_candidates = params.extra_candidates.len();
+    cands.extend(params.extra_candidates.iter().map(|p| (*p, None)));
+    st.field_us = us(t);
+
+    // 2a. ORF
+    let t = Instant::now();
+    let reach = params.reach.or_else(|| robot.map(estimate_reach));
+    if let Some(r) = reach {
+        let base = params.robot_base.translation.vector;
+        cands.retain(|(p, _)| (p.translation.vector - base).norm() <= r);
+    }
+    st.after_orf = cands.len();
+    st.orf_us = us(t);
+
+    // 2b. PTF
+    let t = Instant::now();
+    let mut kd: KdTree<f64, 3> = KdTree::with_capacity(cands.len().max(1));
+    let mut kept: Vec<(Isometry3<f64>, Option<Point3<f64>>)> = Vec::with_capacity(cands.len());
+    let r2 = params.position_threshold * params.position_threshold;
+    for c in cands {
+        let p = c.0.translation.vector;
+        let dir = c.0.rotation * nalgebra::Vector3::z();
+        let near = kd.within_unsorted::<SquaredEuclidean>(&[p.x, p.y, p.z], r2);
+        let clash = near.iter().any(|nb| {
+            let other = kept[nb.item as usize].0.rotation * nalgebra::Vector3::z();
+            dir.angle(&other) < params.orientation_threshold
+        });
+        if !clash {
+            kd.add(&[p.x, p.y, p.z], kept.len() as u64);
+            kept.push(c);
+        }
+    }
+    st.after_ptf = kept.len();
+    st.ptf_us = us(t);
+
+    // 2c. IGF
+    let t = Instant::now();
+    let c_max = camera.frustum_volume() / tree.resolution().powi(3);
+    let gains: Vec<Option<(f64, f64, u64)>> = kept
+        .par_iter()
+        .map_init(GainWorkspace::default, |ws, (pose, _)| {
+            if clock.interrupted().is_some() {
+                return None;
+            }
+            Some(match params.gain {
+                GainMethod::Intersection => {
+                    let c = frustum_unknown_count(tree, &Frustum::new(camera, pose)) as f64;
+                    (c, c / c_max, 0)
+                }
+                m => {
+                    let g = ray_gain(tree, camera, pose, m, ws, &stop);
+                    (g.cells, g.ig, g.ray_steps)
+                }
+            })
+        })
+        .collect();
+    if gains.iter().any(Option::is_none)
+        && let Some(s) = clock.interrupted()
+    {
+        status = s;
+    }
+    let mut scored: Vec<NbvCandidate> = Vec::with_capacity(kept.len());
+    for ((pose, frontier), g) in kept.into_iter().zip(gains) {
+        let Some((cells, ig, steps)) = g else { continue };
+        st.ray_steps += steps;
+        if ig < params.gain_threshold {
+            continue;
+        }
+        scored.push(NbvCandidate {
+            pose,
+            frontier,
+            distance_term: 0.0,
+            rotation_term: 0.0,
+            ig,
+            unknown_cells: cells,
+            utility: 0.0,
+            reachable: None,
+            joints: None,
+            failures: 0,
+        });
+    }
+    st.after_igf = scored.len();
+    st.igf_us = us(t);
+
+    // 3. utility
+    let mut w = params.weights;
+    if params.adaptive_weights
+        && let Some((a, b)) = &region
+    {
+        let v = tree.volumes_in_box(a, b)?;
+        let total = v.free + v.occupied + v.unknown;
+        let u = if total > 0.0 { v.unknown / total } else { 0.0 };
+        w = Weights {
+            w_i: w.w_i * (0.5 + u),
+            w_d: w.w_d * (1.5 - u),
+            w_r: w.w_r * (1.5 - u),
+        };
+    }
+    let pc = current_pose.translation.vector;
+    let d_max = scored
+        .iter()
+        .map(|c| (c.pose.translation.vector - pc).norm())
+        .fold(0.0f64, f64::max)
+        .max(1e-12);
+    for c in scored.iter_mut() {
+        c.distance_term = 1.0 - (c.pose.translation.vector - pc).norm() / (2.0 * d_max);
+        c.rotation_term = 1.0 - current_pose.rotation.angle_to(&c.pose.rotation) / std::f64::consts::PI;
+        c.utility = w.w_d * c.distance_term + w.w_r * c.rotation_term + w.w_i * c.ig;
+        if params.count_failures {
+            let pos = Point3::from(c.pose.translation.vector);
+            c.failures = params
+                .prior_failures
+                .iter()
+                .filter(|(p, _)| (p - pos).norm() <= params.position_threshold)
+                .map(|(_, n)| *n)
+                .sum();
+            c.utility -= params.failure_penalty * c.failures as f64;
+        }
+    }
+    let rank = |v: &mut Vec<NbvCandidate>| v.sort_by(|a, b| b.utility.total_cmp(&a.utility));
+    rank(&mut scored);
+
+    // 4. reachability
+    let t = Instant::now();
+    if let Some(chain) = robot
+        && params.ik_check > 0
+    {
+        let base_inv = params.robot_base.inverse();
+        let mount_inv = params.camera_mount.inverse();
+        let mut out = Vec::with_capacity(scored.len());
+        let mut checked = 0;
+        for (i, mut c) in scored.into_iter().enumerate() {
+            if checked >= params.ik_check || status != NbvStatus::Complete {
+                out.push(c);
+                continue;
+            }
+            if let Some(s) = clock.interrupted() {
+                status = s;
+                out.push(c);
+                continue;
+            }
+            checked += 1;
+            let target = IkTarget::Pose(base_inv * c.pose * mount_inv);
+            let r = solve_ik(
+                chain,
+                &target,
+                None,
+                &params.ik,
+                params.seed.wrapping_add(i as u64),
+                should_stop,
+            )?;
+            if let Some(s) = r.solutions.first() {
+                c.reachable = Some(true);
+                c.joints = Some(s.joints.clone());
+                out.push(c);
+            } else {
+                st.ik_failed += 1;
+                c.reachable = Some(false);
+                if params.count_failures {
+                    c.failures += 1;
+                    c.utility -= params.failure_penalty;
+                    out.push(c);
+                }
+            }
+        }
+        st.ik_checked = checked;
+        scored = out;
+        rank(&mut scored);
+    }
+    st.ik_us = us(t);
+    scored.truncate(params.max_results);
+    Ok(NbvResult {
+        candidates: scored,
+        stages: st,
+        status,
+        weights: w,
+        reach,
+        elapsed_us: us(start),
+    })
+}

@@ -1,0 +1,287 @@
+//! NBV tests against brute force and hand-built trees.
+
+use nalgebra::{Point3, Vector3};
+
+use super::*;
+use crate::octree::{CellState, OcKey, Octree};
+
+fn hm(t: &Octree) -> (f32, f32) {
+    let m = t.sensor_model().log_odds();
+    (m.hit, m.miss)
+}
+
+/// Free cells in the key box `[lo, hi]`.
+fn free_box(t: &mut Octree, lo: OcKey, hi: OcKey) {
+    let (_, miss) = hm(t);
+    for x in lo[0]..=hi[0] {
+        for y in lo[1]..=hi[1] {
+            for z in lo[2]..=hi[2] {
+                t.update_key(&[x, y, z], miss);
+            }
+        }
+    }
+}
+
+fn small_camera() -> CameraModel {
+    CameraModel {
+        hfov: 1.0,
+        vfov: 0.8,
+        near: 0.15,
+        far: 1.2,
+        width: 40,
+        height: 30,
+    }
+}
+
+#[test]
+fn frustum_count_matches_a_brute_force_count() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+    let mut t = Octree::new(0.1).unwrap();
+    let (hit, miss) = hm(&t);
+    for _ in 0..6000 {
+        let k = [0; 3].map(|_| 32768u16 - 12 + rng.random_range(0..24u16));
+        t.update_key(&k, if rng.random_bool(0.2) { hit } else { miss });
+    }
+    let cam = small_camera();
+    for trial in 0..12 {
+        let pos = Point3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-0.5..0.5),
+        );
+        let dir = Vector3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        let pose = look_along(&pos, &dir).unwrap();
+        let f = Frustum::new(&cam, &pose);
+        // brute force: every cell of the corners' key box, centre inside and unknown
+        let ks: Vec<OcKey> = f.corners.iter().map(|c| t.key_of(c).unwrap()).collect();
+        let lo = [0, 1, 2].map(|i| ks.iter().map(|k| k[i]).min().unwrap());
+        let hi = [0, 1, 2].map(|i| ks.iter().map(|k| k[i]).max().unwrap());
+        let mut n = 0u64;
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    let k = [x, y, z];
+                    if t.state_of_key(&k) == CellState::Unknown && f.contains(&t.key_center(&k, 16)) {
+                        n += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(frustum_unknown_count(&t, &f), n, "trial {trial}");
+    }
+    // empty tree: the count approaches volume / res³
+    let e = Octree::new(0.05).unwrap();
+    let pose = look_along(&Point3::new(0.01, 0.02, 0.03), &Vector3::new(1.0, 0.2, 0.1)).unwrap();
+    let c = frustum_unknown_count(&e, &Frustum::new(&cam, &pose)) as f64;
+    let v = cam.frustum_volume() / 0.05f64.powi(3);
+    assert!((c / v - 1.0).abs() < 0.05, "{c} vs {v}");
+}
+
+#[test]
+fn walk_visits_the_cells_along_an_axis_and_rays_stop_at_occupied() {
+    let mut t = Octree::new(0.1).unwrap();
+    let mut keys = Vec::new();
+    walk(
+        &t,
+        &Point3::new(0.05, 0.05, 0.05),
+        &Vector3::x(),
+        0.0,
+        1.0,
+        |k, s, _| {
+            assert_eq!(s, CellState::Unknown);
+            keys.push(*k);
+            true
+        },
+    );
+    // cells 32768 … 32778: the last is entered at t = 0.95 ≤ 1
+    assert_eq!(
+        keys,
+        (32768..=32778u16).map(|x| [x, 32768, 32768]).collect::<Vec<_>>()
+    );
+    // a wall of occupied cells at x = 32772 stops the rays of a camera looking along +x
+    let (hit, _) = hm(&t);
+    for y in 32700..32840u16 {
+        for z in 32700..32840u16 {
+            t.update_key(&[32772, y, z], hit);
+        }
+    }
+    let cam = CameraModel {
+        near: 0.01,
+        far: 3.0,
+        ..small_camera()
+    };
+    let pose = look_along(&Point3::new(0.05, 0.05, 0.05), &Vector3::x()).unwrap();
+    let mut ws = GainWorkspace::default();
+    let g = ray_gain(
+        &t,
+        &cam,
+        &pose,
+        GainMethod::Rays { fraction: 1.0 },
+        &mut ws,
+        &|| false,
+    );
+    let f = frustum_unknown_count(&t, &Frustum::new(&cam, &pose)) as f64;
+    // everything in front of the wall (x < 0.4) is unknown: the rays find no more than
+    // the frustum holds there, and far fewer than the whole frustum
+    let near_part = Frustum::new(&CameraModel { far: 0.35, ..cam }, &pose);
+    assert!(g.cells <= frustum_unknown_count(&t, &near_part) as f64 * 1.5 + 50.0);
+    assert!(g.cells < f / 4.0 && g.cells > 0.0);
+    let g10 = ray_gain(
+        &t,
+        &cam,
+        &pose,
+        GainMethod::Rays { fraction: 0.1 },
+        &mut ws,
+        &|| false,
+    );
+    assert!(g10.cells <= g.cells && g10.cells > 0.0);
+    let u = ray_gain(
+        &t,
+        &cam,
+        &pose,
+        GainMethod::UnobservedVoxels { fraction: 1.0 },
+        &mut ws,
+        &|| false,
+    );
+    assert!(u.cells >= g.cells);
+    let o = ray_gain(
+        &t,
+        &cam,
+        &pose,
+        GainMethod::OcclusionAware { fraction: 1.0 },
+        &mut ws,
+        &|| false,
+    );
+    // unknown cells have entropy 1 bit and halve the visibility: Σ 2^−i per ray < 2
+    assert!(o.cells > 0.0 && o.cells < 2.0 * 1200.0);
+}
+
+#[test]
+fn frontier_of_a_free_cube_is_its_surface() {
+    let mut t = Octree::new(0.1).unwrap();
+    free_box(&mut t, [32768; 3], [32771; 3]);
+    // the 4³ block is pruned into one depth-14 cube
+    assert_eq!(t.search_key(&[32769; 3], 16).map(|(_, d)| d), Some(14));
+    let (a, b) = (Point3::new(-1.0, -1.0, -1.0), Point3::new(1.0, 1.0, 1.0));
+    let f = frontier_cells(&t, &a, &b, 0.25, &|| false).unwrap();
+    assert_eq!(f.len(), 64 - 8);
+    // edges and corners: 19/26 and 15/26 unknown; faces 9/26 < 0.5
+    let f = frontier_cells(&t, &a, &b, 0.5, &|| false).unwrap();
+    assert_eq!(f.len(), 8 + 12 * 2);
+}
+
+#[test]
+fn potential_field_points_into_the_unknown() {
+    let mut t = Octree::new(0.1).unwrap();
+    // known free slab x < 0, unknown x ≥ 0, symmetric in y and z about the probe
+    free_box(&mut t, [32758, 32758, 32758], [32767, 32777, 32777]);
+    let p = Point3::new(-0.05, 0.0, 0.0);
+    let f = potential_field(&t, &p, 0.5).unwrap();
+    assert!(f.x > 0.0, "{f}");
+    assert!(f.y.abs() < 1e-9 * f.x.abs().max(1.0) + 1e-9 && f.z.abs() < 1e-9 + 1e-9 * f.x.abs());
+    let pose = candidate_pose(&p, &f, 0.3, 0.5).unwrap();
+    // stand-off raised to the near range, camera behind the frontier looking at it
+    assert!((pose.translation.vector - Vector3::new(-0.55, 0.0, 0.0)).norm() < 1e-9);
+    assert!((pose.rotation * Vector3::z() - Vector3::x()).norm() < 1e-9);
+}
+
+#[test]
+fn next_best_view_ranks_filters_and_checks_reach() {
+    let mut t = Octree::new(0.1).unwrap();
+    free_box(&mut t, [32758, 32758, 32768], [32782, 32778, 32782]);
+    let chain = crate::robot::builtin_chain("abb_irb4600_60_205").unwrap();
+    let cam = CameraModel {
+        width: 64,
+        height: 48,
+        ..CameraModel::default()
+    };
+    let current = look_along(&Point3::new(1.0, 0.0, 1.0), &Vector3::x()).unwrap();
+    let params = NbvParams {
+        extra_candidates: vec![
+            look_along(&Point3::new(1.2, 0.3, 1.1), &Vector3::new(1.0, 0.0, -0.3)).unwrap(),
+        ],
+        ik_check: 4,
+        max_results: 8,
+        ..NbvParams::default()
+    };
+    let r = next_best_view(&t, &params, &cam, &current, Some(&chain), &|| false).unwrap();
+    assert_eq!(r.status, NbvStatus::Complete);
+    let s = r.stages;
+    assert!(s.frontier_cells > 0 && s.frontier_candidates > 0 && s.caller_candidates == 1);
+    assert!(
+        s.after_orf <= s.frontier_candidates + 1 && s.after_ptf <= s.after_orf && s.after_igf <= s.after_ptf
+    );
+    assert!(!r.candidates.is_empty());
+    let w = Weights::default();
+    for (i, c) in r.candidates.iter().enumerate() {
+        // utility recomputed from its terms, and each term from the poses
+        let f = w.w_d * c.distance_term + w.w_r * c.rotation_term + w.w_i * c.ig;
+        assert!((c.utility - f).abs() < 1e-12);
+        let dr = current.rotation.angle_to(&c.pose.rotation);
+        assert!((c.rotation_term - (1.0 - dr / std::f64::consts::PI)).abs() < 1e-12);
+        assert!(c.ig >= params.gain_threshold);
+        assert!((c.pose.translation.vector).norm() <= r.reach.unwrap() + 1e-9);
+        if i > 0 {
+            assert!(r.candidates[i - 1].utility >= c.utility);
+        }
+        if let Some(q) = &c.joints {
+            let tip = chain.fk(q);
+            assert!((tip.translation.vector - c.pose.translation.vector).norm() < 1e-4);
+        }
+        // PTF: no two results are close in both position and direction
+        for d in &r.candidates[..i] {
+            let close =
+                (d.pose.translation.vector - c.pose.translation.vector).norm() < params.position_threshold;
+            let aligned = (d.pose.rotation * Vector3::z()).angle(&(c.pose.rotation * Vector3::z()))
+                < params.orientation_threshold;
+            assert!(!(close && aligned));
+        }
+    }
+    assert!(s.ik_checked > 0);
+    // cancellation is a status, not an error
+    let r = next_best_view(&t, &params, &cam, &current, Some(&chain), &|| true).unwrap();
+    assert_eq!(r.status, NbvStatus::Cancelled);
+    // bad parameters are errors
+    let bad = NbvParams {
+        gain: GainMethod::Rays { fraction: 0.0 },
+        ..NbvParams::default()
+    };
+    assert!(next_best_view(&t, &bad, &cam, &current, None, &|| false).is_err());
+}
+
+#[test]
+fn huge_free_cubes_from_a_hostile_tree_stop_at_the_deadline() {
+    use crate::octree::OctreeLimits;
+    // two node bytes: the root's eight children are free leaves, each 32768 cells wide
+    let t = Octree::from_message_data(true, "OcTree", 0.1, &[0x55, 0x55], &OctreeLimits::default()).unwrap();
+    assert_eq!(t.num_nodes(), 9);
+    let cam = small_camera();
+    let current = look_along(&Point3::new(0.0, 0.0, 1.0), &Vector3::x()).unwrap();
+    let params = NbvParams {
+        time_budget: Some(std::time::Duration::from_millis(50)),
+        ..NbvParams::default()
+    };
+    let start = std::time::Instant::now();
+    let r = next_best_view(&t, &params, &cam, &current, None, &|| false).unwrap();
+    assert_eq!(r.status, NbvStatus::TimeBudget);
+    assert!(
+        start.elapsed() < std::time::Duration::from_secs(5),
+        "{:?}",
+        start.elapsed()
+    );
+    // a small region clips the scan: done at once, and no frontier (nothing unknown)
+    let f = frontier_cells(
+        &t,
+        &Point3::new(-1.0, -1.0, -1.0),
+        &Point3::new(1.0, 1.0, 1.0),
+        0.25,
+        &|| false,
+    )
+    .unwrap();
+    assert!(f.is_empty());
+}
