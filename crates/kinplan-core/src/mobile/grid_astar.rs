@@ -112,6 +112,18 @@ pub fn plan_grid_astar(
     goal: Point2,
     params: &GridAstarParams,
 ) -> Result<Option<Vec<Point2>>, MobileError> {
+    plan_grid_astar_until(world, start, goal, params, &|| false)
+}
+
+/// [`plan_grid_astar`], asking `should_stop` every grid cell while the grid is
+/// built and every 1024 expansions while it is searched; `None` when stopped.
+pub fn plan_grid_astar_until(
+    world: &World,
+    start: Point2,
+    goal: Point2,
+    params: &GridAstarParams,
+    should_stop: &dyn Fn() -> bool,
+) -> Result<Option<Vec<Point2>>, MobileError> {
     params.validate()?;
     start.validate("start")?;
     goal.validate("goal")?;
@@ -132,7 +144,7 @@ pub fn plan_grid_astar(
     let nxf = ((hi.x + params.padding - x0) / res).ceil() + 1.0;
     let nyf = ((hi.y + params.padding - y0) / res).ceil() + 1.0;
     let cells = nxf * nyf;
-    if !(cells <= params.max_cells as f64) {
+    if cells.is_nan() || cells > params.max_cells as f64 {
         return Err(MobileError::OutOfRange {
             field: "astar grid cells".into(),
             value: cells,
@@ -151,6 +163,10 @@ pub fn plan_grid_astar(
     };
     for j in 0..ny {
         for i in 0..nx {
+            // One distance query costs O(obstacle edges): ask after each.
+            if should_stop() {
+                return Ok(None);
+            }
             g.blocked[j * nx + i] = world.distance(g.centre(i, j)).0 < params.inflation;
         }
     }
@@ -171,7 +187,12 @@ pub fn plan_grid_astar(
     heap.push(Open(hfun(si, sj), idx(si, sj)));
     let goal_idx = idx(gi, gj);
     let mut found = false;
+    let mut expanded = 0u32;
     while let Some(Open(f, c)) = heap.pop() {
+        expanded = expanded.wrapping_add(1);
+        if expanded.is_multiple_of(1024) && should_stop() {
+            return Ok(None);
+        }
         if c == goal_idx {
             found = true;
             break;
