@@ -68,6 +68,9 @@ struct ServeArgs {
     /// Parsed robot models kept in the cache.
     #[arg(long, env = "KINPLAN_MODEL_CACHE", default_value_t = 256)]
     model_cache: usize,
+    /// Bytes of URDF text and parsed models the cache may hold.
+    #[arg(long, env = "KINPLAN_MODEL_CACHE_BYTES", default_value_t = 256 * 1024 * 1024)]
+    model_cache_bytes: usize,
 }
 
 fn main() {
@@ -108,6 +111,7 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
         concurrency_limit: args.concurrency_limit,
         max_urdf_bytes: args.max_urdf_bytes,
         model_cache_entries: args.model_cache,
+        model_cache_bytes: args.model_cache_bytes,
         drain_delay: seconds(args.drain_delay_secs, "--drain-delay-secs")?,
         drain_timeout: seconds(args.drain_timeout_secs, "--drain-timeout-secs")?,
         stream_idle_timeout: seconds(args.stream_idle_timeout_secs, "--stream-idle-timeout-secs")?,

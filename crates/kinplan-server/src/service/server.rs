@@ -42,6 +42,8 @@ pub struct ServerConfig {
     pub max_urdf_bytes: usize,
     /// Parsed models kept in the cache.
     pub model_cache_entries: usize,
+    /// Bytes of URDF text and parsed models the cache may hold.
+    pub model_cache_bytes: usize,
     /// Time between reporting NOT_SERVING and closing the listener on
     /// shutdown, so load balancers stop sending new calls first.
     pub drain_delay: Duration,
@@ -64,6 +66,7 @@ impl Default for ServerConfig {
             concurrency_limit: 256,
             max_urdf_bytes: 2 * 1024 * 1024,
             model_cache_entries: 256,
+            model_cache_bytes: 256 * 1024 * 1024,
             drain_delay: Duration::ZERO,
             drain_timeout: Duration::from_secs(10),
             stream_idle_timeout: Duration::from_secs(60),
@@ -95,6 +98,7 @@ pub async fn serve(
             ..UrdfLimits::default()
         },
         config.model_cache_entries,
+        config.model_cache_bytes,
     ));
     let shared = Shared { models, compute };
     let limit = config.max_message_bytes;
