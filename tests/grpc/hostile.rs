@@ -177,7 +177,7 @@ async fn every_rpc(v: Values) -> Result<(), TestCaseError> {
         let fk = pb::ForwardKinematicsRequest {
             robot: r.clone(),
             joint_positions: joints.clone(),
-            include_links: v.n[1] % 2 == 0,
+            include_links: v.n[1].is_multiple_of(2),
         };
         judge("ForwardKinematics", t, robots.forward_kinematics(fk).await)?;
         let t = Instant::now();
@@ -199,7 +199,7 @@ async fn every_rpc(v: Values) -> Result<(), TestCaseError> {
         num_solutions: v.n[6] % 4,
         time_budget: Some(f[11].abs().min(0.05)),
         rlxa_max_iterations: Some(v.n[7]),
-        position_only: v.n[1] % 3 == 0,
+        position_only: v.n[1].is_multiple_of(3),
         ..Default::default()
     });
     let target = pose([f[12], f[13], f[14], f[15], f[16], f[17], f[18]]);
@@ -281,7 +281,7 @@ async fn every_rpc(v: Values) -> Result<(), TestCaseError> {
         method: (v.n[3] % 4) as i32,
         max_iterations: v.n[5],
         tolerance: Some(f[22]),
-        record_history: v.n[6] % 2 == 0,
+        record_history: v.n[6].is_multiple_of(2),
         ..Default::default()
     };
     judge("SolveLinearSystem", t, ik.solve_linear_system(linear).await)?;
@@ -370,7 +370,7 @@ async fn every_rpc(v: Values) -> Result<(), TestCaseError> {
             path: path.clone(),
             goal,
             readings: f[..(v.n[2] % 10) as usize].to_vec(),
-            world: if v.n[3] % 2 == 0 {
+            world: if v.n[3].is_multiple_of(2) {
                 world.clone()
             } else {
                 Vec::new()
