@@ -881,4 +881,17 @@ mod tests {
         );
         assert_eq!(time_budget(None, None), None);
     }
+
+    /// Short deadlines: the reserve is at most half the time left (the
+    /// 200 µs floor would otherwise eat a 300 µs deadline's whole budget).
+    #[test]
+    fn a_short_deadline_keeps_half_for_the_work() {
+        let deadline = Instant::now() + Duration::from_micros(300);
+        let reserve = deadline - soft_deadline(Some(deadline)).unwrap();
+        assert!(reserve <= Duration::from_micros(150), "{reserve:?}");
+        assert!(reserve >= Duration::from_micros(50), "{reserve:?}");
+        // A deadline already passed leaves no reserve and no overflow.
+        let past = Instant::now() - Duration::from_millis(1);
+        assert_eq!(soft_deadline(Some(past)), Some(past));
+    }
 }
