@@ -171,7 +171,11 @@ fn newton_rlxa_returns_a_flagged_answer() {
     let goal = Point3::new(0.5, 0.3, 0.0);
     let reached = chain.fk(&b.joints).translation.vector;
     let by_fk = (reached - goal.coords).norm();
-    assert!((by_fk - b.position_error).abs() < 1e-9, "{by_fk} vs {}", b.position_error);
+    assert!(
+        (by_fk - b.position_error).abs() < 1e-9,
+        "{by_fk} vs {}",
+        b.position_error
+    );
     let from_seed = (chain.fk(&seed).translation.vector - goal.coords).norm();
     assert!(
         by_fk < 0.5 * from_seed,
