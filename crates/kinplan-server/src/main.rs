@@ -78,6 +78,9 @@ struct ServeArgs {
     /// (computed once per model).
     #[arg(long, env = "KINPLAN_ACM_SAMPLES", default_value_t = 10_000)]
     acm_samples: usize,
+    /// Bytes of URDF text and parsed models the cache may hold.
+    #[arg(long, env = "KINPLAN_MODEL_CACHE_BYTES", default_value_t = 256 * 1024 * 1024)]
+    model_cache_bytes: usize,
 }
 
 fn main() {
@@ -155,6 +158,7 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
         max_urdf_bytes: args.max_urdf_bytes,
         model_cache_entries: args.model_cache,
         acm_samples: args.acm_samples,
+        model_cache_bytes: args.model_cache_bytes,
         drain_delay: seconds(args.drain_delay_secs, "--drain-delay-secs")?,
         drain_timeout: seconds(args.drain_timeout_secs, "--drain-timeout-secs")?,
         stream_idle_timeout: seconds(args.stream_idle_timeout_secs, "--stream-idle-timeout-secs")?,

@@ -156,10 +156,24 @@ fn newton_rlxa_returns_a_flagged_answer() {
         max_restarts: 3,
         ..jacobian_params(IkMethod::Newton, LinearSolverKind::AngleRelaxation)
     };
-    let r = solve_ik(&chain, &target, None, &p, 1, &never).unwrap();
+    let seed = chain.mid_limits();
+    let r = solve_ik(&chain, &target, Some(&seed), &p, 1, &never).unwrap();
     let b = r.best().unwrap();
-    assert!(b.position_error.is_finite());
     assert_eq!(r.success(), r.best_attempt.is_none());
+    // The answer (flagged or not) is what FK says of its joints, and better than the seed.
+    let goal = Point3::new(0.5, 0.3, 0.0);
+    let reached = chain.fk(&b.joints).translation.vector;
+    let by_fk = (reached - goal.coords).norm();
+    assert!(
+        (by_fk - b.position_error).abs() < 1e-9,
+        "{by_fk} vs {}",
+        b.position_error
+    );
+    let from_seed = (chain.fk(&seed).translation.vector - goal.coords).norm();
+    assert!(
+        by_fk < 0.5 * from_seed,
+        "best attempt {by_fk} is not clearly better than the seed's {from_seed}"
+    );
 }
 
 /// Heuristics converge on planar chains n = 2…10 from the stretched pose (S2 Tab. 7 setting).

@@ -34,7 +34,21 @@ pub fn solve_ik_batch(
         .enumerate()
         .map_init(
             || IkSolver::new(chain),
-            |solver, (i, t)| solver.solve(t, seed, params, batch_seed(rng_seed, i), should_stop),
+            |solver, (i, t)| {
+                // Once stopped, the remaining targets are answered at once
+                // (CANCELLED, no attempt) instead of each starting a solve.
+                if should_stop() {
+                    return Ok(IkResult {
+                        solutions: Vec::new(),
+                        best_attempt: None,
+                        stop_reason: IkStatus::Cancelled,
+                        attempts: 0,
+                        total_iterations: 0,
+                        elapsed_us: 0,
+                    });
+                }
+                solver.solve(t, seed, params, batch_seed(rng_seed, i), should_stop)
+            },
         )
         .collect()
 }

@@ -137,7 +137,24 @@ impl RlxaWorkspace {
         x: &mut DVector<f64>,
         params: &RlxaParams,
         rng: &mut R,
+        history: Option<&mut Vec<f64>>,
+    ) -> Result<RlxaReport, LinalgError> {
+        self.solve_into_until(a, b, x, params, rng, history, &|| false)
+    }
+
+    /// [`RlxaWorkspace::solve_into`], asking `should_stop` every
+    /// [`STOP_CHECK_WORK`] / (m·n) iterations; a stopped solve reports
+    /// [`SolveStatus::IterationCap`] with the iterations done.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_into_until<R: Rng + ?Sized>(
+        &mut self,
+        a: &DMatrix<f64>,
+        b: &DVector<f64>,
+        x: &mut DVector<f64>,
+        params: &RlxaParams,
+        rng: &mut R,
         mut history: Option<&mut Vec<f64>>,
+        should_stop: &dyn Fn() -> bool,
     ) -> Result<RlxaReport, LinalgError> {
         params.validate()?;
         check_system(a, b)?;
@@ -174,8 +191,13 @@ impl RlxaWorkspace {
             });
         }
         let n_parts = active as f64;
+        // Cost-bounded: about STOP_CHECK_WORK matrix entries touched between checks.
+        let check_every = (STOP_CHECK_WORK / (m * n).max(1)).max(1);
         let mut it = 0;
         while it < params.max_iterations {
+            if it % check_every == check_every - 1 && should_stop() {
+                break;
+            }
             if rn < threshold {
                 return Ok(RlxaReport {
                     iterations: it,
@@ -252,6 +274,10 @@ impl RlxaWorkspace {
     }
 }
 
+/// Matrix entries touched (iterations × m·n) between two cancellation checks:
+/// a check costs one clock read, so this keeps checks cheap and prompt.
+pub const STOP_CHECK_WORK: usize = 4096;
+
 /// λ uniform in the open interval (0, 1).
 fn sample_open_unit<R: Rng + ?Sized>(rng: &mut R) -> f64 {
     loop {
@@ -288,6 +314,18 @@ pub fn solve_angle_relaxation<R: Rng + ?Sized>(
     params: &RlxaParams,
     rng: &mut R,
 ) -> Result<LinearSolution, LinalgError> {
+    solve_angle_relaxation_until(a, b, params, rng, &|| false)
+}
+
+/// [`solve_angle_relaxation`], stopping early (status
+/// [`SolveStatus::IterationCap`]) once `should_stop` says so.
+pub fn solve_angle_relaxation_until<R: Rng + ?Sized>(
+    a: &DMatrix<f64>,
+    b: &DVector<f64>,
+    params: &RlxaParams,
+    rng: &mut R,
+    should_stop: &dyn Fn() -> bool,
+) -> Result<LinearSolution, LinalgError> {
     params.validate()?;
     check_system(a, b)?;
     let mut ws = RlxaWorkspace::new(a.nrows(), a.ncols());
@@ -298,7 +336,7 @@ pub fn solve_angle_relaxation<R: Rng + ?Sized>(
     } else {
         None
     };
-    let rep = ws.solve_into(a, b, &mut x, params, rng, hist)?;
+    let rep = ws.solve_into_until(a, b, &mut x, params, rng, hist, should_stop)?;
     Ok(LinearSolution {
         x,
         residual_norm: rep.residual_norm,

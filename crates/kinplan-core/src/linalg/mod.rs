@@ -8,7 +8,10 @@ mod error;
 mod pseudoinverse;
 mod solution;
 
-pub use angle_relaxation::{RlxaParams, RlxaReport, RlxaVariant, RlxaWorkspace, solve_angle_relaxation};
+pub use angle_relaxation::{
+    RlxaParams, RlxaReport, RlxaVariant, RlxaWorkspace, STOP_CHECK_WORK, solve_angle_relaxation,
+    solve_angle_relaxation_until,
+};
 pub use error::LinalgError;
 pub use pseudoinverse::{PseudoinverseParams, SvdWorkspace, solve_pseudoinverse};
 pub use solution::{LinearSolution, LinearSolverKind, SolveStatus};

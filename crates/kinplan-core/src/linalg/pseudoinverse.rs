@@ -646,6 +646,24 @@ mod tests {
         })
     }
 
+    /// Sweep counts pinned on fixed matrices, for the fixed-size path (≤ 8 rows)
+    /// and the general one: a wrong cached column norm still converges, only
+    /// slower, so correctness tests alone would not notice it (checked: leaving
+    /// `norms[i]` stale after a rotation fails only this test).
+    const PINNED_SWEEPS: [usize; 7] = [5, 5, 4, 6, 2, 2, 8];
+
+    #[test]
+    fn sweep_counts_are_pinned() {
+        let mut got = Vec::new();
+        for (m, n) in [(6, 6), (6, 7), (3, 6), (13, 7), (2, 9), (9, 2), (12, 12)] {
+            let a = lcg_matrix(m, n, (m * 17 + n) as u64);
+            let mut ws = SvdWorkspace::new(m, n);
+            got.push(ws.decompose(&a));
+        }
+        eprintln!("sweeps: {got:?}");
+        assert_eq!(got, PINNED_SWEEPS);
+    }
+
     #[test]
     fn jacobi_matches_nalgebra_singular_values() {
         for (m, n) in [(6, 6), (6, 7), (3, 6), (13, 7), (2, 9), (9, 2)] {

@@ -112,6 +112,18 @@ pub fn plan_grid_astar(
     goal: Point2,
     params: &GridAstarParams,
 ) -> Result<Option<Vec<Point2>>, MobileError> {
+    plan_grid_astar_until(world, start, goal, params, &|| false)
+}
+
+/// [`plan_grid_astar`], asking `should_stop` every grid cell while the grid is
+/// built and every 1024 expansions while it is searched; `None` when stopped.
+pub fn plan_grid_astar_until(
+    world: &World,
+    start: Point2,
+    goal: Point2,
+    params: &GridAstarParams,
+    should_stop: &dyn Fn() -> bool,
+) -> Result<Option<Vec<Point2>>, MobileError> {
     params.validate()?;
     start.validate("start")?;
     goal.validate("goal")?;
@@ -152,6 +164,10 @@ pub fn plan_grid_astar(
     };
     for j in 0..ny {
         for i in 0..nx {
+            // One distance query costs O(obstacle edges): ask after each.
+            if should_stop() {
+                return Ok(None);
+            }
             g.blocked[j * nx + i] = world.distance(g.centre(i, j)).0 < params.inflation;
         }
     }
@@ -172,7 +188,12 @@ pub fn plan_grid_astar(
     heap.push(Open(hfun(si, sj), idx(si, sj)));
     let goal_idx = idx(gi, gj);
     let mut found = false;
+    let mut expanded = 0u32;
     while let Some(Open(f, c)) = heap.pop() {
+        expanded = expanded.wrapping_add(1);
+        if expanded.is_multiple_of(1024) && should_stop() {
+            return Ok(None);
+        }
         if c == goal_idx {
             found = true;
             break;

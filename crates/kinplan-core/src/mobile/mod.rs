@@ -23,7 +23,7 @@ pub use chassis::{
 };
 pub use error::MobileError;
 pub use goal_seeking::{SteeringCommand, SteeringParams, goal_seeking_finished, goal_seeking_step};
-pub use grid_astar::{GridAstarParams, plan_grid_astar};
+pub use grid_astar::{GridAstarParams, plan_grid_astar, plan_grid_astar_until};
 pub use lyapunov::{LyapunovCommand, LyapunovParams, lyapunov_step, lyapunov_value};
 pub use path_follow::{
     ControllerKind, PathFollowParams, PathFollowState, PathFollowStep, PathNode, path_follow_step,

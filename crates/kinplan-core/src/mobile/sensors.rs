@@ -81,6 +81,20 @@ impl RangeSensors {
     /// of radius `robot_radius` at `pose`: the minimum over the beam's rays of the ray length
     /// from the centre minus the radius, plus noise.
     pub fn sense(&mut self, world: &World, pose: Pose, robot_radius: f64, out: &mut [f64]) {
+        self.sense_until(world, pose, robot_radius, out, &|| false);
+    }
+
+    /// [`RangeSensors::sense`], asking `should_stop` before each ray cast (a
+    /// ray costs O(obstacles within reach)); false when
+    /// stopped early (then `out` is partly filled).
+    pub fn sense_until(
+        &mut self,
+        world: &World,
+        pose: Pose,
+        robot_radius: f64,
+        out: &mut [f64],
+        should_stop: &dyn Fn() -> bool,
+    ) -> bool {
         let p = self.params;
         let o = Point2::new(pose.x, pose.y);
         let reach = p.max_range + robot_radius;
@@ -89,6 +103,10 @@ impl RangeSensors {
             let centre = pose.theta + p.angle(i);
             let mut m = reach;
             for k in 0..p.rays_per_beam {
+                // A ray costs O(obstacles nearby): ask before each.
+                if should_stop() {
+                    return false;
+                }
                 let off = if p.rays_per_beam == 1 {
                     0.0
                 } else {
@@ -102,6 +120,7 @@ impl RangeSensors {
             }
             *d = g.clamp(0.0, p.max_range);
         }
+        true
     }
 }
 

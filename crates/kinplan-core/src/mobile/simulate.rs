@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::chassis::Chassis;
 use super::error::{MobileError, check_positive};
-use super::grid_astar::{GridAstarParams, plan_grid_astar};
+use super::grid_astar::{GridAstarParams, plan_grid_astar_until};
 use super::path_follow::{PathFollowParams, PathFollowState, PathNode, path_follow_unchecked, validate_path};
 use super::pose::{Point2, Pose, Twist, integrate_twist};
 use super::sensors::{RangeSensorParams, RangeSensors};
@@ -321,7 +321,10 @@ pub fn navigate(
             run.outcome = Outcome::Cancelled;
             break;
         }
-        sensors.sense(world, pose, sim.robot_radius, &mut readings);
+        if !sensors.sense_until(world, pose, sim.robot_radius, &mut readings, should_stop) {
+            run.outcome = Outcome::Cancelled;
+            break;
+        }
         let out = vdf_step_mut(&mut state, pose, goal, &readings, &params.vdf);
         match out.event {
             Some(VdfEvent::Reached) => {
@@ -366,9 +369,13 @@ pub fn navigate_astar(
     start.validate("start")?;
     sim.validate()?;
     start_check(Some(world), start, sim.robot_radius)?;
-    let Some(points) = plan_grid_astar(world, start.point(), goal, astar)? else {
+    let Some(points) = plan_grid_astar_until(world, start.point(), goal, astar, should_stop)? else {
         return Ok(SimRun {
-            outcome: Outcome::NoPath,
+            outcome: if should_stop() {
+                Outcome::Cancelled
+            } else {
+                Outcome::NoPath
+            },
             states: vec![start],
             ..SimRun::default()
         });

@@ -21,7 +21,7 @@ use tonic::{Request, Response, Status, Streaming};
 use super::convert::{finite_slice, matrix_in, pose_in, pose_out, vec3_in};
 use super::pb::{self, kinematics_service_server::KinematicsService};
 use super::server::Shared;
-use super::status::{invalid, robot_error};
+use super::status::{invalid, robot_error, too_large};
 use super::{Budget, Compute, ModelStore};
 use kinplan_core::ik::{
     IkError, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
@@ -29,7 +29,7 @@ use kinplan_core::ik::{
 };
 use kinplan_core::linalg::{
     LinalgError, LinearSolution, LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus,
-    solve_angle_relaxation, solve_pseudoinverse,
+    solve_angle_relaxation_until, solve_pseudoinverse,
 };
 use kinplan_core::robot::Chain;
 
@@ -44,9 +44,18 @@ pub const MAX_SOLUTIONS: u32 = 1_000;
 pub const MAX_BATCH_SOLUTIONS: usize = 100_000;
 /// Most entries of a `SolveLinearSystem` matrix.
 pub const MAX_MATRIX_ENTRIES: usize = 10_000;
-/// Most RLXA work (iteration cap × m × n) of one `SolveLinearSystem`: about a
-/// second of CPU, since RLXA has no cancellation check.
+/// Most RLXA work (iteration cap × m × n) of one `SolveLinearSystem`; the
+/// solve also stops at the deadline (checked every 1024 iterations).
 pub const MAX_RLXA_WORK: u64 = 1_000_000_000;
+/// Most iterations of a `SolveLinearSystem` that records its residual history
+/// (8 bytes each in the reply, so at most 8 MB): bounded up front.
+pub const MAX_LINEAR_HISTORY: usize = 1_000_000;
+/// Largest magnitude of a matrix or right-hand-side entry: norms of up to
+/// `MAX_MATRIX_ENTRIES` squared entries stay finite.
+pub const MAX_LINEAR_ENTRY: f64 = 1e100;
+/// Most RLXA iterations inside one IK iteration (`options.rlxa_max_iterations`):
+/// the IK loop checks its deadline between iterations.
+pub const MAX_IK_RLXA_ITERATIONS: u32 = 100_000;
 /// Default random restarts of `SolveIk` and `SolveIkBatch` (the domain default).
 const RESTARTS_SOLVE: usize = 200;
 /// Default random restarts of `TrackPath` and `StreamIk`: stay on the seed's branch.
@@ -274,6 +283,18 @@ impl KinematicsService for KinematicsApi {
             ));
         }
         finite_slice("b", &req.b)?;
+        if let Some(i) = a.iter().position(|v| v.abs() > MAX_LINEAR_ENTRY) {
+            return Err(invalid(
+                format!("a.data[{i}]"),
+                format!("magnitude above the limit of {MAX_LINEAR_ENTRY:e}"),
+            ));
+        }
+        if let Some(i) = req.b.iter().position(|v| v.abs() > MAX_LINEAR_ENTRY) {
+            return Err(invalid(
+                format!("b[{i}]"),
+                format!("magnitude above the limit of {MAX_LINEAR_ENTRY:e}"),
+            ));
+        }
         let b = DVector::from_vec(req.b);
         let solver = match linear_solver_in("method", req.method)? {
             None => {
@@ -302,6 +323,15 @@ impl KinematicsService for KinematicsApi {
                     ..d
                 };
                 params.validate().map_err(|e| linalg_error(e, ""))?;
+                if params.record_history && params.max_iterations > MAX_LINEAR_HISTORY {
+                    return Err(too_large(
+                        "max_iterations",
+                        format!(
+                            "{} iterations with record_history exceed the history limit of {MAX_LINEAR_HISTORY}",
+                            params.max_iterations
+                        ),
+                    ));
+                }
                 let work = (params.max_iterations as u64).saturating_mul(a.len() as u64);
                 if work > MAX_RLXA_WORK {
                     return Err(invalid(
@@ -320,13 +350,13 @@ impl KinematicsService for KinematicsApi {
         let (solution, elapsed) = self
             .shared
             .compute
-            .run(&budget, move |_| {
+            .run(&budget, move |budget| {
                 let start = Instant::now();
                 let s = match solver {
                     LinearSolve::Svd(p) => solve_pseudoinverse(&a, &b, &p),
                     LinearSolve::Rlxa(p, seed) => {
                         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-                        solve_angle_relaxation(&a, &b, &p, &mut rng)
+                        solve_angle_relaxation_until(&a, &b, &p, &mut rng, &|| budget.should_stop())
                     }
                 };
                 s.map(|s| (s, start.elapsed()))
@@ -376,6 +406,12 @@ impl Options {
             }
         };
         if let Some(n) = o.rlxa_max_iterations {
+            if n > MAX_IK_RLXA_ITERATIONS {
+                return Err(invalid(
+                    "options.rlxa_max_iterations",
+                    format!("{n} exceeds the limit of {MAX_IK_RLXA_ITERATIONS}"),
+                ));
+            }
             rlxa.max_iterations = n as usize;
         }
         if o.num_solutions > MAX_SOLUTIONS {
@@ -844,5 +880,18 @@ mod tests {
                 <= Duration::from_millis(10)
         );
         assert_eq!(time_budget(None, None), None);
+    }
+
+    /// Short deadlines: the reserve is at most half the time left (the
+    /// 200 µs floor would otherwise eat a 300 µs deadline's whole budget).
+    #[test]
+    fn a_short_deadline_keeps_half_for_the_work() {
+        let deadline = Instant::now() + Duration::from_micros(300);
+        let reserve = deadline - soft_deadline(Some(deadline)).unwrap();
+        assert!(reserve <= Duration::from_micros(150), "{reserve:?}");
+        assert!(reserve >= Duration::from_micros(50), "{reserve:?}");
+        // A deadline already passed leaves no reserve and no overflow.
+        let past = Instant::now() - Duration::from_millis(1);
+        assert_eq!(soft_deadline(Some(past)), Some(past));
     }
 }

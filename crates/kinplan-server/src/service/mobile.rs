@@ -26,6 +26,9 @@ pub const MAX_STEPS: f64 = 100_000.0;
 pub const MAX_OBSTACLES: usize = 10_000;
 /// Largest polygon accepted, vertices.
 pub const MAX_POLYGON_VERTICES: usize = 1_000;
+/// Most polygon vertices in one world: bounds the cost of one ray cast or
+/// distance query (the unit between cancellation checks).
+pub const MAX_WORLD_VERTICES: usize = 100_000;
 /// Longest path accepted, nodes.
 pub const MAX_PATH_NODES: usize = 10_000;
 /// Largest sensor ring accepted.
@@ -98,11 +101,11 @@ impl MobileService for MobileApi {
         }
         // Sensing a world costs up to obstacles × rays: the CPU pool; the rest inline.
         if req.world.is_empty() {
-            control_step(req).map(Response::new)
+            control_step(req, &|| false).map(Response::new)
         } else {
             self.shared
                 .compute
-                .run(&budget, move |_| control_step(req))
+                .run(&budget, move |b| control_step(req, &|| b.should_stop()))
                 .await?
                 .map(Response::new)
         }
@@ -195,7 +198,10 @@ impl MobileService for MobileApi {
 
 /// One controller step: vector distance with its `VdfState` token, or a path-following
 /// controller with its `PathFollowState` token (JSON).
-fn control_step(req: pb::ControlStepRequest) -> Result<pb::ControlStepResponse, Status> {
+fn control_step(
+    req: pb::ControlStepRequest,
+    should_stop: &dyn Fn() -> bool,
+) -> Result<pb::ControlStepResponse, Status> {
     let chassis = chassis_in(req.chassis.as_ref());
     chassis.validate().map_err(mobile_error)?;
     let state = pose_in(req.state.as_ref());
@@ -215,7 +221,11 @@ fn control_step(req: pb::ControlStepRequest) -> Result<pb::ControlStepResponse, 
             state.validate("state").map_err(mobile_error)?;
             let mut ring = RangeSensors::new(sensors, req.seed).map_err(mobile_error)?;
             let mut out = vec![0.0; sensors.count];
-            ring.sense(&world, state, radius, &mut out);
+            if !ring.sense_until(&world, state, radius, &mut out, should_stop) {
+                return Err(Status::deadline_exceeded(
+                    "the request's deadline passed before the work finished",
+                ));
+            }
             out
         };
         let goal = point_in(req.goal.as_ref());
@@ -501,6 +511,19 @@ fn world_in(obstacles: &[pb::Obstacle]) -> Result<World, Status> {
         return Err(invalid(
             "world",
             format!("{} obstacles, at most {MAX_OBSTACLES}", obstacles.len()),
+        ));
+    }
+    let vertices: usize = obstacles
+        .iter()
+        .map(|o| match &o.shape {
+            Some(Shape::Polygon(p)) => p.vertices.len(),
+            _ => 1,
+        })
+        .sum();
+    if vertices > MAX_WORLD_VERTICES {
+        return Err(invalid(
+            "world",
+            format!("{vertices} polygon vertices in all, at most {MAX_WORLD_VERTICES}"),
         ));
     }
     let mut out = Vec::with_capacity(obstacles.len());

@@ -22,45 +22,73 @@ pub struct Resolved {
     pub model_id: Vec<u8>,
 }
 
-/// A small least-recently-used map.
+/// A small least-recently-used map, bounded in entries and in bytes (each
+/// value's size as given on insertion).
 struct Lru<K, V> {
-    entries: HashMap<K, (V, u64)>,
+    entries: HashMap<K, (V, u64, usize)>,
     capacity: usize,
+    max_bytes: usize,
+    bytes: usize,
     tick: u64,
 }
 
 impl<K: std::hash::Hash + Eq + Clone, V: Clone> Lru<K, V> {
-    fn new(capacity: usize) -> Self {
+    fn new(capacity: usize, max_bytes: usize) -> Self {
         Self {
             entries: HashMap::new(),
             capacity: capacity.max(1),
+            max_bytes,
+            bytes: 0,
             tick: 0,
+        }
+    }
+
+    fn evict_oldest(&mut self) {
+        let oldest = self
+            .entries
+            .iter()
+            .min_by_key(|(_, (_, used, _))| *used)
+            .map(|(k, _)| k.clone());
+        if let Some(k) = oldest
+            && let Some((_, _, size)) = self.entries.remove(&k)
+        {
+            self.bytes -= size;
         }
     }
 
     fn get(&mut self, key: &K) -> Option<V> {
         self.tick += 1;
         let tick = self.tick;
-        self.entries.get_mut(key).map(|(v, used)| {
+        self.entries.get_mut(key).map(|(v, used, _)| {
             *used = tick;
             v.clone()
         })
     }
 
-    fn insert(&mut self, key: K, value: V) {
+    /// Keeps `value` (of `size` bytes) unless it alone exceeds the byte bound;
+    /// evicts the least recently used entries to make room.
+    fn insert(&mut self, key: K, value: V, size: usize) {
         self.tick += 1;
-        if self.entries.len() >= self.capacity && !self.entries.contains_key(&key) {
-            let oldest = self
-                .entries
-                .iter()
-                .min_by_key(|(_, (_, used))| *used)
-                .map(|(k, _)| k.clone());
-            if let Some(k) = oldest {
-                self.entries.remove(&k);
-            }
+        if let Some((_, _, old)) = self.entries.remove(&key) {
+            self.bytes -= old;
         }
-        self.entries.insert(key, (value, self.tick));
+        if size > self.max_bytes {
+            return;
+        }
+        while !self.entries.is_empty()
+            && (self.entries.len() >= self.capacity || self.bytes + size > self.max_bytes)
+        {
+            self.evict_oldest();
+        }
+        self.bytes += size;
+        self.entries.insert(key, (value, self.tick, size));
     }
+}
+
+/// Bytes a parsed chain holds, roughly: its frames, joints and shapes.
+fn chain_bytes(chain: &Chain) -> usize {
+    let shapes: usize = chain.collision().iter().map(|c| c.shapes.len()).sum();
+    std::mem::size_of::<Chain>() + chain.links().len() * 256 + chain.joints().len() * 256 + shapes * 128
 }
 
 type ModelId = [u8; 32];
@@ -73,12 +101,19 @@ pub struct ModelStore {
 }
 
 impl ModelStore {
-    pub fn new(limits: UrdfLimits, capacity: usize) -> Self {
+    /// At most `capacity` models, and at most `max_bytes` of URDF text plus
+    /// parsed chains in all (half for each).
+    pub fn new(limits: UrdfLimits, capacity: usize, max_bytes: usize) -> Self {
         Self {
             limits,
-            chains: Mutex::new(Lru::new(capacity)),
-            texts: Mutex::new(Lru::new(capacity)),
+            chains: Mutex::new(Lru::new(capacity, max_bytes / 2)),
+            texts: Mutex::new(Lru::new(capacity, max_bytes / 2)),
         }
+    }
+
+    /// Bytes held by the cache now (texts and chains).
+    pub fn bytes(&self) -> usize {
+        self.chains.lock().expect("cache lock").bytes + self.texts.lock().expect("cache lock").bytes
     }
 
     /// The chain a request names; parses (on the CPU pool) only on a miss.
@@ -152,8 +187,16 @@ impl ModelStore {
             })?,
         };
         let chain = self.parse(text.clone(), spec, compute, budget).await?;
-        self.texts.lock().expect("cache lock").insert(id, text);
-        self.chains.lock().expect("cache lock").insert(key, chain.clone());
+        let text_bytes = text.len();
+        self.texts
+            .lock()
+            .expect("cache lock")
+            .insert(id, text, text_bytes);
+        let size = chain_bytes(&chain);
+        self.chains
+            .lock()
+            .expect("cache lock")
+            .insert(key, chain.clone(), size);
         Ok(Resolved { chain, model_id })
     }
 
@@ -189,7 +232,7 @@ mod tests {
     /// from the cache (the same shared chain comes back).
     #[tokio::test]
     async fn models_are_parsed_once() {
-        let store = ModelStore::new(UrdfLimits::default(), 8);
+        let store = ModelStore::new(UrdfLimits::default(), 8, 64 << 20);
         let compute = Compute::new(1, 4, None);
         let budget = Budget::new(None);
         let flange = named("kuka_kr210_r2700_extra", "flange");
@@ -219,5 +262,26 @@ mod tests {
         let d = store.resolve(Some(&by_id), &compute, &budget).await.unwrap();
         assert!(Arc::ptr_eq(&c.chain, &d.chain));
         assert_eq!(c.model_id.len(), 32);
+    }
+
+    /// Regression: the cache bounded entries, not bytes (300 URDFs of 1.9 MB
+    /// kept 602 MB). Now its bytes stay under the configured bound.
+    #[tokio::test]
+    async fn the_cache_is_bounded_in_bytes() {
+        let max = 1 << 20;
+        let store = ModelStore::new(UrdfLimits::default(), 1000, max);
+        let compute = Compute::new(1, 4, None);
+        let budget = Budget::new(None);
+        let padding = format!("<!-- {} -->", "x".repeat(100_000));
+        for k in 0..40 {
+            let urdf = format!(r#"<robot name="r{k}">{padding}<link name="a"/></robot>"#);
+            let inline = pb::RobotRef {
+                source: Some(Source::Urdf(urdf)),
+                ..Default::default()
+            };
+            store.resolve(Some(&inline), &compute, &budget).await.unwrap();
+            assert!(store.bytes() <= max, "{} bytes after {k} models", store.bytes());
+        }
+        assert!(store.bytes() > max / 4, "the cache still holds models");
     }
 }

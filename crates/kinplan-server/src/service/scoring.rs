@@ -13,18 +13,59 @@ use tonic::{Request, Response, Status};
 use super::Budget;
 use super::pb::{self, scoring_service_server::ScoringService};
 use super::server::Shared;
-use super::status::invalid;
+use super::status::{invalid, too_large};
 use kinplan_core::robot::Chain;
 use kinplan_core::score::{
     self, CycleTime, CycleTimeParams, JerkPeakParams, JointLimits, LabelledSet, PointSet, Rows, ScoreError,
     ScoreInput, ScoreParams, ScoreReport, Scores, Series, TrajectoryData, cartesian_slowdown, joint_slowdown,
 };
 
-/// Requests with at least this many waypoints (all trajectories together)
-/// are scored on the CPU pool; smaller ones inline on the async runtime
-/// (at most ~1 ms of FK and criteria for a 6-joint arm with collision-shape
-/// points, see benches/RESULTS.md).
-const INLINE_WAYPOINTS: usize = 500;
+/// Requests whose estimated cost (waypoints × (1 + robot points per
+/// waypoint), all trajectories together) is below this are scored inline on
+/// the async runtime, others on the CPU pool: 500 waypoints of a 6-joint arm
+/// with its ~64 collision-vertex points is ~1 ms (see benches/RESULTS.md).
+/// The estimate counts points, not waypoints alone, so a model with thousands
+/// of collision shapes never runs inline.
+const INLINE_COST: usize = 32_000;
+/// Most robot points sampled over a whole request (points per waypoint ×
+/// waypoints): 24 bytes each, so at most ~96 MB, refused up front beyond.
+pub const MAX_ROBOT_POINT_SAMPLES: usize = 4_000_000;
+
+/// Smallest step between timestamps, s: smaller ones overflow the divided differences.
+pub const MIN_TIME_STEP: f64 = 1e-6;
+/// Largest timestamp magnitude, s.
+pub const MAX_TIME: f64 = 1e9;
+/// Smallest positive speed or acceleration limit: a 5e-324 limit made
+/// durations infinite.
+pub const MIN_RATE_LIMIT: f64 = 1e-6;
+
+/// Robot points per waypoint the request's options ask for.
+fn points_per_waypoint(o: Option<&pb::ScoreOptions>, chain: &Chain) -> usize {
+    let robot_points = o.map_or(0, |o| o.robot_points);
+    match pb::RobotPoints::try_from(robot_points) {
+        Ok(pb::RobotPoints::None) => 0,
+        Ok(pb::RobotPoints::CollisionVertices) => {
+            score::robot_link_points(chain, PointSet::CollisionVertices).len()
+        }
+        _ => chain.links().len(),
+    }
+}
+
+/// The estimated cost of scoring `waypoints` with `points` per waypoint, or
+/// RESOURCE_EXHAUSTED naming `options.robot_points` when the samples cannot fit.
+fn estimate(waypoints: usize, points: usize) -> Result<usize, Status> {
+    let samples = waypoints.saturating_mul(points);
+    if samples > MAX_ROBOT_POINT_SAMPLES {
+        return Err(too_large(
+            "options.robot_points",
+            format!(
+                "{points} robot points x {waypoints} waypoints exceed the limit of \
+                 {MAX_ROBOT_POINT_SAMPLES} samples per request"
+            ),
+        ));
+    }
+    Ok(waypoints.saturating_add(samples))
+}
 
 pub struct ScoringApi {
     shared: Shared,
@@ -39,10 +80,10 @@ impl ScoringApi {
     async fn run<T: Send + 'static>(
         &self,
         budget: &Budget,
-        waypoints: usize,
+        cost: usize,
         work: impl FnOnce(&Budget) -> Result<T, Status> + Send + 'static,
     ) -> Result<T, Status> {
-        if waypoints < INLINE_WAYPOINTS {
+        if cost < INLINE_COST {
             work(budget)
         } else {
             self.shared.compute.run(budget, work).await?
@@ -63,8 +104,9 @@ impl ScoringService for ScoringApi {
         let req = request.into_inner();
         let chain = robot.chain.clone();
         let waypoints = req.trajectory.as_ref().map_or(0, |t| t.points.len());
+        let cost = estimate(waypoints, points_per_waypoint(req.options.as_ref(), &chain))?;
         let mut reply = self
-            .run(&budget, waypoints, move |_| {
+            .run(&budget, cost, move |_| {
                 let options = Options::from_proto(req.options.as_ref(), &chain)?;
                 let trajectory = Trajectory::from_proto(req.trajectory, &chain, "trajectory")?;
                 let report = score_one(&chain, &trajectory, &options, options.series)
@@ -112,10 +154,9 @@ impl ScoringService for ScoringApi {
             .flat_map(|s| &s.trajectories)
             .map(|t| t.points.len())
             .sum();
+        let cost = estimate(waypoints, points_per_waypoint(req.options.as_ref(), &chain))?;
         let mut reply = self
-            .run(&budget, waypoints, move |budget| {
-                compare_sets(&chain, req, budget)
-            })
+            .run(&budget, cost, move |budget| compare_sets(&chain, req, budget))
             .await?;
         reply.model_id = robot.model_id;
         Ok(Response::new(reply))
@@ -148,6 +189,23 @@ impl Options {
                 ));
             }
         };
+        for (name, values) in [
+            ("max_velocity", &o.max_velocity),
+            ("max_acceleration", &o.max_acceleration),
+        ] {
+            if let Some(i) = values
+                .iter()
+                .position(|v| v.is_finite() && *v > 0.0 && !(MIN_RATE_LIMIT..).contains(v))
+            {
+                return Err(invalid(
+                    format!("options.{name}[{i}]"),
+                    format!(
+                        "{:e} is below the smallest accepted limit of {MIN_RATE_LIMIT:e}",
+                        values[i]
+                    ),
+                ));
+            }
+        }
         let limits = if !o.max_velocity.is_empty() {
             Ok(o.max_velocity)
         } else {
@@ -224,6 +282,26 @@ impl Trajectory {
             }
         }
         let timed = t.points.iter().any(|p| p.time_from_start != 0.0);
+        if timed {
+            // Steps of 1e-300 s divided differences into infinities: bound them.
+            for (i, w) in t.points.windows(2).enumerate() {
+                let step = w[1].time_from_start - w[0].time_from_start;
+                if step.is_finite() && step > 0.0 && step < MIN_TIME_STEP {
+                    return Err(invalid(
+                        format!("{field}.points[{}].time_from_start", i + 1),
+                        format!(
+                            "steps of {step:e} s are below the smallest accepted step of {MIN_TIME_STEP:e} s"
+                        ),
+                    ));
+                }
+            }
+            if let Some(i) = t.points.iter().position(|p| p.time_from_start.abs() > MAX_TIME) {
+                return Err(invalid(
+                    format!("{field}.points[{i}].time_from_start"),
+                    format!("magnitude above {MAX_TIME:e} s"),
+                ));
+            }
+        }
         let times = timed.then(|| t.points.iter().map(|p| p.time_from_start).collect());
         let rows = t.points.into_iter().map(|p| p.positions).collect();
         Ok(Self { rows, times })

@@ -48,6 +48,8 @@ pub struct ServerConfig {
     /// Random states sampled for a robot's allowed-collision matrix (once
     /// per model; MoveIt's setup assistant samples 10,000).
     pub acm_samples: usize,
+    /// Bytes of URDF text and parsed models the cache may hold.
+    pub model_cache_bytes: usize,
     /// Time between reporting NOT_SERVING and closing the listener on
     /// shutdown, so load balancers stop sending new calls first.
     pub drain_delay: Duration,
@@ -71,6 +73,7 @@ impl Default for ServerConfig {
             max_urdf_bytes: 2 * 1024 * 1024,
             model_cache_entries: 256,
             acm_samples: 10_000,
+            model_cache_bytes: 256 * 1024 * 1024,
             drain_delay: Duration::ZERO,
             drain_timeout: Duration::from_secs(10),
             stream_idle_timeout: Duration::from_secs(60),
@@ -102,6 +105,7 @@ pub async fn serve(
             ..UrdfLimits::default()
         },
         config.model_cache_entries,
+        config.model_cache_bytes,
     ));
     let collision = Arc::new(CollisionModels::new(
         config.model_cache_entries,

@@ -11,6 +11,12 @@ pub fn invalid(field: impl Into<String>, description: impl Into<String>) -> Stat
     field_status(Code::InvalidArgument, field, description)
 }
 
+/// RESOURCE_EXHAUSTED naming `field`: a request that cannot fit the server's
+/// limits, refused before any work.
+pub fn too_large(field: impl Into<String>, description: impl Into<String>) -> Status {
+    field_status(Code::ResourceExhausted, field, description)
+}
+
 /// NOT_FOUND naming `field`, with a BadRequest field violation.
 pub fn not_found(field: impl Into<String>, description: impl Into<String>) -> Status {
     field_status(Code::NotFound, field, description)
