@@ -86,7 +86,9 @@ async fn health_reflection_and_listing() {
     assert_eq!(dof("kuka_kr210_r2700_extra"), Some(6));
     assert_eq!(dof("franka_panda"), Some(7));
     assert_eq!(dof("planar_10"), Some(10));
-    assert_eq!(list.robots.len(), 15);
+    // The Panda with its hand: the fingers hang off the chain, so still 7 joints.
+    assert_eq!(dof("franka_panda_hand"), Some(7));
+    assert_eq!(list.robots.len(), 16);
 }
 
 #[tokio::test]

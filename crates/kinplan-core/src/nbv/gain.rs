@@ -40,7 +40,10 @@ impl GainMethod {
 pub struct ViewGain {
     /// c: unknown cells found (or the weighted sum for `OcclusionAware`).
     pub cells: f64,
-    /// `Ig = c / c_max`, `c_max = frustum volume / res³`.
+    /// `Ig = c / c_max`, `c_max = frustum volume / res³`. Not clipped: counting cell
+    /// centres can put an intersection count a fraction of a percent above `c_max`
+    /// (cells straddling the frustum's faces), and the unobserved-voxel sum counts a
+    /// cell once per ray, so it can exceed 1 by design.
     pub ig: f64,
     /// DDA steps taken (ray methods).
     pub ray_steps: u64,

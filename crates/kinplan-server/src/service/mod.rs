@@ -7,6 +7,8 @@ pub mod pb;
 mod collision_models;
 mod compute;
 mod convert;
+mod exploration;
+mod exploration_convert;
 mod finite;
 mod guard;
 mod kinematics;

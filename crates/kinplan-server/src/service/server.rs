@@ -13,10 +13,12 @@ use tonic::transport::server::TcpIncoming;
 use tonic_health::ServingStatus;
 
 use super::collision_models::CollisionModels;
+use super::exploration::ExplorationApi;
 use super::guard::GuardLayer;
 use super::kinematics::KinematicsApi;
 use super::mobile::MobileApi;
 use super::models::Resolved;
+use super::pb::exploration_service_server::ExplorationServiceServer;
 use super::pb::kinematics_service_server::KinematicsServiceServer;
 use super::pb::mobile_service_server::MobileServiceServer;
 use super::pb::planning_service_server::PlanningServiceServer;
@@ -130,6 +132,7 @@ pub async fn serve(
     let mobile = service!(MobileServiceServer, MobileApi::new(shared.clone()));
     let kinematics = service!(KinematicsServiceServer, KinematicsApi::new(shared.clone()));
     let planning = service!(PlanningServiceServer, PlanningApi::new(shared.clone()));
+    let exploration = service!(ExplorationServiceServer, ExplorationApi::new(shared.clone()));
 
     let services = [
         name_of(&robot),
@@ -137,6 +140,7 @@ pub async fn serve(
         name_of(&mobile),
         name_of(&kinematics),
         name_of(&planning),
+        name_of(&exploration),
     ];
     let (health, health_service) = tonic_health::server::health_reporter();
     for name in services {
@@ -189,6 +193,7 @@ pub async fn serve(
         .add_service(mobile)
         .add_service(kinematics)
         .add_service(planning)
+        .add_service(exploration)
         .serve_with_incoming_shutdown(
             // Small replies must not wait for Nagle + delayed ACK (40 ms on loopback).
             TcpIncoming::from(listener)
