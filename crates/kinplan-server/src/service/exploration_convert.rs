@@ -117,7 +117,7 @@ pub fn nbv_params_in(req: &pb::NextBestViewRequest) -> Result<NbvParams, Status>
             0
         },
         camera_mount: optional_pose("camera_mount", req.camera_mount.as_ref())?,
-        ik: d.ik.clone(),
+        ik: d.ik,
         count_failures: o.count_failures,
         failure_penalty: number("options.failure_penalty", o.failure_penalty, d.failure_penalty)?,
         prior_failures: o
