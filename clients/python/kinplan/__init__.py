@@ -7,6 +7,7 @@
 from ._convert import matrix_to_pose, pose_to_matrix
 from .client import Client, Robot, RobotDescription
 from .errors import KinplanError
+from .exploration import Octree, Views
 from .kinematics import IkBatchResult, IkResult, IkSolution, IkStream, LinearSolution, TrackResult
 from .mobile import Mobile, MobileRun, StepResult, WheelKinematics
 from .planning import Box, Capsule, Cylinder, Mesh, OctreeObstacle, Plan, Sphere, StateChecks
@@ -18,6 +19,7 @@ __all__ = [
     "Client",
     "Cylinder",
     "Mesh",
+    "Octree",
     "OctreeObstacle",
     "Plan",
     "Sphere",
@@ -36,6 +38,7 @@ __all__ = [
     "Scores",
     "StepResult",
     "TrackResult",
+    "Views",
     "WheelKinematics",
     "matrix_to_pose",
     "pose_to_matrix",
