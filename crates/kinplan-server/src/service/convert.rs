@@ -17,6 +17,18 @@ pub fn finite(field: &str, value: f64) -> Result<f64, Status> {
     }
 }
 
+/// An optional duration in seconds: unset is `None`; set, it must be finite and > 0.
+pub fn optional_seconds(field: &str, value: Option<f64>) -> Result<Option<std::time::Duration>, Status> {
+    value
+        .map(|b| {
+            std::time::Duration::try_from_secs_f64(b)
+                .ok()
+                .filter(|d| !d.is_zero())
+                .ok_or_else(|| invalid(field, format!("must be finite and > 0 s, got {b}")))
+        })
+        .transpose()
+}
+
 pub fn finite_slice(field: &str, values: &[f64]) -> Result<(), Status> {
     match values.iter().position(|v| !v.is_finite()) {
         Some(i) => Err(invalid(

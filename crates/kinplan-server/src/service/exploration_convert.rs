@@ -2,11 +2,9 @@
 //! (unset fields take the domain's `Default`), candidates, stages and tree
 //! statistics out.
 
-use std::time::Duration;
-
 use tonic::Status;
 
-use super::convert::{finite, pose_in, vec3_in, vec3_out};
+use super::convert::{finite, optional_seconds, pose_in, vec3_in, vec3_out};
 use super::exploration::box_in;
 use super::pb;
 use super::status::invalid;
@@ -55,20 +53,7 @@ pub fn nbv_params_in(req: &pb::NextBestViewRequest) -> Result<NbvParams, Status>
         w_d: number("options.weights.distance", w.distance, d.weights.w_d)?,
         w_r: number("options.weights.rotation", w.rotation, d.weights.w_r)?,
     };
-    let time_budget = match o.time_budget {
-        None => None,
-        Some(b) => Some(
-            Duration::try_from_secs_f64(b)
-                .ok()
-                .filter(|d| !d.is_zero())
-                .ok_or_else(|| {
-                    invalid(
-                        "options.time_budget",
-                        format!("must be finite and > 0 s, got {b}"),
-                    )
-                })?,
-        ),
-    };
+    let time_budget = optional_seconds("options.time_budget", o.time_budget)?;
     let optional_pose = |field: &str, p: Option<&pb::Pose>| match p {
         Some(p) => pose_in(field, Some(p)),
         None => Ok(nalgebra::Isometry3::identity()),

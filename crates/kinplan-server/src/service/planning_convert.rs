@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use tonic::Status;
 
-use super::convert::{finite, pose_in};
+use super::convert::{finite, optional_seconds, pose_in};
 use super::pb;
 use super::status::invalid;
 use kinplan_core::collision::{CheckerParams, Part, StateReport};
@@ -198,20 +198,7 @@ pub fn plan_input(req: &pb::PlanRequest) -> Result<PlanInput, Status> {
         }
         checker.motion_resolution = res;
     }
-    let time_budget = match options.time_budget {
-        None => None,
-        Some(b) => Some(
-            Duration::try_from_secs_f64(b)
-                .ok()
-                .filter(|d| !d.is_zero())
-                .ok_or_else(|| {
-                    invalid(
-                        "options.time_budget",
-                        format!("must be finite and > 0 s, got {b}"),
-                    )
-                })?,
-        ),
-    };
+    let time_budget = optional_seconds("options.time_budget", options.time_budget)?;
     Ok(PlanInput {
         request,
         checker,
