@@ -13,7 +13,7 @@ install -m 0755 "$bin" "$out/usr/local/bin/kinplan"
 strip --strip-debug "$out/usr/local/bin/kinplan"
 # Every library the dynamic loader resolves, plus the loader itself, at the
 # paths the binary expects.
-ldd "$bin" | awk '/=> \// { print $3 } /^\s*\/[^ ]*ld-linux/ { print $1 }' | sort -u |
+ldd "$bin" | awk '/=> \// { print $3 } /^[ \t]*\/[^ ]*ld-linux/ { print $1 }' | sort -u |
   while read -r lib; do
     mkdir -p "$out$(dirname "$lib")"
     cp -L "$lib" "$out$lib"
