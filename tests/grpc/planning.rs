@@ -497,6 +497,34 @@ async fn bad_input_is_named_by_field() {
         ),
         (
             {
+                let mut r = request(pb::PlanAlgorithm::Ccstomp, Vec::new());
+                r.options = Some(pb::PlanOptions {
+                    cartesian: Some(pb::CartesianOptions {
+                        violation_penalty: Some(-1.0),
+                        ..Default::default()
+                    }),
+                    ..Default::default()
+                });
+                r
+            },
+            "options.cartesian.violation_penalty",
+        ),
+        (
+            {
+                let mut r = request(pb::PlanAlgorithm::Ccstomp, Vec::new());
+                r.options = Some(pb::PlanOptions {
+                    cartesian: Some(pb::CartesianOptions {
+                        rotation_stddev: Some(0.0),
+                        ..Default::default()
+                    }),
+                    ..Default::default()
+                });
+                r
+            },
+            "options.cartesian.rotation_stddev",
+        ),
+        (
+            {
                 let mut r = request(pb::PlanAlgorithm::Stomp, Vec::new());
                 r.options = Some(pb::PlanOptions {
                     stomp: Some(pb::StompOptions {

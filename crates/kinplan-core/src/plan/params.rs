@@ -202,15 +202,15 @@ impl CartesianParams {
         for (field, v) in [
             (F::TranslationTolerance, self.translation_tolerance),
             (F::RotationTolerance, self.rotation_tolerance),
-            (F::CartesianStddev, self.translation_stddev),
-            (F::CartesianStddev, self.rotation_stddev),
+            (F::TranslationStddev, self.translation_stddev),
+            (F::RotationStddev, self.rotation_stddev),
         ] {
             require(v.is_finite() && v > 0.0, field, v, "must be finite and > 0")?;
         }
         for (field, v) in [
             (F::TranslationWeight, self.translation_weight),
             (F::RotationWeight, self.rotation_weight),
-            (F::TranslationWeight, self.violation_penalty),
+            (F::ViolationPenalty, self.violation_penalty),
         ] {
             require(v.is_finite() && v >= 0.0, field, v, "must be finite and >= 0")?;
         }
