@@ -37,8 +37,6 @@ pub enum PlanField {
     VelocityLimits,
     AccelerationLimits,
     VelocityScale,
-    Waypoints,
-    GoalIk,
 }
 
 impl PlanField {
@@ -75,8 +73,6 @@ impl PlanField {
             PlanField::VelocityLimits => "timing.velocity_limits",
             PlanField::AccelerationLimits => "timing.acceleration_limits",
             PlanField::VelocityScale => "timing.velocity_scale",
-            PlanField::Waypoints => "waypoints",
-            PlanField::GoalIk => "goal_ik",
         }
     }
 }

@@ -240,8 +240,6 @@ fn plan_field(field: PlanField) -> &'static str {
         PlanField::VelocityLimits => "options.timing.max_velocity",
         PlanField::AccelerationLimits => "options.timing.max_acceleration",
         PlanField::VelocityScale => "options.timing.velocity_scale",
-        PlanField::Waypoints => "start",
-        PlanField::GoalIk => "goal_pose",
     }
 }
 
