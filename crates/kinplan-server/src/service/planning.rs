@@ -76,7 +76,7 @@ impl PlanningApi {
             (a, b) => a.or(b),
         };
         Ok(Prepared {
-            permit,
+            _permit: permit,
             budget,
             robot,
             input,
@@ -88,7 +88,8 @@ impl PlanningApi {
 }
 
 struct Prepared {
-    permit: tokio::sync::OwnedSemaphorePermit,
+    /// Held for its drop: the admission slot is released when the plan is done.
+    _permit: tokio::sync::OwnedSemaphorePermit,
     budget: Budget,
     robot: Resolved,
     input: PlanInput,
@@ -155,8 +156,8 @@ impl PlanningService for PlanningApi {
         let compute = self.shared.compute.clone();
         let budget = prepared.budget.clone();
         let reply = compute
+            // `prepared` (and with it the admission permit) lives until the plan ends.
             .run(&budget, move |b| {
-                let _permit = &prepared.permit;
                 run_plan(&prepared, &|| b.should_stop(), None, started)
             })
             .await??;
