@@ -7,6 +7,7 @@
 //! users can depend on the algorithms alone.
 
 pub mod collision;
+pub mod explore;
 pub mod ik;
 pub mod linalg;
 pub mod mobile;

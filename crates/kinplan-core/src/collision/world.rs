@@ -157,6 +157,42 @@ impl SceneGeometry {
         &self.scene
     }
 
+    /// Distance along the ray `origin + t·dir` (`dir` of unit length, base
+    /// frame) to the first obstacle surface with `t ≤ max_distance`, or
+    /// `None`. Solid shapes: a ray starting inside an obstacle hits at 0.
+    /// Broad phase by the BVH (boxes entered beyond the best hit so far are
+    /// skipped), exact hits by parry's ray casts.
+    pub fn cast_ray(&self, origin: &Point3<f64>, dir: &Vector3<f64>, max_distance: f64) -> Option<f64> {
+        let ray = parry3d_f64::query::Ray::new(vec_to_parry(&origin.coords), vec_to_parry(dir));
+        let mut hit = false;
+        let end = self
+            .bvh
+            .ray_traverse(&origin.coords, dir, max_distance, |leaf, t_max| {
+                let l = &self.leaves[leaf as usize];
+                match l.shape.cast_ray(&l.pose, &ray, t_max, true) {
+                    Some(t) if t <= t_max => {
+                        hit = true;
+                        t
+                    }
+                    _ => t_max,
+                }
+            });
+        hit.then_some(end)
+    }
+
+    /// True when `p` (base frame) lies inside a solid obstacle (on its
+    /// boundary counts). Meshes are surfaces here, as everywhere in this
+    /// room, and contain nothing.
+    pub fn contains_point(&self, p: &Point3<f64>) -> bool {
+        let v = vec_to_parry(&p.coords);
+        let obstacles = self.scene.obstacles();
+        !self.bvh.for_each_near(&p.coords, 0.0, |leaf| {
+            let l = &self.leaves[leaf as usize];
+            let mesh = matches!(obstacles[l.obstacle as usize].geometry, Geometry::Mesh { .. });
+            mesh || !l.shape.contains_point(&l.pose, v)
+        })
+    }
+
     /// Name of obstacle `index` (empty names become `obstacles[index]`).
     pub fn obstacle_name(&self, index: usize) -> String {
         match self.scene.obstacles().get(index) {

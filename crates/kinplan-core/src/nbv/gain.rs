@@ -73,6 +73,13 @@ pub struct GainWorkspace {
 /// assert!((c / v - 1.0).abs() < 0.1);
 /// ```
 pub fn frustum_unknown_count(tree: &Octree, frustum: &Frustum) -> u64 {
+    frustum_unknown_count_in(tree, frustum, None)
+}
+
+/// [`frustum_unknown_count`] restricted to the depth-16 cells whose keys lie in
+/// the inclusive key box `keys` (`None`: no restriction). Cubes reaching out
+/// of the box are split like cubes crossing a plane.
+pub fn frustum_unknown_count_in(tree: &Octree, frustum: &Frustum, keys: Option<(OcKey, OcKey)>) -> u64 {
     let res = tree.resolution();
     let planes = &frustum.planes;
     let norm1: [f64; 6] = planes.map(|(n, _)| n.x.abs() + n.y.abs() + n.z.abs());
@@ -111,9 +118,22 @@ pub fn frustum_unknown_count(tree: &Octree, frustum: &Frustum) -> u64 {
             hi[i] = hi[i].max(k[i]);
         }
     }
+    if let Some((a, b)) = keys {
+        for i in 0..3 {
+            lo[i] = lo[i].max(a[i]);
+            hi[i] = hi[i].min(b[i]);
+            if lo[i] > hi[i] {
+                return 0;
+            }
+        }
+    }
     let overlaps = |key: &OcKey, depth: u8| {
         let span = (1u32 << (TREE_DEPTH - depth)) - 1;
         (0..3).all(|i| key[i] as u32 <= hi[i] as u32 && key[i] as u32 + span >= lo[i] as u32)
+    };
+    let within = |key: &OcKey, depth: u8| {
+        let span = (1u32 << (TREE_DEPTH - depth)) - 1;
+        (0..3).all(|i| key[i] >= lo[i] && key[i] as u32 + span <= hi[i] as u32)
     };
     let mut count = 0u64;
     // stack entries: (key, depth, known node value or None for unknown)
@@ -132,7 +152,7 @@ pub fn frustum_unknown_count(tree: &Octree, frustum: &Frustum) -> u64 {
         if !touch {
             continue;
         }
-        if node.is_none() && inside {
+        if node.is_none() && inside && within(&key, depth) {
             count += 1u64 << (3 * (TREE_DEPTH - depth) as u32);
             continue;
         }

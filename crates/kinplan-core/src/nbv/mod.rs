@@ -15,6 +15,8 @@ mod tests;
 pub use camera::{CameraModel, Frustum, look_along};
 pub use error::NbvError;
 pub use frontier::{Frontier, candidate_pose, frontier_cells, potential_field};
-pub use gain::{GainMethod, GainWorkspace, ViewGain, frustum_unknown_count, ray_gain, walk};
+pub use gain::{
+    GainMethod, GainWorkspace, ViewGain, frustum_unknown_count, frustum_unknown_count_in, ray_gain, walk,
+};
 pub use params::{NbvParams, Weights};
 pub use select::{NbvCandidate, NbvResult, NbvStatus, StageStats, estimate_reach, next_best_view};

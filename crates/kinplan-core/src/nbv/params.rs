@@ -54,6 +54,12 @@ pub struct NbvParams {
     /// ORF: candidates farther than this from the base are dropped (m, > 0; `None` =
     /// estimated from the robot's forward kinematics). Default None.
     pub reach: Option<f64>,
+    /// ORF also drops a candidate whose camera position lies in an occupied
+    /// cell, in an unknown cell inside `region`, or below `region` (the
+    /// camera cannot stand in an obstacle nor in unseen space of the cell;
+    /// unseen space around the cell, above its floor, is allowed, since the
+    /// planner checks the way there). Default false.
+    pub free_viewpoint: bool,
     /// PTF: a candidate closer than this to a kept one (m, ≥ 0)… Default 0.2.
     pub position_threshold: f64,
     /// … and whose view direction differs by less than this (rad, ≥ 0) is dropped.
@@ -63,6 +69,10 @@ pub struct NbvParams {
     pub gain_threshold: f64,
     /// Gain method. Default intersection (S0).
     pub gain: GainMethod,
+    /// The intersection gain counts only unknown cells inside `region`
+    /// (space beyond it, e.g. behind the room's walls, never becomes known
+    /// and would lure views forever). Ray gains ignore it. Default false.
+    pub gain_in_region: bool,
     pub weights: Weights,
     /// Scale the weights by the unknown share u of the region: `w_i·(0.5 + u)`,
     /// `w_d·(1.5 − u)`, `w_r·(1.5 − u)` (S0 future work; our rule). Default false.
@@ -106,10 +116,12 @@ impl Default for NbvParams {
             extra_candidates: Vec::new(),
             robot_base: Isometry3::identity(),
             reach: None,
+            free_viewpoint: false,
             position_threshold: 0.2,
             orientation_threshold: 0.35,
             gain_threshold: 0.01,
             gain: GainMethod::Intersection,
+            gain_in_region: false,
             weights: Weights::default(),
             adaptive_weights: false,
             ik_check: 10,

@@ -11,10 +11,10 @@ use rayon::prelude::*;
 
 use super::camera::{CameraModel, Frustum};
 use super::frontier::{candidate_pose, frontier_cells, potential_field};
-use super::gain::{GainMethod, GainWorkspace, frustum_unknown_count, ray_gain};
+use super::gain::{GainMethod, GainWorkspace, frustum_unknown_count_in, ray_gain};
 use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
-use crate::octree::Octree;
+use crate::octree::{CellState, Octree};
 use crate::robot::Chain;
 
 /// How the request ended.
@@ -138,7 +138,9 @@ pub fn estimate_reach(chain: &Chain) -> f64 {
 /// 1. candidates: frontier cells (free, ≥ `frontier_unknown_ratio` unknown
 ///    neighbours), each looking along its potential field `F = ΣF_p − ΣF_o` from a
 ///    stand-off, plus `extra_candidates`;
-/// 2. ORF: `‖p' − base‖ > reach` dropped; PTF: dropped when a kept candidate is within
+/// 2. ORF: `‖p' − base‖ > reach` dropped (with `free_viewpoint`, also a
+///    camera position in an occupied cell, in an unknown cell inside the
+///    region, or below the region); PTF: dropped when a kept candidate is within
 ///    `position_threshold` (k-d tree) and `orientation_threshold`; IGF: `Ig <
 ///    gain_threshold` dropped (gains computed in parallel);
 /// 3. `f = w_d·D + w_r·R + w_i·Ig`, `D = 1 − ‖p_c − p'‖/(2·d_max)` (d_max the largest
@@ -237,6 +239,20 @@ pub fn next_best_view(
         let base = params.robot_base.translation.vector;
         cands.retain(|(p, _)| (p.translation.vector - base).norm() <= r);
     }
+    if params.free_viewpoint {
+        cands.retain(|(p, _)| {
+            let at = Point3::from(p.translation.vector);
+            let inside = region
+                .as_ref()
+                .map(|(a, b)| (0..3).all(|i| at[i] >= a[i] && at[i] <= b[i]));
+            let below = region.as_ref().is_some_and(|(a, _)| at.z < a.z);
+            match tree.state_at(&at, crate::octree::TREE_DEPTH) {
+                Ok((CellState::Free, _)) => true,
+                Ok((CellState::Unknown, _)) => inside == Some(false) && !below,
+                _ => false,
+            }
+        });
+    }
     st.after_orf = cands.len();
     st.orf_us = us(t);
 
@@ -263,6 +279,10 @@ pub fn next_best_view(
 
     // 2c. IGF
     let t = Instant::now();
+    let gain_keys = match (&region, params.gain_in_region) {
+        (Some((a, b)), true) => Some((tree.key_of(a)?, tree.key_of(b)?)),
+        _ => None,
+    };
     let c_max = camera.frustum_volume() / tree.resolution().powi(3);
     let gains: Vec<Option<(f64, f64, u64)>> = kept
         .par_iter()
@@ -272,7 +292,7 @@ pub fn next_best_view(
             }
             Some(match params.gain {
                 GainMethod::Intersection => {
-                    let c = frustum_unknown_count(tree, &Frustum::new(camera, pose)) as f64;
+                    let c = frustum_unknown_count_in(tree, &Frustum::new(camera, pose), gain_keys) as f64;
                     (c, c / c_max, 0)
                 }
                 m => {

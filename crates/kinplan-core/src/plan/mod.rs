@@ -9,7 +9,7 @@ mod costs;
 mod entry;
 mod error;
 mod initial;
-mod noise;
+pub(crate) mod noise;
 mod params;
 mod rrt_connect;
 mod stomp;

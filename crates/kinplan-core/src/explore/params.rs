@@ -1,0 +1,223 @@
+//! Parameters of an exploration run, with units, defaults and validation.
+
+use std::time::Duration;
+
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+
+use super::{ExploreError, ExploreField, SensorParams};
+use crate::nbv::{CameraModel, NbvParams};
+use crate::plan::{Algorithm, PlanRequest};
+
+/// When the loop stops (whichever comes first).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StopRule {
+    /// Share of the region's observable cells known (free or occupied) at
+    /// which the exploration is complete (in (0, 1]). Default 0.95.
+    pub known_ratio: f64,
+    /// Iterations at most (count ≥ 1). Default 40.
+    pub max_iterations: usize,
+    /// Iterations in a row without a successful motion at most (count ≥ 1).
+    /// Default 4.
+    pub max_consecutive_failures: usize,
+}
+
+impl Default for StopRule {
+    fn default() -> Self {
+        StopRule {
+            known_ratio: 0.95,
+            max_iterations: 40,
+            max_consecutive_failures: 4,
+        }
+    }
+}
+
+/// Options of [`explore`](super::explore) (ALGORITHMS.md §5, S0 §4–5). The
+/// world frame is the robot's base frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExploreParams {
+    /// The box explored (m): NBV searches it for frontiers, the known ratio
+    /// counts its cells, and the planner avoids the occupied cells inside it.
+    pub region: (Point3<f64>, Point3<f64>),
+    /// Octree resolution (m, in [0.01, 1]). Default 0.1.
+    pub resolution: f64,
+    pub camera: CameraModel,
+    /// Camera optical frame in the chain's tip frame. Default: 5 cm along
+    /// the tip's z axis, turned −90° about it, so a tip whose x axis points
+    /// down (ROS-Industrial's tool0 on a level arm) gives an upright image.
+    pub camera_mount: Isometry3<f64>,
+    pub sensor: SensorParams,
+    /// Next-best-view options. The loop sets `region`, `robot_base`,
+    /// `camera_mount`, `count_failures`, `prior_failures`, `max_results`
+    /// and `seed` itself; the rest (weights, filters, gain method, IK) is
+    /// taken from here.
+    pub nbv: NbvParams,
+    /// Planner and its options. The loop sets `start`, `goal` and `seed`.
+    /// Default CCSTOMP with the defaults of [`PlanRequest`].
+    pub plan: PlanRequest,
+    /// Wall-clock budget of one planning call (m, > 0). Default 2 s.
+    pub plan_time_budget: Duration,
+    /// Ranked views tried per iteration, best first, until one is reached
+    /// (count ≥ 1); each that fails IK or planning is recorded as a failure
+    /// at its position and lowers its utility in later iterations (S0's
+    /// future work). Default 5.
+    pub candidates_per_iteration: usize,
+    /// Camera poses (optical frame, world) offered to NBV beside the
+    /// frontier candidates in every iteration; they pass the same filters
+    /// and gain. Frontier views sit a stand-off from the frontier, often
+    /// inside clutter a large arm cannot enter; these stand in the free
+    /// band between the robot and the region. Default
+    /// [`ExploreParams::approach_views`] of the region.
+    pub extra_views: Vec<Isometry3<f64>>,
+    /// Joint offsets (rad, one vector of `dof` values each) visited from the
+    /// start before the first iteration, scanning at each (S0 §4: an
+    /// initial motion of the last joints only). Offsets that would put the
+    /// robot in collision or outside its limits are skipped. Default:
+    /// [`ExploreParams::wrist_sweep`] for a 6-joint arm.
+    pub initial_offsets: Vec<Vec<f64>>,
+    pub stop: StopRule,
+    /// Seeds the NBV IK restarts, the planner and the sensor noise.
+    pub seed: u64,
+}
+
+impl ExploreParams {
+    /// Offsets of the last three joints of a 6-joint arm: ±0.5 rad on joint
+    /// 5 (pitch) and ±0.6 rad on joint 4 (roll), then back to the start.
+    pub fn wrist_sweep(dof: usize) -> Vec<Vec<f64>> {
+        if dof < 3 {
+            return Vec::new();
+        }
+        let offset = |j: usize, v: f64| {
+            let mut o = vec![0.0; dof];
+            o[j] = v;
+            o
+        };
+        vec![
+            offset(dof - 2, 0.5),
+            offset(dof - 2, -0.5),
+            offset(dof - 3, 0.6),
+            offset(dof - 3, -0.6),
+        ]
+    }
+
+    /// Views from the band in front of the region's near (−x) face: camera
+    /// positions 0.4 m and 0.8 m before it, at five evenly spaced y across
+    /// the region and at three heights (the region's middle, 0.3 m and
+    /// 0.7 m above its top), each aimed at three points on the region's
+    /// mid-height line (y at ¼, ½, ¾): 90 poses.
+    pub fn approach_views(region: &(Point3<f64>, Point3<f64>)) -> Vec<Isometry3<f64>> {
+        let (a, b) = region;
+        let mid_z = 0.5 * (a.z + b.z);
+        let mid_x = 0.5 * (a.x + b.x);
+        let mut out = Vec::with_capacity(90);
+        for dx in [0.4, 0.8] {
+            for k in 0..5 {
+                let y = a.y + (b.y - a.y) * (k as f64 + 0.5) / 5.0;
+                for z in [mid_z, b.z + 0.3, b.z + 0.7] {
+                    let p = Point3::new(a.x - dx, y, z);
+                    for t in [0.25, 0.5, 0.75] {
+                        let aim = Point3::new(mid_x, a.y + (b.y - a.y) * t, mid_z);
+                        out.extend(crate::nbv::look_along(&p, &(aim - p)));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Defaults for a region and a robot with `dof` joints.
+    pub fn new(region: (Point3<f64>, Point3<f64>), dof: usize) -> Self {
+        ExploreParams {
+            region,
+            resolution: 0.1,
+            camera: CameraModel::default(),
+            camera_mount: Isometry3::from_parts(
+                Translation3::new(0.0, 0.0, 0.05),
+                UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -std::f64::consts::FRAC_PI_2),
+            ),
+            sensor: SensorParams::default(),
+            nbv: NbvParams::default(),
+            plan: PlanRequest {
+                algorithm: Algorithm::Ccstomp,
+                ..PlanRequest::default()
+            },
+            plan_time_budget: Duration::from_secs(2),
+            candidates_per_iteration: 5,
+            extra_views: Self::approach_views(&region),
+            initial_offsets: Self::wrist_sweep(dof),
+            stop: StopRule::default(),
+            seed: 0,
+        }
+    }
+
+    /// Checks the ranges given in the field docs (the NBV and planner
+    /// options are checked by their own rooms).
+    pub fn validate(&self, dof: usize) -> Result<(), ExploreError> {
+        use ExploreField as F;
+        let bad = |f, r: &str| Err(ExploreError::invalid(f, r));
+        let (a, b) = &self.region;
+        if a.iter()
+            .chain(b.iter())
+            .any(|v| !v.is_finite() || v.abs() > 1.0e3)
+        {
+            return bad(F::Region, "corners must be finite and within ±1000 m");
+        }
+        if (0..3).any(|i| a[i] >= b[i]) {
+            return bad(F::Region, "min must be below max on every axis");
+        }
+        if !(self.resolution >= 0.01 && self.resolution <= 1.0) {
+            return bad(F::Resolution, "must lie in [0.01, 1] m");
+        }
+        let cells = (0..3)
+            .map(|i| ((b[i] - a[i]) / self.resolution).ceil())
+            .product::<f64>();
+        if cells > 4.0e6 {
+            return bad(F::Region, "holds more than 4 million cells at this resolution");
+        }
+        let m = &self.camera_mount;
+        if m.translation
+            .vector
+            .iter()
+            .chain(m.rotation.coords.iter())
+            .any(|v| !v.is_finite())
+        {
+            return bad(F::CameraMount, "must be finite");
+        }
+        if self.sensor.pixel_stride == 0 || self.sensor.pixel_stride > 64 {
+            return bad(F::PixelStride, "must lie in [1, 64]");
+        }
+        if !(self.sensor.noise_stddev.is_finite() && self.sensor.noise_stddev >= 0.0) {
+            return bad(F::NoiseStddev, "must be finite and ≥ 0");
+        }
+        if !(self.stop.known_ratio > 0.0 && self.stop.known_ratio <= 1.0) {
+            return bad(F::KnownRatio, "must lie in (0, 1]");
+        }
+        if self.stop.max_iterations == 0 || self.stop.max_iterations > 10_000 {
+            return bad(F::MaxIterations, "must lie in [1, 10000]");
+        }
+        if self.stop.max_consecutive_failures == 0 {
+            return bad(F::ConsecutiveFailures, "must be ≥ 1");
+        }
+        if self.candidates_per_iteration == 0 || self.candidates_per_iteration > 100 {
+            return bad(F::CandidatesPerIteration, "must lie in [1, 100]");
+        }
+        if self.plan_time_budget.is_zero() {
+            return bad(F::PlanTimeBudget, "must be > 0");
+        }
+        if self.extra_views.len() > 10_000 {
+            return bad(F::ExtraViews, "at most 10000 views");
+        }
+        if self.initial_offsets.len() > 64 {
+            return bad(F::InitialOffsets, "at most 64 offsets");
+        }
+        if self
+            .initial_offsets
+            .iter()
+            .any(|o| o.len() != dof || o.iter().any(|v| !v.is_finite()))
+        {
+            return bad(F::InitialOffsets, "each offset needs one finite value per joint");
+        }
+        self.camera.validate()?;
+        self.nbv.validate()?;
+        Ok(())
+    }
+}
