@@ -2,6 +2,7 @@
 //! loopback port and calls it over gRPC, as clients do.
 
 mod exploration;
+mod explore;
 mod hardening;
 mod hostile;
 mod kinematics;

@@ -89,6 +89,29 @@ impl CollisionModels {
     }
 }
 
+/// The chain's collision setup: cached, or built on the CPU pool (and cached
+/// even if this request's deadline passes meanwhile).
+pub async fn collision_setup(
+    shared: &super::server::Shared,
+    robot: &super::models::Resolved,
+    budget: &super::Budget,
+) -> Result<Arc<CollisionSetup>, tonic::Status> {
+    let cache = shared.collision.clone();
+    if let Some(s) = cache.get(&robot.chain) {
+        return Ok(s);
+    }
+    let chain = robot.chain.clone();
+    shared
+        .compute
+        .run(budget, move |_| {
+            let setup = Arc::new(CollisionSetup::build(chain.clone(), cache.acm_samples)?);
+            cache.insert(&chain, setup.clone());
+            Ok(setup)
+        })
+        .await?
+        .map_err(|e: CollisionError| super::status::invalid("robot", e.to_string()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -55,6 +55,17 @@ impl ExplorationApi {
 
 #[tonic::async_trait]
 impl ExplorationService for ExplorationApi {
+    type ExploreStream = super::explore::ExploreStream;
+
+    async fn explore(
+        &self,
+        request: Request<pb::ExploreRequest>,
+    ) -> Result<Response<Self::ExploreStream>, Status> {
+        super::explore::explore_stream(&self.shared, request)
+            .await
+            .map(Response::new)
+    }
+
     async fn next_best_view(
         &self,
         request: Request<pb::NextBestViewRequest>,

@@ -118,6 +118,8 @@ pub fn nbv_params_in(req: &pb::NextBestViewRequest) -> Result<NbvParams, Status>
             })
             .collect::<Result<_, _>>()?,
         max_results: o.max_results.map_or(d.max_results, |v| v as usize),
+        free_viewpoint: o.free_viewpoint,
+        gain_in_region: o.gain_in_region,
         time_budget,
         seed: o.seed,
     };

@@ -9,6 +9,8 @@ mod compute;
 mod convert;
 mod exploration;
 mod exploration_convert;
+mod explore;
+mod explore_convert;
 mod finite;
 mod guard;
 mod kinematics;

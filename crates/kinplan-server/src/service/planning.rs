@@ -12,7 +12,7 @@ use std::time::Instant;
 use tokio_stream::wrappers::ReceiverStream;
 use tonic::{Request, Response, Status};
 
-use super::collision_models::CollisionSetup;
+use super::collision_models::{CollisionSetup, collision_setup};
 use super::convert::vec3_out;
 use super::kinematics::soft_deadline;
 use super::pb::{self, planning_service_server::PlanningService};
@@ -38,25 +38,6 @@ impl PlanningApi {
         Self { shared }
     }
 
-    /// The chain's collision setup: cached, or built on the CPU pool (and
-    /// cached even if this request's deadline passes meanwhile).
-    async fn setup(&self, robot: &Resolved, budget: &Budget) -> Result<Arc<CollisionSetup>, Status> {
-        let cache = self.shared.collision.clone();
-        if let Some(s) = cache.get(&robot.chain) {
-            return Ok(s);
-        }
-        let chain = robot.chain.clone();
-        self.shared
-            .compute
-            .run(budget, move |_| {
-                let setup = Arc::new(CollisionSetup::build(chain.clone(), cache.acm_samples)?);
-                cache.insert(&chain, setup.clone());
-                Ok(setup)
-            })
-            .await?
-            .map_err(|e: kinplan_core::collision::CollisionError| invalid("robot", e.to_string()))
-    }
-
     /// Everything a plan needs before the planner runs.
     async fn prepare(&self, request: &Request<pb::PlanRequest>) -> Result<Prepared, Status> {
         let (permit, budget, robot) = self
@@ -66,7 +47,7 @@ impl PlanningApi {
         let req = request.get_ref();
         let input = plan_input(req)?;
         let scene = scene_in("scene", req.scene.as_ref(), &SceneLimits::default())?;
-        let setup = self.setup(&robot, &budget).await?;
+        let setup = collision_setup(&self.shared, &robot, &budget).await?;
         let soft = soft_deadline(budget.deadline());
         let deadline = match (
             input.time_budget.and_then(|b| Instant::now().checked_add(b)),
@@ -252,7 +233,7 @@ impl PlanningService for PlanningApi {
             }
         };
         let scene = scene_in("scene", req.scene.as_ref(), &SceneLimits::default())?;
-        let setup = self.setup(&robot, &budget).await?;
+        let setup = collision_setup(&self.shared, &robot, &budget).await?;
         let states = self
             .shared
             .compute
