@@ -11,6 +11,7 @@ from ._convert import joints, matrix_from_proto, pose_to_matrix
 from .errors import KinplanError
 from .kinematics import KinematicsMixin, RobotKinematicsMixin
 from .mobile import MobileMixin
+from .explore import ExploreMixin
 from .exploration import ExplorationMixin
 from .planning import PlanningMixin
 from .scoring import ScoringMixin
@@ -19,7 +20,7 @@ from .v1 import common_pb2, robot_pb2, robot_pb2_grpc
 DEFAULT_TIMEOUT = 30.0
 
 
-class Client(ExplorationMixin, PlanningMixin, ScoringMixin, MobileMixin, KinematicsMixin):
+class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, MobileMixin, KinematicsMixin):
     """A connection to a kinplan server.
 
     `timeout` (seconds) is the default deadline of every call; each method

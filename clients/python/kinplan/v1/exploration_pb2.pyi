@@ -1,4 +1,5 @@
 from kinplan.v1 import common_pb2 as _common_pb2
+from kinplan.v1 import planning_pb2 as _planning_pb2
 from google.protobuf.internal import containers as _containers
 from google.protobuf.internal import enum_type_wrapper as _enum_type_wrapper
 from google.protobuf import descriptor as _descriptor
@@ -28,6 +29,16 @@ class NbvStatus(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
     NBV_STATUS_COMPLETE: _ClassVar[NbvStatus]
     NBV_STATUS_TIME_BUDGET: _ClassVar[NbvStatus]
     NBV_STATUS_CANCELLED: _ClassVar[NbvStatus]
+
+class ExploreStatus(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
+    __slots__ = ()
+    EXPLORE_STATUS_UNSPECIFIED: _ClassVar[ExploreStatus]
+    EXPLORE_STATUS_EXPLORED: _ClassVar[ExploreStatus]
+    EXPLORE_STATUS_ITERATION_CAP: _ClassVar[ExploreStatus]
+    EXPLORE_STATUS_CONSECUTIVE_FAILURES: _ClassVar[ExploreStatus]
+    EXPLORE_STATUS_NO_CANDIDATES: _ClassVar[ExploreStatus]
+    EXPLORE_STATUS_TIMEOUT: _ClassVar[ExploreStatus]
+    EXPLORE_STATUS_CANCELLED: _ClassVar[ExploreStatus]
 GAIN_METHOD_UNSPECIFIED: GainMethod
 GAIN_METHOD_INTERSECTION: GainMethod
 GAIN_METHOD_RAYS: GainMethod
@@ -40,6 +51,13 @@ NBV_STATUS_UNSPECIFIED: NbvStatus
 NBV_STATUS_COMPLETE: NbvStatus
 NBV_STATUS_TIME_BUDGET: NbvStatus
 NBV_STATUS_CANCELLED: NbvStatus
+EXPLORE_STATUS_UNSPECIFIED: ExploreStatus
+EXPLORE_STATUS_EXPLORED: ExploreStatus
+EXPLORE_STATUS_ITERATION_CAP: ExploreStatus
+EXPLORE_STATUS_CONSECUTIVE_FAILURES: ExploreStatus
+EXPLORE_STATUS_NO_CANDIDATES: ExploreStatus
+EXPLORE_STATUS_TIMEOUT: ExploreStatus
+EXPLORE_STATUS_CANCELLED: ExploreStatus
 
 class CameraModel(_message.Message):
     __slots__ = ("horizontal_fov", "vertical_fov", "near_range", "far_range", "width", "height")
@@ -84,7 +102,7 @@ class ViewFailure(_message.Message):
     def __init__(self, position: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., count: _Optional[int] = ...) -> None: ...
 
 class NbvOptions(_message.Message):
-    __slots__ = ("region", "frontier_unknown_ratio", "max_frontier_candidates", "field_radius", "standoff", "reach", "position_threshold", "orientation_threshold", "gain_threshold", "gain", "ray_fraction", "weights", "adaptive_weights", "ik_check", "count_failures", "failure_penalty", "prior_failures", "max_results", "time_budget", "seed")
+    __slots__ = ("region", "frontier_unknown_ratio", "max_frontier_candidates", "field_radius", "standoff", "reach", "position_threshold", "orientation_threshold", "gain_threshold", "gain", "ray_fraction", "weights", "adaptive_weights", "ik_check", "count_failures", "failure_penalty", "prior_failures", "max_results", "time_budget", "seed", "free_viewpoint", "gain_in_region")
     REGION_FIELD_NUMBER: _ClassVar[int]
     FRONTIER_UNKNOWN_RATIO_FIELD_NUMBER: _ClassVar[int]
     MAX_FRONTIER_CANDIDATES_FIELD_NUMBER: _ClassVar[int]
@@ -105,6 +123,8 @@ class NbvOptions(_message.Message):
     MAX_RESULTS_FIELD_NUMBER: _ClassVar[int]
     TIME_BUDGET_FIELD_NUMBER: _ClassVar[int]
     SEED_FIELD_NUMBER: _ClassVar[int]
+    FREE_VIEWPOINT_FIELD_NUMBER: _ClassVar[int]
+    GAIN_IN_REGION_FIELD_NUMBER: _ClassVar[int]
     region: BoundingBox
     frontier_unknown_ratio: float
     max_frontier_candidates: int
@@ -125,7 +145,9 @@ class NbvOptions(_message.Message):
     max_results: int
     time_budget: float
     seed: int
-    def __init__(self, region: _Optional[_Union[BoundingBox, _Mapping]] = ..., frontier_unknown_ratio: _Optional[float] = ..., max_frontier_candidates: _Optional[int] = ..., field_radius: _Optional[float] = ..., standoff: _Optional[float] = ..., reach: _Optional[float] = ..., position_threshold: _Optional[float] = ..., orientation_threshold: _Optional[float] = ..., gain_threshold: _Optional[float] = ..., gain: _Optional[_Union[GainMethod, str]] = ..., ray_fraction: _Optional[float] = ..., weights: _Optional[_Union[UtilityWeights, _Mapping]] = ..., adaptive_weights: _Optional[bool] = ..., ik_check: _Optional[int] = ..., count_failures: _Optional[bool] = ..., failure_penalty: _Optional[float] = ..., prior_failures: _Optional[_Iterable[_Union[ViewFailure, _Mapping]]] = ..., max_results: _Optional[int] = ..., time_budget: _Optional[float] = ..., seed: _Optional[int] = ...) -> None: ...
+    free_viewpoint: bool
+    gain_in_region: bool
+    def __init__(self, region: _Optional[_Union[BoundingBox, _Mapping]] = ..., frontier_unknown_ratio: _Optional[float] = ..., max_frontier_candidates: _Optional[int] = ..., field_radius: _Optional[float] = ..., standoff: _Optional[float] = ..., reach: _Optional[float] = ..., position_threshold: _Optional[float] = ..., orientation_threshold: _Optional[float] = ..., gain_threshold: _Optional[float] = ..., gain: _Optional[_Union[GainMethod, str]] = ..., ray_fraction: _Optional[float] = ..., weights: _Optional[_Union[UtilityWeights, _Mapping]] = ..., adaptive_weights: _Optional[bool] = ..., ik_check: _Optional[int] = ..., count_failures: _Optional[bool] = ..., failure_penalty: _Optional[float] = ..., prior_failures: _Optional[_Iterable[_Union[ViewFailure, _Mapping]]] = ..., max_results: _Optional[int] = ..., time_budget: _Optional[float] = ..., seed: _Optional[int] = ..., free_viewpoint: _Optional[bool] = ..., gain_in_region: _Optional[bool] = ...) -> None: ...
 
 class NextBestViewRequest(_message.Message):
     __slots__ = ("octree", "camera", "camera_pose", "robot", "robot_base", "camera_mount", "candidate_poses", "options")
@@ -314,3 +336,166 @@ class OctreeInfoResponse(_message.Message):
     free_volume: float
     unknown_volume: float
     def __init__(self, stats: _Optional[_Union[OctreeStats, _Mapping]] = ..., occupied_volume: _Optional[float] = ..., free_volume: _Optional[float] = ..., unknown_volume: _Optional[float] = ...) -> None: ...
+
+class ExploreStopRule(_message.Message):
+    __slots__ = ("known_ratio", "max_iterations", "max_consecutive_failures")
+    KNOWN_RATIO_FIELD_NUMBER: _ClassVar[int]
+    MAX_ITERATIONS_FIELD_NUMBER: _ClassVar[int]
+    MAX_CONSECUTIVE_FAILURES_FIELD_NUMBER: _ClassVar[int]
+    known_ratio: float
+    max_iterations: int
+    max_consecutive_failures: int
+    def __init__(self, known_ratio: _Optional[float] = ..., max_iterations: _Optional[int] = ..., max_consecutive_failures: _Optional[int] = ...) -> None: ...
+
+class ExploreRequest(_message.Message):
+    __slots__ = ("robot", "start", "scene", "region", "camera", "camera_mount", "nbv", "algorithm", "plan_options", "stop", "resolution", "pixel_stride", "noise_stddev", "candidates_per_iteration", "plan_time_budget", "initial_offsets", "no_initial_offsets", "extra_views", "no_extra_views", "seed", "time_budget")
+    ROBOT_FIELD_NUMBER: _ClassVar[int]
+    START_FIELD_NUMBER: _ClassVar[int]
+    SCENE_FIELD_NUMBER: _ClassVar[int]
+    REGION_FIELD_NUMBER: _ClassVar[int]
+    CAMERA_FIELD_NUMBER: _ClassVar[int]
+    CAMERA_MOUNT_FIELD_NUMBER: _ClassVar[int]
+    NBV_FIELD_NUMBER: _ClassVar[int]
+    ALGORITHM_FIELD_NUMBER: _ClassVar[int]
+    PLAN_OPTIONS_FIELD_NUMBER: _ClassVar[int]
+    STOP_FIELD_NUMBER: _ClassVar[int]
+    RESOLUTION_FIELD_NUMBER: _ClassVar[int]
+    PIXEL_STRIDE_FIELD_NUMBER: _ClassVar[int]
+    NOISE_STDDEV_FIELD_NUMBER: _ClassVar[int]
+    CANDIDATES_PER_ITERATION_FIELD_NUMBER: _ClassVar[int]
+    PLAN_TIME_BUDGET_FIELD_NUMBER: _ClassVar[int]
+    INITIAL_OFFSETS_FIELD_NUMBER: _ClassVar[int]
+    NO_INITIAL_OFFSETS_FIELD_NUMBER: _ClassVar[int]
+    EXTRA_VIEWS_FIELD_NUMBER: _ClassVar[int]
+    NO_EXTRA_VIEWS_FIELD_NUMBER: _ClassVar[int]
+    SEED_FIELD_NUMBER: _ClassVar[int]
+    TIME_BUDGET_FIELD_NUMBER: _ClassVar[int]
+    robot: _common_pb2.RobotRef
+    start: _containers.RepeatedScalarFieldContainer[float]
+    scene: _common_pb2.Scene
+    region: BoundingBox
+    camera: CameraModel
+    camera_mount: _common_pb2.Pose
+    nbv: NbvOptions
+    algorithm: _planning_pb2.PlanAlgorithm
+    plan_options: _planning_pb2.PlanOptions
+    stop: ExploreStopRule
+    resolution: float
+    pixel_stride: int
+    noise_stddev: float
+    candidates_per_iteration: int
+    plan_time_budget: float
+    initial_offsets: _common_pb2.Matrix
+    no_initial_offsets: bool
+    extra_views: _containers.RepeatedCompositeFieldContainer[_common_pb2.Pose]
+    no_extra_views: bool
+    seed: int
+    time_budget: float
+    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., start: _Optional[_Iterable[float]] = ..., scene: _Optional[_Union[_common_pb2.Scene, _Mapping]] = ..., region: _Optional[_Union[BoundingBox, _Mapping]] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ..., camera_mount: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., nbv: _Optional[_Union[NbvOptions, _Mapping]] = ..., algorithm: _Optional[_Union[_planning_pb2.PlanAlgorithm, str]] = ..., plan_options: _Optional[_Union[_planning_pb2.PlanOptions, _Mapping]] = ..., stop: _Optional[_Union[ExploreStopRule, _Mapping]] = ..., resolution: _Optional[float] = ..., pixel_stride: _Optional[int] = ..., noise_stddev: _Optional[float] = ..., candidates_per_iteration: _Optional[int] = ..., plan_time_budget: _Optional[float] = ..., initial_offsets: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., no_initial_offsets: _Optional[bool] = ..., extra_views: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., no_extra_views: _Optional[bool] = ..., seed: _Optional[int] = ..., time_budget: _Optional[float] = ...) -> None: ...
+
+class FailedView(_message.Message):
+    __slots__ = ("position", "reason")
+    POSITION_FIELD_NUMBER: _ClassVar[int]
+    REASON_FIELD_NUMBER: _ClassVar[int]
+    position: _common_pb2.Vec3
+    reason: str
+    def __init__(self, position: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., reason: _Optional[str] = ...) -> None: ...
+
+class ExploreTimes(_message.Message):
+    __slots__ = ("nbv", "plan", "sense", "insert", "total")
+    NBV_FIELD_NUMBER: _ClassVar[int]
+    PLAN_FIELD_NUMBER: _ClassVar[int]
+    SENSE_FIELD_NUMBER: _ClassVar[int]
+    INSERT_FIELD_NUMBER: _ClassVar[int]
+    TOTAL_FIELD_NUMBER: _ClassVar[int]
+    nbv: float
+    plan: float
+    sense: float
+    insert: float
+    total: float
+    def __init__(self, nbv: _Optional[float] = ..., plan: _Optional[float] = ..., sense: _Optional[float] = ..., insert: _Optional[float] = ..., total: _Optional[float] = ...) -> None: ...
+
+class ExploreIteration(_message.Message):
+    __slots__ = ("iteration", "view", "view_rank", "trajectory", "criteria", "hits_scene", "failures", "candidates", "known_ratio", "joints", "times")
+    class CriteriaEntry(_message.Message):
+        __slots__ = ("key", "value")
+        KEY_FIELD_NUMBER: _ClassVar[int]
+        VALUE_FIELD_NUMBER: _ClassVar[int]
+        key: str
+        value: float
+        def __init__(self, key: _Optional[str] = ..., value: _Optional[float] = ...) -> None: ...
+    ITERATION_FIELD_NUMBER: _ClassVar[int]
+    VIEW_FIELD_NUMBER: _ClassVar[int]
+    VIEW_RANK_FIELD_NUMBER: _ClassVar[int]
+    TRAJECTORY_FIELD_NUMBER: _ClassVar[int]
+    CRITERIA_FIELD_NUMBER: _ClassVar[int]
+    HITS_SCENE_FIELD_NUMBER: _ClassVar[int]
+    FAILURES_FIELD_NUMBER: _ClassVar[int]
+    CANDIDATES_FIELD_NUMBER: _ClassVar[int]
+    KNOWN_RATIO_FIELD_NUMBER: _ClassVar[int]
+    JOINTS_FIELD_NUMBER: _ClassVar[int]
+    TIMES_FIELD_NUMBER: _ClassVar[int]
+    iteration: int
+    view: ViewCandidate
+    view_rank: int
+    trajectory: _common_pb2.JointTrajectory
+    criteria: _containers.ScalarMap[str, float]
+    hits_scene: bool
+    failures: _containers.RepeatedCompositeFieldContainer[FailedView]
+    candidates: int
+    known_ratio: float
+    joints: _containers.RepeatedScalarFieldContainer[float]
+    times: ExploreTimes
+    def __init__(self, iteration: _Optional[int] = ..., view: _Optional[_Union[ViewCandidate, _Mapping]] = ..., view_rank: _Optional[int] = ..., trajectory: _Optional[_Union[_common_pb2.JointTrajectory, _Mapping]] = ..., criteria: _Optional[_Mapping[str, float]] = ..., hits_scene: _Optional[bool] = ..., failures: _Optional[_Iterable[_Union[FailedView, _Mapping]]] = ..., candidates: _Optional[int] = ..., known_ratio: _Optional[float] = ..., joints: _Optional[_Iterable[float]] = ..., times: _Optional[_Union[ExploreTimes, _Mapping]] = ...) -> None: ...
+
+class ExploreTotals(_message.Message):
+    __slots__ = ("jd", "cpc", "cd", "oc", "rdm", "trajectories")
+    JD_FIELD_NUMBER: _ClassVar[int]
+    CPC_FIELD_NUMBER: _ClassVar[int]
+    CD_FIELD_NUMBER: _ClassVar[int]
+    OC_FIELD_NUMBER: _ClassVar[int]
+    RDM_FIELD_NUMBER: _ClassVar[int]
+    TRAJECTORIES_FIELD_NUMBER: _ClassVar[int]
+    jd: float
+    cpc: float
+    cd: float
+    oc: float
+    rdm: float
+    trajectories: int
+    def __init__(self, jd: _Optional[float] = ..., cpc: _Optional[float] = ..., cd: _Optional[float] = ..., oc: _Optional[float] = ..., rdm: _Optional[float] = ..., trajectories: _Optional[int] = ...) -> None: ...
+
+class ExploreSummary(_message.Message):
+    __slots__ = ("status", "iterations", "initial_known_ratio", "known_ratio", "observable_cells", "totals", "failures", "scene_hits", "final_joints", "octree", "scans", "elapsed")
+    STATUS_FIELD_NUMBER: _ClassVar[int]
+    ITERATIONS_FIELD_NUMBER: _ClassVar[int]
+    INITIAL_KNOWN_RATIO_FIELD_NUMBER: _ClassVar[int]
+    KNOWN_RATIO_FIELD_NUMBER: _ClassVar[int]
+    OBSERVABLE_CELLS_FIELD_NUMBER: _ClassVar[int]
+    TOTALS_FIELD_NUMBER: _ClassVar[int]
+    FAILURES_FIELD_NUMBER: _ClassVar[int]
+    SCENE_HITS_FIELD_NUMBER: _ClassVar[int]
+    FINAL_JOINTS_FIELD_NUMBER: _ClassVar[int]
+    OCTREE_FIELD_NUMBER: _ClassVar[int]
+    SCANS_FIELD_NUMBER: _ClassVar[int]
+    ELAPSED_FIELD_NUMBER: _ClassVar[int]
+    status: ExploreStatus
+    iterations: int
+    initial_known_ratio: float
+    known_ratio: float
+    observable_cells: int
+    totals: ExploreTotals
+    failures: int
+    scene_hits: int
+    final_joints: _containers.RepeatedScalarFieldContainer[float]
+    octree: _common_pb2.Octree
+    scans: int
+    elapsed: float
+    def __init__(self, status: _Optional[_Union[ExploreStatus, str]] = ..., iterations: _Optional[int] = ..., initial_known_ratio: _Optional[float] = ..., known_ratio: _Optional[float] = ..., observable_cells: _Optional[int] = ..., totals: _Optional[_Union[ExploreTotals, _Mapping]] = ..., failures: _Optional[int] = ..., scene_hits: _Optional[int] = ..., final_joints: _Optional[_Iterable[float]] = ..., octree: _Optional[_Union[_common_pb2.Octree, _Mapping]] = ..., scans: _Optional[int] = ..., elapsed: _Optional[float] = ...) -> None: ...
+
+class ExploreResponse(_message.Message):
+    __slots__ = ("iteration", "summary")
+    ITERATION_FIELD_NUMBER: _ClassVar[int]
+    SUMMARY_FIELD_NUMBER: _ClassVar[int]
+    iteration: ExploreIteration
+    summary: ExploreSummary
+    def __init__(self, iteration: _Optional[_Union[ExploreIteration, _Mapping]] = ..., summary: _Optional[_Union[ExploreSummary, _Mapping]] = ...) -> None: ...

@@ -49,6 +49,11 @@ class ExplorationServiceStub:
                 request_serializer=kinplan_dot_v1_dot_exploration__pb2.OctreeInfoRequest.SerializeToString,
                 response_deserializer=kinplan_dot_v1_dot_exploration__pb2.OctreeInfoResponse.FromString,
                 _registered_method=True)
+        self.Explore = channel.unary_stream(
+                '/kinplan.v1.ExplorationService/Explore',
+                request_serializer=kinplan_dot_v1_dot_exploration__pb2.ExploreRequest.SerializeToString,
+                response_deserializer=kinplan_dot_v1_dot_exploration__pb2.ExploreResponse.FromString,
+                _registered_method=True)
 
 
 class ExplorationServiceServicer:
@@ -78,6 +83,19 @@ class ExplorationServiceServicer:
         context.set_details('Method not implemented!')
         raise NotImplementedError('Method not implemented!')
 
+    def Explore(self, request, context):
+        """Explores a region of a simulated scene end to end (S0 §4-5): a depth
+        camera on the robot scans from the start and a short wrist sweep, then
+        per iteration next-best-view -> IK -> plan (in the world known so far:
+        the octree's occupied cells) -> execute -> scan -> insert, until the
+        stop rule holds. One message per iteration, then a summary with the
+        final octree. The scene is the ground truth the camera renders; the
+        planner never sees it.
+        """
+        context.set_code(grpc.StatusCode.UNIMPLEMENTED)
+        context.set_details('Method not implemented!')
+        raise NotImplementedError('Method not implemented!')
+
 
 def add_ExplorationServiceServicer_to_server(servicer, server):
     rpc_method_handlers = {
@@ -95,6 +113,11 @@ def add_ExplorationServiceServicer_to_server(servicer, server):
                     servicer.OctreeInfo,
                     request_deserializer=kinplan_dot_v1_dot_exploration__pb2.OctreeInfoRequest.FromString,
                     response_serializer=kinplan_dot_v1_dot_exploration__pb2.OctreeInfoResponse.SerializeToString,
+            ),
+            'Explore': grpc.unary_stream_rpc_method_handler(
+                    servicer.Explore,
+                    request_deserializer=kinplan_dot_v1_dot_exploration__pb2.ExploreRequest.FromString,
+                    response_serializer=kinplan_dot_v1_dot_exploration__pb2.ExploreResponse.SerializeToString,
             ),
     }
     generic_handler = grpc.method_handlers_generic_handler(
@@ -178,6 +201,33 @@ class ExplorationService:
             '/kinplan.v1.ExplorationService/OctreeInfo',
             kinplan_dot_v1_dot_exploration__pb2.OctreeInfoRequest.SerializeToString,
             kinplan_dot_v1_dot_exploration__pb2.OctreeInfoResponse.FromString,
+            options,
+            channel_credentials,
+            insecure,
+            call_credentials,
+            compression,
+            wait_for_ready,
+            timeout,
+            metadata,
+            _registered_method=True)
+
+    @staticmethod
+    def Explore(request,
+            target,
+            options=(),
+            channel_credentials=None,
+            call_credentials=None,
+            insecure=False,
+            compression=None,
+            wait_for_ready=None,
+            timeout=None,
+            metadata=None):
+        return grpc.experimental.unary_stream(
+            request,
+            target,
+            '/kinplan.v1.ExplorationService/Explore',
+            kinplan_dot_v1_dot_exploration__pb2.ExploreRequest.SerializeToString,
+            kinplan_dot_v1_dot_exploration__pb2.ExploreResponse.FromString,
             options,
             channel_credentials,
             insecure,

@@ -53,6 +53,15 @@ class ExplorationServiceStub:
     """Resolution, node and leaf counts, bounds, and the free / occupied /
     unknown volume inside a box.
     """
+    Explore: _grpc.UnaryStreamMultiCallable[_exploration_pb2.ExploreRequest, _exploration_pb2.ExploreResponse]
+    """Explores a region of a simulated scene end to end (S0 §4-5): a depth
+    camera on the robot scans from the start and a short wrist sweep, then
+    per iteration next-best-view -> IK -> plan (in the world known so far:
+    the octree's occupied cells) -> execute -> scan -> insert, until the
+    stop rule holds. One message per iteration, then a summary with the
+    final octree. The scene is the ground truth the camera renders; the
+    planner never sees it.
+    """
 
 @_typing.type_check_only
 class ExplorationServiceAsyncStub(ExplorationServiceStub):
@@ -68,6 +77,15 @@ class ExplorationServiceAsyncStub(ExplorationServiceStub):
     OctreeInfo: _aio.UnaryUnaryMultiCallable[_exploration_pb2.OctreeInfoRequest, _exploration_pb2.OctreeInfoResponse]  # type: ignore[assignment]
     """Resolution, node and leaf counts, bounds, and the free / occupied /
     unknown volume inside a box.
+    """
+    Explore: _aio.UnaryStreamMultiCallable[_exploration_pb2.ExploreRequest, _exploration_pb2.ExploreResponse]  # type: ignore[assignment]
+    """Explores a region of a simulated scene end to end (S0 §4-5): a depth
+    camera on the robot scans from the start and a short wrist sweep, then
+    per iteration next-best-view -> IK -> plan (in the world known so far:
+    the octree's occupied cells) -> execute -> scan -> insert, until the
+    stop rule holds. One message per iteration, then a summary with the
+    final octree. The scene is the ground truth the camera renders; the
+    planner never sees it.
     """
 
 class ExplorationServiceServicer(metaclass=_abc_1.ABCMeta):
@@ -99,6 +117,21 @@ class ExplorationServiceServicer(metaclass=_abc_1.ABCMeta):
     ) -> _typing.Union[_exploration_pb2.OctreeInfoResponse, _abc.Awaitable[_exploration_pb2.OctreeInfoResponse]]:
         """Resolution, node and leaf counts, bounds, and the free / occupied /
         unknown volume inside a box.
+        """
+
+    @_abc_1.abstractmethod
+    def Explore(
+        self,
+        request: _exploration_pb2.ExploreRequest,
+        context: _ServicerContext,
+    ) -> _typing.Union[_abc.Iterator[_exploration_pb2.ExploreResponse], _abc.AsyncIterator[_exploration_pb2.ExploreResponse]]:
+        """Explores a region of a simulated scene end to end (S0 §4-5): a depth
+        camera on the robot scans from the start and a short wrist sweep, then
+        per iteration next-best-view -> IK -> plan (in the world known so far:
+        the octree's occupied cells) -> execute -> scan -> insert, until the
+        stop rule holds. One message per iteration, then a summary with the
+        final octree. The scene is the ground truth the camera renders; the
+        planner never sees it.
         """
 
 def add_ExplorationServiceServicer_to_server(servicer: ExplorationServiceServicer, server: _typing.Union[_grpc.Server, _aio.Server]) -> None: ...
