@@ -8,6 +8,7 @@
 //!   (IG1_T0_R0, IG0_T1_R0, IG1_T025_R01, IG1_T05_R01): iterations, final
 //!   known ratio, JD, CPC, CD, OC, RDM sums (mean ± sd over seeds); the
 //!   known ratio per iteration goes to `target/explore_known_ratio.csv`.
+//!   Seed k runs on the cell variant built with seed k + 1 (other clutter).
 //! - `tab54 [seeds]`: S0 Tab. 5.4/5.5 — the open cell explored with
 //!   RRT-Connect, STOMP and CCSTOMP: OC and CD mean, variance and sum per
 //!   trajectory; per-trajectory values to `target/explore_planners.csv`.
@@ -202,7 +203,8 @@ fn tab53(seeds: u64) {
             let mut cols: Vec<Vec<f64>> = vec![Vec::new(); 10];
             let mut statuses = Vec::new();
             for seed in 0..seeds {
-                let scene = scene_named(scene_name, 1);
+                // each seed is another variant of the cell (clutter sizes and places)
+                let scene = scene_named(scene_name, seed + 1);
                 let out = run(&s, &scene, weights(name), Algorithm::RrtConnect, seed, |st| {
                     let _ = writeln!(
                         csv,
@@ -267,7 +269,7 @@ fn tab54(seeds: u64) {
         let (mut oc, mut cd) = (Vec::new(), Vec::new());
         let (mut failures, mut hits, mut wall) = (0usize, 0usize, 0.0);
         for seed in 0..seeds {
-            let scene = s0_open_cell(1);
+            let scene = s0_open_cell(seed + 1);
             let t0 = Instant::now();
             let out = run(&s, &scene, weights("IG1_T025_R01"), algorithm, seed, |st| {
                 if let Some(m) = &st.motion {

@@ -213,3 +213,34 @@ async fn bad_exploration_requests_are_named_by_field() {
     assert_eq!(err.code(), Code::InvalidArgument);
     assert!(err.message().contains("start"), "{}", err.message());
 }
+
+#[tokio::test]
+async fn the_time_budget_ends_a_long_exploration_with_a_timeout_summary() {
+    let server = start(ServerConfig::default()).await;
+    let mut client = ExplorationServiceClient::new(server.channel.clone());
+    let mut req = request();
+    req.resolution = Some(0.1);
+    req.pixel_stride = Some(2);
+    req.stop = Some(pb::ExploreStopRule {
+        known_ratio: Some(1.0),
+        max_iterations: Some(10_000),
+        max_consecutive_failures: Some(10_000),
+    });
+    req.time_budget = Some(0.4);
+    let t0 = std::time::Instant::now();
+    let mut stream = client.explore(req).await.unwrap().into_inner();
+    let mut summary = None;
+    while let Some(msg) = stream.message().await.unwrap() {
+        if let Some(Event::Summary(s)) = msg.event {
+            summary = Some(s);
+        }
+    }
+    let s = summary.expect("a summary");
+    assert_eq!(s.status, pb::ExploreStatus::Timeout as i32);
+    // one stage past the budget at most: a plan is cut by the same deadline
+    assert!(
+        t0.elapsed() < std::time::Duration::from_secs(4),
+        "{:?}",
+        t0.elapsed()
+    );
+}

@@ -8,7 +8,7 @@ from ._convert import matrix_to_pose, pose_to_matrix
 from .client import Client, Robot, RobotDescription
 from .errors import KinplanError
 from .exploration import Octree, Views
-from .explore import ExploreStep, ExploreSummary
+from .explore import ExploreStep, ExploreSummary, ReferenceScene
 from .kinematics import IkBatchResult, IkResult, IkSolution, IkStream, LinearSolution, TrackResult
 from .mobile import Mobile, MobileRun, StepResult, WheelKinematics
 from .planning import Box, Capsule, Cylinder, Mesh, OctreeObstacle, Plan, Sphere, StateChecks
@@ -23,6 +23,7 @@ __all__ = [
     "ExploreStep",
     "ExploreSummary",
     "Octree",
+    "ReferenceScene",
     "OctreeObstacle",
     "Plan",
     "Sphere",

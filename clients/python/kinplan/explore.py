@@ -15,6 +15,30 @@ from .planning import ALGORITHMS, Obstacle, _pose, scene_to_proto
 from .v1 import common_pb2, exploration_pb2, planning_pb2
 
 
+SCENES = {
+    "s0_open_cell": exploration_pb2.REFERENCE_SCENE_NAME_S0_OPEN_CELL,
+    "s0_walled_cell": exploration_pb2.REFERENCE_SCENE_NAME_S0_WALLED_CELL,
+}
+
+
+@dataclass
+class ReferenceScene:
+    """One of kinplan's seeded reference cells: the robot's name, the
+    obstacles (CollisionObject messages, usable as ``scene=``), the region
+    (min xyz, max xyz) and the start joints. Pass it as ``scene=`` to
+    :meth:`ExploreMixin.explore` and the region, start and robot follow."""
+
+    name: str
+    robot: str
+    obstacles: List[common_pb2.CollisionObject]
+    region: Tuple[np.ndarray, np.ndarray]
+    start: np.ndarray
+
+    def __repr__(self) -> str:
+        lo, hi = self.region
+        return f"ReferenceScene({self.name!r}, {len(self.obstacles)} obstacles, region {lo.tolist()} - {hi.tolist()})"
+
+
 @dataclass
 class ExploreStep:
     """One iteration: the view moved to (4x4 camera pose in the world, or
@@ -114,15 +138,32 @@ def _summary(s: exploration_pb2.ExploreSummary) -> ExploreSummary:
 
 
 class ExploreMixin:
-    """``Client.explore``."""
+    """``Client.explore``, ``Client.reference_scene``."""
+
+    def reference_scene(self, name: str = "s0_open_cell", *, seed: int = 1,
+                        timeout: Optional[float] = None) -> ReferenceScene:
+        """The reference cell ``name`` ("s0_open_cell" or "s0_walled_cell")
+        built with ``seed``."""
+        if name not in SCENES:
+            raise ValueError(f"name must be one of {sorted(SCENES)}, got {name!r}")
+        req = exploration_pb2.ReferenceSceneRequest(name=SCENES[name], seed=int(seed))
+        r = self._call(self._exploration().ReferenceScene, req, timeout)  # type: ignore[attr-defined]
+        v = lambda p: np.array([p.x, p.y, p.z], dtype=float)  # noqa: E731
+        return ReferenceScene(
+            name=name,
+            robot=r.robot,
+            obstacles=list(r.scene.objects),
+            region=(v(r.region.min), v(r.region.max)),
+            start=np.array(r.start, dtype=float),
+        )
 
     def explore(
         self,
-        robot: Any,
+        robot: Any = None,
         *,
-        start: Any,
-        scene: Sequence[Obstacle],
-        region: Tuple[Sequence[float], Sequence[float]],
+        scene: Union[ReferenceScene, Sequence[Obstacle]],
+        start: Any = None,
+        region: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
         planner: str = "rrt_connect",
         weights: Optional[Sequence[float]] = None,
         seed: int = 0,
@@ -139,7 +180,8 @@ class ExploreMixin:
         **options: Any,
     ) -> Iterator[Union[ExploreStep, ExploreSummary]]:
         """Explores ``region`` = (min xyz, max xyz) of the simulated ``scene``
-        with a depth camera on ``robot`` from joints ``start``: yields an
+        with a depth camera on ``robot`` from joints ``start`` (all three
+        taken from ``scene`` when it is a :class:`ReferenceScene`): yields an
         :class:`ExploreStep` per iteration, then the :class:`ExploreSummary`.
         ``planner``: "rrt_connect", "stomp" or "ccstomp"; ``weights`` =
         (w_i, w_d, w_r) of the NBV utility (S0's IG1_T025_R01 = (1, 0.25, 0.1)
@@ -148,6 +190,14 @@ class ExploreMixin:
         further ``options`` the remaining ``ExploreRequest`` fields
         (``noise_stddev``, ``candidates_per_iteration``, ``plan_time_budget``,
         ``time_budget``)."""
+        if isinstance(scene, ReferenceScene):
+            start = scene.start if start is None else start
+            region = scene.region if region is None else region
+            if robot is None:
+                robot = self.robot(scene.robot)  # type: ignore[attr-defined]
+            scene = scene.obstacles
+        if robot is None or start is None or region is None:
+            raise ValueError("robot, start and region are required unless scene is a ReferenceScene")
         if planner not in ALGORITHMS:
             raise ValueError(f"planner must be one of {sorted(ALGORITHMS)}, got {planner!r}")
         lo, hi = (np.asarray(b, dtype=float).reshape(3) for b in region)

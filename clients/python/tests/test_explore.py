@@ -59,3 +59,24 @@ def test_bad_exploration_input_raises_naming_the_field(client):
         explore(client, start=[0.0] * 5)
     with pytest.raises(ValueError, match="planner"):
         explore(client, planner="rrt")
+
+
+def test_a_reference_cell_comes_with_its_region_and_a_collision_free_start(client):
+    ref = client.reference_scene("s0_walled_cell", seed=1)
+    assert ref.robot == "abb_irb4600_60_205" and len(ref.start) == 6
+    lo, hi = ref.region
+    assert np.all(lo < hi)
+    names = [o.id for o in ref.obstacles]
+    assert {"front wall", "far wall", "floor"} <= set(names)
+    irb = client.robot(ref.robot)
+    checks = client.check_states(irb, ref.start, ref.obstacles)
+    assert bool(checks.valid[0])
+    # the same seed gives the same cell, another seed moves the clutter
+    again = client.reference_scene("s0_walled_cell", seed=1)
+    assert [o.SerializeToString() for o in again.obstacles] == [o.SerializeToString() for o in ref.obstacles]
+    other = client.reference_scene("s0_walled_cell", seed=2)
+    assert [o.SerializeToString() for o in other.obstacles] != [o.SerializeToString() for o in ref.obstacles]
+    # and it can be explored as it is (robot, start and region from the scene)
+    *steps, summary = client.explore(scene=ref, resolution=0.2, pixel_stride=8, max_iterations=1)
+    assert summary.initial_known_ratio < 0.5
+    assert summary.iterations == len(steps) <= 1

@@ -39,6 +39,12 @@ class ExploreStatus(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
     EXPLORE_STATUS_NO_CANDIDATES: _ClassVar[ExploreStatus]
     EXPLORE_STATUS_TIMEOUT: _ClassVar[ExploreStatus]
     EXPLORE_STATUS_CANCELLED: _ClassVar[ExploreStatus]
+
+class ReferenceSceneName(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
+    __slots__ = ()
+    REFERENCE_SCENE_NAME_UNSPECIFIED: _ClassVar[ReferenceSceneName]
+    REFERENCE_SCENE_NAME_S0_OPEN_CELL: _ClassVar[ReferenceSceneName]
+    REFERENCE_SCENE_NAME_S0_WALLED_CELL: _ClassVar[ReferenceSceneName]
 GAIN_METHOD_UNSPECIFIED: GainMethod
 GAIN_METHOD_INTERSECTION: GainMethod
 GAIN_METHOD_RAYS: GainMethod
@@ -58,6 +64,9 @@ EXPLORE_STATUS_CONSECUTIVE_FAILURES: ExploreStatus
 EXPLORE_STATUS_NO_CANDIDATES: ExploreStatus
 EXPLORE_STATUS_TIMEOUT: ExploreStatus
 EXPLORE_STATUS_CANCELLED: ExploreStatus
+REFERENCE_SCENE_NAME_UNSPECIFIED: ReferenceSceneName
+REFERENCE_SCENE_NAME_S0_OPEN_CELL: ReferenceSceneName
+REFERENCE_SCENE_NAME_S0_WALLED_CELL: ReferenceSceneName
 
 class CameraModel(_message.Message):
     __slots__ = ("horizontal_fov", "vertical_fov", "near_range", "far_range", "width", "height")
@@ -499,3 +508,23 @@ class ExploreResponse(_message.Message):
     iteration: ExploreIteration
     summary: ExploreSummary
     def __init__(self, iteration: _Optional[_Union[ExploreIteration, _Mapping]] = ..., summary: _Optional[_Union[ExploreSummary, _Mapping]] = ...) -> None: ...
+
+class ReferenceSceneRequest(_message.Message):
+    __slots__ = ("name", "seed")
+    NAME_FIELD_NUMBER: _ClassVar[int]
+    SEED_FIELD_NUMBER: _ClassVar[int]
+    name: ReferenceSceneName
+    seed: int
+    def __init__(self, name: _Optional[_Union[ReferenceSceneName, str]] = ..., seed: _Optional[int] = ...) -> None: ...
+
+class ReferenceSceneResponse(_message.Message):
+    __slots__ = ("robot", "scene", "region", "start")
+    ROBOT_FIELD_NUMBER: _ClassVar[int]
+    SCENE_FIELD_NUMBER: _ClassVar[int]
+    REGION_FIELD_NUMBER: _ClassVar[int]
+    START_FIELD_NUMBER: _ClassVar[int]
+    robot: str
+    scene: _common_pb2.Scene
+    region: BoundingBox
+    start: _containers.RepeatedScalarFieldContainer[float]
+    def __init__(self, robot: _Optional[str] = ..., scene: _Optional[_Union[_common_pb2.Scene, _Mapping]] = ..., region: _Optional[_Union[BoundingBox, _Mapping]] = ..., start: _Optional[_Iterable[float]] = ...) -> None: ...

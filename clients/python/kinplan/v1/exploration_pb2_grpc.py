@@ -54,6 +54,11 @@ class ExplorationServiceStub:
                 request_serializer=kinplan_dot_v1_dot_exploration__pb2.ExploreRequest.SerializeToString,
                 response_deserializer=kinplan_dot_v1_dot_exploration__pb2.ExploreResponse.FromString,
                 _registered_method=True)
+        self.ReferenceScene = channel.unary_unary(
+                '/kinplan.v1.ExplorationService/ReferenceScene',
+                request_serializer=kinplan_dot_v1_dot_exploration__pb2.ReferenceSceneRequest.SerializeToString,
+                response_deserializer=kinplan_dot_v1_dot_exploration__pb2.ReferenceSceneResponse.FromString,
+                _registered_method=True)
 
 
 class ExplorationServiceServicer:
@@ -96,6 +101,15 @@ class ExplorationServiceServicer:
         context.set_details('Method not implemented!')
         raise NotImplementedError('Method not implemented!')
 
+    def ReferenceScene(self, request, context):
+        """One of kinplan's seeded reference cells for exploration (S0 Fig. 5.2
+        and 5.8 in spirit): its obstacles, region and start joints, ready to be
+        sent back in an ExploreRequest or drawn.
+        """
+        context.set_code(grpc.StatusCode.UNIMPLEMENTED)
+        context.set_details('Method not implemented!')
+        raise NotImplementedError('Method not implemented!')
+
 
 def add_ExplorationServiceServicer_to_server(servicer, server):
     rpc_method_handlers = {
@@ -118,6 +132,11 @@ def add_ExplorationServiceServicer_to_server(servicer, server):
                     servicer.Explore,
                     request_deserializer=kinplan_dot_v1_dot_exploration__pb2.ExploreRequest.FromString,
                     response_serializer=kinplan_dot_v1_dot_exploration__pb2.ExploreResponse.SerializeToString,
+            ),
+            'ReferenceScene': grpc.unary_unary_rpc_method_handler(
+                    servicer.ReferenceScene,
+                    request_deserializer=kinplan_dot_v1_dot_exploration__pb2.ReferenceSceneRequest.FromString,
+                    response_serializer=kinplan_dot_v1_dot_exploration__pb2.ReferenceSceneResponse.SerializeToString,
             ),
     }
     generic_handler = grpc.method_handlers_generic_handler(
@@ -228,6 +247,33 @@ class ExplorationService:
             '/kinplan.v1.ExplorationService/Explore',
             kinplan_dot_v1_dot_exploration__pb2.ExploreRequest.SerializeToString,
             kinplan_dot_v1_dot_exploration__pb2.ExploreResponse.FromString,
+            options,
+            channel_credentials,
+            insecure,
+            call_credentials,
+            compression,
+            wait_for_ready,
+            timeout,
+            metadata,
+            _registered_method=True)
+
+    @staticmethod
+    def ReferenceScene(request,
+            target,
+            options=(),
+            channel_credentials=None,
+            call_credentials=None,
+            insecure=False,
+            compression=None,
+            wait_for_ready=None,
+            timeout=None,
+            metadata=None):
+        return grpc.experimental.unary_unary(
+            request,
+            target,
+            '/kinplan.v1.ExplorationService/ReferenceScene',
+            kinplan_dot_v1_dot_exploration__pb2.ReferenceSceneRequest.SerializeToString,
+            kinplan_dot_v1_dot_exploration__pb2.ReferenceSceneResponse.FromString,
             options,
             channel_credentials,
             insecure,

@@ -62,6 +62,11 @@ class ExplorationServiceStub:
     final octree. The scene is the ground truth the camera renders; the
     planner never sees it.
     """
+    ReferenceScene: _grpc.UnaryUnaryMultiCallable[_exploration_pb2.ReferenceSceneRequest, _exploration_pb2.ReferenceSceneResponse]
+    """One of kinplan's seeded reference cells for exploration (S0 Fig. 5.2
+    and 5.8 in spirit): its obstacles, region and start joints, ready to be
+    sent back in an ExploreRequest or drawn.
+    """
 
 @_typing.type_check_only
 class ExplorationServiceAsyncStub(ExplorationServiceStub):
@@ -86,6 +91,11 @@ class ExplorationServiceAsyncStub(ExplorationServiceStub):
     stop rule holds. One message per iteration, then a summary with the
     final octree. The scene is the ground truth the camera renders; the
     planner never sees it.
+    """
+    ReferenceScene: _aio.UnaryUnaryMultiCallable[_exploration_pb2.ReferenceSceneRequest, _exploration_pb2.ReferenceSceneResponse]  # type: ignore[assignment]
+    """One of kinplan's seeded reference cells for exploration (S0 Fig. 5.2
+    and 5.8 in spirit): its obstacles, region and start joints, ready to be
+    sent back in an ExploreRequest or drawn.
     """
 
 class ExplorationServiceServicer(metaclass=_abc_1.ABCMeta):
@@ -132,6 +142,17 @@ class ExplorationServiceServicer(metaclass=_abc_1.ABCMeta):
         stop rule holds. One message per iteration, then a summary with the
         final octree. The scene is the ground truth the camera renders; the
         planner never sees it.
+        """
+
+    @_abc_1.abstractmethod
+    def ReferenceScene(
+        self,
+        request: _exploration_pb2.ReferenceSceneRequest,
+        context: _ServicerContext,
+    ) -> _typing.Union[_exploration_pb2.ReferenceSceneResponse, _abc.Awaitable[_exploration_pb2.ReferenceSceneResponse]]:
+        """One of kinplan's seeded reference cells for exploration (S0 Fig. 5.2
+        and 5.8 in spirit): its obstacles, region and start joints, ready to be
+        sent back in an ExploreRequest or drawn.
         """
 
 def add_ExplorationServiceServicer_to_server(servicer: ExplorationServiceServicer, server: _typing.Union[_grpc.Server, _aio.Server]) -> None: ...

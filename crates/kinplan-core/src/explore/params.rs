@@ -99,24 +99,29 @@ impl ExploreParams {
         ]
     }
 
-    /// Views from the band in front of the region's near (−x) face: camera
-    /// positions 0.4 m and 0.8 m before it, at five evenly spaced y across
-    /// the region and at three heights (the region's middle, 0.3 m and
-    /// 0.7 m above its top), each aimed at three points on the region's
-    /// mid-height line (y at ¼, ½, ¾): 90 poses.
+    /// Views from before and above the region's near (−x) face: camera
+    /// positions 0.8 m and 0.4 m before it and a quarter of the way into it,
+    /// at five evenly spaced y across the region and at three heights (the
+    /// region's middle, 0.3 m and 0.7 m above its top), each aimed at six
+    /// points: y at ¼, ½, ¾ of the region on its mid-height line and on a
+    /// line 15 % above its floor (through the middle of its x range) — 270
+    /// poses. Views from above let the camera look over a wall into the cell.
     pub fn approach_views(region: &(Point3<f64>, Point3<f64>)) -> Vec<Isometry3<f64>> {
         let (a, b) = region;
         let mid_z = 0.5 * (a.z + b.z);
+        let low_z = a.z + 0.15 * (b.z - a.z);
         let mid_x = 0.5 * (a.x + b.x);
-        let mut out = Vec::with_capacity(90);
-        for dx in [0.4, 0.8] {
+        let mut out = Vec::with_capacity(270);
+        for x in [a.x - 0.8, a.x - 0.4, a.x + 0.25 * (b.x - a.x)] {
             for k in 0..5 {
                 let y = a.y + (b.y - a.y) * (k as f64 + 0.5) / 5.0;
                 for z in [mid_z, b.z + 0.3, b.z + 0.7] {
-                    let p = Point3::new(a.x - dx, y, z);
-                    for t in [0.25, 0.5, 0.75] {
-                        let aim = Point3::new(mid_x, a.y + (b.y - a.y) * t, mid_z);
-                        out.extend(crate::nbv::look_along(&p, &(aim - p)));
+                    let p = Point3::new(x, y, z);
+                    for aim_z in [mid_z, low_z] {
+                        for t in [0.25, 0.5, 0.75] {
+                            let aim = Point3::new(mid_x, a.y + (b.y - a.y) * t, aim_z);
+                            out.extend(crate::nbv::look_along(&p, &(aim - p)));
+                        }
                     }
                 }
             }

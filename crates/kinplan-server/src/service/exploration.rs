@@ -57,6 +57,19 @@ impl ExplorationApi {
 impl ExplorationService for ExplorationApi {
     type ExploreStream = super::explore::ExploreStream;
 
+    async fn reference_scene(
+        &self,
+        request: Request<pb::ReferenceSceneRequest>,
+    ) -> Result<Response<pb::ReferenceSceneResponse>, Status> {
+        let req = request.into_inner();
+        let scene = match pb::ReferenceSceneName::try_from(req.name) {
+            Ok(pb::ReferenceSceneName::S0OpenCell) => kinplan_core::explore::s0_open_cell(req.seed),
+            Ok(pb::ReferenceSceneName::S0WalledCell) => kinplan_core::explore::s0_walled_cell(req.seed),
+            _ => return Err(invalid("name", format!("unknown reference scene {}", req.name))),
+        };
+        Ok(Response::new(super::explore_convert::reference_scene_out(&scene)))
+    }
+
     async fn explore(
         &self,
         request: Request<pb::ExploreRequest>,

@@ -217,3 +217,51 @@ pub fn summary_out(o: &ExploreOutcome, octree: pb::Octree, elapsed: Duration) ->
         elapsed: elapsed.as_secs_f64(),
     }
 }
+
+/// A domain obstacle as a proto collision object (occupied-cell sets, which
+/// only octrees produce, have no proto form and are left out).
+fn obstacle_out(o: &kinplan_core::collision::Obstacle) -> Option<pb::CollisionObject> {
+    use kinplan_core::collision::Geometry;
+    use pb::collision_object::Shape;
+    let shape = match &o.geometry {
+        Geometry::Box { half_extents: h } => Shape::Box(pb::Box {
+            size: Some(vec3_out(&(h * 2.0))),
+        }),
+        Geometry::Sphere { radius } => Shape::Sphere(pb::Sphere { radius: *radius }),
+        Geometry::Cylinder { radius, length } => Shape::Cylinder(pb::Cylinder {
+            radius: *radius,
+            length: *length,
+        }),
+        Geometry::Capsule { radius, length } => Shape::Capsule(pb::Capsule {
+            radius: *radius,
+            length: *length,
+        }),
+        Geometry::Mesh { vertices, indices } => Shape::Mesh(pb::TriangleMesh {
+            vertices: vertices.iter().map(|v| vec3_out(&v.coords)).collect(),
+            indices: indices.clone(),
+        }),
+        Geometry::OccupiedCells { .. } => return None,
+    };
+    Some(pb::CollisionObject {
+        id: o.name.clone(),
+        pose: Some(pose_out(&o.pose)),
+        shape: Some(shape),
+        unknown_as_obstacle: false,
+    })
+}
+
+/// A reference scene as its reply.
+pub fn reference_scene_out(s: &kinplan_core::explore::ReferenceScene) -> pb::ReferenceSceneResponse {
+    let (a, b) = &s.region;
+    pb::ReferenceSceneResponse {
+        robot: s.robot.to_owned(),
+        scene: Some(pb::Scene {
+            objects: s.obstacles.iter().filter_map(obstacle_out).collect(),
+        }),
+        region: Some(pb::BoundingBox {
+            min: Some(vec3_out(&a.coords)),
+            max: Some(vec3_out(&b.coords)),
+        }),
+        start: s.start.clone(),
+    }
+}
