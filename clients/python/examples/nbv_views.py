@@ -5,9 +5,8 @@ chosen camera views.
     python nbv_views.py [host:port] [out.png]
 
 Needs matplotlib and a running `kinplan serve`. The tree travels as OctoMap
-.bt node bytes; `occupied_cells` below decodes them (2 bits per child:
-01 free leaf, 10 occupied leaf, 11 inner node; child i at depth d from bit
-15 - d of the keys x + 2y + 4z) to draw the occupied cells.
+.bt node bytes; `Octree.occupied_cells()` decodes them to draw the
+occupied cells.
 """
 import sys
 
@@ -20,30 +19,6 @@ import numpy as np
 import kinplan
 
 RES = 0.1
-
-
-def occupied_cells(tree: kinplan.Octree) -> np.ndarray:
-    """Centres (n x 3, m) of the occupied leaves of a binary tree, any depth
-    (a pruned leaf at depth d stands for 2^(16-d) cells a side)."""
-    data, out, i = tree.data, [], 0
-    stack = [((0, 0, 0), 0)]  # (key of the node's lowest corner, depth)
-    while stack:
-        (kx, ky, kz), depth = stack.pop()
-        bits = data[i] | (data[i + 1] << 8)
-        i += 2
-        half = 1 << (15 - depth)
-        children = []
-        for c in range(8):
-            kind = (bits >> (2 * c)) & 3
-            key = (kx + half * (c & 1), ky + half * ((c >> 1) & 1), kz + half * ((c >> 2) & 1))
-            if kind == 2:
-                size = half * tree.resolution
-                centre = (np.array(key) - 32768) * tree.resolution + size / 2
-                out.append(centre)
-            elif kind == 3:
-                children.append((key, depth + 1))
-        stack.extend(reversed(children))  # depth first, children in order 0..7
-    return np.array(out).reshape(-1, 3)
 
 
 def room_points(rng: np.random.Generator) -> np.ndarray:
@@ -70,7 +45,7 @@ with kinplan.Client(address, timeout=60) as c:
     camera[:3, 3] = (0.0, 0.2, 0.5)
     views = c.next_best_view(tree, camera_pose=camera, weights=(1.0, 0.25, 0.1), max_results=5)
     print(info["occupied_leaves"], "occupied leaves;", views)
-    cells = occupied_cells(tree)
+    cells = tree.occupied_cells()
     fig, ax = plt.subplots(figsize=(6, 5))
     band = cells[np.abs(cells[:, 2] - 0.5) < RES]
     ax.scatter(band[:, 0], band[:, 1], s=4, c="k", label=f"occupied (z ≈ 0.5 m), {len(cells)} leaves")

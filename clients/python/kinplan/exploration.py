@@ -54,6 +54,33 @@ class Octree:
         header = header.replace("size 0", f"size {_count_binary_nodes(self.data)}")
         return header.encode() + self.data
 
+    def occupied_cells(self) -> np.ndarray:
+        """Centres (n x 3, m, world frame) of the occupied leaves of a binary
+        tree, any depth (a pruned leaf at depth d stands for 2^(16-d) cells a
+        side), decoded from the .bt node bytes: 2 bits per child, 01 free
+        leaf, 10 occupied leaf, 11 inner node; child i at depth d from bit
+        15 - d of the keys, i = x + 2y + 4z."""
+        if not self.binary:
+            raise ValueError("only a binary tree's nodes are decoded")
+        data, out, i = self.data, [], 0
+        stack = [((0, 0, 0), 0)] if data else []  # (key of the node's lowest corner, depth)
+        while stack:
+            (kx, ky, kz), depth = stack.pop()
+            bits = data[i] | (data[i + 1] << 8)
+            i += 2
+            half = 1 << (15 - depth)
+            children = []
+            for c in range(8):
+                kind = (bits >> (2 * c)) & 3
+                key = (kx + half * (c & 1), ky + half * ((c >> 1) & 1), kz + half * ((c >> 2) & 1))
+                if kind == 2:
+                    size = half * self.resolution
+                    out.append((np.array(key) - 32768) * self.resolution + size / 2)
+                elif kind == 3:
+                    children.append((key, depth + 1))
+            stack.extend(reversed(children))  # depth first, children in order 0..7
+        return np.array(out, dtype=float).reshape(-1, 3)
+
     def to_proto(self) -> common_pb2.Octree:
         return common_pb2.Octree(id=self.tree_id, resolution=self.resolution, binary=self.binary, data=self.data)
 

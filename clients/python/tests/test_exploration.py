@@ -24,6 +24,9 @@ def test_a_scanned_wall_counts_its_cells_and_round_trips_as_bt(client):
     again = kinplan.Octree.from_bt(tree.to_bt())
     assert again.data == tree.data and again.resolution == 0.1
     assert client.octree_info(again)["free_leaves"] == info["free_leaves"]
+    # the decoded occupied cells are the wall's 36 cell centres
+    cells = tree.occupied_cells()
+    np.testing.assert_allclose(cells[np.lexsort(cells.T[::-1])], wall()[np.lexsort(wall().T[::-1])], atol=1e-9)
 
 
 def test_views_follow_the_utility_formula(client):
