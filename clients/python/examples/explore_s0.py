@@ -44,11 +44,12 @@ def main():
     address = sys.argv[1] if len(sys.argv) > 1 else "localhost:50051"
     prefix = sys.argv[2] if len(sys.argv) > 2 else "explore_s0"
     client = kinplan.Client(address, timeout=300)
+    scenes = {"s0_open_cell": kinplan.scenes.s0_open_cell, "s0_walled_cell": kinplan.scenes.s0_walled_cell}
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
     last = None
     for ax, (name, sets) in zip(axes, SETS.items()):
-        scene = client.reference_scene(name, seed=1)
+        scene = scenes[name](client)
         for w in sets:
             steps, summary = run(client, scene, planner="rrt_connect", weights=WEIGHTS[w])
             ratios = [summary.initial_known_ratio] + [s.known_ratio for s in steps]
@@ -64,7 +65,7 @@ def main():
     fig.tight_layout()
     fig.savefig(f"{prefix}_known_ratio.png", dpi=120)
 
-    open_cell = client.reference_scene("s0_open_cell", seed=1)
+    open_cell = kinplan.scenes.s0_open_cell(client)
     per_planner = {}
     for planner in ["rrt_connect", "stomp", "ccstomp"]:
         cd, oc = [], []

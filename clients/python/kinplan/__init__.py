@@ -6,8 +6,19 @@
 """
 from ._convert import matrix_to_pose, pose_to_matrix
 from .client import Client, Robot, RobotDescription
-from .errors import KinplanError
+from .errors import (
+    Cancelled,
+    DeadlineExceeded,
+    Internal,
+    InvalidArgument,
+    KinplanError,
+    NotFound,
+    ResourceExhausted,
+    Unavailable,
+)
+from .local import LocalServer
 from .exploration import Octree, Views
+from . import scenes
 from .explore import ExploreStep, ExploreSummary, ReferenceScene
 from .kinematics import IkBatchResult, IkResult, IkSolution, IkStream, LinearSolution, TrackResult
 from .mobile import Mobile, MobileRun, StepResult, WheelKinematics
@@ -33,7 +44,15 @@ __all__ = [
     "IkResult",
     "IkSolution",
     "IkStream",
+    "Cancelled",
+    "DeadlineExceeded",
+    "Internal",
+    "InvalidArgument",
     "KinplanError",
+    "LocalServer",
+    "NotFound",
+    "ResourceExhausted",
+    "Unavailable",
     "LinearSolution",
     "Mobile",
     "MobileRun",

@@ -2,13 +2,16 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Optional, Sequence
+import json
+import socket
+import time
+from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 import grpc
 import numpy as np
 
 from ._convert import joints, matrix_from_proto, pose_to_matrix
-from .errors import KinplanError
+from .errors import KinplanError, error_for, invalid_argument
 from .kinematics import KinematicsMixin, RobotKinematicsMixin
 from .mobile import MobileMixin
 from .explore import ExploreMixin
@@ -20,6 +23,69 @@ from .v1 import common_pb2, robot_pb2, robot_pb2_grpc
 DEFAULT_TIMEOUT = 30.0
 
 
+DEFAULT_PORT = 50051
+
+# Round robin over the resolved addresses; UNAVAILABLE (replica gone or not
+# yet up) is retried up to three attempts with a short backoff.
+_REPLICA_SERVICE_CONFIG = json.dumps(
+    {
+        "loadBalancingConfig": [{"round_robin": {}}],
+        "methodConfig": [
+            {
+                "name": [{}],
+                "retryPolicy": {
+                    "maxAttempts": 3,
+                    "initialBackoff": "0.01s",
+                    "maxBackoff": "0.2s",
+                    "backoffMultiplier": 2,
+                    "retryableStatusCodes": ["UNAVAILABLE"],
+                },
+            }
+        ],
+    }
+)
+
+
+def normalize_target(target: Union[str, Sequence[str]]) -> str:
+    """A gRPC target from what people type: "host" gets port 50051,
+    "http://host:port" loses its scheme, several addresses become one
+    "ipv4:a:p,b:p" target; "dns:///..." and other gRPC targets pass."""
+    if not isinstance(target, str):
+        parts = [str(t) for t in target]
+    else:
+        if target.startswith(("dns:", "ipv4:", "ipv6:", "unix:")):
+            return target
+        if target.startswith("https://"):
+            raise invalid_argument("target", "TLS is not supported by this client; give host:port")
+        parts = [p.strip() for p in target.split(",") if p.strip()]
+    if not parts:
+        raise invalid_argument("target", "no address given")
+    out = []
+    for p in parts:
+        p = p.removeprefix("http://").rstrip("/")
+        if "/" in p:
+            raise invalid_argument("target", f"{p!r} is not host[:port]")
+        bracketed = p.startswith("[")
+        has_port = (bracketed and "]:" in p) or (not bracketed and p.count(":") == 1)
+        if p.count(":") > 1 and not bracketed:
+            p = f"[{p}]"  # a bare IPv6 address
+        out.append(p if has_port else f"{p}:{DEFAULT_PORT}")
+    if len(out) == 1:
+        return out[0]
+    # gRPC's ipv4:/ipv6: targets take literal addresses: resolve host names once
+    resolved = []
+    for o in out:
+        host, port = o.rsplit(":", 1)
+        if not host.startswith("["):
+            try:
+                socket.inet_aton(host)
+            except OSError:
+                host = socket.gethostbyname(host)
+        resolved.append(f"{host}:{port}")
+    scheme = "ipv6" if any(o.startswith("[") for o in resolved) else "ipv4"
+    return f"{scheme}:{','.join(resolved)}"
+
+
 class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, MobileMixin, KinematicsMixin):
     """A connection to a kinplan server.
 
@@ -29,22 +95,59 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
 
     def __init__(
         self,
-        target: str = "127.0.0.1:50051",
+        target: Union[str, Sequence[str]] = "127.0.0.1:50051",
         *,
         timeout: Optional[float] = DEFAULT_TIMEOUT,
         max_message_bytes: int = 16 * 1024 * 1024,
         channel: Optional[grpc.Channel] = None,
+        wait_for_ready: bool = False,
     ):
-        self.target = target
+        """`target`: "host", "host:port" (port 50051 when left out),
+        "dns:///name:port" (every address the name resolves to, round robin),
+        or several "host:port" (a list or one comma-separated string; calls
+        spread round robin over identical replicas). With `wait_for_ready`,
+        the constructor waits up to `timeout` for the server and raises
+        :class:`kinplan.errors.Unavailable` if none answers."""
+        self.target = normalize_target(target)
         self.timeout = timeout
-        self._channel = channel or grpc.insecure_channel(
-            target,
-            options=[
-                ("grpc.max_send_message_length", max_message_bytes),
-                ("grpc.max_receive_message_length", max_message_bytes),
-            ],
-        )
+        options = [
+            ("grpc.max_send_message_length", max_message_bytes),
+            ("grpc.max_receive_message_length", max_message_bytes),
+        ]
+        if self.target.startswith(("dns:", "ipv4:", "ipv6:")):
+            # Replicas are identical and every call is stateless, so a call
+            # that finds its replica gone is retried on another.
+            options.append(("grpc.service_config", _REPLICA_SERVICE_CONFIG))
+            options.append(("grpc.enable_retries", 1))
+        if self.target.startswith(("ipv4:", "ipv6:")):
+            # the default :authority would be the whole address list, which
+            # HTTP/2 servers refuse (RST_STREAM PROTOCOL_ERROR)
+            options.append(("grpc.default_authority", "kinplan"))
+        self._channel = channel or grpc.insecure_channel(self.target, options=options)
         self._robots = robot_pb2_grpc.RobotServiceStub(self._channel)
+        if wait_for_ready:
+            self.wait_for_ready(timeout)
+
+    def wait_for_ready(self, timeout: Optional[float] = None) -> None:
+        """Blocks until the channel connects (at most `timeout` s, default the
+        client's); raises :class:`kinplan.errors.Unavailable` otherwise."""
+        t = self.timeout if timeout is None else timeout
+        try:
+            grpc.channel_ready_future(self._channel).result(timeout=t)
+        except grpc.FutureTimeoutError:
+            raise error_for(
+                grpc.StatusCode.UNAVAILABLE, f"no server at {self.target} within {t} s", []
+            ) from None
+
+    def ping(self, *, timeout: Optional[float] = None) -> float:
+        """Round-trip time (s) of the cheapest call (ListRobots); raises
+        :class:`kinplan.errors.Unavailable` when no server answers."""
+        t0 = time.perf_counter()
+        self._call(self._robots.ListRobots, robot_pb2.ListRobotsRequest(), timeout)
+        return time.perf_counter() - t0
+
+    def __repr__(self) -> str:
+        return f"kinplan.Client({self.target!r}, timeout={self.timeout})"
 
     def __enter__(self) -> "Client":
         return self

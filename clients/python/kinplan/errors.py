@@ -8,13 +8,25 @@ import grpc
 
 class KinplanError(Exception):
     """A call failed. `code` is the gRPC status code, `message` the server's
-    text, `field_violations` the (field, description) pairs it named."""
+    text, `field_violations` the (field, description) pairs it named.
+
+    Each status code has its subclass, which also derives from the matching
+    builtin, so plain Python handlers work: :class:`InvalidArgument` is a
+    ``ValueError``, :class:`DeadlineExceeded` a ``TimeoutError``,
+    :class:`Unavailable` a ``ConnectionError``, :class:`NotFound` a
+    ``LookupError``. Errors pickle (multiprocessing, joblib)."""
 
     def __init__(self, code: grpc.StatusCode, message: str, field_violations: List[Tuple[str, str]]):
         super().__init__(f"{code.name}: {message}")
         self.code = code
         self.message = message
         self.field_violations = field_violations
+
+    def __reduce__(self):  # type: ignore[override]
+        return (_rebuild, (self.code.name, self.message, self.field_violations))
+
+    def __str__(self) -> str:
+        return f"{self.code.name}: {self.message}"
 
     @property
     def code_name(self) -> str:
@@ -24,7 +36,66 @@ class KinplanError(Exception):
     def from_rpc_error(cls, err: grpc.RpcError) -> "KinplanError":
         code = err.code() if hasattr(err, "code") else grpc.StatusCode.UNKNOWN
         message = err.details() if hasattr(err, "details") else str(err)
-        return cls(code, message or "", _field_violations(err))
+        return error_for(code, message or "", _field_violations(err))
+
+
+class InvalidArgument(KinplanError, ValueError):
+    """INVALID_ARGUMENT: the request named a bad field (see field_violations)."""
+
+
+class DeadlineExceeded(KinplanError, TimeoutError):
+    """DEADLINE_EXCEEDED: the call's timeout passed."""
+
+
+class Unavailable(KinplanError, ConnectionError):
+    """UNAVAILABLE: no server answered at the address."""
+
+    def __str__(self) -> str:
+        return (
+            f"{self.code.name}: {self.message} (is `kinplan serve` running at that address? "
+            "kinplan.LocalServer() starts one)"
+        )
+
+
+class NotFound(KinplanError, LookupError):
+    """NOT_FOUND: e.g. an unknown built-in robot name."""
+
+
+class ResourceExhausted(KinplanError, RuntimeError):
+    """RESOURCE_EXHAUSTED: the server shed the call (overload) or the request is too large."""
+
+
+class Cancelled(KinplanError):
+    """CANCELLED: the call was cancelled."""
+
+
+class Internal(KinplanError, RuntimeError):
+    """INTERNAL: a server bug; the message says what."""
+
+
+_BY_CODE = {
+    grpc.StatusCode.INVALID_ARGUMENT: InvalidArgument,
+    grpc.StatusCode.DEADLINE_EXCEEDED: DeadlineExceeded,
+    grpc.StatusCode.UNAVAILABLE: Unavailable,
+    grpc.StatusCode.NOT_FOUND: NotFound,
+    grpc.StatusCode.RESOURCE_EXHAUSTED: ResourceExhausted,
+    grpc.StatusCode.CANCELLED: Cancelled,
+    grpc.StatusCode.INTERNAL: Internal,
+}
+
+
+def error_for(code: grpc.StatusCode, message: str, field_violations: List[Tuple[str, str]]) -> KinplanError:
+    """The exception of the subclass that matches `code`."""
+    return _BY_CODE.get(code, KinplanError)(code, message, field_violations)
+
+
+def invalid_argument(field: str, message: str) -> InvalidArgument:
+    """A locally detected bad argument, as the server would report it."""
+    return InvalidArgument(grpc.StatusCode.INVALID_ARGUMENT, f"{field}: {message}", [(field, message)])
+
+
+def _rebuild(code_name: str, message: str, field_violations: List[Tuple[str, str]]) -> KinplanError:
+    return error_for(grpc.StatusCode[code_name], message, field_violations)
 
 
 def _field_violations(err: grpc.RpcError) -> List[Tuple[str, str]]:

@@ -62,7 +62,7 @@ def test_bad_exploration_input_raises_naming_the_field(client):
 
 
 def test_a_reference_cell_comes_with_its_region_and_a_collision_free_start(client):
-    ref = client.reference_scene("s0_walled_cell", seed=1)
+    ref = kinplan.scenes.s0_walled_cell(client)
     assert ref.robot == "abb_irb4600_60_205" and len(ref.start) == 6
     lo, hi = ref.region
     assert np.all(lo < hi)
@@ -79,4 +79,5 @@ def test_a_reference_cell_comes_with_its_region_and_a_collision_free_start(clien
     # and it can be explored as it is (robot, start and region from the scene)
     *steps, summary = client.explore(scene=ref, resolution=0.2, pixel_stride=8, max_iterations=1)
     assert summary.initial_known_ratio < 0.5
+    assert kinplan.scenes.s0_open_cell(client).name == "s0_open_cell"
     assert summary.iterations == len(steps) <= 1

@@ -120,7 +120,7 @@ pub fn s0_open_cell(seed: u64) -> ReferenceScene {
         robot: "abb_irb4600_60_205",
         obstacles,
         region: (Point3::new(1.2, -1.5, FLOOR + 0.06), Point3::new(3.2, 1.5, 1.2)),
-        start: vec![0.0, -0.2, 0.3, 0.0, 0.75, 0.0],
+        start: vec![0.35, -0.2, 0.3, 0.0, 0.75, 0.0],
     }
 }
 

@@ -1,0 +1,96 @@
+"""A kinplan server for this Python process: ``with kinplan.LocalServer() as
+server: client = server.client()`` starts ``kinplan serve`` on a free
+loopback port, waits until it answers, and stops it on exit."""
+from __future__ import annotations
+
+import os
+import shutil
+import socket
+import subprocess
+from typing import Any, List, Optional
+
+from .client import Client
+from .errors import error_for
+
+import grpc
+
+
+def find_binary(binary: Optional[str] = None) -> str:
+    """`binary`, else $KINPLAN_BIN, else `kinplan` on the PATH."""
+    path = binary or os.environ.get("KINPLAN_BIN") or shutil.which("kinplan")
+    if not path or not os.path.exists(path):
+        raise FileNotFoundError(
+            "no kinplan server binary: pass binary=, set KINPLAN_BIN, or put `kinplan` on the PATH "
+            "(cargo install --path crates/kinplan-server)"
+        )
+    return path
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class LocalServer:
+    """``kinplan serve`` as a child process on 127.0.0.1 (a free port unless
+    `port` is given). `args` are extra ``serve`` options, e.g.
+    ``["--cpu-threads", "2"]``. `startup_timeout` bounds the wait for the
+    first answer (s)."""
+
+    def __init__(self, *, binary: Optional[str] = None, port: Optional[int] = None,
+                 args: Optional[List[str]] = None, startup_timeout: float = 30.0):
+        self.binary = find_binary(binary)
+        self.address = f"127.0.0.1:{port or _free_port()}"
+        self.args = list(args or [])
+        self.startup_timeout = startup_timeout
+        self._proc: Optional[subprocess.Popen] = None
+
+    def start(self) -> "LocalServer":
+        if self._proc is not None:
+            return self
+        self._proc = subprocess.Popen(
+            [self.binary, "serve", "--listen", self.address, *self.args],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+        )
+        channel = grpc.insecure_channel(self.address)
+        try:
+            grpc.channel_ready_future(channel).result(timeout=self.startup_timeout)
+        except grpc.FutureTimeoutError:
+            self.stop()
+            raise error_for(grpc.StatusCode.UNAVAILABLE, f"kinplan serve did not start at {self.address}", [])
+        finally:
+            channel.close()
+        return self
+
+    def client(self, **kwargs: Any) -> Client:
+        """A client of this server (keyword arguments as for :class:`Client`)."""
+        return Client(self.address, **kwargs)
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """SIGTERM (the server drains its calls), then SIGKILL after `timeout` s."""
+        proc, self._proc = self._proc, None
+        if proc is None:
+            return
+        proc.terminate()
+        try:
+            proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+        if proc.stderr is not None:
+            proc.stderr.close()
+
+    @property
+    def running(self) -> bool:
+        return self._proc is not None and self._proc.poll() is None
+
+    def __enter__(self) -> "LocalServer":
+        return self.start()
+
+    def __exit__(self, *exc: Any) -> None:
+        self.stop()
+
+    def __repr__(self) -> str:
+        return f"LocalServer({self.address!r}, running={self.running})"

@@ -1,0 +1,83 @@
+"""The client's plumbing against real server processes: LocalServer, ping,
+wait_for_ready, addresses, the exception hierarchy (pickled too), and calls
+spread over two replicas surviving the loss of one."""
+import pickle
+
+import grpc
+import pytest
+
+import kinplan
+from kinplan.client import normalize_target
+
+
+@pytest.mark.parametrize(
+    "typed, target",
+    [
+        ("localhost", "localhost:50051"),
+        ("10.1.2.3:7000", "10.1.2.3:7000"),
+        ("http://10.1.2.3:7000/", "10.1.2.3:7000"),
+        ("dns:///kinplan.default.svc:50051", "dns:///kinplan.default.svc:50051"),
+        ("10.0.0.1, 10.0.0.2:7", "ipv4:10.0.0.1:50051,10.0.0.2:7"),
+        (["127.0.0.1:1", "localhost:2"], "ipv4:127.0.0.1:1,127.0.0.1:2"),
+        ("::1", "[::1]:50051"),
+    ],
+)
+def test_addresses_people_type_become_grpc_targets(typed, target):
+    assert normalize_target(typed) == target
+
+
+def test_a_tls_url_or_a_path_is_refused_locally():
+    with pytest.raises(kinplan.InvalidArgument, match="target"):
+        normalize_target("https://example.com")
+    with pytest.raises(ValueError):
+        normalize_target("host:1/path")
+
+
+def test_a_local_server_starts_answers_and_stops():
+    with kinplan.LocalServer() as server:
+        assert server.running
+        with server.client(timeout=5) as c:
+            assert 0 < c.ping() < 5
+            assert any(r["name"] == "ur5" for r in c.list_robots())
+        address = server.address
+    assert not server.running
+    with kinplan.Client(address, timeout=2) as c:
+        with pytest.raises(kinplan.Unavailable) as err:
+            c.ping()
+    # an Unavailable is a ConnectionError and says what to do
+    assert isinstance(err.value, ConnectionError)
+    assert "kinplan serve" in str(err.value)
+
+
+def test_wait_for_ready_gives_up_with_unavailable():
+    with kinplan.LocalServer() as server:
+        address = server.address
+    with pytest.raises(kinplan.Unavailable):
+        kinplan.Client(address, timeout=0.5, wait_for_ready=True)
+
+
+def test_server_errors_are_builtin_exceptions_too_and_pickle(client):
+    with pytest.raises(ValueError) as err:  # InvalidArgument is a ValueError
+        client.robot("ur5").fk([0.0] * 5)
+    e = err.value
+    assert isinstance(e, kinplan.InvalidArgument) and e.code == grpc.StatusCode.INVALID_ARGUMENT
+    again = pickle.loads(pickle.dumps(e))
+    assert type(again) is kinplan.InvalidArgument and str(again) == str(e)
+    assert again.field_violations == e.field_violations
+    with pytest.raises(LookupError):  # NotFound
+        client.robot("no_such_robot").fk([0.0])
+    from test_robot import long_chain_urdf
+
+    with pytest.raises(TimeoutError):  # DeadlineExceeded: a 900-joint model takes > 1 ms to parse
+        client.robot(urdf=long_chain_urdf(900)).describe(timeout=1e-3)
+
+
+def test_calls_over_two_replicas_survive_the_loss_of_one():
+    with kinplan.LocalServer() as a, kinplan.LocalServer() as b:
+        with kinplan.Client([a.address, b.address], timeout=5, wait_for_ready=True) as c:
+            for _ in range(10):
+                c.ping()
+            a.stop()
+            # every call still answers: the gone replica is retried on the other
+            for _ in range(20):
+                assert c.ping() < 5
