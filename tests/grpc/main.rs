@@ -11,6 +11,7 @@ mod mobile;
 mod planning;
 mod robot;
 mod scoring;
+mod security;
 
 use kinplan_server::service::pb::{self, robot_ref::Source};
 use kinplan_server::service::{ServerConfig, serve};
@@ -23,7 +24,14 @@ pub struct TestServer {
     pub handle: tokio::task::JoinHandle<()>,
 }
 
-pub async fn start(config: ServerConfig) -> TestServer {
+/// Starts the server on a free loopback port without connecting to it.
+pub async fn spawn(
+    config: ServerConfig,
+) -> (
+    std::net::SocketAddr,
+    tokio::sync::oneshot::Sender<()>,
+    tokio::task::JoinHandle<()>,
+) {
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
     let addr = listener.local_addr().unwrap();
     let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
@@ -34,6 +42,11 @@ pub async fn start(config: ServerConfig) -> TestServer {
         .await
         .unwrap();
     });
+    (addr, stop, handle)
+}
+
+pub async fn start(config: ServerConfig) -> TestServer {
+    let (addr, stop, handle) = spawn(config).await;
     let channel = Channel::from_shared(format!("http://{addr}"))
         .unwrap()
         .connect()

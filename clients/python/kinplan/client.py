@@ -86,6 +86,54 @@ def normalize_target(target: Union[str, Sequence[str]]) -> str:
     return f"{scheme}:{','.join(resolved)}"
 
 
+def _pem(v: Union[str, bytes]) -> bytes:
+    """PEM bytes, or the content of the file a string names."""
+    if isinstance(v, bytes):
+        return v
+    with open(v, "rb") as f:
+        return f.read()
+
+
+class _BearerToken(
+    grpc.UnaryUnaryClientInterceptor,
+    grpc.UnaryStreamClientInterceptor,
+    grpc.StreamUnaryClientInterceptor,
+    grpc.StreamStreamClientInterceptor,
+):
+    """Adds ``authorization: Bearer <token>`` to every call."""
+
+    def __init__(self, token: str):
+        if not token or any(c in token for c in "\r\n"):
+            raise invalid_argument("token", "must be a non-empty single line")
+        self._header = ("authorization", f"Bearer {token}")
+
+    def _details(self, d: Any) -> Any:
+        metadata = list(d.metadata or []) + [self._header]
+        return _CallDetails(d.method, d.timeout, metadata, d.credentials, d.wait_for_ready, d.compression)
+
+    def intercept_unary_unary(self, continuation, details, request):  # type: ignore[no-untyped-def]
+        return continuation(self._details(details), request)
+
+    def intercept_unary_stream(self, continuation, details, request):  # type: ignore[no-untyped-def]
+        return continuation(self._details(details), request)
+
+    def intercept_stream_unary(self, continuation, details, requests):  # type: ignore[no-untyped-def]
+        return continuation(self._details(details), requests)
+
+    def intercept_stream_stream(self, continuation, details, requests):  # type: ignore[no-untyped-def]
+        return continuation(self._details(details), requests)
+
+
+class _CallDetails(grpc.ClientCallDetails):
+    def __init__(self, method, timeout, metadata, credentials, wait_for_ready, compression):  # type: ignore[no-untyped-def]
+        self.method = method
+        self.timeout = timeout
+        self.metadata = metadata
+        self.credentials = credentials
+        self.wait_for_ready = wait_for_ready
+        self.compression = compression
+
+
 class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, MobileMixin, KinematicsMixin):
     """A connection to a kinplan server.
 
@@ -101,13 +149,22 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         max_message_bytes: int = 16 * 1024 * 1024,
         channel: Optional[grpc.Channel] = None,
         wait_for_ready: bool = False,
+        token: Optional[str] = None,
+        tls_ca: Union[None, str, bytes] = None,
+        tls_cert: Union[None, str, bytes] = None,
+        tls_key: Union[None, str, bytes] = None,
     ):
         """`target`: "host", "host:port" (port 50051 when left out),
         "dns:///name:port" (every address the name resolves to, round robin),
         or several "host:port" (a list or one comma-separated string; calls
         spread round robin over identical replicas). With `wait_for_ready`,
         the constructor waits up to `timeout` for the server and raises
-        :class:`kinplan.errors.Unavailable` if none answers."""
+        :class:`kinplan.errors.Unavailable` if none answers.
+
+        Security (both off by default, as on the server): `token` is sent as
+        ``authorization: Bearer <token>`` on every call; `tls_ca` (a PEM
+        file path or bytes) turns on TLS, trusting that CA; `tls_cert` and
+        `tls_key` add a client certificate for mutual TLS."""
         self.target = normalize_target(target)
         self.timeout = timeout
         options = [
@@ -123,7 +180,21 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
             # the default :authority would be the whole address list, which
             # HTTP/2 servers refuse (RST_STREAM PROTOCOL_ERROR)
             options.append(("grpc.default_authority", "kinplan"))
-        self._channel = channel or grpc.insecure_channel(self.target, options=options)
+        if channel is None:
+            if tls_ca is not None:
+                creds = grpc.ssl_channel_credentials(
+                    root_certificates=_pem(tls_ca),
+                    private_key=_pem(tls_key) if tls_key is not None else None,
+                    certificate_chain=_pem(tls_cert) if tls_cert is not None else None,
+                )
+                channel = grpc.secure_channel(self.target, creds, options=options)
+            elif tls_cert is not None or tls_key is not None:
+                raise invalid_argument("tls_ca", "a client certificate needs TLS: give tls_ca too")
+            else:
+                channel = grpc.insecure_channel(self.target, options=options)
+            if token is not None:
+                channel = grpc.intercept_channel(channel, _BearerToken(token))
+        self._channel = channel
         self._robots = robot_pb2_grpc.RobotServiceStub(self._channel)
         if wait_for_ready:
             self.wait_for_ready(timeout)

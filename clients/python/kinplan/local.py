@@ -7,6 +7,8 @@ import os
 import shutil
 import socket
 import subprocess
+import tempfile
+import time
 from typing import Any, List, Optional
 
 from .client import Client
@@ -45,24 +47,37 @@ class LocalServer:
         self.args = list(args or [])
         self.startup_timeout = startup_timeout
         self._proc: Optional[subprocess.Popen] = None
+        self._log: Any = None
 
     def start(self) -> "LocalServer":
         if self._proc is not None:
             return self
+        # a file, not a pipe: a chatty server must never block on a full pipe
+        self._log = tempfile.TemporaryFile()
         self._proc = subprocess.Popen(
             [self.binary, "serve", "--listen", self.address, *self.args],
             stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
+            stderr=self._log,
         )
-        channel = grpc.insecure_channel(self.address)
-        try:
-            grpc.channel_ready_future(channel).result(timeout=self.startup_timeout)
-        except grpc.FutureTimeoutError:
-            self.stop()
-            raise error_for(grpc.StatusCode.UNAVAILABLE, f"kinplan serve did not start at {self.address}", [])
-        finally:
-            channel.close()
-        return self
+        # Ready when the port accepts connections (TLS or not, tokens or not).
+        host, port = self.address.rsplit(":", 1)
+        deadline = time.monotonic() + self.startup_timeout
+        while True:
+            if self._proc.poll() is not None:
+                self._log.seek(0)
+                err = self._log.read().decode(errors="replace")
+                self._proc = None
+                raise error_for(grpc.StatusCode.UNAVAILABLE, f"kinplan serve exited: {err.strip()[-500:]}", [])
+            try:
+                with socket.create_connection((host, int(port)), timeout=0.2):
+                    return self
+            except OSError:
+                if time.monotonic() > deadline:
+                    self.stop()
+                    raise error_for(
+                        grpc.StatusCode.UNAVAILABLE, f"kinplan serve did not start at {self.address}", []
+                    ) from None
+                time.sleep(0.02)
 
     def client(self, **kwargs: Any) -> Client:
         """A client of this server (keyword arguments as for :class:`Client`)."""
@@ -79,8 +94,7 @@ class LocalServer:
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()
-        if proc.stderr is not None:
-            proc.stderr.close()
+        self._log.close()
 
     @property
     def running(self) -> bool:

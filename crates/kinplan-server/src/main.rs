@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use kinplan_server::loadtest::{HealthArgs, LoadtestArgs, check_health, run_loadtest};
-use kinplan_server::service::{ServerConfig, serve};
+use kinplan_server::service::{ServerConfig, TlsPem, Tokens, serve};
 
 #[derive(Parser)]
 #[command(name = "kinplan", version, about = "Stateless gRPC motion-planning service")]
@@ -81,6 +81,60 @@ struct ServeArgs {
     /// Bytes of URDF text and parsed models the cache may hold.
     #[arg(long, env = "KINPLAN_MODEL_CACHE_BYTES", default_value_t = 256 * 1024 * 1024)]
     model_cache_bytes: usize,
+    /// Serve TLS with this certificate chain (PEM file); needs --tls-key.
+    #[arg(long, env = "KINPLAN_TLS_CERT", requires = "tls_key")]
+    tls_cert: Option<std::path::PathBuf>,
+    /// The certificate's private key (PEM file).
+    #[arg(long, env = "KINPLAN_TLS_KEY", requires = "tls_cert")]
+    tls_key: Option<std::path::PathBuf>,
+    /// Require client certificates signed by this CA (PEM file): mutual TLS.
+    #[arg(long, env = "KINPLAN_TLS_CLIENT_CA", requires = "tls_cert")]
+    tls_client_ca: Option<std::path::PathBuf>,
+    /// Require `authorization: Bearer <token>` with one of these tokens
+    /// (comma-separated); health checks and reflection stay open.
+    #[arg(
+        long,
+        env = "KINPLAN_AUTH_TOKENS",
+        value_delimiter = ',',
+        hide_env_values = true
+    )]
+    auth_tokens: Vec<String>,
+    /// Like --auth-tokens, from a file with one token per line.
+    #[arg(long, env = "KINPLAN_AUTH_TOKENS_FILE")]
+    auth_tokens_file: Option<std::path::PathBuf>,
+}
+
+/// Reads a file named on the command line (never one named in a request).
+fn read_file(path: &std::path::Path, flag: &str) -> Result<Vec<u8>, String> {
+    std::fs::read(path).map_err(|e| format!("{flag} {}: {e}", path.display()))
+}
+
+/// TLS and token settings from the flags.
+fn security(args: &ServeArgs) -> Result<(Option<TlsPem>, Option<Tokens>), String> {
+    let tls = match (&args.tls_cert, &args.tls_key) {
+        (Some(cert), Some(key)) => Some(TlsPem {
+            cert: read_file(cert, "--tls-cert")?,
+            key: read_file(key, "--tls-key")?,
+            client_ca: args
+                .tls_client_ca
+                .as_deref()
+                .map(|p| read_file(p, "--tls-client-ca"))
+                .transpose()?,
+        }),
+        _ => None,
+    };
+    let mut tokens = args.auth_tokens.clone();
+    if let Some(path) = &args.auth_tokens_file {
+        let text = String::from_utf8(read_file(path, "--auth-tokens-file")?)
+            .map_err(|_| "--auth-tokens-file is not UTF-8".to_string())?;
+        tokens.extend(text.lines().map(str::to_string));
+    }
+    let any_given = !args.auth_tokens.is_empty() || args.auth_tokens_file.is_some();
+    let tokens = Tokens::new(tokens);
+    if any_given && tokens.is_none() {
+        return Err("--auth-tokens / --auth-tokens-file name no token".into());
+    }
+    Ok((tls, tokens))
 }
 
 fn main() {
@@ -150,7 +204,16 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
     }
     let runtime = runtime.enable_all().build()?;
     let timeout = seconds(args.request_timeout_secs, "--request-timeout-secs")?;
+    let (tls, auth_tokens) = security(&args)?;
+    if tls.is_some() {
+        tracing::info!(mutual = args.tls_client_ca.is_some(), "serving TLS");
+    }
+    if auth_tokens.is_some() {
+        tracing::info!("bearer-token authentication on (health and reflection stay open)");
+    }
     let config = ServerConfig {
+        tls,
+        auth_tokens,
         cpu_threads: args.cpu_threads,
         max_message_bytes: args.max_message_bytes,
         request_timeout: (!timeout.is_zero()).then_some(timeout),

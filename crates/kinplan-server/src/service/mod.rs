@@ -4,6 +4,7 @@
 
 pub mod pb;
 
+mod auth;
 mod collision_models;
 mod compute;
 mod convert;
@@ -24,8 +25,9 @@ mod scoring;
 mod server;
 mod status;
 
+pub use auth::Tokens;
 pub use compute::{Budget, Compute};
 pub use guard::HANDLING_BUCKETS;
 pub use models::ModelStore;
-pub use server::{ServerConfig, serve};
+pub use server::{ServerConfig, TlsPem, serve};
 pub use status::code_name;

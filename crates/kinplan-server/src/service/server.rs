@@ -8,10 +8,11 @@ use std::time::Duration;
 
 use tokio::net::TcpListener;
 use tokio::sync::OwnedSemaphorePermit;
-use tonic::transport::Server;
 use tonic::transport::server::TcpIncoming;
+use tonic::transport::{Certificate, Identity, Server, ServerTlsConfig};
 use tonic_health::ServingStatus;
 
+use super::auth::{AuthLayer, Tokens};
 use super::collision_models::CollisionModels;
 use super::exploration::ExplorationApi;
 use super::guard::GuardLayer;
@@ -63,6 +64,31 @@ pub struct ServerConfig {
     pub stream_idle_timeout: Duration,
     /// Counts jobs running on the CPU pool (tests watch it to see work stop).
     pub running_jobs: Arc<AtomicUsize>,
+    /// Accepted bearer tokens; `None`: no authentication (health checks and
+    /// reflection are always open).
+    pub auth_tokens: Option<Tokens>,
+    /// Certificate, key and optional client CA (PEM); `None`: plaintext.
+    pub tls: Option<TlsPem>,
+}
+
+/// The server's TLS identity (PEM bytes). With `client_ca`, clients must
+/// present a certificate that CA signed (mutual TLS).
+#[derive(Clone)]
+pub struct TlsPem {
+    pub cert: Vec<u8>,
+    pub key: Vec<u8>,
+    pub client_ca: Option<Vec<u8>>,
+}
+
+impl std::fmt::Debug for TlsPem {
+    /// Never prints the key.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TlsPem")
+            .field("cert_bytes", &self.cert.len())
+            .field("key", &"<redacted>")
+            .field("mutual", &self.client_ca.is_some())
+            .finish()
+    }
 }
 
 impl Default for ServerConfig {
@@ -80,6 +106,8 @@ impl Default for ServerConfig {
             drain_timeout: Duration::from_secs(10),
             stream_idle_timeout: Duration::from_secs(60),
             running_jobs: Arc::default(),
+            auth_tokens: None,
+            tls: None,
         }
     }
 }
@@ -183,8 +211,17 @@ pub async fn serve(
         tracing::warn!("connections still open after the drain timeout; stopping anyway");
     };
     tracing::info!(addr = ?listener.local_addr().ok(), "kinplan serving");
-    let server = Server::builder()
+    let mut builder = Server::builder();
+    if let Some(tls) = &config.tls {
+        let mut tls_config = ServerTlsConfig::new().identity(Identity::from_pem(&tls.cert, &tls.key));
+        if let Some(ca) = &tls.client_ca {
+            tls_config = tls_config.client_ca_root(Certificate::from_pem(ca));
+        }
+        builder = builder.tls_config(tls_config)?;
+    }
+    let server = builder
         .layer(GuardLayer::new(cut_rx, config.request_timeout))
+        .layer(AuthLayer::new(config.auth_tokens.clone()))
         .add_service(health_service)
         .add_service(reflection_v1)
         .add_service(reflection_v1alpha)
