@@ -690,3 +690,78 @@ async fn scoring_limits_are_checked_up_front() {
     assert_eq!(err.code(), Code::ResourceExhausted, "{err:?}");
     assert!(err.message().starts_with("options.robot_points"), "{err:?}");
 }
+
+/// 200 calls in flight when SIGTERM arrives: health turns NOT_SERVING, every
+/// call already sent finishes OK (0 lost), and a call made after the
+/// listener closed is refused rather than left hanging.
+#[tokio::test]
+async fn a_drain_finishes_200_calls_in_flight_and_refuses_new_ones() {
+    use kinplan_server::service::pb::kinematics_service_client::KinematicsServiceClient;
+    let mut server = crate::start(ServerConfig {
+        drain_delay: Duration::from_millis(150),
+        drain_timeout: Duration::from_secs(20),
+        ..ServerConfig::default()
+    })
+    .await;
+    // an unreachable target: each call runs until its 15 ms budget is spent
+    let request = pb::SolveIkRequest {
+        robot: crate::named("ur5"),
+        target: Some(pb::Pose {
+            position: Some(pb::Vec3 {
+                x: 5.0,
+                y: 0.0,
+                z: 0.0,
+            }),
+            orientation: Some(pb::Quaternion {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+                w: 1.0,
+            }),
+        }),
+        seed: Vec::new(),
+        options: Some(pb::IkOptions {
+            time_budget: Some(0.015),
+            max_restarts: Some(1_000_000),
+            ..Default::default()
+        }),
+    };
+    let calls: Vec<_> = (0..200)
+        .map(|_| {
+            let mut ik = KinematicsServiceClient::new(server.channel.clone());
+            let mut r = tonic::Request::new(request.clone());
+            r.set_timeout(Duration::from_secs(30));
+            tokio::spawn(async move { ik.solve_ik(r).await })
+        })
+        .collect();
+    tokio::time::sleep(Duration::from_millis(20)).await;
+    let mut health = HealthClient::new(server.channel.clone());
+    server.stop.take().unwrap().send(()).unwrap();
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    let status = health
+        .check(HealthCheckRequest {
+            service: String::new(),
+        })
+        .await
+        .unwrap()
+        .into_inner()
+        .status;
+    assert_eq!(status, 2, "NOT_SERVING during the drain delay");
+    let mut lost = 0;
+    for c in calls {
+        if c.await.unwrap().is_err() {
+            lost += 1;
+        }
+    }
+    assert_eq!(lost, 0, "calls in flight lost over the drain");
+    tokio::time::timeout(Duration::from_secs(20), server.handle)
+        .await
+        .expect("the server exits once the calls are done")
+        .unwrap();
+    // the listener is closed: a new connection is refused
+    let refused = tonic::transport::Channel::from_shared(format!("http://{}", server.addr))
+        .unwrap()
+        .connect()
+        .await;
+    assert!(refused.is_err());
+}
