@@ -96,6 +96,14 @@ class LocalServer:
             proc.wait()
         self._log.close()
 
+    def kill(self) -> None:
+        """SIGKILL: the server dies with its calls (a crash, for failover tests)."""
+        proc, self._proc = self._proc, None
+        if proc is not None:
+            proc.kill()
+            proc.wait()
+            self._log.close()
+
     @property
     def running(self) -> bool:
         return self._proc is not None and self._proc.poll() is None
