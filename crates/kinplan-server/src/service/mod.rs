@@ -13,6 +13,7 @@ mod exploration_convert;
 mod explore;
 mod explore_convert;
 mod finite;
+pub mod fuzzing;
 mod guard;
 mod kinematics;
 mod mobile;
