@@ -259,7 +259,12 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
     ) -> "Robot":
         """A built-in robot by `name`, or a model sent as `urdf` text."""
         if (name is None) == (urdf is None):
-            raise ValueError("give exactly one of name or urdf=")
+            raise invalid_argument("name", "give exactly one of name or urdf=")
+        if urdf is not None and "<" not in urdf and urdf.strip().lower().endswith((".urdf", ".xml")):
+            raise invalid_argument(
+                "urdf",
+                f"{urdf!r} looks like a file path; urdf= takes the document's text: urdf=open(path).read()",
+            )
         return Robot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link)
 
 

@@ -197,6 +197,13 @@ class IkResult:
     sequence: Optional[int] = None
     raw: Any = field(default=None, repr=False)
 
+    def __repr__(self) -> str:
+        return (
+            f"IkResult(success={self.success}, status={self.status!r}, position_error={self.position_error:.2e} m, "
+            f"orientation_error={self.orientation_error:.2e} rad, solutions={len(self.solutions)}, "
+            f"attempts={self.attempts}, {self.elapsed_us} us)"
+        )
+
     @classmethod
     def from_proto(cls, r: kinematics_pb2.SolveIkResponse) -> "IkResult":
         solutions = [IkSolution.from_proto(s) for s in r.solutions]
@@ -230,6 +237,9 @@ class IkBatchResult:
     results: List[IkResult]
     succeeded: int
     elapsed_us: int
+
+    def __repr__(self) -> str:
+        return f"IkBatchResult({self.succeeded}/{len(self.results)} solved, {self.elapsed_us} us)"
 
     @property
     def q(self) -> np.ndarray:
@@ -278,6 +288,14 @@ class TrackResult:
     stop_reason: str
     total_elapsed_us: int
     raw: Any = field(default=None, repr=False)
+
+    def __repr__(self) -> str:
+        worst = float(np.max(self.position_error)) if len(self.position_error) else 0.0
+        return (
+            f"TrackResult({len(self.q)} targets, all_converged={self.all_converged}, "
+            f"max position error {worst:.2e} m, max joint step {self.max_joint_step:.3f} rad, "
+            f"stop_reason={self.stop_reason!r}, {self.total_elapsed_us} us)"
+        )
 
     @classmethod
     def from_proto(cls, r: kinematics_pb2.TrackPathResponse) -> "TrackResult":
@@ -439,7 +457,8 @@ class RobotKinematicsMixin:
         **options: Any,
     ) -> IkResult:
         """Joints that put the tool at ``T`` (4x4, or (position, quaternion
-        xyzw)), base frame. ``method``: "lm" (default), "jacobian_inverse",
+        xyzw), or a bare position 3-vector, which means ``position_only``),
+        base frame. ``method``: "lm" (default), "jacobian_inverse",
         "newton", "ccd", "fabrik", "length_relaxation"; ``linear_solver``
         (Jacobian methods): "svd" (default), "angle_relaxation",
         "angle_relaxation_safeguarded". Tolerances in m and rad (default
@@ -450,6 +469,10 @@ class RobotKinematicsMixin:
         (s; default: the call's deadline), ``adaptive_damping``,
         ``max_step``, ``distinct_tolerance``, ``rlxa_max_iterations``,
         ``history`` (True: each solution carries its per-iteration errors)."""
+        # a bare 3-vector is a position: solve for it alone
+        if not isinstance(T, common_pb2.Pose) and np.asarray(T, dtype=object).shape == (3,):
+            T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
+            position_only = True
         o = ik_options(
             method,
             linear_solver,

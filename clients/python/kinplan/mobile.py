@@ -179,6 +179,13 @@ class MobileRun:
     steps: int
     raw: Any = field(default=None, repr=False)
 
+    def __repr__(self) -> str:
+        clearance = "n/a" if self.min_clearance is None else f"{self.min_clearance:.3f} m"
+        return (
+            f"MobileRun(outcome={self.outcome!r}, {self.steps} steps, {self.time:.2f} s, "
+            f"path {self.path_length:.2f} m, min clearance {clearance})"
+        )
+
     @property
     def reached(self) -> bool:
         return self.outcome == "REACHED"

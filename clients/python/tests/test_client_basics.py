@@ -3,6 +3,8 @@ wait_for_ready, addresses, the exception hierarchy (pickled too), and calls
 spread over two replicas surviving the loss of one."""
 import pickle
 
+import numpy as np
+
 import grpc
 import pytest
 
@@ -81,3 +83,24 @@ def test_calls_over_two_replicas_survive_the_loss_of_one():
             # every call still answers: the gone replica is retried on the other
             for _ in range(20):
                 assert c.ping() < 5
+
+
+def test_notebook_reprs_are_short_and_a_bare_position_means_position_only(client):
+    ur5 = client.robot("ur5")
+    T = ur5.fk([0.3, -1.2, 1.4, -0.6, 1.2, 0.1])
+    r = ur5.ik(T[:3, 3])
+    assert r.success
+    # the position is reached, the orientation is free
+    np.testing.assert_allclose(ur5.fk(r.q)[:3, 3], T[:3, 3], atol=1e-4)
+    assert len(repr(r)) < 300
+    path = np.array([T @ np.diag([1, 1, 1, 1]) for _ in range(50)])
+    path[:, 0, 3] += np.linspace(0, 0.1, 50)
+    track = ur5.track(path)
+    assert len(repr(track)) < 300 and "targets" in repr(track)
+    run = client.mobile.navigate(start=(0, 0, 0), goal=(2, 0))
+    assert len(repr(run)) < 300 and "outcome" in repr(run)
+
+
+def test_a_urdf_path_gets_a_hint_instead_of_a_parser_error(client):
+    with pytest.raises(kinplan.InvalidArgument, match="open\\(path\\).read"):
+        client.robot(urdf="robots/arm.urdf")
