@@ -468,7 +468,16 @@ class RobotKinematicsMixin:
         ``rng_seed``, ``joint_limits`` ("clamp"/"ignore"), ``time_budget``
         (s; default: the call's deadline), ``adaptive_damping``,
         ``max_step``, ``distinct_tolerance``, ``rlxa_max_iterations``,
-        ``history`` (True: each solution carries its per-iteration errors)."""
+        ``history`` (True: each solution carries its per-iteration errors).
+
+        Which combinations converge (1,000 random reachable targets per arm,
+        5 ms budget, ``benches/IK_RESULTS.md`` §0.5): "lm", "jacobian_inverse"
+        and "newton" with "svd" solve 100 % on all six built-in arms in
+        ~20-30 us median; with "angle_relaxation" 84-96 % (slower); "ccd"
+        20-58 % on 6-axis arms; "newton" + "angle_relaxation" solves 0 %,
+        as S2 predicts (the relaxation's inexact solve is not accurate enough
+        for Newton's fixed-point step): do not use it. "fabrik" and
+        "length_relaxation" take position targets only."""
         # a bare 3-vector is a position: solve for it alone
         if not isinstance(T, common_pb2.Pose) and np.asarray(T, dtype=object).shape == (3,):
             T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))

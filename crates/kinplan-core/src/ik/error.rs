@@ -23,7 +23,7 @@ pub enum IkError {
         value: f64,
         reason: &'static str,
     },
-    #[error("method {method:?} cannot serve this request: {reason}")]
+    #[error("method \"{}\" cannot serve this request: {reason}", method.name())]
     MethodCannotServe { method: IkMethod, reason: String },
     #[error("path has no poses")]
     EmptyPath,

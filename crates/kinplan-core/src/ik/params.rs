@@ -24,6 +24,19 @@ pub enum IkMethod {
 }
 
 impl IkMethod {
+    /// The method's name on the wire and in the Python client
+    /// ("jacobian_inverse", "lm", "newton", "ccd", "fabrik", "length_relaxation").
+    pub fn name(self) -> &'static str {
+        match self {
+            IkMethod::JacobianInverse => "jacobian_inverse",
+            IkMethod::LevenbergMarquardt => "lm",
+            IkMethod::Newton => "newton",
+            IkMethod::Ccd => "ccd",
+            IkMethod::Fabrik => "fabrik",
+            IkMethod::LengthRelaxation => "length_relaxation",
+        }
+    }
+
     /// True for the three methods that take a [`LinearSolverKind`].
     pub fn is_jacobian_method(self) -> bool {
         matches!(

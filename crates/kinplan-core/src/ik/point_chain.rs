@@ -44,7 +44,8 @@ pub(crate) fn check_servable(chain: &Chain, target: &IkTarget, method: IkMethod)
     if !target.is_position_only() {
         return Err(IkError::MethodCannotServe {
             method,
-            reason: "it solves position targets only; use CCD or a Jacobian method for an orientation target"
+            reason: "it solves position targets only: set position_only (or give a 3-vector target), \
+                     or use \"ccd\" or a Jacobian method (\"lm\", \"jacobian_inverse\", \"newton\") for an orientation target"
                 .into(),
         });
     }
