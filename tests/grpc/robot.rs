@@ -263,3 +263,121 @@ async fn shutdown_reports_not_serving_then_stops() {
         .expect("server stops after draining")
         .unwrap();
 }
+
+/// Batch FK agrees with one-state FK calls, and each batch Jacobian's
+/// linear rows agree with central finite differences of batch positions.
+#[tokio::test]
+async fn batch_fk_matches_single_calls_and_its_jacobians_match_finite_differences() {
+    let server = start(ServerConfig::default()).await;
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let dof = 6;
+    let states: Vec<Vec<f64>> = (0..40)
+        .map(|i| {
+            (0..dof)
+                .map(|j| ((i * 7 + j * 3) % 11) as f64 * 0.4 - 2.0)
+                .collect()
+        })
+        .collect();
+    let matrix = |rows: &[Vec<f64>]| pb::Matrix {
+        rows: rows.len() as u32,
+        cols: dof as u32,
+        data: rows.concat(),
+    };
+    let batch = robots
+        .forward_kinematics_batch(pb::ForwardKinematicsBatchRequest {
+            robot: named("ur5"),
+            joint_positions: Some(matrix(&states)),
+            include_jacobians: true,
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    let poses = batch.tool_poses.unwrap();
+    assert_eq!((poses.rows, poses.cols), (40, 7));
+    let jac = batch.jacobians.unwrap();
+    assert_eq!((jac.rows, jac.cols), (40, 36));
+    for (i, q) in states.iter().enumerate() {
+        let single = robots
+            .forward_kinematics(pb::ForwardKinematicsRequest {
+                robot: named("ur5"),
+                joint_positions: q.clone(),
+                include_links: false,
+            })
+            .await
+            .unwrap()
+            .into_inner()
+            .tool_pose
+            .unwrap();
+        let p = single.position.unwrap();
+        let o = single.orientation.unwrap();
+        let row = &poses.data[i * 7..i * 7 + 7];
+        for (a, b) in row.iter().zip([p.x, p.y, p.z, o.x, o.y, o.z, o.w]) {
+            assert!((a - b).abs() < 1e-12, "state {i}");
+        }
+    }
+    // finite differences of positions for state 3, joint by joint
+    let h = 1e-6;
+    let q = &states[3];
+    let mut plus_minus = Vec::new();
+    for j in 0..dof {
+        for s in [h, -h] {
+            let mut x = q.clone();
+            x[j] += s;
+            plus_minus.push(x);
+        }
+    }
+    let fd = robots
+        .forward_kinematics_batch(pb::ForwardKinematicsBatchRequest {
+            robot: named("ur5"),
+            joint_positions: Some(matrix(&plus_minus)),
+            include_jacobians: false,
+        })
+        .await
+        .unwrap()
+        .into_inner()
+        .tool_poses
+        .unwrap();
+    let j3 = &jac.data[3 * 36..4 * 36];
+    for j in 0..dof {
+        for r in 0..3 {
+            let d = (fd.data[(2 * j) * 7 + r] - fd.data[(2 * j + 1) * 7 + r]) / (2.0 * h);
+            assert!((d - j3[r * dof + j]).abs() < 1e-6, "J[{r},{j}]");
+        }
+    }
+    // bad shapes and values are named
+    let bad = robots
+        .forward_kinematics_batch(pb::ForwardKinematicsBatchRequest {
+            robot: named("ur5"),
+            joint_positions: Some(pb::Matrix {
+                rows: 2,
+                cols: 6,
+                data: [vec![0.0; 6], vec![0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0]].concat(),
+            }),
+            include_jacobians: false,
+        })
+        .await
+        .unwrap_err();
+    assert_eq!(bad.code(), Code::InvalidArgument);
+    assert!(
+        bad.message().contains("joint_positions[1][2]"),
+        "{}",
+        bad.message()
+    );
+    let bad = robots
+        .forward_kinematics_batch(pb::ForwardKinematicsBatchRequest {
+            robot: named("ur5"),
+            joint_positions: Some(pb::Matrix {
+                rows: 1,
+                cols: 5,
+                data: vec![0.0; 5],
+            }),
+            include_jacobians: false,
+        })
+        .await
+        .unwrap_err();
+    assert!(
+        bad.message().contains("joint_positions.cols"),
+        "{}",
+        bad.message()
+    );
+}

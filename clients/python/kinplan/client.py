@@ -362,6 +362,42 @@ class Robot(RobotKinematicsMixin):
             return tool, {link.name: pose_to_matrix(link.pose) for link in r.links}
         return tool
 
+    def fk_batch(self, qs: Any, *, jacobians: bool = False, timeout: Optional[float] = None) -> Any:
+        """Tool poses of every row of `qs` (n x dof, rad) in one call: an
+        (n, 4, 4) array; with `jacobians=True` also the (n, 6, dof)
+        Jacobians (rows 0-2 linear, 3-5 angular, base frame)."""
+        arr = np.ascontiguousarray(qs, dtype=np.float64)
+        if arr.ndim == 1:
+            arr = arr[None, :]
+        if arr.ndim != 2 or arr.shape[0] == 0:
+            raise invalid_argument("qs", f"must be n x dof with n >= 1, got shape {arr.shape}")
+        matrix = common_pb2.Matrix(rows=arr.shape[0], cols=arr.shape[1], data=arr.ravel())
+        r = self._call(
+            self.client._robots.ForwardKinematicsBatch,
+            lambda ref: robot_pb2.ForwardKinematicsBatchRequest(
+                robot=ref, joint_positions=matrix, include_jacobians=jacobians
+            ),
+            timeout,
+        )
+        p = np.asarray(r.tool_poses.data, dtype=np.float64).reshape(-1, 7)
+        x, y, z, w = p[:, 3], p[:, 4], p[:, 5], p[:, 6]
+        T = np.zeros((len(p), 4, 4))
+        T[:, 0, 0] = 1 - 2 * (y * y + z * z)
+        T[:, 0, 1] = 2 * (x * y - z * w)
+        T[:, 0, 2] = 2 * (x * z + y * w)
+        T[:, 1, 0] = 2 * (x * y + z * w)
+        T[:, 1, 1] = 1 - 2 * (x * x + z * z)
+        T[:, 1, 2] = 2 * (y * z - x * w)
+        T[:, 2, 0] = 2 * (x * z - y * w)
+        T[:, 2, 1] = 2 * (y * z + x * w)
+        T[:, 2, 2] = 1 - 2 * (x * x + y * y)
+        T[:, :3, 3] = p[:, :3]
+        T[:, 3, 3] = 1.0
+        if jacobians:
+            J = np.asarray(r.jacobians.data, dtype=np.float64).reshape(len(p), 6, arr.shape[1])
+            return T, J
+        return T
+
     def jacobian(self, q: Sequence[float], *, timeout: Optional[float] = None) -> np.ndarray:
         """6 x n geometric Jacobian in the base frame (rows: vx, vy, vz, wx, wy, wz)."""
         positions = joints(q)

@@ -104,3 +104,16 @@ def test_notebook_reprs_are_short_and_a_bare_position_means_position_only(client
 def test_a_urdf_path_gets_a_hint_instead_of_a_parser_error(client):
     with pytest.raises(kinplan.InvalidArgument, match="open\\(path\\).read"):
         client.robot(urdf="robots/arm.urdf")
+
+
+def test_batch_fk_equals_single_calls_and_batch_jacobians_equal_single_ones(client):
+    ur5 = client.robot("ur5")
+    rng = np.random.default_rng(3)
+    qs = rng.uniform(-2.5, 2.5, size=(25, 6))
+    T, J = ur5.fk_batch(qs, jacobians=True)
+    assert T.shape == (25, 4, 4) and J.shape == (25, 6, 6)
+    for q, t, j in zip(qs, T, J):
+        np.testing.assert_allclose(t, ur5.fk(q), atol=1e-12)
+        np.testing.assert_allclose(j, ur5.jacobian(q), atol=1e-12)
+    with pytest.raises(kinplan.InvalidArgument, match=r"joint_positions\[1\]"):
+        ur5.fk_batch([[0.0] * 6, [np.nan] * 6])

@@ -158,3 +158,23 @@ class JacobianResponse(_message.Message):
     tool_pose: _common_pb2.Pose
     model_id: bytes
     def __init__(self, jacobian: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., tool_pose: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., model_id: _Optional[bytes] = ...) -> None: ...
+
+class ForwardKinematicsBatchRequest(_message.Message):
+    __slots__ = ("robot", "joint_positions", "include_jacobians")
+    ROBOT_FIELD_NUMBER: _ClassVar[int]
+    JOINT_POSITIONS_FIELD_NUMBER: _ClassVar[int]
+    INCLUDE_JACOBIANS_FIELD_NUMBER: _ClassVar[int]
+    robot: _common_pb2.RobotRef
+    joint_positions: _common_pb2.Matrix
+    include_jacobians: bool
+    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., joint_positions: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., include_jacobians: _Optional[bool] = ...) -> None: ...
+
+class ForwardKinematicsBatchResponse(_message.Message):
+    __slots__ = ("tool_poses", "jacobians", "model_id")
+    TOOL_POSES_FIELD_NUMBER: _ClassVar[int]
+    JACOBIANS_FIELD_NUMBER: _ClassVar[int]
+    MODEL_ID_FIELD_NUMBER: _ClassVar[int]
+    tool_poses: _common_pb2.Matrix
+    jacobians: _common_pb2.Matrix
+    model_id: bytes
+    def __init__(self, tool_poses: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., jacobians: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., model_id: _Optional[bytes] = ...) -> None: ...

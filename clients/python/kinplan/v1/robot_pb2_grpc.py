@@ -54,6 +54,11 @@ class RobotServiceStub:
                 request_serializer=kinplan_dot_v1_dot_robot__pb2.JacobianRequest.SerializeToString,
                 response_deserializer=kinplan_dot_v1_dot_robot__pb2.JacobianResponse.FromString,
                 _registered_method=True)
+        self.ForwardKinematicsBatch = channel.unary_unary(
+                '/kinplan.v1.RobotService/ForwardKinematicsBatch',
+                request_serializer=kinplan_dot_v1_dot_robot__pb2.ForwardKinematicsBatchRequest.SerializeToString,
+                response_deserializer=kinplan_dot_v1_dot_robot__pb2.ForwardKinematicsBatchResponse.FromString,
+                _registered_method=True)
 
 
 class RobotServiceServicer:
@@ -87,6 +92,15 @@ class RobotServiceServicer:
         context.set_details('Method not implemented!')
         raise NotImplementedError('Method not implemented!')
 
+    def ForwardKinematicsBatch(self, request, context):
+        """Tool poses (and, on request, Jacobians) of many joint states in one
+        call: for notebooks and samplers that would otherwise pay one round
+        trip per state.
+        """
+        context.set_code(grpc.StatusCode.UNIMPLEMENTED)
+        context.set_details('Method not implemented!')
+        raise NotImplementedError('Method not implemented!')
+
 
 def add_RobotServiceServicer_to_server(servicer, server):
     rpc_method_handlers = {
@@ -109,6 +123,11 @@ def add_RobotServiceServicer_to_server(servicer, server):
                     servicer.Jacobian,
                     request_deserializer=kinplan_dot_v1_dot_robot__pb2.JacobianRequest.FromString,
                     response_serializer=kinplan_dot_v1_dot_robot__pb2.JacobianResponse.SerializeToString,
+            ),
+            'ForwardKinematicsBatch': grpc.unary_unary_rpc_method_handler(
+                    servicer.ForwardKinematicsBatch,
+                    request_deserializer=kinplan_dot_v1_dot_robot__pb2.ForwardKinematicsBatchRequest.FromString,
+                    response_serializer=kinplan_dot_v1_dot_robot__pb2.ForwardKinematicsBatchResponse.SerializeToString,
             ),
     }
     generic_handler = grpc.method_handlers_generic_handler(
@@ -219,6 +238,33 @@ class RobotService:
             '/kinplan.v1.RobotService/Jacobian',
             kinplan_dot_v1_dot_robot__pb2.JacobianRequest.SerializeToString,
             kinplan_dot_v1_dot_robot__pb2.JacobianResponse.FromString,
+            options,
+            channel_credentials,
+            insecure,
+            call_credentials,
+            compression,
+            wait_for_ready,
+            timeout,
+            metadata,
+            _registered_method=True)
+
+    @staticmethod
+    def ForwardKinematicsBatch(request,
+            target,
+            options=(),
+            channel_credentials=None,
+            call_credentials=None,
+            insecure=False,
+            compression=None,
+            wait_for_ready=None,
+            timeout=None,
+            metadata=None):
+        return grpc.experimental.unary_unary(
+            request,
+            target,
+            '/kinplan.v1.RobotService/ForwardKinematicsBatch',
+            kinplan_dot_v1_dot_robot__pb2.ForwardKinematicsBatchRequest.SerializeToString,
+            kinplan_dot_v1_dot_robot__pb2.ForwardKinematicsBatchResponse.FromString,
             options,
             channel_credentials,
             insecure,

@@ -41,6 +41,11 @@ class RobotServiceStub:
     """Tool pose (and optionally every link frame) for a joint vector."""
     Jacobian: _grpc.UnaryUnaryMultiCallable[_robot_pb2.JacobianRequest, _robot_pb2.JacobianResponse]
     """The 6 x n geometric Jacobian of the tool in the base frame."""
+    ForwardKinematicsBatch: _grpc.UnaryUnaryMultiCallable[_robot_pb2.ForwardKinematicsBatchRequest, _robot_pb2.ForwardKinematicsBatchResponse]
+    """Tool poses (and, on request, Jacobians) of many joint states in one
+    call: for notebooks and samplers that would otherwise pay one round
+    trip per state.
+    """
 
 @_typing.type_check_only
 class RobotServiceAsyncStub(RobotServiceStub):
@@ -53,6 +58,11 @@ class RobotServiceAsyncStub(RobotServiceStub):
     """Tool pose (and optionally every link frame) for a joint vector."""
     Jacobian: _aio.UnaryUnaryMultiCallable[_robot_pb2.JacobianRequest, _robot_pb2.JacobianResponse]  # type: ignore[assignment]
     """The 6 x n geometric Jacobian of the tool in the base frame."""
+    ForwardKinematicsBatch: _aio.UnaryUnaryMultiCallable[_robot_pb2.ForwardKinematicsBatchRequest, _robot_pb2.ForwardKinematicsBatchResponse]  # type: ignore[assignment]
+    """Tool poses (and, on request, Jacobians) of many joint states in one
+    call: for notebooks and samplers that would otherwise pay one round
+    trip per state.
+    """
 
 class RobotServiceServicer(metaclass=_abc_1.ABCMeta):
     @_abc_1.abstractmethod
@@ -86,5 +96,16 @@ class RobotServiceServicer(metaclass=_abc_1.ABCMeta):
         context: _ServicerContext,
     ) -> _typing.Union[_robot_pb2.JacobianResponse, _abc.Awaitable[_robot_pb2.JacobianResponse]]:
         """The 6 x n geometric Jacobian of the tool in the base frame."""
+
+    @_abc_1.abstractmethod
+    def ForwardKinematicsBatch(
+        self,
+        request: _robot_pb2.ForwardKinematicsBatchRequest,
+        context: _ServicerContext,
+    ) -> _typing.Union[_robot_pb2.ForwardKinematicsBatchResponse, _abc.Awaitable[_robot_pb2.ForwardKinematicsBatchResponse]]:
+        """Tool poses (and, on request, Jacobians) of many joint states in one
+        call: for notebooks and samplers that would otherwise pay one round
+        trip per state.
+        """
 
 def add_RobotServiceServicer_to_server(servicer: RobotServiceServicer, server: _typing.Union[_grpc.Server, _aio.Server]) -> None: ...

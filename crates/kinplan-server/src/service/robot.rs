@@ -8,7 +8,7 @@ use tonic::{Request, Response, Status};
 use super::convert::{matrix_out, pose_out, vec3_out};
 use super::pb::{self, robot_service_server::RobotService};
 use super::server::Shared;
-use super::status::robot_error;
+use super::status::{invalid, robot_error};
 use kinplan_core::robot::{BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf};
 
 pub struct RobotApi {
@@ -94,6 +94,65 @@ impl RobotService for RobotApi {
         }))
     }
 
+    async fn forward_kinematics_batch(
+        &self,
+        request: Request<pb::ForwardKinematicsBatchRequest>,
+    ) -> Result<Response<pb::ForwardKinematicsBatchResponse>, Status> {
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
+        let req = request.into_inner();
+        let dof = robot.chain.dof();
+        let Some(m) = req.joint_positions.as_ref() else {
+            return Err(invalid("joint_positions", "is required"));
+        };
+        if m.cols as usize != dof {
+            return Err(invalid(
+                "joint_positions.cols",
+                format!("is {}, the robot has {dof} joints", m.cols),
+            ));
+        }
+        let rows = m.rows as usize;
+        if rows == 0 || m.data.len() != rows.saturating_mul(dof) {
+            return Err(invalid(
+                "joint_positions.data",
+                format!(
+                    "has {} values, {rows} rows x {dof} joints need {}",
+                    m.data.len(),
+                    rows.saturating_mul(dof)
+                ),
+            ));
+        }
+        for (i, row) in m.data.chunks_exact(dof).enumerate() {
+            robot
+                .chain
+                .check_joints(row)
+                .map_err(|e| robot_error(e, &format!("joint_positions[{i}]")))?;
+        }
+        let chain = robot.chain.clone();
+        let jacobians = req.include_jacobians;
+        let q = req.joint_positions.map(|m| m.data).unwrap_or_default();
+        let (poses, jac) = self
+            .shared
+            .compute
+            .run(&budget, move |b| {
+                batch_kinematics(&chain, &q, jacobians, &|| b.should_stop())
+            })
+            .await?
+            .ok_or_else(|| Status::deadline_exceeded("the deadline passed during the batch"))?;
+        let matrix = |cols: usize, data: Vec<f64>| pb::Matrix {
+            rows: rows as u32,
+            cols: cols as u32,
+            data,
+        };
+        Ok(Response::new(pb::ForwardKinematicsBatchResponse {
+            tool_poses: Some(matrix(7, poses)),
+            jacobians: jacobians.then(|| matrix(6 * dof, jac)),
+            model_id: robot.model_id,
+        }))
+    }
+
     async fn jacobian(
         &self,
         request: Request<pb::JacobianRequest>,
@@ -116,6 +175,44 @@ impl RobotService for RobotApi {
             model_id: robot.model_id,
         }))
     }
+}
+
+/// Rows computed between deadline checks in a batch.
+const BATCH_CHECK_ROWS: usize = 1024;
+
+/// Tool poses (n × 7: x, y, z, qx, qy, qz, qw) and, with `jacobians`, the
+/// flattened 6 × dof Jacobians (n × 6·dof) of every row of `q` (n × dof,
+/// row-major, already checked). `None` when `should_stop` fired.
+fn batch_kinematics(
+    chain: &Chain,
+    q: &[f64],
+    jacobians: bool,
+    should_stop: &dyn Fn() -> bool,
+) -> Option<(Vec<f64>, Vec<f64>)> {
+    let dof = chain.dof();
+    let n = q.len() / dof;
+    let mut poses = Vec::with_capacity(n * 7);
+    let mut jac_out = Vec::with_capacity(if jacobians { n * 6 * dof } else { 0 });
+    let mut jac = nalgebra::Matrix6xX::zeros(dof);
+    for (i, row) in q.chunks_exact(dof).enumerate() {
+        if i % BATCH_CHECK_ROWS == BATCH_CHECK_ROWS - 1 && should_stop() {
+            return None;
+        }
+        let tool = if jacobians {
+            let tool = chain.jacobian_into(row, &mut jac);
+            // row-major 6 × dof
+            for r in 0..6 {
+                jac_out.extend((0..dof).map(|c| jac[(r, c)]));
+            }
+            tool
+        } else {
+            chain.fk(row)
+        };
+        let t = tool.translation.vector;
+        let r = tool.rotation.quaternion().coords; // (i, j, k, w)
+        poses.extend([t.x, t.y, t.z, r.x, r.y, r.z, r.w]);
+    }
+    Some((poses, jac_out))
 }
 
 /// The first XML comment of a built-in URDF: its data source.
