@@ -1,0 +1,24 @@
+"""Executes examples/tour.ipynb headless against the test server: every cell
+runs and its asserts hold (the notebook a new user opens first)."""
+import os
+import pathlib
+
+import pytest
+
+nbformat = pytest.importorskip("nbformat")
+nbclient = pytest.importorskip("nbclient")
+
+NOTEBOOK = pathlib.Path(__file__).resolve().parents[1] / "examples" / "tour.ipynb"
+
+
+def test_the_tour_notebook_runs_top_to_bottom(server_address, monkeypatch):
+    monkeypatch.setenv("KINPLAN_ADDRESS", server_address)
+    nb = nbformat.read(NOTEBOOK, as_version=4)
+    client = nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
+                                     resources={"metadata": {"path": str(NOTEBOOK.parent)}})
+    client.execute()
+    outputs = [o for cell in nb.cells if cell.cell_type == "code" for o in cell.get("outputs", [])]
+    assert not [o for o in outputs if o.get("output_type") == "error"]
+    # the last displayed value is the exploration summary
+    shown = [o for o in outputs if o.get("output_type") == "execute_result"]
+    assert "ExploreSummary" in shown[-1]["data"]["text/plain"]
