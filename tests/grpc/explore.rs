@@ -180,6 +180,16 @@ async fn bad_exploration_requests_are_named_by_field() {
             r.stop.as_mut().unwrap().known_ratio = Some(1.5);
             r
         }),
+        ("camera_link", {
+            let mut r = request();
+            r.camera_link = "no_such_link".into();
+            r
+        }),
+        ("camera_link", {
+            let mut r = request();
+            r.camera_link = "link_3".into();
+            r
+        }),
         ("nbv.weights.distance", {
             let mut r = request();
             r.nbv = Some(pb::NbvOptions {

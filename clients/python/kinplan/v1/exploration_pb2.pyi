@@ -357,7 +357,7 @@ class ExploreStopRule(_message.Message):
     def __init__(self, known_ratio: _Optional[float] = ..., max_iterations: _Optional[int] = ..., max_consecutive_failures: _Optional[int] = ...) -> None: ...
 
 class ExploreRequest(_message.Message):
-    __slots__ = ("robot", "start", "scene", "region", "camera", "camera_mount", "nbv", "algorithm", "plan_options", "stop", "resolution", "pixel_stride", "noise_stddev", "candidates_per_iteration", "plan_time_budget", "initial_offsets", "no_initial_offsets", "extra_views", "no_extra_views", "seed", "time_budget")
+    __slots__ = ("robot", "start", "scene", "region", "camera", "camera_mount", "nbv", "algorithm", "plan_options", "stop", "resolution", "pixel_stride", "noise_stddev", "candidates_per_iteration", "plan_time_budget", "initial_offsets", "no_initial_offsets", "extra_views", "no_extra_views", "seed", "time_budget", "camera_link")
     ROBOT_FIELD_NUMBER: _ClassVar[int]
     START_FIELD_NUMBER: _ClassVar[int]
     SCENE_FIELD_NUMBER: _ClassVar[int]
@@ -379,6 +379,7 @@ class ExploreRequest(_message.Message):
     NO_EXTRA_VIEWS_FIELD_NUMBER: _ClassVar[int]
     SEED_FIELD_NUMBER: _ClassVar[int]
     TIME_BUDGET_FIELD_NUMBER: _ClassVar[int]
+    CAMERA_LINK_FIELD_NUMBER: _ClassVar[int]
     robot: _common_pb2.RobotRef
     start: _containers.RepeatedScalarFieldContainer[float]
     scene: _common_pb2.Scene
@@ -400,7 +401,8 @@ class ExploreRequest(_message.Message):
     no_extra_views: bool
     seed: int
     time_budget: float
-    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., start: _Optional[_Iterable[float]] = ..., scene: _Optional[_Union[_common_pb2.Scene, _Mapping]] = ..., region: _Optional[_Union[BoundingBox, _Mapping]] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ..., camera_mount: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., nbv: _Optional[_Union[NbvOptions, _Mapping]] = ..., algorithm: _Optional[_Union[_planning_pb2.PlanAlgorithm, str]] = ..., plan_options: _Optional[_Union[_planning_pb2.PlanOptions, _Mapping]] = ..., stop: _Optional[_Union[ExploreStopRule, _Mapping]] = ..., resolution: _Optional[float] = ..., pixel_stride: _Optional[int] = ..., noise_stddev: _Optional[float] = ..., candidates_per_iteration: _Optional[int] = ..., plan_time_budget: _Optional[float] = ..., initial_offsets: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., no_initial_offsets: _Optional[bool] = ..., extra_views: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., no_extra_views: _Optional[bool] = ..., seed: _Optional[int] = ..., time_budget: _Optional[float] = ...) -> None: ...
+    camera_link: str
+    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., start: _Optional[_Iterable[float]] = ..., scene: _Optional[_Union[_common_pb2.Scene, _Mapping]] = ..., region: _Optional[_Union[BoundingBox, _Mapping]] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ..., camera_mount: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., nbv: _Optional[_Union[NbvOptions, _Mapping]] = ..., algorithm: _Optional[_Union[_planning_pb2.PlanAlgorithm, str]] = ..., plan_options: _Optional[_Union[_planning_pb2.PlanOptions, _Mapping]] = ..., stop: _Optional[_Union[ExploreStopRule, _Mapping]] = ..., resolution: _Optional[float] = ..., pixel_stride: _Optional[int] = ..., noise_stddev: _Optional[float] = ..., candidates_per_iteration: _Optional[int] = ..., plan_time_budget: _Optional[float] = ..., initial_offsets: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., no_initial_offsets: _Optional[bool] = ..., extra_views: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., no_extra_views: _Optional[bool] = ..., seed: _Optional[int] = ..., time_budget: _Optional[float] = ..., camera_link: _Optional[str] = ...) -> None: ...
 
 class FailedView(_message.Message):
     __slots__ = ("position", "reason")

@@ -46,7 +46,7 @@ pub async fn explore_stream(
         .await?;
     let req = request.into_inner();
     let dof = robot.chain.dof();
-    let (params, time_budget) = explore_params_in(&req, dof)?;
+    let (params, time_budget) = explore_params_in(&req, &robot.chain)?;
     let scene = scene_in("scene", req.scene.as_ref(), &SceneLimits::default())?;
     if scene.is_empty() {
         return Err(invalid("scene", "is empty: the camera would see nothing"));

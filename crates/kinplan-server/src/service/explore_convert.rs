@@ -22,8 +22,9 @@ const MAX_EXTRA_VIEWS: usize = 10_000;
 /// The loop's parameters and the run's time budget.
 pub fn explore_params_in(
     req: &pb::ExploreRequest,
-    dof: usize,
+    chain: &Chain,
 ) -> Result<(ExploreParams, Option<Duration>), Status> {
+    let dof = chain.dof();
     let region = match &req.region {
         Some(b) => box_in("region", b)?,
         None => return Err(invalid("region", "is required")),
@@ -99,6 +100,21 @@ pub fn explore_params_in(
             .collect::<Result<_, _>>()?;
     }
     p.seed = req.seed;
+    if !req.camera_link.is_empty() && req.camera_link != chain.tip_link() {
+        let on_robot = chain.links().iter().any(|l| l.name == req.camera_link);
+        return Err(invalid(
+            "camera_link",
+            if on_robot {
+                format!(
+                    "{:?} is not the chain's tip {:?}: only a camera on the tip is supported (use camera_mount for its offset)",
+                    req.camera_link,
+                    chain.tip_link()
+                )
+            } else {
+                format!("{:?} is not a link of the robot", req.camera_link)
+            },
+        ));
+    }
     if req.start.len() != dof {
         return Err(invalid(
             "start",

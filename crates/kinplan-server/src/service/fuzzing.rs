@@ -16,8 +16,10 @@ pub fn convert_requests(data: &[u8]) {
         let _ = super::planning_convert::plan_input(&r);
         let _ = scene_in("scene", r.scene.as_ref(), &SceneLimits::default());
     }
-    if let Ok(r) = pb::ExploreRequest::decode(data) {
-        let _ = super::explore_convert::explore_params_in(&r, 6);
+    if let Ok(r) = pb::ExploreRequest::decode(data)
+        && let Ok(chain) = kinplan_core::robot::builtin_chain("ur5")
+    {
+        let _ = super::explore_convert::explore_params_in(&r, &chain);
     }
     if let Ok(r) = pb::NextBestViewRequest::decode(data) {
         let _ = super::exploration_convert::nbv_params_in(&r);
