@@ -513,14 +513,23 @@ class RobotKinematicsMixin:
     ) -> IkBatchResult:
         """Solves every target of ``Ts`` (n x 4 x 4 array, or a list of 4x4
         matrices / (position, quaternion) pairs) in parallel on the server,
-        each from ``seed``. Options as :meth:`ik`; ``time_budget`` is per
+        each from ``seed``: one joint vector for all targets, or an (n x dof)
+        array with one seed per target. Options as :meth:`ik`; ``time_budget`` is per
         target, the call's deadline bounds the batch."""
         o = ik_options(method, linear_solver, **options)
         targets = _targets(Ts)
-        seed_list = [] if seed is None else joints(seed, "seed")
+        seed_arr = None if seed is None else np.asarray(seed, dtype=np.float64)
+        per_target = None
+        seed_list: List[float] = []
+        if seed_arr is not None and seed_arr.ndim == 2:
+            per_target = common_pb2.Matrix(rows=seed_arr.shape[0], cols=seed_arr.shape[1], data=seed_arr.ravel())
+        elif seed is not None:
+            seed_list = joints(seed, "seed")
         reply = self._call(  # type: ignore[attr-defined]
             self.client._kinematics.SolveIkBatch,  # type: ignore[attr-defined]
-            lambda ref: kinematics_pb2.SolveIkBatchRequest(robot=ref, targets=targets, seed=seed_list, options=o),
+            lambda ref: kinematics_pb2.SolveIkBatchRequest(
+                robot=ref, targets=targets, seed=seed_list, options=o, seeds=per_target
+            ),
             timeout,
         )
         return IkBatchResult(

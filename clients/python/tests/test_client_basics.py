@@ -117,3 +117,16 @@ def test_batch_fk_equals_single_calls_and_batch_jacobians_equal_single_ones(clie
         np.testing.assert_allclose(j, ur5.jacobian(q), atol=1e-12)
     with pytest.raises(kinplan.InvalidArgument, match=r"joint_positions\[1\]"):
         ur5.fk_batch([[0.0] * 6, [np.nan] * 6])
+
+
+def test_ik_batch_takes_one_seed_per_target(client):
+    ur5 = client.robot("ur5")
+    rng = np.random.default_rng(5)
+    qs = rng.uniform(-2.5, 2.5, size=(6, 6))
+    Ts = ur5.fk_batch(qs)
+    r = ur5.ik_batch(Ts, seed=qs + 0.03, max_restarts=0)
+    assert r.succeeded == 6
+    for res, q in zip(r.results, qs):
+        np.testing.assert_allclose(res.q, q, atol=1e-2)  # each stayed on its own seed's branch (another is > 0.5 rad away)
+    with pytest.raises(kinplan.InvalidArgument, match="seeds"):
+        ur5.ik_batch(Ts, seed=qs[:5])

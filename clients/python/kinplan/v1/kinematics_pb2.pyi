@@ -162,16 +162,18 @@ class SolveIkResponse(_message.Message):
     def __init__(self, solutions: _Optional[_Iterable[_Union[IkSolution, _Mapping]]] = ..., best_attempt: _Optional[_Union[IkSolution, _Mapping]] = ..., success: _Optional[bool] = ..., status: _Optional[_Union[IkStatus, str]] = ..., attempts: _Optional[int] = ..., total_iterations: _Optional[int] = ..., elapsed_us: _Optional[int] = ..., model_id: _Optional[bytes] = ...) -> None: ...
 
 class SolveIkBatchRequest(_message.Message):
-    __slots__ = ("robot", "targets", "seed", "options")
+    __slots__ = ("robot", "targets", "seed", "options", "seeds")
     ROBOT_FIELD_NUMBER: _ClassVar[int]
     TARGETS_FIELD_NUMBER: _ClassVar[int]
     SEED_FIELD_NUMBER: _ClassVar[int]
     OPTIONS_FIELD_NUMBER: _ClassVar[int]
+    SEEDS_FIELD_NUMBER: _ClassVar[int]
     robot: _common_pb2.RobotRef
     targets: _containers.RepeatedCompositeFieldContainer[_common_pb2.Pose]
     seed: _containers.RepeatedScalarFieldContainer[float]
     options: IkOptions
-    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., targets: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., seed: _Optional[_Iterable[float]] = ..., options: _Optional[_Union[IkOptions, _Mapping]] = ...) -> None: ...
+    seeds: _common_pb2.Matrix
+    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., targets: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., seed: _Optional[_Iterable[float]] = ..., options: _Optional[_Union[IkOptions, _Mapping]] = ..., seeds: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ...) -> None: ...
 
 class SolveIkBatchResponse(_message.Message):
     __slots__ = ("results", "succeeded", "elapsed_us", "model_id")

@@ -24,5 +24,7 @@ pub use params::{IkMethod, IkParams, JointLimitMode};
 pub use point_chain::PointWorkspace;
 pub use solve::{IkResult, IkSolution, IkSolver, IkStatus, budget_until, solve_ik};
 pub use target::{IkTarget, PoseError, pose_error};
-pub use track::{PathStep, TrackParams, TrackResult, circle_path, line_path, solve_ik_batch, track_path};
+pub use track::{
+    BatchSeeds, PathStep, TrackParams, TrackResult, circle_path, line_path, solve_ik_batch, track_path,
+};
 pub use workspace::IkWorkspace;

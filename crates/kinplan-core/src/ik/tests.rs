@@ -499,13 +499,55 @@ fn batch_matches_sequential() {
         .map(|_| IkTarget::Pose(chain.fk(&random_joints(&chain, &mut rng))))
         .collect();
     let p = IkParams::default();
-    let a = solve_ik_batch(&chain, &targets, None, &p, 5, &never);
-    let b = solve_ik_batch(&chain, &targets, None, &p, 5, &never);
+    let a = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, &never);
+    let b = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, &never);
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
         let (x, y) = (x.as_ref().unwrap(), y.as_ref().unwrap());
         assert_reaches(&chain, &targets[k], x, &p, "batch");
         assert_eq!(x.solutions[0].joints, y.solutions[0].joints);
     }
+}
+
+/// Per-target seeds: with no restarts, each target lands on the branch of its
+/// own seed (the solution nearest it), and a wrong seed length is an error
+/// for every target.
+#[test]
+fn batch_per_target_seeds_keep_each_target_on_its_seeds_branch() {
+    let chain = builtin_chain("ur5").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let qs: Vec<Vec<f64>> = (0..8).map(|_| random_joints(&chain, &mut rng)).collect();
+    let targets: Vec<IkTarget> = qs.iter().map(|q| IkTarget::Pose(chain.fk(q))).collect();
+    // seeds 0.05 rad away from the joints that made each target
+    let seeds: Vec<f64> = qs.iter().flat_map(|q| q.iter().map(|v| v + 0.05)).collect();
+    let p = IkParams {
+        max_restarts: 0,
+        ..IkParams::default()
+    };
+    let r = solve_ik_batch(&chain, &targets, BatchSeeds::PerTarget(&seeds), &p, 1, &never);
+    for (k, res) in r.iter().enumerate() {
+        let res = res.as_ref().unwrap();
+        assert_reaches(&chain, &targets[k], res, &p, "per-target seed");
+        let far = res.solutions[0]
+            .joints
+            .iter()
+            .zip(&qs[k])
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(far < 1e-3, "target {k} left its seed's branch by {far}");
+    }
+    let short = solve_ik_batch(
+        &chain,
+        &targets,
+        BatchSeeds::PerTarget(&seeds[..6]),
+        &p,
+        1,
+        &never,
+    );
+    assert!(
+        short
+            .iter()
+            .all(|r| matches!(r, Err(IkError::WrongSeedLength { .. })))
+    );
 }
 
 /// Planar chain tracing a circle (S2 Tab. 5 setting): every step converges, joints move

@@ -18,17 +18,56 @@ fn batch_seed(rng_seed: u64, index: usize) -> u64 {
     z ^ (z >> 31)
 }
 
+/// Where the targets of a batch start from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BatchSeeds<'a> {
+    /// The middle of the joint limits (and random restarts).
+    None,
+    /// One seed (`dof` values) for every target.
+    Shared(&'a [f64]),
+    /// Target `i` starts from `seeds[i·dof .. (i+1)·dof]`; the length must be
+    /// `targets.len() · dof` (else every target answers `WrongSeedLength`).
+    PerTarget(&'a [f64]),
+}
+
+impl<'a> BatchSeeds<'a> {
+    /// `None` / `Shared` from an optional single seed.
+    pub fn shared(seed: Option<&'a [f64]>) -> Self {
+        seed.map_or(BatchSeeds::None, BatchSeeds::Shared)
+    }
+}
+
 /// Solves every target independently and in parallel (rayon, one workspace per worker),
-/// each from `seed` with its own deterministic RNG seed, so the answers do not depend on
-/// the thread count. `params.time_budget` applies to each target; `should_stop` to all.
+/// each from its seed (see [`BatchSeeds`]) with its own deterministic RNG seed, so the
+/// answers do not depend on the thread count. `params.time_budget` applies to each
+/// target; `should_stop` to all.
 pub fn solve_ik_batch(
     chain: &Chain,
     targets: &[IkTarget],
-    seed: Option<&[f64]>,
+    seeds: BatchSeeds<'_>,
     params: &IkParams,
     rng_seed: u64,
     should_stop: &(dyn Fn() -> bool + Sync),
 ) -> Vec<Result<IkResult, IkError>> {
+    let dof = chain.dof();
+    if let BatchSeeds::PerTarget(all) = seeds
+        && all.len() != targets.len() * dof
+    {
+        return targets
+            .iter()
+            .map(|_| {
+                Err(IkError::WrongSeedLength {
+                    expected: targets.len() * dof,
+                    got: all.len(),
+                })
+            })
+            .collect();
+    }
+    let seed_of = |i: usize| match seeds {
+        BatchSeeds::None => None,
+        BatchSeeds::Shared(s) => Some(s),
+        BatchSeeds::PerTarget(all) => Some(&all[i * dof..(i + 1) * dof]),
+    };
     targets
         .par_iter()
         .enumerate()
@@ -47,7 +86,7 @@ pub fn solve_ik_batch(
                         elapsed_us: 0,
                     });
                 }
-                solver.solve(t, seed, params, batch_seed(rng_seed, i), should_stop)
+                solver.solve(t, seed_of(i), params, batch_seed(rng_seed, i), should_stop)
             },
         )
         .collect()

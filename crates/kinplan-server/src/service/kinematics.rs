@@ -24,7 +24,7 @@ use super::server::Shared;
 use super::status::{invalid, robot_error, too_large};
 use super::{Budget, Compute, ModelStore};
 use kinplan_core::ik::{
-    IkError, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
+    BatchSeeds, IkError, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
     JointLimitMode, TrackParams, TrackResult, circle_path, line_path, solve_ik, solve_ik_batch, track_path,
 };
 use kinplan_core::linalg::{
@@ -149,6 +149,36 @@ impl KinematicsService for KinematicsApi {
             .enumerate()
             .map(|(i, t)| target_in(&format!("targets[{i}]"), Some(t), options.position_only))
             .collect::<Result<Vec<_>, _>>()?;
+        let dof = robot.chain.dof();
+        let per_target = match &req.seeds {
+            Some(m) => {
+                if m.rows as usize != req.targets.len() || m.cols as usize != dof {
+                    return Err(invalid(
+                        "seeds",
+                        format!(
+                            "is {}x{}, needs one row per target and one column per joint ({}x{dof})",
+                            m.rows,
+                            m.cols,
+                            req.targets.len()
+                        ),
+                    ));
+                }
+                if m.data.len() != req.targets.len() * dof {
+                    return Err(invalid(
+                        "seeds.data",
+                        format!("has {} values, needs {}", m.data.len(), req.targets.len() * dof),
+                    ));
+                }
+                for (i, row) in m.data.chunks_exact(dof).enumerate() {
+                    robot
+                        .chain
+                        .check_joints(row)
+                        .map_err(|e| robot_error(e, &format!("seeds[{i}]")))?;
+                }
+                Some(m.data.clone())
+            }
+            None => None,
+        };
         let seed = (!req.seed.is_empty()).then_some(req.seed);
         let chain = robot.chain.clone();
         let soft = soft_deadline(budget.deadline());
@@ -158,14 +188,12 @@ impl KinematicsService for KinematicsApi {
             .run(&budget, move |b| {
                 let start = Instant::now();
                 let stop = || b.should_stop() || soft.is_some_and(|d| Instant::now() >= d);
-                let results = solve_ik_batch(
-                    &chain,
-                    &targets,
-                    seed.as_deref(),
-                    &options.params,
-                    options.rng_seed,
-                    &stop,
-                );
+                let seeds = match &per_target {
+                    Some(all) => BatchSeeds::PerTarget(all),
+                    None => BatchSeeds::shared(seed.as_deref()),
+                };
+                let results =
+                    solve_ik_batch(&chain, &targets, seeds, &options.params, options.rng_seed, &stop);
                 // a cancellation seen while the caller still waits is the deadline
                 let late = soft.is_some_and(|d| Instant::now() >= d);
                 let results = results
