@@ -368,6 +368,7 @@ async fn work_stops_soon_after_a_missed_deadline() {
         orientation: None,
     };
     let batch = pb::SolveIkBatchRequest {
+        seeds: None,
         robot: named("kuka_kr210_r2700_extra"),
         targets: vec![far; 200],
         options: Some(pb::IkOptions {

@@ -213,6 +213,7 @@ async fn every_rpc(v: Values) -> Result<(), TestCaseError> {
     judge("SolveIk", t, ik.solve_ik(solve).await)?;
     let t = Instant::now();
     let batch = pb::SolveIkBatchRequest {
+        seeds: None,
         robot: robot.clone(),
         targets: vec![target.unwrap_or_default(); (v.n[0] % 5) as usize],
         seed: joints.clone(),

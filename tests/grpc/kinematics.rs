@@ -394,6 +394,7 @@ async fn time_budgets_and_deadlines_end_promptly_with_a_status() {
 
     // a batch under a deadline: every target answers, those cut end TIME_BUDGET
     let mut request = tonic::Request::new(pb::SolveIkBatchRequest {
+        seeds: None,
         robot: named("kuka_kr210_r2700_extra"),
         targets: vec![pose_pb(&target); 8],
         seed: Vec::new(),
@@ -420,6 +421,7 @@ async fn batch_answers_every_target_in_order() {
         targets.push(fk(&mut robots, "kuka_kr210_r2700_extra", &q).await);
     }
     let request = pb::SolveIkBatchRequest {
+        seeds: None,
         robot: named("kuka_kr210_r2700_extra"),
         targets: targets.iter().map(pose_pb).collect(),
         seed: Vec::new(),
@@ -979,6 +981,7 @@ async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
     }
 
     let batch = |targets: Vec<pb::Pose>| pb::SolveIkBatchRequest {
+        seeds: None,
         robot: named("kuka_kr210_r2700_extra"),
         targets,
         seed: Vec::new(),
@@ -991,6 +994,7 @@ async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
         (
             "too many solutions over the batch",
             pb::SolveIkBatchRequest {
+                seeds: None,
                 options: Some(pb::IkOptions {
                     num_solutions: 1_000,
                     ..Default::default()
