@@ -181,7 +181,8 @@ class ExploreMixin:
     ) -> Iterator[Union[ExploreStep, ExploreSummary]]:
         """Explores ``region`` = (min xyz, max xyz) of the simulated ``scene``
         with a depth camera on ``robot`` from joints ``start`` (all three
-        taken from ``scene`` when it is a :class:`ReferenceScene`): yields an
+        taken from ``scene`` when it is a :class:`ReferenceScene`; ``robot``
+        may be a built-in's name): yields an
         :class:`ExploreStep` per iteration, then the :class:`ExploreSummary`.
         ``planner``: "rrt_connect", "stomp" or "ccstomp"; ``weights`` =
         (w_i, w_d, w_r) of the NBV utility (S0's IG1_T025_R01 = (1, 0.25, 0.1)
@@ -196,6 +197,8 @@ class ExploreMixin:
             if robot is None:
                 robot = self.robot(scene.robot)  # type: ignore[attr-defined]
             scene = scene.obstacles
+        if isinstance(robot, str):
+            robot = self.robot(robot)  # type: ignore[attr-defined]
         if robot is None or start is None or region is None:
             raise ValueError("robot, start and region are required unless scene is a ReferenceScene")
         if planner not in ALGORITHMS:

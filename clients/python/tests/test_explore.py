@@ -20,7 +20,7 @@ def scene():
 
 
 def explore(client, **kw):
-    irb = client.robot("abb_irb4600_60_205")
+    irb = "abb_irb4600_60_205"  # a name works as well as client.robot(name)
     args = dict(
         start=START, scene=scene(), region=([1.4, -1.2, -0.29], [3.2, 1.2, 1.0]),
         resolution=0.2, pixel_stride=8, known_ratio=1.0, max_iterations=3, seed=5,
