@@ -10,7 +10,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 import grpc
 import numpy as np
 
-from ._convert import joints, matrix_from_proto, pose_to_matrix
+from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
 from .errors import KinplanError, error_for, invalid_argument
 from .kinematics import KinematicsMixin, RobotKinematicsMixin
 from .mobile import MobileMixin
@@ -371,7 +371,7 @@ class Robot(RobotKinematicsMixin):
             arr = arr[None, :]
         if arr.ndim != 2 or arr.shape[0] == 0:
             raise invalid_argument("qs", f"must be n x dof with n >= 1, got shape {arr.shape}")
-        matrix = common_pb2.Matrix(rows=arr.shape[0], cols=arr.shape[1], data=arr.ravel())
+        matrix = matrix_to_proto(arr)
         r = self._call(
             self.client._robots.ForwardKinematicsBatch,
             lambda ref: robot_pb2.ForwardKinematicsBatchRequest(

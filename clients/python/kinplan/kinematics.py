@@ -23,7 +23,7 @@ from typing import Any, Dict, Iterable, Iterator, List, Mapping, Optional, Seque
 import grpc
 import numpy as np
 
-from ._convert import joints, matrix_to_pose, pose_to_matrix
+from ._convert import joints, matrix_to_pose, matrix_to_proto, pose_to_matrix
 from .errors import KinplanError
 from .v1 import common_pb2, kinematics_pb2, kinematics_pb2_grpc
 
@@ -522,7 +522,7 @@ class RobotKinematicsMixin:
         per_target = None
         seed_list: List[float] = []
         if seed_arr is not None and seed_arr.ndim == 2:
-            per_target = common_pb2.Matrix(rows=seed_arr.shape[0], cols=seed_arr.shape[1], data=seed_arr.ravel())
+            per_target = matrix_to_proto(seed_arr)
         elif seed is not None:
             seed_list = joints(seed, "seed")
         reply = self._call(  # type: ignore[attr-defined]
@@ -654,7 +654,7 @@ class KinematicsMixin:
             raise ValueError(f"A must be two-dimensional, got shape {a.shape}")
         rhs = np.asarray(b, dtype=float).ravel()
         request = kinematics_pb2.SolveLinearSystemRequest(
-            a=common_pb2.Matrix(rows=a.shape[0], cols=a.shape[1], data=a.ravel().tolist()),
+            a=matrix_to_proto(a),
             b=rhs.tolist(),
             method=_choice(LINEAR_SOLVERS, method, "method"),
             max_iterations=int(max_iterations or 0),

@@ -130,3 +130,16 @@ def test_ik_batch_takes_one_seed_per_target(client):
         np.testing.assert_allclose(res.q, q, atol=1e-2)  # each stayed on its own seed's branch (another is > 0.5 rad away)
     with pytest.raises(kinplan.InvalidArgument, match="seeds"):
         ur5.ik_batch(Ts, seed=qs[:5])
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (3, 6), (200, 7), (1, 200)])
+def test_the_fast_matrix_encoder_equals_protobufs_own(shape):
+    from kinplan._convert import matrix_to_proto
+    from kinplan.v1 import common_pb2
+
+    a = np.random.default_rng(1).normal(size=shape) * 1e3
+    a.flat[0] = -0.0
+    slow = common_pb2.Matrix(rows=shape[0], cols=shape[1], data=a.ravel().tolist())
+    fast = matrix_to_proto(a)
+    assert fast == slow and fast.SerializeToString() == slow.SerializeToString()
+    assert matrix_to_proto(a.T.copy(order="F").T).data == slow.data  # any memory layout
