@@ -569,6 +569,7 @@ async fn echoed_values_are_truncated() {
     let err = robots
         .describe_robot(pb::DescribeRobotRequest {
             robot: named(&"r".repeat(3000)),
+            ..Default::default()
         })
         .await
         .unwrap_err();
@@ -592,6 +593,7 @@ async fn hostile_urdfs_are_refused_quickly() {
             source: Some(pb::robot_ref::Source::Urdf(text)),
             ..Default::default()
         }),
+        ..Default::default()
     };
     let nested = format!(
         r#"<robot name="r"><link name="a"/>{}{}</robot>"#,
@@ -610,7 +612,10 @@ async fn hostile_urdfs_are_refused_quickly() {
         );
     }
     robots
-        .describe_robot(pb::DescribeRobotRequest { robot: named("ur5") })
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: named("ur5"),
+            ..Default::default()
+        })
         .await
         .expect("still serving");
 }

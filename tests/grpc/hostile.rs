@@ -169,6 +169,7 @@ async fn every_rpc(v: Values) -> Result<(), TestCaseError> {
         robots
             .describe_robot(pb::DescribeRobotRequest {
                 robot: inline.clone(),
+                ..Default::default()
             })
             .await,
     )?;

@@ -153,7 +153,10 @@ async fn every_planner_goes_around_a_blocking_sphere_within_the_speed_limits() {
     );
 
     let limits: Vec<f64> = robots
-        .describe_robot(pb::DescribeRobotRequest { robot: named(ROBOT) })
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: named(ROBOT),
+            ..Default::default()
+        })
         .await
         .unwrap()
         .into_inner()

@@ -171,7 +171,10 @@ async fn fk_and_jacobian_over_grpc() {
     assert_eq!(position(again.tool_pose.as_ref().unwrap()), p);
 
     let described = robots
-        .describe_robot(pb::DescribeRobotRequest { robot: inline })
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: inline,
+            ..Default::default()
+        })
         .await
         .unwrap()
         .into_inner();
@@ -380,4 +383,59 @@ async fn batch_fk_matches_single_calls_and_its_jacobians_match_finite_difference
         "{}",
         bad.message()
     );
+}
+
+/// A built-in's URDF comes back as standard URDF (no <capsule>), which the
+/// server itself reads back as the same robot; kept capsules on request.
+#[tokio::test]
+async fn a_builtin_urdf_round_trips_as_standard_urdf() {
+    let server = start(ServerConfig::default()).await;
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let reply = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: named("kuka_kr210_r2700_extra"),
+            include_urdf: true,
+            keep_capsules: false,
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(reply.urdf.contains("<cylinder") && !reply.urdf.contains("capsule"));
+    let q = vec![0.2, -1.0, 1.1, 0.3, 0.7, -0.4];
+    let fk = |robot: Option<pb::RobotRef>| pb::ForwardKinematicsRequest {
+        robot,
+        joint_positions: q.clone(),
+        include_links: false,
+    };
+    let a = robots
+        .forward_kinematics(fk(named("kuka_kr210_r2700_extra")))
+        .await
+        .unwrap()
+        .into_inner();
+    let inline = Some(pb::RobotRef {
+        source: Some(Source::Urdf(reply.urdf.clone())),
+        ..Default::default()
+    });
+    let b = robots.forward_kinematics(fk(inline)).await.unwrap().into_inner();
+    assert_eq!(a.tool_pose, b.tool_pose);
+    let kept = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: named("kuka_kr210_r2700_extra"),
+            include_urdf: true,
+            keep_capsules: true,
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(kept.urdf.contains("<capsule"));
+    // without include_urdf the reply stays small
+    let plain = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: named("ur5"),
+            ..Default::default()
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(plain.urdf.is_empty());
 }

@@ -298,7 +298,7 @@ class Robot(RobotKinematicsMixin):
     def __init__(self, client: Client, *, name: Optional[str], urdf: Optional[str], base_link: str, tip_link: str):
         self.client = client
         self.name = name
-        self.urdf = urdf
+        self.urdf_text = urdf
         self.base_link = base_link
         self.tip_link = tip_link
         self.model_id: bytes = b""
@@ -310,19 +310,19 @@ class Robot(RobotKinematicsMixin):
         elif self.model_id and not inline:
             ref.model_id = self.model_id
         else:
-            ref.urdf = self.urdf or ""
+            ref.urdf = self.urdf_text or ""
         return ref
 
     def _call(self, method: Callable, build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
         try:
             reply = self.client._call(method, build(self._ref()), timeout)
         except KinplanError as err:
-            if not (err.code == grpc.StatusCode.NOT_FOUND and self.model_id and self.urdf):
+            if not (err.code == grpc.StatusCode.NOT_FOUND and self.model_id and self.urdf_text):
                 raise
             self.model_id = b""
             reply = self.client._call(method, build(self._ref(inline=True)), timeout)
         model_id = getattr(reply, "model_id", b"")
-        if model_id and self.urdf is not None:
+        if model_id and self.urdf_text is not None:
             self.model_id = model_id
         return reply
 
@@ -345,6 +345,20 @@ class Robot(RobotKinematicsMixin):
             model_id=r.model_id,
             raw=r,
         )
+
+    def urdf(self, *, keep_capsules: bool = False, timeout: Optional[float] = None) -> str:
+        """The robot's URDF text: a built-in's from the server, in standard URDF
+        (each ``<capsule>``, a ROS extension urdfdom and pinocchio refuse,
+        written as a cylinder and two end spheres) unless `keep_capsules`;
+        an inline model's own text as given."""
+        if self.urdf_text is not None:
+            return self.urdf_text
+        r = self._call(
+            self.client._robots.DescribeRobot,
+            lambda ref: robot_pb2.DescribeRobotRequest(robot=ref, include_urdf=True, keep_capsules=keep_capsules),
+            timeout,
+        )
+        return str(r.urdf)
 
     def fk(self, q: Sequence[float], *, links: bool = False, timeout: Optional[float] = None):
         """Tool pose (4x4, base frame, metres) for joint vector `q`; with

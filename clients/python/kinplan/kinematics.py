@@ -387,7 +387,7 @@ class IkStream:
             self._sequence += 1
             msg = kinematics_pb2.StreamIkRequest(sequence=self._sequence, target=target_to_pose(T))
             if self._first:
-                msg.robot.CopyFrom(self._robot._ref(inline=self._robot.urdf is not None))
+                msg.robot.CopyFrom(self._robot._ref(inline=self._robot.urdf_text is not None))
                 msg.options.CopyFrom(self._options)
                 if self._seed is not None and seed is None:
                     seed = self._seed

@@ -143,3 +143,14 @@ def test_the_fast_matrix_encoder_equals_protobufs_own(shape):
     fast = matrix_to_proto(a)
     assert fast == slow and fast.SerializeToString() == slow.SerializeToString()
     assert matrix_to_proto(a.T.copy(order="F").T).data == slow.data  # any memory layout
+
+
+def test_a_builtin_urdf_comes_back_standard_and_loads_as_the_same_robot(client):
+    kr = client.robot("kuka_kr210_r2700_extra")
+    text = kr.urdf()
+    assert "<robot" in text and "capsule" not in text
+    assert "<capsule" in kr.urdf(keep_capsules=True)
+    again = client.robot(urdf=text)
+    q = [0.2, -1.0, 1.1, 0.3, 0.7, -0.4]
+    np.testing.assert_allclose(again.fk(q), kr.fk(q), atol=1e-12)
+    assert again.urdf() == text  # an inline model's own text

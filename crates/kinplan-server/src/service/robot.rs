@@ -9,7 +9,9 @@ use super::convert::{matrix_out, pose_out, vec3_out};
 use super::pb::{self, robot_service_server::RobotService};
 use super::server::Shared;
 use super::status::{invalid, robot_error};
-use kinplan_core::robot::{BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf};
+use kinplan_core::robot::{
+    BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf, expand_capsules,
+};
 
 pub struct RobotApi {
     shared: Shared,
@@ -52,7 +54,20 @@ impl RobotService for RobotApi {
             .shared
             .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
-        Ok(Response::new(describe(&robot.chain, robot.model_id)))
+        let req = request.get_ref();
+        let mut reply = describe(&robot.chain, robot.model_id);
+        if req.include_urdf
+            && let Some(pb::robot_ref::Source::Name(name)) =
+                req.robot.as_ref().and_then(|r| r.source.as_ref())
+        {
+            let text = builtin_urdf(name).map_err(|e| robot_error(e, "robot"))?;
+            reply.urdf = if req.keep_capsules {
+                text.to_owned()
+            } else {
+                expand_capsules(text).map_err(|e| Status::internal(format!("built-in URDF: {e}")))?
+            };
+        }
+        Ok(Response::new(reply))
     }
 
     async fn forward_kinematics(
@@ -267,6 +282,7 @@ fn describe(chain: &Chain, model_id: Vec<u8>) -> pb::DescribeRobotResponse {
         joints,
         links,
         tip_offset: Some(pose_out(chain.tip_offset())),
+        urdf: String::new(),
     }
 }
 
