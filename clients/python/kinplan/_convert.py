@@ -79,11 +79,38 @@ def pose_to_matrix(pose: common_pb2.Pose) -> np.ndarray:
     return t
 
 
+def as_homogeneous(t: object) -> object:
+    """The 4x4 array of a pose object from the libraries people pair with
+    kinplan (pinocchio ``SE3``: ``.homogeneous``; spatialmath ``SE3``:
+    ``.A``); anything else is returned unchanged."""
+    h = getattr(t, "homogeneous", None)
+    if h is not None and np.shape(h) == (4, 4):
+        return np.asarray(h, dtype=float)
+    a = getattr(t, "A", None)
+    if a is not None and not isinstance(t, np.ndarray) and np.shape(a) == (4, 4):
+        return np.asarray(a, dtype=float)
+    return t
+
+
+def as_quat_xyzw(q: object) -> np.ndarray:
+    """A quaternion as (x, y, z, w): arrays are taken in that order;
+    spatialmath ``UnitQuaternion`` (scalar first: ``.s`` and ``.v``) and
+    pinocchio/Eigen quaternions (``.x``, ``.y``, ``.z``, ``.w``) by their
+    named parts, so a scalar-first object cannot be misread."""
+    if hasattr(q, "s") and hasattr(q, "v"):
+        v = np.asarray(getattr(q, "v"), dtype=float).ravel()
+        return np.array([v[0], v[1], v[2], float(getattr(q, "s"))])
+    if all(hasattr(q, k) for k in ("x", "y", "z", "w")) and not isinstance(q, np.ndarray):
+        return np.array([float(getattr(q, k)) for k in ("x", "y", "z", "w")])
+    return np.asarray(q, dtype=float)
+
+
 def matrix_to_pose(t: np.ndarray) -> common_pb2.Pose:
     """Proto Pose of a 4x4 homogeneous matrix (or of a (position, quaternion
-    x-y-z-w) pair)."""
+    x-y-z-w) pair, or of a pinocchio / spatialmath SE3)."""
+    t = as_homogeneous(t)  # type: ignore[assignment]
     if isinstance(t, tuple) and len(t) == 2:
-        p, q = (np.asarray(v, dtype=float) for v in t)
+        p, q = np.asarray(t[0], dtype=float), as_quat_xyzw(t[1])
     else:
         m = np.asarray(t, dtype=float)
         if m.shape != (4, 4):

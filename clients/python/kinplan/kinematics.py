@@ -75,12 +75,14 @@ def _ik_status(value: int) -> str:
 
 
 def target_to_pose(T: Any) -> common_pb2.Pose:
-    """A proto Pose from a 4x4 matrix or a (position, quaternion x-y-z-w) pair."""
+    """A proto Pose from a 4x4 matrix, a (position, quaternion x-y-z-w) pair,
+    or a pinocchio / spatialmath SE3 (quaternion objects by their named
+    parts: spatialmath's scalar-first ``UnitQuaternion`` is read right)."""
     if isinstance(T, common_pb2.Pose):
         return T
     if isinstance(T, (tuple, list)) and len(T) == 2 and np.asarray(T[0]).shape == (3,):
-        return matrix_to_pose((np.asarray(T[0], dtype=float), np.asarray(T[1], dtype=float)))
-    return matrix_to_pose(np.asarray(T, dtype=float))
+        return matrix_to_pose((np.asarray(T[0], dtype=float), T[1]))
+    return matrix_to_pose(T)
 
 
 def _targets(Ts: Any) -> List[common_pb2.Pose]:

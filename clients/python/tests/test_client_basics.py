@@ -154,3 +154,38 @@ def test_a_builtin_urdf_comes_back_standard_and_loads_as_the_same_robot(client):
     q = [0.2, -1.0, 1.1, 0.3, 0.7, -0.4]
     np.testing.assert_allclose(again.fk(q), kr.fk(q), atol=1e-12)
     assert again.urdf() == text  # an inline model's own text
+
+
+class _PinocchioLikeSE3:
+    """Stands in for pinocchio.SE3 (attribute `homogeneous`)."""
+
+    def __init__(self, m):
+        self.homogeneous = m
+
+
+class _SpatialmathLikeSE3:
+    """Stands in for spatialmath.SE3 (attribute `A`)."""
+
+    def __init__(self, m):
+        self.A = m
+
+
+class _ScalarFirstQuaternion:
+    """Stands in for spatialmath.UnitQuaternion: `.s` scalar, `.v` vector,
+    and `.vec` in w-first order (the trap the issue names)."""
+
+    def __init__(self, xyzw):
+        self.s, self.v = xyzw[3], np.asarray(xyzw[:3])
+        self.vec = np.r_[xyzw[3], xyzw[:3]]
+
+
+def test_pose_objects_of_pinocchio_and_spatialmath_are_read_right(client):
+    from kinplan._convert import matrix_to_quat
+
+    ur5 = client.robot("ur5")
+    T = ur5.fk([0.3, -1.2, 1.4, -0.6, 1.2, 0.1])
+    xyzw = matrix_to_quat(T[:3, :3])
+    for target in (_PinocchioLikeSE3(T), _SpatialmathLikeSE3(T), (T[:3, 3], _ScalarFirstQuaternion(xyzw))):
+        r = ur5.ik(target)
+        assert r.success
+        np.testing.assert_allclose(ur5.fk(r.q), T, atol=1e-5)
