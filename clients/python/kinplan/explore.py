@@ -9,6 +9,7 @@ from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ._display import html_table
 from ._convert import pose_to_matrix
 from .exploration import Octree
 from .planning import ALGORITHMS, Obstacle, _pose, scene_to_proto
@@ -86,6 +87,14 @@ class ExploreSummary:
     octree: Octree
     scans: int
     elapsed: float
+
+    def _repr_html_(self) -> str:
+        rows = [("status", self.status), ("iterations", self.iterations),
+                ("known ratio", f"{self.initial_known_ratio:.3f} -> {self.known_ratio:.3f}"),
+                ("observable cells", self.observable_cells), ("failed views", self.failures),
+                ("trajectories hitting the scene", self.scene_hits), ("elapsed (s)", self.elapsed)]
+        rows += [(f"{k} (sum)", v) for k, v in self.totals.items()]
+        return html_table("ExploreSummary", rows, "CD, RDM in m; JD, OC in rad; sums over every executed trajectory (S0 Tab. 5.3)")
 
     def __repr__(self) -> str:
         return (

@@ -23,6 +23,7 @@ from typing import Any, Dict, Iterable, Iterator, List, Mapping, Optional, Seque
 import grpc
 import numpy as np
 
+from ._display import html_table
 from ._convert import joints, matrix_to_pose, matrix_to_proto, pose_to_matrix
 from .errors import KinplanError
 from .v1 import common_pb2, kinematics_pb2, kinematics_pb2_grpc
@@ -198,6 +199,13 @@ class IkResult:
     #: The request's sequence number (StreamIk answers only).
     sequence: Optional[int] = None
     raw: Any = field(default=None, repr=False)
+
+    def _repr_html_(self) -> str:
+        return html_table("IkResult", [
+            ("success", self.success), ("status", self.status),
+            ("position error (m)", self.position_error), ("orientation error (rad)", self.orientation_error),
+            ("solutions", len(self.solutions)), ("attempts", self.attempts), ("elapsed (us)", self.elapsed_us),
+        ])
 
     def __repr__(self) -> str:
         return (

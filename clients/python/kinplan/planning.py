@@ -13,6 +13,7 @@ from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
+from ._display import html_table
 from ._convert import joints, matrix_to_pose
 from .v1 import common_pb2, planning_pb2, planning_pb2_grpc
 
@@ -219,6 +220,12 @@ class Plan:
     @property
     def success(self) -> bool:
         return self.status == "SUCCEEDED"
+
+    def _repr_html_(self) -> str:
+        rows = [("status", self.status), ("waypoints", len(self.q)), ("valid", self.valid),
+                ("duration (s)", float(self.t[-1]) if len(self.t) else 0.0)]
+        rows += [(k, v) for k, v in self.scores.items() if k in ("CD", "JD", "OC", "CPC", "RDM")]
+        return html_table("Plan", rows, "CD, RDM in m; JD, OC in rad (S0 criteria)")
 
     def __repr__(self) -> str:
         return (

@@ -189,3 +189,16 @@ def test_pose_objects_of_pinocchio_and_spatialmath_are_read_right(client):
         r = ur5.ik(target)
         assert r.success
         np.testing.assert_allclose(ur5.fk(r.q), T, atol=1e-5)
+
+
+def test_results_render_as_html_tables_in_notebooks(client):
+    ur5 = client.robot("ur5")
+    T = ur5.fk([0.3, -1.2, 1.4, -0.6, 1.2, 0.1])
+    ik_html = ur5.ik(T)._repr_html_()
+    assert ik_html.startswith("<table>") and "position error (m)" in ik_html
+    plan = client.plan(ur5, start=[0.0] * 6, goal=[0.5] * 6, algorithm="rrt_connect")
+    assert "JD" in plan._repr_html_() and plan.status in plan._repr_html_()
+    *_, summary = client.explore("abb_irb4600_60_205", scene=kinplan.scenes.s0_open_cell(client),
+                                 resolution=0.2, pixel_stride=8, max_iterations=1)
+    h = summary._repr_html_()
+    assert "known ratio" in h and "S0 Tab. 5.3" in h and "&lt;" not in h.split("caption")[0]
