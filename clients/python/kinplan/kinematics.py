@@ -75,6 +75,13 @@ def _ik_status(value: int) -> str:
     return _IK_STATUS.get(value) or kinematics_pb2.IkStatus.Name(value).removeprefix("IK_STATUS_").lower()
 
 
+def _is_position(T: Any) -> bool:
+    """True for a bare 3-vector (array or sequence of three numbers)."""
+    if isinstance(T, np.ndarray):
+        return T.shape == (3,)
+    return isinstance(T, (list, tuple)) and len(T) == 3 and all(isinstance(v, (int, float)) for v in T)
+
+
 def target_to_pose(T: Any) -> common_pb2.Pose:
     """A proto Pose from a 4x4 matrix, a (position, quaternion x-y-z-w) pair,
     or a pinocchio / spatialmath SE3 (quaternion objects by their named
@@ -113,7 +120,35 @@ def ik_options(
     history: bool = False,
 ) -> kinematics_pb2.IkOptions:
     """IkOptions from Python values; ``None`` means the server's documented
-    default. Values are checked by the server, which names a bad field."""
+    default. Values are checked by the server, which names a bad field.
+    Built once per distinct set of arguments (a request copies the message)."""
+    key = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
+           damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
+           max_step, distinct_tolerance, rlxa_max_iterations, history)
+    try:
+        cached = _IK_OPTIONS_CACHE.get(key)
+    except TypeError:  # an unhashable argument: build without the cache
+        key, cached = None, None
+    if cached is not None:
+        out = kinematics_pb2.IkOptions()
+        out.CopyFrom(cached)  # callers may change theirs
+        return out
+    o = _build_ik_options(method, linear_solver, position_tolerance, orientation_tolerance, position_only,
+                          max_iterations, damping, max_restarts, num_solutions, rng_seed, joint_limits,
+                          time_budget, adaptive_damping, max_step, distinct_tolerance, rlxa_max_iterations, history)
+    if key is not None and len(_IK_OPTIONS_CACHE) < 256:
+        _IK_OPTIONS_CACHE[key] = kinematics_pb2.IkOptions()
+        _IK_OPTIONS_CACHE[key].CopyFrom(o)
+    return o
+
+
+_IK_OPTIONS_CACHE: Dict[Any, kinematics_pb2.IkOptions] = {}
+
+
+def _build_ik_options(method, linear_solver, position_tolerance, orientation_tolerance,  # type: ignore[no-untyped-def]
+                      position_only, max_iterations, damping, max_restarts, num_solutions, rng_seed,
+                      joint_limits, time_budget, adaptive_damping, max_step, distinct_tolerance,
+                      rlxa_max_iterations, history):
     o = kinematics_pb2.IkOptions(
         method=_choice(METHODS, method, "method"),
         linear_solver=_choice(LINEAR_SOLVERS, linear_solver, "linear_solver"),
@@ -489,7 +524,7 @@ class RobotKinematicsMixin:
         for Newton's fixed-point step): do not use it. "fabrik" and
         "length_relaxation" take position targets only."""
         # a bare 3-vector is a position: solve for it alone
-        if not isinstance(T, common_pb2.Pose) and np.asarray(T, dtype=object).shape == (3,):
+        if _is_position(T):
             T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
             position_only = True
         o = ik_options(

@@ -202,3 +202,20 @@ def test_results_render_as_html_tables_in_notebooks(client):
                                  resolution=0.2, pixel_stride=8, max_iterations=1)
     h = summary._repr_html_()
     assert "known ratio" in h and "S0 Tab. 5.3" in h and "&lt;" not in h.split("caption")[0]
+
+
+def test_the_fast_quaternion_is_bit_identical_to_the_numpy_one():
+    from kinplan._convert import _quat_of_rows, matrix_to_quat, quat_to_matrix
+
+    rng = np.random.default_rng(0)
+    branches = set()
+    for _ in range(3000):
+        q = rng.normal(size=4)
+        q /= np.linalg.norm(q)
+        R = quat_to_matrix(*q)
+        branches.add(int(np.trace(R) > 0) if np.trace(R) > 0 else 10 + int(np.argmax(np.diag(R))))
+        assert np.array_equal(np.array(_quat_of_rows(R.tolist())), matrix_to_quat(R))
+        # and it is the rotation's quaternion, up to sign
+        fast = np.array(_quat_of_rows(R.tolist()))
+        assert min(np.abs(fast - q).max(), np.abs(fast + q).max()) < 1e-12
+    assert branches == {1, 10, 11, 12}  # every branch was exercised

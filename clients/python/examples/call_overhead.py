@@ -1,0 +1,64 @@
+"""Python-side cost of the client over the raw generated stub, same server,
+same calls, one run:
+
+    python call_overhead.py [host:port] [calls]
+
+For FK and warm IK on the UR5: the mean time of `robot.fk(q)` / `robot.ik(T,
+seed=...)` against the generated stub called with a request built once, and
+the difference (the client's own overhead per call). Calls alternate, so
+drift in the machine's speed hits both alike.
+"""
+import sys
+import time
+
+import numpy as np
+
+import kinplan
+from kinplan.kinematics import ik_options, target_to_pose
+from kinplan.v1 import kinematics_pb2, robot_pb2
+
+
+def interleaved_us(a, b, n):
+    """Mean µs of `a` and of `b`, called alternately so that drift in the
+    machine's speed hits both alike."""
+    for _ in range(50):
+        a()
+        b()
+    ta = tb = 0.0
+    for _ in range(n):
+        t0 = time.perf_counter()
+        a()
+        t1 = time.perf_counter()
+        b()
+        t2 = time.perf_counter()
+        ta += t1 - t0
+        tb += t2 - t1
+    return ta / n * 1e6, tb / n * 1e6
+
+
+def main():
+    address = sys.argv[1] if len(sys.argv) > 1 else "127.0.0.1:50051"
+    n = int(sys.argv[2]) if len(sys.argv) > 2 else 3000
+    with kinplan.Client(address, timeout=10) as c:
+        ur5 = c.robot("ur5")
+        q = np.array([0.3, -1.2, 1.4, -0.6, 1.2, 0.1])
+        T = ur5.fk(q)
+        ref = ur5._ref()
+        fk_req = robot_pb2.ForwardKinematicsRequest(robot=ref, joint_positions=q.tolist())
+        ik_req = kinematics_pb2.SolveIkRequest(
+            robot=ref, target=target_to_pose(T), seed=(q + 0.02).tolist(), options=ik_options("lm", "svd")
+        )
+        rows = []
+        raw, ours = interleaved_us(lambda: c._robots.ForwardKinematics(fk_req, timeout=10), lambda: ur5.fk(q), n)
+        rows.append(("ForwardKinematics", raw, ours))
+        raw, ours = interleaved_us(
+            lambda: c._kinematics.SolveIk(ik_req, timeout=10), lambda: ur5.ik(T, seed=q + 0.02), n
+        )
+        rows.append(("SolveIk (warm)", raw, ours))
+        for name, raw, ours in rows:
+            print(f"{name:18s} raw stub {raw:7.1f} us   client {ours:7.1f} us   overhead {ours - raw:6.1f} us "
+                  f"({ours / raw:.2f}x)")
+
+
+if __name__ == "__main__":
+    main()
