@@ -73,18 +73,39 @@ pub fn render_depth(
     sensor: &SensorParams,
     seed: u64,
 ) -> DepthImage {
+    render_depth_until(world, camera, pose, sensor, seed, &|| false).expect("never stopped")
+}
+
+/// [`render_depth`] that polls `should_stop` before each row and returns
+/// `None` once it fires (an image of up to 2^24 rays takes seconds).
+pub fn render_depth_until(
+    world: &SceneGeometry,
+    camera: &CameraModel,
+    pose: &Isometry3<f64>,
+    sensor: &SensorParams,
+    seed: u64,
+    should_stop: &(dyn Fn() -> bool + Sync),
+) -> Option<DepthImage> {
     let (cols, rows) = grid(camera, sensor.pixel_stride);
     let origin = Point3::from(pose.translation.vector);
+    let stopped = std::sync::atomic::AtomicBool::new(false);
     // along a ray of unit length, z = t·d_z ≤ far means t ≤ far / d_z
     let depth: Vec<f32> = rows
         .par_iter()
         .enumerate()
         .flat_map_iter(|(r, &v)| {
+            let skip = stopped.load(std::sync::atomic::Ordering::Relaxed) || should_stop();
+            if skip {
+                stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
             let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (r as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
             let cols = &cols;
             let origin = &origin;
             cols.iter()
                 .map(move |&u| {
+                    if skip {
+                        return 0.0;
+                    }
                     let local = camera.ray_direction(u, v);
                     let dir = pose.rotation * local;
                     let max_t = camera.far / local.z;
@@ -108,11 +129,14 @@ pub fn render_depth(
                 .collect::<Vec<f32>>()
         })
         .collect();
-    DepthImage {
+    if stopped.into_inner() {
+        return None;
+    }
+    Some(DepthImage {
         width: cols.len(),
         height: rows.len(),
         depth,
-    }
+    })
 }
 
 /// The base-frame points of `image` (rendered by [`render_depth`] with the

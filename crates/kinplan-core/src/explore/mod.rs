@@ -12,7 +12,7 @@ mod world_model;
 #[cfg(test)]
 mod tests;
 
-pub use depth_camera::{DepthImage, SensorParams, depth_to_points, render_depth};
+pub use depth_camera::{DepthImage, SensorParams, depth_to_points, render_depth, render_depth_until};
 pub use error::{ExploreError, ExploreField};
 pub use params::{ExploreParams, StopRule};
 pub use run::{

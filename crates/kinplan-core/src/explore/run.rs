@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use nalgebra::{Isometry3, Point3};
 
-use super::depth_camera::{depth_to_points, render_depth};
+use super::depth_camera::{depth_to_points, render_depth_until};
 use super::world_model::{ObservableCells, occupied_obstacles};
 use super::{ExploreError, ExploreField, ExploreParams};
 use crate::collision::{
@@ -205,13 +205,16 @@ impl Explorer<'_> {
         let pose = self.camera_pose(q);
         let t0 = Instant::now();
         let seed = self.params.seed ^ (self.scans as u64).wrapping_mul(0xA24B_AED4_963E_E407);
-        let image = render_depth(
+        let Some(image) = render_depth_until(
             self.world.truth,
             &self.params.camera,
             &pose,
             &self.params.sensor,
             seed,
-        );
+            &|| self.interrupted().is_some(),
+        ) else {
+            return Ok((us(t0), 0)); // stopped: nothing inserted
+        };
         let points = depth_to_points(
             &image,
             &self.params.camera,

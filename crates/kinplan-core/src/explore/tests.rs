@@ -94,6 +94,8 @@ fn a_sphere_is_seen_at_the_distance_of_its_surface_and_out_of_range_is_no_return
     assert_eq!(a, render_depth(&world, &cam, &pose, &noisy, 7));
     let moved = a.depth[15 * a.width + 20] as f64;
     assert!(moved != centre && (moved - centre).abs() < 0.06);
+    // a render that is told to stop returns nothing
+    assert!(render_depth_until(&world, &cam, &pose, &sensor, 0, &|| true).is_none());
 }
 
 struct Rig {
