@@ -4,51 +4,23 @@
 
 use nalgebra::Point3;
 
-use crate::collision::{Geometry, Obstacle, SceneGeometry};
-use crate::octree::{CellState, OcKey, Octree, OctreeError, StateFilter, TREE_DEPTH};
+use crate::collision::{Obstacle, SceneGeometry, octree_cells};
+use crate::octree::{CellState, OcKey, Octree, OctreeError, TREE_DEPTH};
 
-/// The occupied cubes of `tree` overlapping `[min, max]`, one
-/// [`Geometry::OccupiedCells`] per cube size (pruned leaves stand for larger
-/// cubes), at most `limit` cubes; `None` when there are more.
+/// The occupied cubes of `tree` overlapping `[min, max]` as obstacles, at
+/// most `limit` cubes; `None` when there are more.
 pub fn occupied_obstacles(
     tree: &Octree,
     min: &Point3<f64>,
     max: &Point3<f64>,
     limit: usize,
 ) -> Result<Option<Vec<Obstacle>>, OctreeError> {
-    let mut by_depth: Vec<Vec<Point3<f64>>> = vec![Vec::new(); TREE_DEPTH as usize + 1];
-    let mut count = 0usize;
-    let filter = StateFilter {
-        free: false,
-        occupied: true,
-        unknown: false,
-    };
-    tree.for_each_in_box(min, max, TREE_DEPTH, filter, |cell| {
-        count += 1;
-        if count <= limit {
-            by_depth[cell.depth as usize].push(cell.center);
-        }
-    })?;
-    if count > limit {
-        return Ok(None);
-    }
-    Ok(Some(
-        by_depth
+    Ok(octree_cells(tree, min, max, false, limit)?.map(|cells| {
+        cells
             .into_iter()
-            .enumerate()
-            .filter(|(_, c)| !c.is_empty())
-            .map(|(depth, centers)| {
-                Obstacle::new(
-                    format!("octree cells {:.3} m", tree.node_size(depth as u8)),
-                    nalgebra::Isometry3::identity(),
-                    Geometry::OccupiedCells {
-                        size: tree.node_size(depth as u8),
-                        centers,
-                    },
-                )
-            })
-            .collect(),
-    ))
+            .map(|g| Obstacle::new("octree cells", nalgebra::Isometry3::identity(), g))
+            .collect()
+    }))
 }
 
 /// The cells of a region that a camera could observe: depth-16 cells whose

@@ -8,8 +8,8 @@ use tonic::Status;
 use super::convert::{finite, pose_in, vec3_in};
 use super::pb::{self, collision_object::Shape};
 use super::status::invalid;
-use kinplan_core::collision::{Geometry, Obstacle, Scene, SceneLimits};
-use kinplan_core::octree::{CellState, Octree, OctreeLimits, StateFilter, TREE_DEPTH};
+use kinplan_core::collision::{self, Geometry, Obstacle, Scene, SceneLimits};
+use kinplan_core::octree::{Octree, OctreeLimits};
 
 /// Largest octree a scene object may carry, in nodes.
 const MAX_SCENE_OCTREE_NODES: usize = 2_000_000;
@@ -147,41 +147,15 @@ fn octree_cells(
     let Some((min, max)) = octree.known_bounds() else {
         return Ok(Vec::new());
     };
-    let filter = StateFilter {
-        free: false,
-        occupied: true,
-        unknown,
-    };
-    // centres per depth (cube size = resolution · 2^(16 − depth))
-    let mut by_depth: Vec<Vec<Point3<f64>>> = vec![Vec::new(); TREE_DEPTH as usize + 1];
-    let mut count = 0usize;
-    let mut too_many = false;
-    octree
-        .for_each_in_box(&min, &max, TREE_DEPTH, filter, |cell| {
-            if cell.state == CellState::Free || too_many {
-                return;
-            }
-            count += 1;
-            too_many = count > limits.max_total_elements;
-            by_depth[cell.depth as usize].push(cell.center);
+    collision::octree_cells(&octree, &min, &max, unknown, limits.max_total_elements)
+        .map_err(|e| invalid(path, e.to_string()))?
+        .ok_or_else(|| {
+            invalid(
+                path,
+                format!(
+                    "more than {} obstacle cells; send a coarser tree",
+                    limits.max_total_elements
+                ),
+            )
         })
-        .map_err(|e| invalid(path, e.to_string()))?;
-    if too_many {
-        return Err(invalid(
-            path,
-            format!(
-                "more than {} obstacle cells; send a coarser tree",
-                limits.max_total_elements
-            ),
-        ));
-    }
-    Ok(by_depth
-        .into_iter()
-        .enumerate()
-        .filter(|(_, c)| !c.is_empty())
-        .map(|(depth, centers)| Geometry::OccupiedCells {
-            size: octree.node_size(depth as u8),
-            centers,
-        })
-        .collect())
 }
