@@ -14,7 +14,7 @@ mod tests;
 
 pub use depth_camera::{DepthImage, SensorParams, depth_to_points, render_depth, render_depth_until};
 pub use error::{ExploreError, ExploreField};
-pub use params::{ExploreParams, StopRule};
+pub use params::{ExploreParams, MAX_RAYS_PER_IMAGE, MAX_REGION_CELLS, StopRule};
 pub use run::{
     ChosenView, CriteriaTotals, ExploreControl, ExploreOutcome, ExploreStatus, ExploreStep, ExploreWorld,
     Motion, StageTimes, ViewFailure, explore,

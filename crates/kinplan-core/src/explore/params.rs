@@ -8,6 +8,12 @@ use super::{ExploreError, ExploreField, SensorParams};
 use crate::nbv::{CameraModel, NbvParams};
 use crate::plan::{Algorithm, PlanRequest};
 
+/// Most cells a region may hold (each iteration looks every one up).
+pub const MAX_REGION_CELLS: usize = 1 << 20;
+/// Most rays one rendered image may cast (`⌈width/stride⌉·⌈height/stride⌉`):
+/// the image, its points and their beams grow with it.
+pub const MAX_RAYS_PER_IMAGE: usize = 1 << 20;
+
 /// When the loop stops (whichever comes first).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StopRule {
@@ -175,8 +181,9 @@ impl ExploreParams {
         let cells = (0..3)
             .map(|i| ((b[i] - a[i]) / self.resolution).ceil())
             .product::<f64>();
-        if cells > 4.0e6 {
-            return bad(F::Region, "holds more than 4 million cells at this resolution");
+        // every iteration looks each region cell up (known ratio)
+        if cells > MAX_REGION_CELLS as f64 {
+            return bad(F::Region, "holds more than 1 million cells at this resolution");
         }
         let m = &self.camera_mount;
         if m.translation
@@ -189,6 +196,14 @@ impl ExploreParams {
         }
         if self.sensor.pixel_stride == 0 || self.sensor.pixel_stride > 64 {
             return bad(F::PixelStride, "must lie in [1, 64]");
+        }
+        let stride = self.sensor.pixel_stride.max(1);
+        let rays = self.camera.width.div_ceil(stride) * self.camera.height.div_ceil(stride);
+        if rays > MAX_RAYS_PER_IMAGE {
+            return bad(
+                F::PixelStride,
+                "more than 2^20 rays per image: raise the stride or lower the image size",
+            );
         }
         if !(self.sensor.noise_stddev.is_finite() && self.sensor.noise_stddev >= 0.0) {
             return bad(F::NoiseStddev, "must be finite and ≥ 0");

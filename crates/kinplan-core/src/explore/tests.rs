@@ -278,6 +278,17 @@ fn bad_parameters_are_refused_naming_the_field() {
     let mut p = base.clone();
     p.sensor.pixel_stride = 0;
     assert_eq!(field_of(&p, &scene.start), Some(ExploreField::PixelStride));
+    // 2048 x 2048 rays at stride 1 is more than one image may cast
+    let mut p = base.clone();
+    p.camera.width = 2048;
+    p.camera.height = 2048;
+    p.sensor.pixel_stride = 1;
+    assert_eq!(field_of(&p, &scene.start), Some(ExploreField::PixelStride));
+    // a 20 m cube at 0.1 m is 8 million cells
+    let mut p = base.clone();
+    p.resolution = 0.1;
+    p.region = (Point3::new(-10.0, -10.0, -10.0), Point3::new(10.0, 10.0, 10.0));
+    assert_eq!(field_of(&p, &scene.start), Some(ExploreField::Region));
     // a region wholly inside an obstacle has nothing to observe
     let mut p = base.clone();
     p.region = (Point3::new(2.9, -0.1, 0.0), Point3::new(3.0, 0.1, 0.3));
