@@ -383,6 +383,25 @@ async fn batch_fk_matches_single_calls_and_its_jacobians_match_finite_difference
         "{}",
         bad.message()
     );
+    // 40,000 states with Jacobians would need 1.72 million reply values
+    let big = robots
+        .forward_kinematics_batch(pb::ForwardKinematicsBatchRequest {
+            robot: named("ur5"),
+            joint_positions: Some(pb::Matrix {
+                rows: 40_000,
+                cols: 6,
+                data: vec![0.1; 240_000],
+            }),
+            include_jacobians: true,
+        })
+        .await
+        .unwrap_err();
+    assert_eq!(big.code(), Code::ResourceExhausted, "{}", big.message());
+    assert!(
+        big.message().contains("joint_positions.rows"),
+        "{}",
+        big.message()
+    );
 }
 
 /// A built-in's URDF comes back as standard URDF (no <capsule>), which the

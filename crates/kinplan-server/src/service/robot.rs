@@ -8,7 +8,7 @@ use tonic::{Request, Response, Status};
 use super::convert::{matrix_out, pose_out, vec3_out};
 use super::pb::{self, robot_service_server::RobotService};
 use super::server::Shared;
-use super::status::{invalid, robot_error};
+use super::status::{invalid, robot_error, too_large};
 use kinplan_core::robot::{
     BUILTIN_NAMES, Chain, JointKind, Shape, builtin_chain, builtin_urdf, expand_capsules,
 };
@@ -139,6 +139,16 @@ impl RobotService for RobotApi {
                 ),
             ));
         }
+        let per_row = 7 + if req.include_jacobians { 6 * dof } else { 0 };
+        if rows.saturating_mul(per_row) > MAX_BATCH_REPLY_VALUES {
+            return Err(too_large(
+                "joint_positions.rows",
+                format!(
+                    "{rows} states would need {} reply values, more than {MAX_BATCH_REPLY_VALUES}: split the batch",
+                    rows.saturating_mul(per_row)
+                ),
+            ));
+        }
         for (i, row) in m.data.chunks_exact(dof).enumerate() {
             robot
                 .chain
@@ -194,6 +204,10 @@ impl RobotService for RobotApi {
 
 /// Rows computed between deadline checks in a batch.
 const BATCH_CHECK_ROWS: usize = 1024;
+/// Most values a batch reply may carry (poses and Jacobians, 8 bytes each):
+/// the reply grows up to 7× the request for a 6-joint arm with Jacobians,
+/// so it is bounded here rather than by the request's size alone.
+const MAX_BATCH_REPLY_VALUES: usize = 1_500_000;
 
 /// Tool poses (n × 7: x, y, z, qx, qy, qz, qw) and, with `jacobians`, the
 /// flattened 6 × dof Jacobians (n × 6·dof) of every row of `q` (n × dof,
