@@ -1,4 +1,5 @@
-//! Round-trip latency of `ForwardKinematics` from a Rust (tonic) client.
+//! Round-trip latency of `ForwardKinematics` from the typed Rust client
+//! (`kinplan-client`).
 //!
 //! Start a server (`cargo run --release -- serve`), then
 //! `cargo run --release --example fk_latency -- [address] [calls]`
@@ -6,29 +7,22 @@
 
 use std::time::Instant;
 
-use kinplan_server::service::pb::{self, robot_ref::Source, robot_service_client::RobotServiceClient};
+use kinplan_client::Client;
 
 #[tokio::main(flavor = "current_thread")]
 async fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let address = args.next().unwrap_or_else(|| "127.0.0.1:50051".into());
     let calls: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(10_000);
-    let mut client = RobotServiceClient::connect(format!("http://{address}")).await?;
-    let request = pb::ForwardKinematicsRequest {
-        robot: Some(pb::RobotRef {
-            source: Some(Source::Name("kuka_kr210_r2700_extra".into())),
-            ..Default::default()
-        }),
-        joint_positions: vec![0.1, -1.5, 1.4, 0.2, 0.3, 0.4],
-        include_links: false,
-    };
+    let robot = Client::connect(&address).await?.robot("kuka_kr210_r2700_extra");
+    let q = [0.1, -1.5, 1.4, 0.2, 0.3, 0.4];
     for _ in 0..500 {
-        client.forward_kinematics(request.clone()).await?;
+        robot.fk(&q).await?;
     }
     let mut micros = Vec::with_capacity(calls);
     for _ in 0..calls {
         let start = Instant::now();
-        client.forward_kinematics(request.clone()).await?;
+        robot.fk(&q).await?;
         micros.push(start.elapsed().as_secs_f64() * 1e6);
     }
     micros.sort_by(f64::total_cmp);

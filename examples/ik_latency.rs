@@ -1,5 +1,5 @@
-//! Round-trip latency of `SolveIk` and the sustained rate of `StreamIk` from a
-//! Rust (tonic) client, on a KUKA KR 210 R2700 extra.
+//! Round-trip latency of `SolveIk` and the sustained rate of `StreamIk` from
+//! the typed Rust client (`kinplan-client`), on a KUKA KR 210 R2700 extra.
 //!
 //! Start a server (`cargo run --release -- serve`), then
 //! `cargo run --release --example ik_latency -- [address] [calls]`
@@ -11,45 +11,18 @@
 //!   controller's case), which isolates the transport cost;
 //! - `StreamIk` lockstep: one target per message along a 10 mm circle (S2), each
 //!   answer awaited before the next target is sent (a controller cycle), and
-//!   pipelined: all targets sent without waiting (sustained rate).
+//!   pipelined: up to 32 targets in flight (sustained rate).
 //!
 //! Each line gives the client round trip (median, p99, mean) and the server's solve
-//! time (`elapsed_us` median), so the transport share can be read off.
+//! time (median), so the transport share can be read off.
 
 use std::time::Instant;
 
-use kinplan_server::service::pb::{
-    self, kinematics_service_client::KinematicsServiceClient, robot_ref::Source,
-};
+use kinplan_client::{Client, IkOptions};
 use nalgebra::{Isometry3, Vector3};
 use rand::{Rng, SeedableRng};
 
 const ROBOT: &str = "kuka_kr210_r2700_extra";
-
-fn robot() -> Option<pb::RobotRef> {
-    Some(pb::RobotRef {
-        source: Some(Source::Name(ROBOT.into())),
-        ..Default::default()
-    })
-}
-
-fn pose(t: &Isometry3<f64>) -> pb::Pose {
-    let q = t.rotation.quaternion();
-    let p = t.translation.vector;
-    pb::Pose {
-        position: Some(pb::Vec3 {
-            x: p.x,
-            y: p.y,
-            z: p.z,
-        }),
-        orientation: Some(pb::Quaternion {
-            x: q.i,
-            y: q.j,
-            z: q.k,
-            w: q.w,
-        }),
-    }
-}
 
 fn report(label: &str, mut client_us: Vec<f64>, mut server_us: Vec<f64>, failures: usize) {
     client_us.sort_by(f64::total_cmp);
@@ -71,7 +44,7 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let address = args.next().unwrap_or_else(|| "127.0.0.1:50051".into());
     let calls: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(2000);
-    let mut client = KinematicsServiceClient::connect(format!("http://{address}")).await?;
+    let robot = Client::connect(&address).await?.robot(ROBOT);
     let chain = kinplan_core::robot::builtin_chain(ROBOT)?;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2026);
     let joints: Vec<Vec<f64>> = (0..calls)
@@ -83,35 +56,32 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .collect()
         })
         .collect();
-    let requests = |warm: bool| -> Vec<pb::SolveIkRequest> {
-        joints
-            .iter()
-            .map(|q| pb::SolveIkRequest {
-                robot: robot(),
-                target: Some(pose(&chain.fk(q))),
-                seed: if warm {
-                    q.iter().map(|v| v + 0.01).collect()
-                } else {
-                    Vec::new()
-                },
-                options: None,
-            })
-            .collect()
-    };
-    for (label, requests) in [
-        ("SolveIk cold (mid-limit seed)", requests(false)),
-        ("SolveIk warm (seed 0.01 rad away)", requests(true)),
-    ] {
-        for r in requests.iter().take(200) {
-            client.solve_ik(r.clone()).await?;
+    let targets: Vec<Isometry3<f64>> = joints.iter().map(|q| chain.fk(q)).collect();
+    let options = IkOptions::default();
+    for warm in [false, true] {
+        let label = if warm {
+            "SolveIk warm (seed 0.01 rad away)"
+        } else {
+            "SolveIk cold (mid-limit seed)"
+        };
+        let seed = |q: &Vec<f64>| -> Vec<f64> {
+            if warm {
+                q.iter().map(|v| v + 0.01).collect()
+            } else {
+                Vec::new()
+            }
+        };
+        for (q, t) in joints.iter().zip(&targets).take(200) {
+            robot.ik(t, &seed(q), &options).await?;
         }
         let (mut c, mut s, mut failures) = (Vec::with_capacity(calls), Vec::with_capacity(calls), 0);
-        for r in requests {
+        for (q, t) in joints.iter().zip(&targets) {
+            let seed = seed(q);
             let start = Instant::now();
-            let reply = client.solve_ik(r).await?.into_inner();
+            let answer = robot.ik(t, &seed, &options).await?;
             c.push(start.elapsed().as_secs_f64() * 1e6);
-            s.push(reply.elapsed_us as f64);
-            failures += usize::from(!reply.success);
+            s.push(answer.elapsed.as_secs_f64() * 1e6);
+            failures += usize::from(!answer.success);
         }
         report(label, c, s, failures);
     }
@@ -120,69 +90,44 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     let q0 = [0.2, -1.6, 1.7, 0.3, 0.8, -0.2];
     let start = chain.fk(&q0);
     let centre = start.translation.vector - Vector3::new(0.01, 0.0, 0.0);
-    let targets: Vec<pb::Pose> = (0..calls)
+    let circle: Vec<Isometry3<f64>> = (0..calls)
         .map(|k| {
             let a = std::f64::consts::TAU * k as f64 / 1000.0;
             let mut t = start;
             t.translation.vector = centre + Vector3::new(a.cos(), a.sin(), 0.0) * 0.01;
-            pose(&t)
+            t
         })
         .collect();
-    let message = |k: usize| pb::StreamIkRequest {
-        sequence: k as u64,
-        robot: if k == 0 { robot() } else { None },
-        options: None,
-        seed: if k == 0 { q0.to_vec() } else { Vec::new() },
-        target: Some(targets[k]),
-    };
     // lockstep: send one, await its answer
-    let (tx, rx) = tokio::sync::mpsc::channel(16);
-    let mut answers = client
-        .stream_ik(tokio_stream::wrappers::ReceiverStream::new(rx))
-        .await?
-        .into_inner();
+    let mut session = robot.ik_stream(&q0, &options).await?;
     let (mut c, mut s, mut failures) = (Vec::with_capacity(calls), Vec::with_capacity(calls), 0);
     let began = Instant::now();
-    for k in 0..calls {
+    for target in &circle {
         let t = Instant::now();
-        tx.send(message(k)).await?;
-        let answer = answers.message().await?.ok_or("stream ended")?;
+        let answer = session.solve(target).await?;
         c.push(t.elapsed().as_secs_f64() * 1e6);
-        let r = answer.result.unwrap_or_default();
-        s.push(r.elapsed_us as f64);
-        failures += usize::from(!r.success);
+        s.push(answer.elapsed.as_secs_f64() * 1e6);
+        failures += usize::from(!answer.success);
     }
     let rate = calls as f64 / began.elapsed().as_secs_f64();
-    drop(tx);
-    while answers.message().await?.is_some() {}
+    drop(session);
     report("StreamIk lockstep (10 mm circle)", c, s, failures);
     println!("rust StreamIk lockstep sustained rate: {rate:.0} targets/s");
 
-    // pipelined: a sender task streams every target, the answers are read as they come
-    let (tx, rx) = tokio::sync::mpsc::channel(64);
-    let mut answers = client
-        .stream_ik(tokio_stream::wrappers::ReceiverStream::new(rx))
-        .await?
-        .into_inner();
-    let msgs: Vec<_> = (0..calls).map(message).collect();
+    // pipelined: keep up to 32 targets in flight, read the answers as they come
+    let mut session = robot.ik_stream(&q0, &options).await?;
     let began = Instant::now();
-    let sender = tokio::spawn(async move {
-        for m in msgs {
-            if tx.send(m).await.is_err() {
-                break;
-            }
+    let (mut sent, mut received, mut failures) = (0, 0, 0);
+    while received < calls {
+        while sent < calls && sent - received < 32 {
+            session.send(&circle[sent], &[]).await?;
+            sent += 1;
         }
-    });
-    let (mut received, mut failures) = (0, 0);
-    while let Some(a) = answers.message().await? {
-        failures += usize::from(!a.result.unwrap_or_default().success);
+        let (_, answer) = session.recv().await?;
+        failures += usize::from(!answer.success);
         received += 1;
-        if received == calls {
-            break;
-        }
     }
     let elapsed = began.elapsed().as_secs_f64();
-    sender.await?;
     println!(
         "rust StreamIk pipelined x{received}: {:.0} targets/s ({:.1} µs per target); not converged {failures}",
         received as f64 / elapsed,
