@@ -121,55 +121,7 @@ pub async fn serve(
     listener: TcpListener,
     shutdown: impl Future<Output = ()> + Send + 'static,
 ) -> Result<(), BoxError> {
-    let mut compute = Compute::new(
-        config.cpu_threads,
-        config.concurrency_limit,
-        config.request_timeout,
-    )
-    .with_running_counter(config.running_jobs.clone());
-    compute.stream_idle_timeout = config.stream_idle_timeout;
-    let compute = Arc::new(compute);
-    let models = Arc::new(ModelStore::new(
-        UrdfLimits {
-            max_bytes: config.max_urdf_bytes,
-            ..UrdfLimits::default()
-        },
-        config.model_cache_entries,
-        config.model_cache_bytes,
-    ));
-    let collision = Arc::new(CollisionModels::new(
-        config.model_cache_entries,
-        config.acm_samples,
-    ));
-    let shared = Shared {
-        models,
-        compute,
-        collision,
-    };
-    let limit = config.max_message_bytes;
-    // Each kinplan service: its adapter, with the message size limits.
-    macro_rules! service {
-        ($server:ident, $api:expr) => {
-            $server::new($api)
-                .max_decoding_message_size(limit)
-                .max_encoding_message_size(limit)
-        };
-    }
-    let robot = service!(RobotServiceServer, RobotApi::new(shared.clone()));
-    let scoring = service!(ScoringServiceServer, ScoringApi::new(shared.clone()));
-    let mobile = service!(MobileServiceServer, MobileApi::new(shared.clone()));
-    let kinematics = service!(KinematicsServiceServer, KinematicsApi::new(shared.clone()));
-    let planning = service!(PlanningServiceServer, PlanningApi::new(shared.clone()));
-    let exploration = service!(ExplorationServiceServer, ExplorationApi::new(shared.clone()));
-
-    let services = [
-        name_of(&robot),
-        name_of(&scoring),
-        name_of(&mobile),
-        name_of(&kinematics),
-        name_of(&planning),
-        name_of(&exploration),
-    ];
+    let (routes, services) = kinplan_routes(&config);
     let (health, health_service) = tonic_health::server::health_reporter();
     for name in services {
         health.set_service_status(name, ServingStatus::Serving).await;
@@ -222,15 +174,10 @@ pub async fn serve(
     let server = builder
         .layer(GuardLayer::new(cut_rx, config.request_timeout))
         .layer(AuthLayer::new(config.auth_tokens.clone()))
+        .add_routes(routes)
         .add_service(health_service)
         .add_service(reflection_v1)
         .add_service(reflection_v1alpha)
-        .add_service(robot)
-        .add_service(scoring)
-        .add_service(mobile)
-        .add_service(kinematics)
-        .add_service(planning)
-        .add_service(exploration)
         .serve_with_incoming_shutdown(
             // Small replies must not wait for Nagle + delayed ACK (40 ms on loopback).
             TcpIncoming::from(listener)
@@ -266,6 +213,65 @@ impl Shared {
         let robot = self.models.resolve(robot, &self.compute, &budget).await?;
         Ok((permit, budget, robot))
     }
+}
+
+/// The kinplan services (without health, reflection or the server's
+/// layers) over one model cache and CPU pool, with the message size
+/// limits, and their names. `serve` puts them behind a listener;
+/// [`super::InProcess`] calls them without one.
+pub(crate) fn kinplan_routes(config: &ServerConfig) -> (tonic::service::Routes, [&'static str; 6]) {
+    let mut compute = Compute::new(
+        config.cpu_threads,
+        config.concurrency_limit,
+        config.request_timeout,
+    )
+    .with_running_counter(config.running_jobs.clone());
+    compute.stream_idle_timeout = config.stream_idle_timeout;
+    let shared = Shared {
+        models: Arc::new(ModelStore::new(
+            UrdfLimits {
+                max_bytes: config.max_urdf_bytes,
+                ..UrdfLimits::default()
+            },
+            config.model_cache_entries,
+            config.model_cache_bytes,
+        )),
+        compute: Arc::new(compute),
+        collision: Arc::new(CollisionModels::new(
+            config.model_cache_entries,
+            config.acm_samples,
+        )),
+    };
+    let limit = config.max_message_bytes;
+    // Each kinplan service: its adapter, with the message size limits.
+    macro_rules! service {
+        ($server:ident, $api:expr) => {
+            $server::new($api)
+                .max_decoding_message_size(limit)
+                .max_encoding_message_size(limit)
+        };
+    }
+    let robot = service!(RobotServiceServer, RobotApi::new(shared.clone()));
+    let scoring = service!(ScoringServiceServer, ScoringApi::new(shared.clone()));
+    let mobile = service!(MobileServiceServer, MobileApi::new(shared.clone()));
+    let kinematics = service!(KinematicsServiceServer, KinematicsApi::new(shared.clone()));
+    let planning = service!(PlanningServiceServer, PlanningApi::new(shared.clone()));
+    let exploration = service!(ExplorationServiceServer, ExplorationApi::new(shared));
+    let names = [
+        name_of(&robot),
+        name_of(&scoring),
+        name_of(&mobile),
+        name_of(&kinematics),
+        name_of(&planning),
+        name_of(&exploration),
+    ];
+    let routes = tonic::service::Routes::new(robot)
+        .add_service(scoring)
+        .add_service(mobile)
+        .add_service(kinematics)
+        .add_service(planning)
+        .add_service(exploration);
+    (routes, names)
 }
 
 fn name_of<S: tonic::server::NamedService>(_: &S) -> &'static str {

@@ -1,0 +1,334 @@
+//! The kinplan services called in the caller's own process: no socket, no
+//! HTTP/2 framing on a wire, the same handlers, validation, admission,
+//! deadlines and panic guard as `kinplan serve`. A request is the encoded
+//! protobuf message; so is the answer. The Python package's in-process
+//! backend (`kinplan.Client.local()`) is built on it.
+
+use std::time::Duration;
+
+use bytes::{Buf, BufMut, Bytes, BytesMut};
+use http_body_util::BodyExt;
+use tokio::sync::{mpsc, watch};
+use tokio_stream::StreamExt;
+use tokio_stream::wrappers::ReceiverStream;
+use tonic::Status;
+use tonic::body::Body;
+use tower::{Layer, ServiceExt};
+
+use super::guard::{Guard, GuardLayer};
+use super::server::{ServerConfig, kinplan_routes};
+
+/// Length of gRPC's message prefix: a compression flag and a 4-byte length.
+const PREFIX: usize = 5;
+
+/// The kinplan services, ready to be called without a server.
+pub struct InProcess {
+    service: Guard<tonic::service::Routes>,
+    max_message_bytes: usize,
+    /// Shutdown never cuts in-process streams; the guard only needs a receiver.
+    _cut: watch::Sender<bool>,
+}
+
+/// The answers of a server-streamed or bidirectional call, in order.
+pub struct ResponseStream {
+    body: Body,
+    buffer: BytesMut,
+    max_message_bytes: usize,
+    done: bool,
+}
+
+impl InProcess {
+    /// The services with `config`'s pool, cache and limits (its network and
+    /// TLS settings do not apply). Call from inside a tokio runtime.
+    pub fn new(config: &ServerConfig) -> InProcess {
+        let (routes, _) = kinplan_routes(config);
+        let (cut, cut_rx) = watch::channel(false);
+        InProcess {
+            service: GuardLayer::new(cut_rx, config.request_timeout).layer(routes),
+            max_message_bytes: config.max_message_bytes,
+            _cut: cut,
+        }
+    }
+
+    /// A unary call: `path` is "/kinplan.v1.RobotService/ForwardKinematics",
+    /// `message` the encoded request; answers the encoded response.
+    pub async fn unary(
+        &self,
+        path: &str,
+        message: &[u8],
+        timeout: Option<Duration>,
+    ) -> Result<Bytes, Status> {
+        let body = Body::new(http_body_util::Full::new(frame(message)));
+        let mut answers = self.call(path, body, timeout).await?;
+        let answer = answers
+            .next()
+            .await
+            .unwrap_or_else(|| Err(Status::internal("a unary call answered no message")))?;
+        match answers.next().await {
+            None => Ok(answer),
+            Some(Err(status)) => Err(status),
+            Some(Ok(_)) => Err(Status::internal("a unary call answered two messages")),
+        }
+    }
+
+    /// A streaming call: returns the sender of request messages (drop it to
+    /// end the request stream) and, once the call has started, its answers.
+    pub async fn stream(
+        &self,
+        path: &str,
+        timeout: Option<Duration>,
+    ) -> Result<(mpsc::Sender<Bytes>, ResponseStream), Status> {
+        let (sender, receiver) = mpsc::channel::<Bytes>(64);
+        let frames = ReceiverStream::new(receiver)
+            .map(|message| Ok::<_, std::convert::Infallible>(http_body::Frame::data(frame(&message))));
+        let body = Body::new(http_body_util::StreamBody::new(frames));
+        let answers = self.call(path, body, timeout).await?;
+        Ok((sender, answers))
+    }
+
+    async fn call(
+        &self,
+        path: &str,
+        body: Body,
+        timeout: Option<Duration>,
+    ) -> Result<ResponseStream, Status> {
+        let mut request = http::Request::builder()
+            .method(http::Method::POST)
+            .uri(path)
+            .header("content-type", "application/grpc")
+            .header("te", "trailers");
+        if let Some(timeout) = timeout {
+            request = request.header("grpc-timeout", grpc_timeout(timeout));
+        }
+        let request = request
+            .body(body)
+            .map_err(|e| Status::invalid_argument(format!("method path: {e}")))?;
+        let response = self
+            .service
+            .clone()
+            .oneshot(request)
+            .await
+            .map_err(|_| Status::internal("the in-process call failed"))?;
+        let (parts, body) = response.into_parts();
+        // a trailers-only answer carries its status in the headers
+        if let Some(status) = Status::from_header_map(&parts.headers)
+            && status.code() != tonic::Code::Ok
+        {
+            return Err(status);
+        }
+        Ok(ResponseStream {
+            body,
+            buffer: BytesMut::new(),
+            max_message_bytes: self.max_message_bytes,
+            done: false,
+        })
+    }
+}
+
+impl ResponseStream {
+    /// The next answer, the call's error status, or `None` after the last one.
+    pub async fn next(&mut self) -> Option<Result<Bytes, Status>> {
+        loop {
+            if let Some(message) = self.take_message() {
+                return Some(message);
+            }
+            if self.done {
+                return None;
+            }
+            match self.body.frame().await {
+                None => {
+                    self.done = true;
+                    if !self.buffer.is_empty() {
+                        return Some(Err(Status::internal("the answer ended inside a message")));
+                    }
+                }
+                Some(Err(status)) => {
+                    self.done = true;
+                    return Some(Err(status));
+                }
+                Some(Ok(frame)) => match frame.into_data() {
+                    Ok(data) => self.buffer.put(data),
+                    Err(frame) => {
+                        self.done = true;
+                        let status = frame.trailers_ref().and_then(Status::from_header_map);
+                        if let Some(status) = status.filter(|s| s.code() != tonic::Code::Ok) {
+                            return Some(Err(status));
+                        }
+                    }
+                },
+            }
+        }
+    }
+
+    /// A whole message from the buffer, if one has arrived.
+    fn take_message(&mut self) -> Option<Result<Bytes, Status>> {
+        if self.buffer.len() < PREFIX {
+            return None;
+        }
+        let length =
+            u32::from_be_bytes([self.buffer[1], self.buffer[2], self.buffer[3], self.buffer[4]]) as usize;
+        if self.buffer[0] != 0 || length > self.max_message_bytes {
+            self.done = true;
+            self.buffer.clear();
+            return Some(Err(Status::internal("a compressed or oversized answer")));
+        }
+        if self.buffer.len() < PREFIX + length {
+            return None;
+        }
+        self.buffer.advance(PREFIX);
+        Some(Ok(self.buffer.split_to(length).freeze()))
+    }
+}
+
+/// A message with gRPC's uncompressed length prefix.
+fn frame(message: &[u8]) -> Bytes {
+    let mut framed = BytesMut::with_capacity(PREFIX + message.len());
+    framed.put_u8(0);
+    framed.put_u32(message.len() as u32);
+    framed.put_slice(message);
+    framed.freeze()
+}
+
+/// The `grpc-timeout` header: at most 8 digits, in the finest unit that fits.
+fn grpc_timeout(timeout: Duration) -> String {
+    const MAX: u128 = 99_999_999;
+    let micros = timeout.as_micros();
+    if micros <= MAX {
+        format!("{micros}u")
+    } else if timeout.as_millis() <= MAX {
+        format!("{}m", timeout.as_millis())
+    } else {
+        format!("{}S", timeout.as_secs().min(MAX as u64))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use prost::Message;
+
+    use super::*;
+    use crate::service::pb;
+
+    fn kr210() -> Option<pb::RobotRef> {
+        Some(pb::RobotRef {
+            source: Some(pb::robot_ref::Source::Name("kuka_kr210_r2700_extra".into())),
+            ..Default::default()
+        })
+    }
+
+    #[test]
+    fn timeouts_are_written_in_the_finest_unit_that_fits() {
+        assert_eq!(grpc_timeout(Duration::from_millis(12)), "12000u");
+        assert_eq!(grpc_timeout(Duration::from_secs(1000)), "1000000m");
+        assert_eq!(grpc_timeout(Duration::from_secs(10_000_000)), "10000000S");
+    }
+
+    #[tokio::test]
+    async fn unary_calls_answer_the_same_as_the_domain_and_errors_keep_their_code() {
+        let local = InProcess::new(&ServerConfig::default());
+        let q = vec![0.1, -1.5, 1.4, 0.2, 0.3, 0.4];
+        let request = pb::ForwardKinematicsRequest {
+            robot: kr210(),
+            joint_positions: q.clone(),
+            include_links: false,
+        };
+        let answer = local
+            .unary(
+                "/kinplan.v1.RobotService/ForwardKinematics",
+                &request.encode_to_vec(),
+                Some(Duration::from_secs(5)),
+            )
+            .await
+            .unwrap();
+        let reply = pb::ForwardKinematicsResponse::decode(answer).unwrap();
+        let p = reply.tool_pose.unwrap().position.unwrap();
+        let expected = kinplan_core::robot::builtin_chain("kuka_kr210_r2700_extra")
+            .unwrap()
+            .fk(&q)
+            .translation
+            .vector;
+        assert!((p.x - expected.x).abs() + (p.y - expected.y).abs() + (p.z - expected.z).abs() < 1e-12);
+
+        let bad = pb::ForwardKinematicsRequest {
+            robot: kr210(),
+            joint_positions: vec![f64::NAN; 6],
+            include_links: false,
+        };
+        let status = local
+            .unary(
+                "/kinplan.v1.RobotService/ForwardKinematics",
+                &bad.encode_to_vec(),
+                None,
+            )
+            .await
+            .unwrap_err();
+        assert_eq!(status.code(), tonic::Code::InvalidArgument);
+        assert!(status.message().contains("joint_positions"), "{status:?}");
+        assert!(
+            !status.details().is_empty(),
+            "field violations travel in the details"
+        );
+
+        let unknown = local
+            .unary("/kinplan.v1.RobotService/Nope", &[], None)
+            .await
+            .unwrap_err();
+        assert_eq!(unknown.code(), tonic::Code::Unimplemented);
+        let garbage = local
+            .unary(
+                "/kinplan.v1.RobotService/ForwardKinematics",
+                &[0xff, 0xff, 0xff],
+                None,
+            )
+            .await
+            .unwrap_err();
+        assert_eq!(garbage.code(), tonic::Code::Internal, "{garbage:?}");
+    }
+
+    #[tokio::test]
+    async fn a_bidirectional_stream_answers_each_message_in_order() {
+        let local = InProcess::new(&ServerConfig::default());
+        let chain = kinplan_core::robot::builtin_chain("kuka_kr210_r2700_extra").unwrap();
+        let q0 = [0.2, -1.6, 1.7, 0.3, 0.8, -0.2];
+        let (sender, mut answers) = local
+            .stream("/kinplan.v1.KinematicsService/StreamIk", None)
+            .await
+            .unwrap();
+        for k in 0..5u32 {
+            let mut target = chain.fk(&q0);
+            target.translation.vector.z += 0.001 * f64::from(k);
+            let (p, r) = (target.translation.vector, target.rotation.quaternion());
+            let message = pb::StreamIkRequest {
+                sequence: u64::from(k),
+                robot: if k == 0 { kr210() } else { None },
+                seed: if k == 0 { q0.to_vec() } else { Vec::new() },
+                target: Some(pb::Pose {
+                    position: Some(pb::Vec3 {
+                        x: p.x,
+                        y: p.y,
+                        z: p.z,
+                    }),
+                    orientation: Some(pb::Quaternion {
+                        x: r.i,
+                        y: r.j,
+                        z: r.k,
+                        w: r.w,
+                    }),
+                }),
+                options: None,
+            };
+            sender.send(message.encode_to_vec().into()).await.unwrap();
+            let answer = pb::StreamIkResponse::decode(answers.next().await.unwrap().unwrap()).unwrap();
+            assert_eq!(answer.sequence, u64::from(k));
+            let result = answer.result.unwrap();
+            assert!(result.success);
+            let reached = chain.fk(&result.solutions[0].joints);
+            assert!((reached.translation.vector - target.translation.vector).norm() < 1e-5);
+        }
+        drop(sender);
+        assert!(
+            answers.next().await.is_none(),
+            "the stream ends when the requests do"
+        );
+    }
+}
