@@ -199,9 +199,26 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         if wait_for_ready:
             self.wait_for_ready(timeout)
 
+    @classmethod
+    def local(cls, *, timeout: Optional[float] = DEFAULT_TIMEOUT, cpu_threads: int = 0,
+              acm_samples: int = 10_000) -> "Client":
+        """A client whose calls run in this process: kinplan's services through
+        the native extension (``pip install kinplan-native``), with the same
+        API, validation and errors as a server, and no network hop — for
+        latency-critical loops. `cpu_threads` sizes its CPU pool (0: one per
+        core); `acm_samples` is the random states sampled per robot for its
+        allowed-collision matrix (planning)."""
+        from .inprocess import LocalChannel
+
+        client = cls(timeout=timeout, channel=LocalChannel(cpu_threads, acm_samples))  # type: ignore[arg-type]
+        client.target = "in-process"
+        return client
+
     def wait_for_ready(self, timeout: Optional[float] = None) -> None:
         """Blocks until the channel connects (at most `timeout` s, default the
         client's); raises :class:`kinplan.errors.Unavailable` otherwise."""
+        if self.target == "in-process":
+            return
         t = self.timeout if timeout is None else timeout
         try:
             grpc.channel_ready_future(self._channel).result(timeout=t)

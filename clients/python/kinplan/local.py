@@ -1,6 +1,8 @@
 """A kinplan server for this Python process: ``with kinplan.LocalServer() as
 server: client = server.client()`` starts ``kinplan serve`` on a free
-loopback port, waits until it answers, and stops it on exit."""
+loopback port, waits until it answers, and stops it on exit. Without a
+``kinplan`` binary it runs the same server on a thread of this process
+through the native extension (``pip install kinplan-native``): no cargo."""
 from __future__ import annotations
 
 import os
@@ -28,6 +30,16 @@ def find_binary(binary: Optional[str] = None) -> str:
     return path
 
 
+def _native_available() -> bool:
+    from .inprocess import native
+
+    try:
+        native()
+        return True
+    except ImportError:
+        return False
+
+
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -38,19 +50,43 @@ class LocalServer:
     """``kinplan serve`` as a child process on 127.0.0.1 (a free port unless
     `port` is given). `args` are extra ``serve`` options, e.g.
     ``["--cpu-threads", "2"]``. `startup_timeout` bounds the wait for the
-    first answer (s)."""
+    first answer (s).
+
+    `in_thread`: run the server on a thread of this process through the
+    native extension instead of a child process (default: only when no
+    ``kinplan`` binary is found). `args` do not apply there; `kill` is `stop`."""
 
     def __init__(self, *, binary: Optional[str] = None, port: Optional[int] = None,
-                 args: Optional[List[str]] = None, startup_timeout: float = 30.0):
-        self.binary = find_binary(binary)
+                 args: Optional[List[str]] = None, startup_timeout: float = 30.0,
+                 in_thread: Optional[bool] = None):
+        if in_thread is None:
+            try:
+                self.binary = find_binary(binary)
+                in_thread = False
+            except FileNotFoundError:
+                in_thread = _native_available()
+                if not in_thread:
+                    raise FileNotFoundError(
+                        "no kinplan server: pip install kinplan-native (a server in this process), "
+                        "or pass binary=, set KINPLAN_BIN, or put `kinplan` on the PATH"
+                    ) from None
+        elif not in_thread:
+            self.binary = find_binary(binary)
+        self.in_thread = in_thread
         self.address = f"127.0.0.1:{port or _free_port()}"
         self.args = list(args or [])
         self.startup_timeout = startup_timeout
         self._proc: Optional[subprocess.Popen] = None
+        self._thread_server: Any = None
         self._log: Any = None
 
     def start(self) -> "LocalServer":
-        if self._proc is not None:
+        if self._proc is not None or self._thread_server is not None:
+            return self
+        if self.in_thread:
+            from .inprocess import native
+
+            self._thread_server = native().serve_in_thread(self.address)
             return self
         # a file, not a pipe: a chatty server must never block on a full pipe
         self._log = tempfile.TemporaryFile()
@@ -85,6 +121,9 @@ class LocalServer:
 
     def stop(self, timeout: float = 10.0) -> None:
         """SIGTERM (the server drains its calls), then SIGKILL after `timeout` s."""
+        server, self._thread_server = self._thread_server, None
+        if server is not None:
+            server.stop()
         proc, self._proc = self._proc, None
         if proc is None:
             return
@@ -98,6 +137,8 @@ class LocalServer:
 
     def kill(self) -> None:
         """SIGKILL: the server dies with its calls (a crash, for failover tests)."""
+        if self._thread_server is not None:
+            self.stop()
         proc, self._proc = self._proc, None
         if proc is not None:
             proc.kill()
@@ -106,6 +147,8 @@ class LocalServer:
 
     @property
     def running(self) -> bool:
+        if self._thread_server is not None:
+            return bool(self._thread_server.running())
         return self._proc is not None and self._proc.poll() is None
 
     def __enter__(self) -> "LocalServer":

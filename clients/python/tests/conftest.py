@@ -1,4 +1,7 @@
-"""Starts a real `kinplan serve` process on a free loopback port."""
+"""Starts a real `kinplan serve` process on a free loopback port; the
+`client` fixture runs each test against it and, when the native extension is
+available (installed, or $KINPLAN_NATIVE names a built libkinplan_native.so),
+again against the in-process backend (`kinplan.Client.local()`)."""
 import os
 import pathlib
 import socket
@@ -51,7 +54,29 @@ def server_address():
         proc.kill()
 
 
-@pytest.fixture()
-def client(server_address):
+def _native_available() -> bool:
+    try:
+        from kinplan.inprocess import native
+
+        native()
+        return True
+    except ImportError:
+        return False
+
+
+BACKENDS = ["remote", "local"] if _native_available() else ["remote"]
+
+
+@pytest.fixture(scope="session")
+def local_client():
+    # one in-process backend (one CPU pool) for the whole session
+    return kinplan.Client.local(timeout=10, acm_samples=1000)
+
+
+@pytest.fixture(params=BACKENDS)
+def client(request, server_address):
+    if request.param == "local":
+        yield request.getfixturevalue("local_client")
+        return
     with kinplan.Client(server_address, timeout=10) as c:
         yield c

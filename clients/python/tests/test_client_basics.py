@@ -9,6 +9,7 @@ import grpc
 import pytest
 
 import kinplan
+from conftest import BACKENDS
 from kinplan.client import normalize_target
 
 
@@ -35,9 +36,11 @@ def test_a_tls_url_or_a_path_is_refused_locally():
         normalize_target("host:1/path")
 
 
-def test_a_local_server_starts_answers_and_stops():
-    with kinplan.LocalServer() as server:
-        assert server.running
+@pytest.mark.parametrize("in_thread", [False, True] if BACKENDS == ["remote", "local"] else [False])
+def test_a_local_server_starts_answers_and_stops(in_thread):
+    # in_thread: the server a pip install without cargo gets (native extension)
+    with kinplan.LocalServer(in_thread=in_thread) as server:
+        assert server.running and server.in_thread == in_thread
         with server.client(timeout=5) as c:
             assert 0 < c.ping() < 5
             assert any(r["name"] == "ur5" for r in c.list_robots())

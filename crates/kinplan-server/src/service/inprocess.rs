@@ -4,6 +4,7 @@
 //! protobuf message; so is the answer. The Python package's in-process
 //! backend (`kinplan.Client.local()`) is built on it.
 
+use std::sync::Arc;
 use std::time::Duration;
 
 use bytes::{Buf, BufMut, Bytes, BytesMut};
@@ -26,11 +27,14 @@ pub struct InProcess {
     service: Guard<tonic::service::Routes>,
     max_message_bytes: usize,
     /// Shutdown never cuts in-process streams; the guard only needs a receiver.
-    _cut: watch::Sender<bool>,
+    _cut: Arc<watch::Sender<bool>>,
 }
 
 /// The answers of a server-streamed or bidirectional call, in order.
 pub struct ResponseStream {
+    /// A bidirectional call whose handler has not answered yet (it may wait
+    /// for the first request message before it does).
+    starting: Option<tokio::task::JoinHandle<Result<ResponseStream, Status>>>,
     body: Body,
     buffer: BytesMut,
     max_message_bytes: usize,
@@ -46,7 +50,7 @@ impl InProcess {
         InProcess {
             service: GuardLayer::new(cut_rx, config.request_timeout).layer(routes),
             max_message_bytes: config.max_message_bytes,
-            _cut: cut,
+            _cut: Arc::new(cut),
         }
     }
 
@@ -71,19 +75,41 @@ impl InProcess {
         }
     }
 
-    /// A streaming call: returns the sender of request messages (drop it to
-    /// end the request stream) and, once the call has started, its answers.
-    pub async fn stream(
+    /// A server-streamed call: one request message, a stream of answers.
+    pub async fn server_stream(
         &self,
         path: &str,
+        message: &[u8],
         timeout: Option<Duration>,
-    ) -> Result<(mpsc::Sender<Bytes>, ResponseStream), Status> {
+    ) -> Result<ResponseStream, Status> {
+        let body = Body::new(http_body_util::Full::new(frame(message)));
+        self.call(path, body, timeout).await
+    }
+
+    /// A bidirectional (or client-streamed) call: the sender of request
+    /// messages (drop it to end the request stream) and the answers. Returns
+    /// at once: the call starts on the runtime, since its handler may wait
+    /// for the first message. Call from inside the runtime.
+    pub fn stream(&self, path: &str, timeout: Option<Duration>) -> (mpsc::Sender<Bytes>, ResponseStream) {
         let (sender, receiver) = mpsc::channel::<Bytes>(64);
         let frames = ReceiverStream::new(receiver)
             .map(|message| Ok::<_, std::convert::Infallible>(http_body::Frame::data(frame(&message))));
         let body = Body::new(http_body_util::StreamBody::new(frames));
-        let answers = self.call(path, body, timeout).await?;
-        Ok((sender, answers))
+        let call = InProcess {
+            service: self.service.clone(),
+            max_message_bytes: self.max_message_bytes,
+            _cut: self._cut.clone(),
+        };
+        let path = path.to_owned();
+        let starting = tokio::spawn(async move { call.call(&path, body, timeout).await });
+        let answers = ResponseStream {
+            starting: Some(starting),
+            body: Body::empty(),
+            buffer: BytesMut::new(),
+            max_message_bytes: self.max_message_bytes,
+            done: false,
+        };
+        (sender, answers)
     }
 
     async fn call(
@@ -117,6 +143,7 @@ impl InProcess {
             return Err(status);
         }
         Ok(ResponseStream {
+            starting: None,
             body,
             buffer: BytesMut::new(),
             max_message_bytes: self.max_message_bytes,
@@ -128,6 +155,19 @@ impl InProcess {
 impl ResponseStream {
     /// The next answer, the call's error status, or `None` after the last one.
     pub async fn next(&mut self) -> Option<Result<Bytes, Status>> {
+        if let Some(starting) = self.starting.take() {
+            match starting.await {
+                Ok(Ok(started)) => *self = started,
+                Ok(Err(status)) => {
+                    self.done = true;
+                    return Some(Err(status));
+                }
+                Err(_) => {
+                    self.done = true;
+                    return Some(Err(Status::internal("the in-process call failed")));
+                }
+            }
+        }
         loop {
             if let Some(message) = self.take_message() {
                 return Some(message);
@@ -290,10 +330,7 @@ mod tests {
         let local = InProcess::new(&ServerConfig::default());
         let chain = kinplan_core::robot::builtin_chain("kuka_kr210_r2700_extra").unwrap();
         let q0 = [0.2, -1.6, 1.7, 0.3, 0.8, -0.2];
-        let (sender, mut answers) = local
-            .stream("/kinplan.v1.KinematicsService/StreamIk", None)
-            .await
-            .unwrap();
+        let (sender, mut answers) = local.stream("/kinplan.v1.KinematicsService/StreamIk", None);
         for k in 0..5u32 {
             let mut target = chain.fk(&q0);
             target.translation.vector.z += 0.001 * f64::from(k);
