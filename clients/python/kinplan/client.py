@@ -5,13 +5,14 @@ from dataclasses import dataclass, field
 import json
 import socket
 import time
+import warnings
 from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 import grpc
 import numpy as np
 
 from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
-from .errors import KinplanError, error_for, invalid_argument
+from .errors import JointLimitWarning, KinplanError, error_for, invalid_argument
 from .kinematics import KinematicsMixin, RobotKinematicsMixin
 from .mobile import MobileMixin
 from .explore import ExploreMixin
@@ -273,8 +274,14 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         urdf: Optional[str] = None,
         base_link: str = "",
         tip_link: str = "",
+        strict: bool = False,
     ) -> "Robot":
-        """A built-in robot by `name`, or a model sent as `urdf` text."""
+        """A built-in robot by `name`, or a model sent as `urdf` text.
+
+        Joint values outside the robot's limits (usually degrees given where
+        radians are meant) raise a :class:`kinplan.JointLimitWarning` in
+        ``fk``, ``fk_batch``, ``jacobian`` and ``Client.score``; with
+        `strict=True` they raise :class:`kinplan.InvalidArgument` instead."""
         if (name is None) == (urdf is None):
             raise invalid_argument("name", "give exactly one of name or urdf=")
         if urdf is not None and "<" not in urdf and urdf.strip().lower().endswith((".urdf", ".xml")):
@@ -282,7 +289,7 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
                 "urdf",
                 f"{urdf!r} looks like a file path; urdf= takes the document's text: urdf=open(path).read()",
             )
-        return Robot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link)
+        return Robot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link, strict=strict)
 
 
 @dataclass
@@ -312,13 +319,49 @@ class Robot(RobotKinematicsMixin):
     the content hash the server returns; if a replica does not hold it
     (NOT_FOUND), the URDF is sent again by itself."""
 
-    def __init__(self, client: Client, *, name: Optional[str], urdf: Optional[str], base_link: str, tip_link: str):
+    def __init__(self, client: Client, *, name: Optional[str], urdf: Optional[str], base_link: str, tip_link: str,
+                 strict: bool = False):
         self.client = client
         self.name = name
         self.urdf_text = urdf
         self.base_link = base_link
         self.tip_link = tip_link
+        self.strict = strict
         self.model_id: bytes = b""
+
+    def _limits(self) -> Any:
+        """(lower, upper) joint limits, fetched once per model and chain per client."""
+        cache = self.client.__dict__.setdefault("_limits_cache", {})
+        key = (self.name, None if self.urdf_text is None else hash(self.urdf_text), self.base_link, self.tip_link)
+        limits = cache.get(key)
+        if limits is None:
+            d = self.describe()
+            limits = cache[key] = (d.lower - 1e-9, d.upper + 1e-9, d.joint_names)
+        return limits
+
+    def check_limits(self, q: Any, field_name: str = "q") -> None:
+        """Warns with :class:`kinplan.JointLimitWarning` (raises
+        :class:`kinplan.InvalidArgument` when the robot is strict) if a joint
+        value of `q` (one state or rows of states) lies outside the limits:
+        kinplan takes radians, and degrees are the usual cause."""
+        lower, upper, names = self._limits()
+        arr = np.asarray(q, dtype=float)
+        if arr.ndim == 0 or arr.shape[-1] != len(lower):
+            return  # the server names a wrong length
+        outside = (arr < lower) | (arr > upper)
+        if not outside.any():
+            return
+        where = np.argwhere(outside)[0]
+        j = int(where[-1])
+        value = float(arr[tuple(where)])
+        message = (
+            f"{int(outside.sum())} joint value(s) outside the limits, e.g. {names[j]} = {value:.6g} not in "
+            f"[{lower[j] + 1e-9:.6g}, {upper[j] - 1e-9:.6g}]; kinplan takes radians (m for prismatic joints): "
+            "degrees? use np.radians(...)"
+        )
+        if self.strict:
+            raise invalid_argument(field_name, message)
+        warnings.warn(f"{field_name}: {message}", JointLimitWarning, stacklevel=3)
 
     def _ref(self, inline: bool = False) -> common_pb2.RobotRef:
         ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link)
@@ -381,6 +424,7 @@ class Robot(RobotKinematicsMixin):
         """Tool pose (4x4, base frame, metres) for joint vector `q`; with
         `links=True`, also a dict of every link's 4x4 pose."""
         positions = joints(q)
+        self.check_limits(positions)
         r = self._call(
             self.client._robots.ForwardKinematics,
             lambda ref: robot_pb2.ForwardKinematicsRequest(
@@ -402,6 +446,7 @@ class Robot(RobotKinematicsMixin):
             arr = arr[None, :]
         if arr.ndim != 2 or arr.shape[0] == 0:
             raise invalid_argument("qs", f"must be n x dof with n >= 1, got shape {arr.shape}")
+        self.check_limits(arr, "qs")
         matrix = matrix_to_proto(arr)
         r = self._call(
             self.client._robots.ForwardKinematicsBatch,
@@ -432,6 +477,7 @@ class Robot(RobotKinematicsMixin):
     def jacobian(self, q: Sequence[float], *, timeout: Optional[float] = None) -> np.ndarray:
         """6 x n geometric Jacobian in the base frame (rows: vx, vy, vz, wx, wy, wz)."""
         positions = joints(q)
+        self.check_limits(positions)
         r = self._call(
             self.client._robots.Jacobian,
             lambda ref: robot_pb2.JacobianRequest(robot=ref, joint_positions=positions),

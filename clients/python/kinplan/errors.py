@@ -73,6 +73,11 @@ class Internal(KinplanError, RuntimeError):
     """INTERNAL: a server bug; the message says what."""
 
 
+class JointLimitWarning(UserWarning):
+    """Joint values outside the robot's limits were sent: kinplan takes
+    radians, and degrees are the usual cause (``np.radians(...)``)."""
+
+
 _BY_CODE = {
     grpc.StatusCode.INVALID_ARGUMENT: InvalidArgument,
     grpc.StatusCode.DEADLINE_EXCEEDED: DeadlineExceeded,

@@ -266,6 +266,18 @@ def _encode_rows(arr: np.ndarray, ts: Optional[np.ndarray]) -> common_pb2.JointT
     return common_pb2.JointTrajectory.FromString(buf.tobytes())
 
 
+def _check_trajectory_limits(robot: Any, q: Any) -> None:
+    """The joint-limit (degrees) guard of a robot, for a rectangular trajectory."""
+    if isinstance(q, common_pb2.JointTrajectory):
+        return
+    try:
+        arr = np.asarray(q, dtype=float)
+    except ValueError:  # ragged rows: the server names the bad one
+        return
+    if arr.ndim == 2 and arr.size:
+        robot.check_limits(arr, "q")
+
+
 def trajectory_to_proto(q: Trajectory, timestamps: Optional[Iterable[float]] = None) -> common_pb2.JointTrajectory:
     """A JointTrajectory from an (n x joints) array or a list of waypoints.
     Ragged lists are sent as they are, so that the server names the bad row.
@@ -364,6 +376,7 @@ class ScoringMixin:
         fields, e.g. ``{"joint_log_gain": 3, "slowdown_floor": 0}``.
         """
         r = self._robot_of(robot)
+        _check_trajectory_limits(r, q)
         traj = trajectory_to_proto(q, timestamps)
         options = score_options(weights, series, robot_points, max_velocity, max_acceleration, jerk_peaks, potential_tolerance)
         reply = r._call(

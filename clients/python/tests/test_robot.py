@@ -32,7 +32,8 @@ def test_list_and_describe(client):
 
 def test_fk_matches_hand_derivation(client):
     kr210 = client.robot("kuka_kr210_r2700_extra")
-    T = kr210.fk(np.zeros(6))
+    with pytest.warns(kinplan.JointLimitWarning):  # A2 = 0 is outside [-140°, -5°]: still computed
+        T = kr210.fk(np.zeros(6))
     assert T.shape == (4, 4)
     assert np.allclose(T[:3, 3], [2.915, 0.0, 0.634], atol=1e-9)
     planar = client.robot("planar_2")
@@ -126,3 +127,33 @@ def test_pose_conversions_round_trip():
         T[:3, :3] = R
         T[:3, 3] = rng.normal(size=3)
         assert np.allclose(kinplan.pose_to_matrix(kinplan.matrix_to_pose(T)), T, atol=1e-12)
+
+
+def test_joints_outside_the_limits_warn_and_strict_robots_refuse(client):
+    import warnings
+
+    ur5 = client.robot("ur5")
+    kr210 = client.robot("kuka_kr210_r2700_extra")
+    # radians within the limits: silent
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        kr210.fk([0.2, -1.6, 1.7, 0.3, 0.8, -0.2])
+    # the KR 210's A2 spans [-140°, -5°]: -90 (meant as degrees) is far outside in radians
+    degrees = [10, -90, 90, 0, 45, 0]
+    with pytest.warns(kinplan.JointLimitWarning, match="np.radians") as w:
+        T = kr210.fk(degrees)
+    assert "joint_1 = 10 not in" in str(w[0].message), "names the first joint outside"
+    assert T.shape == (4, 4), "a warning, not a refusal: the call still answers"
+    with pytest.warns(kinplan.JointLimitWarning):
+        kr210.fk_batch(np.array([degrees, np.radians(degrees)]))
+    with pytest.warns(kinplan.JointLimitWarning):
+        client.score("kuka_kr210_r2700_extra", np.linspace(np.zeros(6), degrees, 10))
+    strict = client.robot("kuka_kr210_r2700_extra", strict=True)
+    with pytest.raises(kinplan.InvalidArgument, match="radians"):
+        strict.jacobian(degrees)
+    # the UR5's joints span ±2π: 6.3 rad is outside, 6.2 inside
+    with pytest.warns(kinplan.JointLimitWarning):
+        ur5.fk([6.3, 0, 0, 0, 0, 0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ur5.fk([6.2, 0, 0, 0, 0, 0])
