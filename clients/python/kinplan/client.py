@@ -87,6 +87,24 @@ def normalize_target(target: Union[str, Sequence[str]]) -> str:
     return f"{scheme}:{','.join(resolved)}"
 
 
+def _channel_options(target: str, max_message_bytes: int) -> List[Any]:
+    """grpc channel options for a normalized target (blocking and asyncio clients)."""
+    options: List[Any] = [
+        ("grpc.max_send_message_length", max_message_bytes),
+        ("grpc.max_receive_message_length", max_message_bytes),
+    ]
+    if target.startswith(("dns:", "ipv4:", "ipv6:")):
+        # Replicas are identical and every call is stateless, so a call
+        # that finds its replica gone is retried on another.
+        options.append(("grpc.service_config", _REPLICA_SERVICE_CONFIG))
+        options.append(("grpc.enable_retries", 1))
+    if target.startswith(("ipv4:", "ipv6:")):
+        # the default :authority would be the whole address list, which
+        # HTTP/2 servers refuse (RST_STREAM PROTOCOL_ERROR)
+        options.append(("grpc.default_authority", "kinplan"))
+    return options
+
+
 def _pem(v: Union[str, bytes]) -> bytes:
     """PEM bytes, or the content of the file a string names."""
     if isinstance(v, bytes):
@@ -168,19 +186,7 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         `tls_key` add a client certificate for mutual TLS."""
         self.target = normalize_target(target)
         self.timeout = timeout
-        options = [
-            ("grpc.max_send_message_length", max_message_bytes),
-            ("grpc.max_receive_message_length", max_message_bytes),
-        ]
-        if self.target.startswith(("dns:", "ipv4:", "ipv6:")):
-            # Replicas are identical and every call is stateless, so a call
-            # that finds its replica gone is retried on another.
-            options.append(("grpc.service_config", _REPLICA_SERVICE_CONFIG))
-            options.append(("grpc.enable_retries", 1))
-        if self.target.startswith(("ipv4:", "ipv6:")):
-            # the default :authority would be the whole address list, which
-            # HTTP/2 servers refuse (RST_STREAM PROTOCOL_ERROR)
-            options.append(("grpc.default_authority", "kinplan"))
+        options = _channel_options(self.target, max_message_bytes)
         if channel is None:
             if tls_ca is not None:
                 creds = grpc.ssl_channel_credentials(
@@ -313,6 +319,22 @@ class RobotDescription:
     def dof(self) -> int:
         return len(self.joint_names)
 
+    @classmethod
+    def from_proto(cls, r: robot_pb2.DescribeRobotResponse) -> "RobotDescription":
+        return cls(
+            name=r.name,
+            base_link=r.base_link,
+            tip_link=r.tip_link,
+            joint_names=[j.name for j in r.joints],
+            joint_types=[robot_pb2.JointType.Name(j.type).removeprefix("JOINT_TYPE_").lower() for j in r.joints],
+            lower=np.array([j.lower for j in r.joints]),
+            upper=np.array([j.upper for j in r.joints]),
+            max_velocity=np.array([j.max_velocity for j in r.joints]),
+            link_names=[link.name for link in r.links],
+            model_id=r.model_id,
+            raw=r,
+        )
+
 
 class Robot(RobotKinematicsMixin):
     """A robot on a server. Inline URDFs are sent once, then referred to by
@@ -392,19 +414,7 @@ class Robot(RobotKinematicsMixin):
             lambda ref: robot_pb2.DescribeRobotRequest(robot=ref),
             timeout,
         )
-        return RobotDescription(
-            name=r.name,
-            base_link=r.base_link,
-            tip_link=r.tip_link,
-            joint_names=[j.name for j in r.joints],
-            joint_types=[robot_pb2.JointType.Name(j.type).removeprefix("JOINT_TYPE_").lower() for j in r.joints],
-            lower=np.array([j.lower for j in r.joints]),
-            upper=np.array([j.upper for j in r.joints]),
-            max_velocity=np.array([j.max_velocity for j in r.joints]),
-            link_names=[link.name for link in r.links],
-            model_id=r.model_id,
-            raw=r,
-        )
+        return RobotDescription.from_proto(r)
 
     def urdf(self, *, keep_capsules: bool = False, timeout: Optional[float] = None) -> str:
         """The robot's URDF text: a built-in's from the server, in standard URDF
@@ -455,6 +465,11 @@ class Robot(RobotKinematicsMixin):
             ),
             timeout,
         )
+        return self._batch_reply(r, arr.shape[1], jacobians)
+
+    @staticmethod
+    def _batch_reply(r: Any, dof: int, jacobians: bool) -> Any:
+        """The (n, 4, 4) poses (and (n, 6, dof) Jacobians) of a batch FK reply."""
         p = np.asarray(r.tool_poses.data, dtype=np.float64).reshape(-1, 7)
         x, y, z, w = p[:, 3], p[:, 4], p[:, 5], p[:, 6]
         T = np.zeros((len(p), 4, 4))
@@ -470,7 +485,7 @@ class Robot(RobotKinematicsMixin):
         T[:, :3, 3] = p[:, :3]
         T[:, 3, 3] = 1.0
         if jacobians:
-            J = np.asarray(r.jacobians.data, dtype=np.float64).reshape(len(p), 6, arr.shape[1])
+            J = np.asarray(r.jacobians.data, dtype=np.float64).reshape(len(p), 6, dof)
             return T, J
         return T
 

@@ -280,6 +280,19 @@ class StateChecks:
     robot_points: np.ndarray
     obstacle_points: np.ndarray
 
+    @classmethod
+    def from_proto(cls, reply: planning_pb2.CheckStateResponse) -> "StateChecks":
+        s = reply.states
+        return cls(
+            valid=np.array([c.valid for c in s], dtype=bool),
+            within_limits=np.array([c.within_limits for c in s], dtype=bool),
+            clearance=np.array([c.clearance for c in s], dtype=float),
+            colliding=[list(c.colliding) for c in s],
+            closest_pair=[c.closest_pair for c in s],
+            robot_points=np.array([_vec(c.robot_point, c.HasField("robot_point")) for c in s]).reshape(-1, 3),
+            obstacle_points=np.array([_vec(c.obstacle_point, c.HasField("obstacle_point")) for c in s]).reshape(-1, 3),
+        )
+
     def __repr__(self) -> str:
         return f"StateChecks({int(self.valid.sum())}/{len(self.valid)} valid, min clearance {self.clearance.min(initial=np.inf):.4f} m)"
 
@@ -435,13 +448,4 @@ class PlanningMixin:
             )
 
         reply = robot._call(self._planning().CheckState, build, timeout)
-        s = reply.states
-        return StateChecks(
-            valid=np.array([c.valid for c in s], dtype=bool),
-            within_limits=np.array([c.within_limits for c in s], dtype=bool),
-            clearance=np.array([c.clearance for c in s], dtype=float),
-            colliding=[list(c.colliding) for c in s],
-            closest_pair=[c.closest_pair for c in s],
-            robot_points=np.array([_vec(c.robot_point, c.HasField("robot_point")) for c in s]).reshape(-1, 3),
-            obstacle_points=np.array([_vec(c.obstacle_point, c.HasField("obstacle_point")) for c in s]).reshape(-1, 3),
-        )
+        return StateChecks.from_proto(reply)
