@@ -61,6 +61,16 @@ fn config(cpu_threads: usize, acm_samples: usize) -> ServerConfig {
     }
 }
 
+/// The in-process backend's: each computation runs on the calling Python
+/// thread (which waits for it with the GIL released) instead of handing it
+/// to the CPU pool and back.
+fn inline_config(cpu_threads: usize, acm_samples: usize) -> ServerConfig {
+    ServerConfig {
+        inline_compute: true,
+        ..config(cpu_threads, acm_samples)
+    }
+}
+
 /// The kinplan services in this process.
 #[pyclass(frozen)]
 struct Backend {
@@ -83,7 +93,7 @@ impl Backend {
             .map_err(|e| PyRuntimeError::new_err(format!("tokio runtime: {e}")))?;
         let services = {
             let _inside = runtime.enter();
-            InProcess::new(&config(cpu_threads, acm_samples))
+            InProcess::new(&inline_config(cpu_threads, acm_samples))
         };
         Ok(Backend {
             runtime: Arc::new(runtime),

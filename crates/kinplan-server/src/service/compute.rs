@@ -70,6 +70,8 @@ pub struct Compute {
     pub stream_idle_timeout: Duration,
     /// Jobs running on the pool now (tests read it to see work stop).
     running: Arc<AtomicUsize>,
+    /// Run work on the calling thread, not the pool (`ServerConfig::inline_compute`).
+    pub inline: bool,
 }
 
 /// Counts a job while it runs.
@@ -108,6 +110,7 @@ impl Compute {
             streams: Arc::new(Semaphore::new(limit)),
             stream_idle_timeout: Duration::from_secs(60),
             running: Arc::new(AtomicUsize::new(0)),
+            inline: false,
         }
     }
 
@@ -172,6 +175,17 @@ impl Compute {
     {
         if budget.should_stop() {
             return Err(deadline_exceeded());
+        }
+        if self.inline {
+            let _running = Running::start(&self.running);
+            // outside the runtime's context, so work that feeds a stream
+            // with blocking sends may run here too
+            let out =
+                tokio::task::block_in_place(|| std::panic::catch_unwind(AssertUnwindSafe(|| work(budget))));
+            return out.map_err(|_panic| {
+                tracing::error!("a computation panicked");
+                Status::internal("the computation failed unexpectedly")
+            });
         }
         let mut cancel_on_drop = CancelOnDrop {
             flag: budget.cancelled.clone(),

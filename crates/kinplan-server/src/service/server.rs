@@ -69,6 +69,11 @@ pub struct ServerConfig {
     pub auth_tokens: Option<Tokens>,
     /// Certificate, key and optional client CA (PEM); `None`: plaintext.
     pub tls: Option<TlsPem>,
+    /// Run each computation on the thread that handles the call instead of
+    /// the CPU pool: for the in-process backend, whose caller blocks anyway
+    /// and would otherwise pay two thread hand-offs per call. Never for a
+    /// network server (it would stall the async runtime).
+    pub inline_compute: bool,
 }
 
 /// The server's TLS identity (PEM bytes). With `client_ca`, clients must
@@ -108,6 +113,7 @@ impl Default for ServerConfig {
             running_jobs: Arc::default(),
             auth_tokens: None,
             tls: None,
+            inline_compute: false,
         }
     }
 }
@@ -227,6 +233,7 @@ pub(crate) fn kinplan_routes(config: &ServerConfig) -> (tonic::service::Routes, 
     )
     .with_running_counter(config.running_jobs.clone());
     compute.stream_idle_timeout = config.stream_idle_timeout;
+    compute.inline = config.inline_compute;
     let shared = Shared {
         models: Arc::new(ModelStore::new(
             UrdfLimits {
