@@ -71,13 +71,21 @@ def matrix_to_quat(r: np.ndarray) -> np.ndarray:
 
 
 def pose_to_matrix(pose: common_pb2.Pose) -> np.ndarray:
-    """4x4 homogeneous matrix of a proto Pose (metres)."""
-    t = np.eye(4)
-    o = pose.orientation
-    if (o.x, o.y, o.z, o.w) != (0.0, 0.0, 0.0, 0.0):
-        t[:3, :3] = quat_to_matrix(o.x, o.y, o.z, o.w)
-    t[:3, 3] = (pose.position.x, pose.position.y, pose.position.z)
-    return t
+    """4x4 homogeneous matrix of a proto Pose (metres): one array built from
+    plain floats (the same products as :func:`quat_to_matrix`)."""
+    o, p = pose.orientation, pose.position
+    x, y, z, w = o.x, o.y, o.z, o.w
+    if x == 0.0 and y == 0.0 and z == 0.0 and w == 0.0:
+        x = y = z = 0.0
+        w = 1.0
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w), p.x],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w), p.y],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y), p.z],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
 
 
 def as_homogeneous(t: object) -> object:

@@ -222,7 +222,8 @@ class AsyncRobot:
         key = (self.name, None if self.urdf_text is None else hash(self.urdf_text), self.base_link, self.tip_link)
         if key not in cache:
             d = await self.describe()
-            cache[key] = (d.lower - 1e-9, d.upper + 1e-9, d.joint_names)
+            lower, upper = d.lower - 1e-9, d.upper + 1e-9
+            cache[key] = (lower, upper, d.joint_names, list(zip(lower.tolist(), upper.tolist())))
         return cache[key]
 
     async def check_limits(self, q: Any, field_name: str = "q") -> None:

@@ -358,7 +358,8 @@ class Robot(RobotKinematicsMixin):
         limits = cache.get(key)
         if limits is None:
             d = self.describe()
-            limits = cache[key] = (d.lower - 1e-9, d.upper + 1e-9, d.joint_names)
+            lower, upper = d.lower - 1e-9, d.upper + 1e-9
+            limits = cache[key] = (lower, upper, d.joint_names, list(zip(lower.tolist(), upper.tolist())))
         return limits
 
     def check_limits(self, q: Any, field_name: str = "q") -> None:
@@ -366,7 +367,11 @@ class Robot(RobotKinematicsMixin):
         :class:`kinplan.InvalidArgument` when the robot is strict) if a joint
         value of `q` (one state or rows of states) lies outside the limits:
         kinplan takes radians, and degrees are the usual cause."""
-        lower, upper, names = self._limits()
+        lower, upper, names, pairs = self._limits()
+        if isinstance(q, list) and len(q) == len(pairs):
+            # one state as floats (fk, jacobian): a plain loop is the cheapest test
+            if all(lo <= v <= hi for v, (lo, hi) in zip(q, pairs)):
+                return
         arr = np.asarray(q, dtype=float)
         if arr.ndim == 0 or arr.shape[-1] != len(lower):
             return  # the server names a wrong length
