@@ -2,19 +2,21 @@
 from __future__ import annotations
 
 import math
-from typing import Iterable
+from typing import Any, List, Tuple
 
 import numpy as np
+import numpy.typing as npt
 
 from .v1 import common_pb2
 
 
-def joints(q: Iterable[float], name: str = "q") -> list:
+def joints(q: npt.ArrayLike, name: str = "q") -> List[float]:
     """A 1-D float list from any array-like; the server validates the values."""
     arr = np.asarray(q, dtype=float)
     if arr.ndim != 1:
         raise ValueError(f"{name} must be one-dimensional, got shape {arr.shape}")
-    return arr.tolist()
+    out: List[float] = arr.tolist()
+    return out
 
 
 def _varint(n: int) -> bytes:
@@ -57,7 +59,7 @@ def matrix_to_quat(r: np.ndarray) -> np.ndarray:
     t = np.trace(m)
     if t > 0:
         s = 2.0 * np.sqrt(t + 1.0)
-        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
+        q: List[Any] = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, 0.25 * s]
     else:
         i = int(np.argmax(np.diag(m)))
         j, k = (i + 1) % 3, (i + 2) % 3
@@ -66,8 +68,9 @@ def matrix_to_quat(r: np.ndarray) -> np.ndarray:
         q[i] = 0.25 * s
         q[j] = (m[j, i] + m[i, j]) / s
         q[k] = (m[k, i] + m[i, k]) / s
-    q = np.asarray(q)
-    return q / np.linalg.norm(q)
+    v = np.asarray(q)
+    out: np.ndarray = v / np.linalg.norm(v)
+    return out
 
 
 def pose_to_matrix(pose: common_pb2.Pose) -> np.ndarray:
@@ -114,7 +117,7 @@ def as_quat_xyzw(q: object) -> np.ndarray:
     return np.asarray(q, dtype=float)
 
 
-def _quat_of_rows(r: list) -> tuple:
+def _quat_of_rows(r: List[List[float]]) -> Tuple[float, float, float, float]:
     """:func:`matrix_to_quat` on a rotation given as nested float lists, with
     the same branches and operation order (the hot path of every IK call:
     plain floats are ~10x faster than numpy here)."""

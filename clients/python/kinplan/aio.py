@@ -18,11 +18,12 @@ as the blocking client's, so both give the same answers.
 from __future__ import annotations
 
 import asyncio
-from typing import Any, Callable, List, Optional, Sequence, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 import grpc
 import grpc.aio
 import numpy as np
+import numpy.typing as npt
 
 from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
 from .client import DEFAULT_TIMEOUT, Robot, RobotDescription, _channel_options, _pem, normalize_target
@@ -93,7 +94,7 @@ class Client:
     def __repr__(self) -> str:
         return f"kinplan.aio.Client({self.target!r}, timeout={self.timeout})"
 
-    async def _call(self, method: Callable, request: Any, timeout: Optional[float]) -> Any:
+    async def _call(self, method: Callable[..., Any], request: Any, timeout: Optional[float]) -> Any:
         try:
             return await method(request, timeout=self.timeout if timeout is None else timeout, metadata=self._metadata)
         except grpc.aio.AioRpcError as err:
@@ -105,7 +106,7 @@ class Client:
         await self._call(self._robots.ListRobots, robot_pb2.ListRobotsRequest(), timeout)
         return asyncio.get_running_loop().time() - t0
 
-    async def list_robots(self, *, timeout: Optional[float] = None) -> List[dict]:
+    async def list_robots(self, *, timeout: Optional[float] = None) -> List[Dict[str, Any]]:
         reply = await self._call(self._robots.ListRobots, robot_pb2.ListRobotsRequest(), timeout)
         return [
             {"name": r.name, "dof": r.dof, "description": r.description, "base_link": r.base_link, "tip_link": r.tip_link}
@@ -131,7 +132,8 @@ class Client:
                    rrt_connect: Any = None, timing: Any = None, timeout: Optional[float] = None) -> Plan:
         """As :meth:`kinplan.Client.plan`."""
         build = PlanningMixin._plan_request(
-            self, robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution,
+            self,  # type: ignore[arg-type]  # it reads no attribute of self
+            robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution,
             return_cost_history, stomp, cartesian, rrt_connect, timing,
         )
         return Plan.from_proto(await self._robot_of(robot)._call(self._planning.Plan, build, timeout))
@@ -202,9 +204,10 @@ class AsyncRobot:
     def __repr__(self) -> str:
         return f"kinplan.aio.AsyncRobot({self.name or 'urdf'!r})"
 
-    _ref = Robot._ref
+    def _ref(self, inline: bool = False) -> common_pb2.RobotRef:
+        return Robot._ref(self, inline)  # type: ignore[arg-type]  # the same fields as Robot's
 
-    async def _call(self, method: Callable, build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
+    async def _call(self, method: Callable[..., Any], build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
         try:
             reply = await self.client._call(method, build(self._ref()), timeout)
         except KinplanError as err:
@@ -235,7 +238,7 @@ class AsyncRobot:
                              lambda ref: robot_pb2.DescribeRobotRequest(robot=ref), timeout)
         return RobotDescription.from_proto(r)
 
-    async def fk(self, q: Sequence[float], *, links: bool = False, timeout: Optional[float] = None) -> Any:
+    async def fk(self, q: npt.ArrayLike, *, links: bool = False, timeout: Optional[float] = None) -> Any:
         positions = joints(q)
         await self.check_limits(positions)
         r = await self._call(
@@ -264,7 +267,7 @@ class AsyncRobot:
         )
         return Robot._batch_reply(r, arr.shape[1], jacobians)
 
-    async def jacobian(self, q: Sequence[float], *, timeout: Optional[float] = None) -> np.ndarray:
+    async def jacobian(self, q: npt.ArrayLike, *, timeout: Optional[float] = None) -> np.ndarray:
         positions = joints(q)
         await self.check_limits(positions)
         r = await self._call(
@@ -274,7 +277,7 @@ class AsyncRobot:
         )
         return matrix_from_proto(r.jacobian)
 
-    async def ik(self, T: Any, seed: Optional[Sequence[float]] = None, method: Optional[str] = "lm",
+    async def ik(self, T: Any, seed: Optional[npt.ArrayLike] = None, method: Optional[str] = "lm",
                  linear_solver: Optional[str] = "svd", *, timeout: Optional[float] = None, **options: Any) -> IkResult:
         """As :meth:`kinplan.Robot.ik`."""
         if _is_position(T):
@@ -308,7 +311,7 @@ class AsyncRobot:
         return IkBatchResult(results=[IkResult.from_proto(r) for r in reply.results], succeeded=reply.succeeded,
                              elapsed_us=reply.elapsed_us)
 
-    def stream_ik(self, seed: Optional[Sequence[float]] = None, method: Optional[str] = "lm",
+    def stream_ik(self, seed: Optional[npt.ArrayLike] = None, method: Optional[str] = "lm",
                   linear_solver: Optional[str] = "svd", *, timeout: Optional[float] = None,
                   **options: Any) -> "AsyncIkStream":
         """An ``async with`` StreamIk session (as :meth:`kinplan.Robot.stream_ik`)."""
@@ -319,14 +322,14 @@ class AsyncIkStream:
     """A ``StreamIk`` call for asyncio: ``await s.solve(T)`` per controller
     cycle, or ``await s.send(T)`` then ``await s.receive()`` to pipeline."""
 
-    def __init__(self, robot: AsyncRobot, options: kinematics_pb2.IkOptions, seed: Optional[Sequence[float]],
+    def __init__(self, robot: AsyncRobot, options: kinematics_pb2.IkOptions, seed: Optional[npt.ArrayLike],
                  timeout: Optional[float]):
         self._robot, self._options = robot, options
         self._seed = None if seed is None else joints(seed, "seed")
         self._sequence = 0
         self._call = robot.client._kinematics.StreamIk(timeout=timeout, metadata=robot.client._metadata)
 
-    async def send(self, T: Any, seed: Optional[Sequence[float]] = None) -> int:
+    async def send(self, T: Any, seed: Optional[npt.ArrayLike] = None) -> int:
         self._sequence += 1
         msg = kinematics_pb2.StreamIkRequest(sequence=self._sequence, target=target_to_pose(T))
         if self._sequence == 1:
@@ -354,7 +357,7 @@ class AsyncIkStream:
         out.sequence = reply.sequence
         return out
 
-    async def solve(self, T: Any, seed: Optional[Sequence[float]] = None) -> IkResult:
+    async def solve(self, T: Any, seed: Optional[npt.ArrayLike] = None) -> IkResult:
         await self.send(T, seed)
         return await self.receive()
 

@@ -10,6 +10,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 import grpc
 import numpy as np
+import numpy.typing as npt
 
 from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
 from .errors import JointLimitWarning, KinplanError, error_for, invalid_argument
@@ -144,7 +145,8 @@ class _BearerToken(
 
 
 class _CallDetails(grpc.ClientCallDetails):
-    def __init__(self, method, timeout, metadata, credentials, wait_for_ready, compression):  # type: ignore[no-untyped-def]
+    def __init__(self, method: Any, timeout: Any, metadata: Any, credentials: Any, wait_for_ready: Any,
+                 compression: Any) -> None:
         self.method = method
         self.timeout = timeout
         self.metadata = metadata
@@ -217,7 +219,7 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         allowed-collision matrix (planning)."""
         from .inprocess import LocalChannel
 
-        client = cls(timeout=timeout, channel=LocalChannel(cpu_threads, acm_samples))  # type: ignore[arg-type]
+        client = cls(timeout=timeout, channel=LocalChannel(cpu_threads, acm_samples))
         client.target = "in-process"
         return client
 
@@ -253,7 +255,7 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
     def close(self) -> None:
         self._channel.close()
 
-    def _call(self, method: Callable, request: Any, timeout: Optional[float]) -> Any:
+    def _call(self, method: Callable[..., Any], request: Any, timeout: Optional[float]) -> Any:
         try:
             return method(request, timeout=self.timeout if timeout is None else timeout)
         except grpc.RpcError as err:
@@ -400,7 +402,7 @@ class Robot(RobotKinematicsMixin):
             ref.urdf = self.urdf_text or ""
         return ref
 
-    def _call(self, method: Callable, build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
+    def _call(self, method: Callable[..., Any], build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
         try:
             reply = self.client._call(method, build(self._ref()), timeout)
         except KinplanError as err:
@@ -435,7 +437,7 @@ class Robot(RobotKinematicsMixin):
         )
         return str(r.urdf)
 
-    def fk(self, q: Sequence[float], *, links: bool = False, timeout: Optional[float] = None):
+    def fk(self, q: npt.ArrayLike, *, links: bool = False, timeout: Optional[float] = None) -> Any:
         """Tool pose (4x4, base frame, metres) for joint vector `q`; with
         `links=True`, also a dict of every link's 4x4 pose."""
         positions = joints(q)
@@ -494,7 +496,7 @@ class Robot(RobotKinematicsMixin):
             return T, J
         return T
 
-    def jacobian(self, q: Sequence[float], *, timeout: Optional[float] = None) -> np.ndarray:
+    def jacobian(self, q: npt.ArrayLike, *, timeout: Optional[float] = None) -> np.ndarray:
         """6 x n geometric Jacobian in the base frame (rows: vx, vy, vz, wx, wy, wz)."""
         positions = joints(q)
         self.check_limits(positions)

@@ -1,7 +1,7 @@
 """Server errors as Python exceptions."""
 from __future__ import annotations
 
-from typing import List, Tuple
+from typing import Any, List, Tuple
 
 import grpc
 
@@ -22,7 +22,7 @@ class KinplanError(Exception):
         self.message = message
         self.field_violations = field_violations
 
-    def __reduce__(self):  # type: ignore[override]
+    def __reduce__(self) -> Tuple[Any, Tuple[str, str, List[Tuple[str, str]]]]:
         return (_rebuild, (self.code.name, self.message, self.field_violations))
 
     def __str__(self) -> str:
@@ -30,7 +30,7 @@ class KinplanError(Exception):
 
     @property
     def code_name(self) -> str:
-        return self.code.name
+        return str(self.code.name)
 
     @classmethod
     def from_rpc_error(cls, err: grpc.RpcError) -> "KinplanError":
@@ -107,7 +107,7 @@ def _field_violations(err: grpc.RpcError) -> List[Tuple[str, str]]:
     """Reads google.rpc.BadRequest from the status details, when present."""
     try:
         from google.protobuf import any_pb2  # noqa: F401
-        from grpc_status import rpc_status  # type: ignore
+        from grpc_status import rpc_status
     except ImportError:
         rpc_status = None
     if rpc_status is not None:
@@ -120,7 +120,7 @@ def _field_violations(err: grpc.RpcError) -> List[Tuple[str, str]]:
     return []
 
 
-def _violations_from_status(status) -> List[Tuple[str, str]]:
+def _violations_from_status(status: Any) -> List[Tuple[str, str]]:
     from google.rpc import error_details_pb2  # type: ignore
 
     out: List[Tuple[str, str]] = []

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from ._display import html_table
 from ._convert import pose_to_matrix
@@ -157,7 +158,9 @@ class ExploreMixin:
             raise ValueError(f"name must be one of {sorted(SCENES)}, got {name!r}")
         req = exploration_pb2.ReferenceSceneRequest(name=SCENES[name], seed=int(seed))
         r = self._call(self._exploration().ReferenceScene, req, timeout)  # type: ignore[attr-defined]
-        v = lambda p: np.array([p.x, p.y, p.z], dtype=float)  # noqa: E731
+        def v(p: Any) -> np.ndarray:
+            return np.array([p.x, p.y, p.z], dtype=float)
+
         return ReferenceScene(
             name=name,
             robot=r.robot,
@@ -172,7 +175,7 @@ class ExploreMixin:
         *,
         scene: Union[ReferenceScene, Sequence[Obstacle]],
         start: Any = None,
-        region: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
+        region: Optional[Tuple[npt.ArrayLike, npt.ArrayLike]] = None,
         planner: str = "rrt_connect",
         weights: Optional[Sequence[float]] = None,
         seed: int = 0,

@@ -28,7 +28,7 @@ def native() -> ModuleType:
     if _native is not None:
         return _native
     try:
-        import kinplan_native  # type: ignore[import-not-found]
+        import kinplan_native
 
         _native = kinplan_native
     except ImportError:
@@ -80,7 +80,7 @@ def _rpc_error(err: Exception) -> LocalRpcError:
 
 
 class _Unary:
-    def __init__(self, backend: Any, path: str, serialize: Callable, deserialize: Callable):
+    def __init__(self, backend: Any, path: str, serialize: Callable[..., Any], deserialize: Callable[..., Any]):
         self._backend, self._path = backend, path
         self._serialize, self._deserialize = serialize, deserialize
         self._error = native().CallError
@@ -96,7 +96,7 @@ class _Unary:
 class _Answers(Iterator[Any]):
     """The answers of a streaming call, as grpcio's response iterator."""
 
-    def __init__(self, stream: Any, deserialize: Callable, feeder: Optional[threading.Thread]):
+    def __init__(self, stream: Any, deserialize: Callable[..., Any], feeder: Optional[threading.Thread]):
         self._stream, self._deserialize, self._feeder = stream, deserialize, feeder
         self._error = native().CallError
 
@@ -115,7 +115,7 @@ class _Answers(Iterator[Any]):
 
 
 class _Streaming:
-    def __init__(self, backend: Any, path: str, serialize: Callable, deserialize: Callable, client_streams: bool):
+    def __init__(self, backend: Any, path: str, serialize: Callable[..., Any], deserialize: Callable[..., Any], client_streams: bool):
         self._backend, self._path = backend, path
         self._serialize, self._deserialize = serialize, deserialize
         self._client_streams = client_streams
@@ -149,16 +149,16 @@ class LocalChannel:
     def __init__(self, cpu_threads: int = 0, acm_samples: int = 10_000):
         self._backend = native().Backend(cpu_threads, acm_samples)
 
-    def unary_unary(self, method: str, request_serializer: Callable, response_deserializer: Callable, **_: Any) -> _Unary:
+    def unary_unary(self, method: str, request_serializer: Callable[..., Any], response_deserializer: Callable[..., Any], **_: Any) -> _Unary:
         return _Unary(self._backend, method, request_serializer, response_deserializer)
 
-    def unary_stream(self, method: str, request_serializer: Callable, response_deserializer: Callable, **_: Any) -> _Streaming:
+    def unary_stream(self, method: str, request_serializer: Callable[..., Any], response_deserializer: Callable[..., Any], **_: Any) -> _Streaming:
         return _Streaming(self._backend, method, request_serializer, response_deserializer, False)
 
-    def stream_stream(self, method: str, request_serializer: Callable, response_deserializer: Callable, **_: Any) -> _Streaming:
+    def stream_stream(self, method: str, request_serializer: Callable[..., Any], response_deserializer: Callable[..., Any], **_: Any) -> _Streaming:
         return _Streaming(self._backend, method, request_serializer, response_deserializer, True)
 
-    def stream_unary(self, method: str, request_serializer: Callable, response_deserializer: Callable, **_: Any) -> Any:
+    def stream_unary(self, method: str, request_serializer: Callable[..., Any], response_deserializer: Callable[..., Any], **_: Any) -> Any:
         streaming = _Streaming(self._backend, method, request_serializer, response_deserializer, True)
 
         def call(requests: Any, timeout: Optional[float] = None, **kw: Any) -> Any:

@@ -22,6 +22,7 @@ from typing import Any, Dict, Iterable, Iterator, List, Mapping, Optional, Seque
 
 import grpc
 import numpy as np
+import numpy.typing as npt
 
 from ._display import html_table
 from ._convert import joints, matrix_to_pose, matrix_to_proto, pose_to_matrix
@@ -61,7 +62,9 @@ JOINT_LIMITS = {
 }
 
 
-def _choice(table: Mapping, value: Any, what: str) -> int:
+def _choice(table: Mapping[Any, int], value: Any, what: str) -> Any:
+    """The proto enum value `table` maps `value` to (an int; Any to the
+    stubs, whose enum parameters take their own wrapper type)."""
     if value not in table:
         raise ValueError(f"{what} must be one of {[k for k in table if k]}, got {value!r}")
     return table[value]
@@ -78,7 +81,7 @@ def _ik_status(value: int) -> str:
 def _is_position(T: Any) -> bool:
     """True for a bare 3-vector (array or sequence of three numbers)."""
     if isinstance(T, np.ndarray):
-        return T.shape == (3,)
+        return bool(T.shape == (3,))
     return isinstance(T, (list, tuple)) and len(T) == 3 and all(isinstance(v, (int, float)) for v in T)
 
 
@@ -89,7 +92,7 @@ def target_to_pose(T: Any) -> common_pb2.Pose:
     if isinstance(T, common_pb2.Pose):
         return T
     if isinstance(T, (tuple, list)) and len(T) == 2 and np.asarray(T[0]).shape == (3,):
-        return matrix_to_pose((np.asarray(T[0], dtype=float), T[1]))
+        return matrix_to_pose((np.asarray(T[0], dtype=float), T[1]))  # type: ignore[arg-type]
     return matrix_to_pose(T)
 
 
@@ -122,7 +125,7 @@ def ik_options(
     """IkOptions from Python values; ``None`` means the server's documented
     default. Values are checked by the server, which names a bad field.
     Built once per distinct set of arguments (a request copies the message)."""
-    key = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
+    key: Any = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
            damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
            max_step, distinct_tolerance, rlxa_max_iterations, history)
     try:
@@ -145,10 +148,11 @@ def ik_options(
 _IK_OPTIONS_CACHE: Dict[Any, kinematics_pb2.IkOptions] = {}
 
 
-def _build_ik_options(method, linear_solver, position_tolerance, orientation_tolerance,  # type: ignore[no-untyped-def]
-                      position_only, max_iterations, damping, max_restarts, num_solutions, rng_seed,
-                      joint_limits, time_budget, adaptive_damping, max_step, distinct_tolerance,
-                      rlxa_max_iterations, history):
+def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, orientation_tolerance: Any,
+                      position_only: Any, max_iterations: Any, damping: Any, max_restarts: Any,
+                      num_solutions: Any, rng_seed: Any, joint_limits: Any, time_budget: Any,
+                      adaptive_damping: Any, max_step: Any, distinct_tolerance: Any, rlxa_max_iterations: Any,
+                      history: Any) -> kinematics_pb2.IkOptions:
     o = kinematics_pb2.IkOptions(
         method=_choice(METHODS, method, "method"),
         linear_solver=_choice(LINEAR_SOLVERS, linear_solver, "linear_solver"),
@@ -288,7 +292,7 @@ class IkBatchResult:
 
     @property
     def q(self) -> np.ndarray:
-        return np.stack([r.q for r in self.results])
+        return np.stack([r.q for r in self.results if r.q is not None])
 
     @property
     def success(self) -> np.ndarray:
@@ -405,7 +409,7 @@ class IkStream:
 
     _END = object()
 
-    def __init__(self, robot: Any, options: kinematics_pb2.IkOptions, seed: Optional[Sequence[float]], timeout: Optional[float]):
+    def __init__(self, robot: Any, options: kinematics_pb2.IkOptions, seed: Optional[npt.ArrayLike], timeout: Optional[float]):
         self._robot = robot
         self._options = options
         self._seed = None if seed is None else joints(seed, "seed")
@@ -424,7 +428,7 @@ class IkStream:
                 return
             yield item
 
-    def send(self, T: Any, seed: Optional[Sequence[float]] = None) -> int:
+    def send(self, T: Any, seed: Optional[npt.ArrayLike] = None) -> int:
         """Queues a target; returns its sequence number."""
         if self._closed:
             raise RuntimeError("the stream is closed")
@@ -454,7 +458,7 @@ class IkStream:
     def __iter__(self) -> "IkStream":
         return self
 
-    def solve(self, T: Any, seed: Optional[Sequence[float]] = None) -> IkResult:
+    def solve(self, T: Any, seed: Optional[npt.ArrayLike] = None) -> IkResult:
         """Sends one target and waits for its answer."""
         self.send(T, seed)
         return next(self)
@@ -489,7 +493,7 @@ class RobotKinematicsMixin:
     def ik(
         self,
         T: Any,
-        seed: Optional[Sequence[float]] = None,
+        seed: Optional[npt.ArrayLike] = None,
         method: Optional[str] = "lm",
         linear_solver: Optional[str] = "svd",
         *,
@@ -549,7 +553,7 @@ class RobotKinematicsMixin:
     def ik_batch(
         self,
         Ts: Any,
-        seed: Optional[Sequence[float]] = None,
+        seed: Optional[npt.ArrayLike] = None,
         method: Optional[str] = "lm",
         linear_solver: Optional[str] = "svd",
         *,
@@ -586,7 +590,7 @@ class RobotKinematicsMixin:
     def track(
         self,
         poses: Any = None,
-        seed: Optional[Sequence[float]] = None,
+        seed: Optional[npt.ArrayLike] = None,
         *,
         line: Optional[Mapping[str, Any]] = None,
         circle: Optional[Mapping[str, Any]] = None,
@@ -646,7 +650,7 @@ class RobotKinematicsMixin:
 
     def stream_ik(
         self,
-        seed: Optional[Sequence[float]] = None,
+        seed: Optional[npt.ArrayLike] = None,
         method: Optional[str] = "lm",
         linear_solver: Optional[str] = "svd",
         *,

@@ -43,7 +43,7 @@ def _native_available() -> bool:
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+        return int(s.getsockname()[1])
 
 
 class LocalServer:
@@ -76,7 +76,7 @@ class LocalServer:
         self.address = f"127.0.0.1:{port or _free_port()}"
         self.args = list(args or [])
         self.startup_timeout = startup_timeout
-        self._proc: Optional[subprocess.Popen] = None
+        self._proc: Optional["subprocess.Popen[bytes]"] = None
         self._thread_server: Any = None
         self._log: Any = None
 

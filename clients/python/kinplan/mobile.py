@@ -118,7 +118,7 @@ def path_to_proto(path: Iterable[Sequence[float]]) -> List[mobile_pb2.PathNode]:
     return nodes
 
 
-def _controller(name: str) -> int:
+def _controller(name: str) -> Any:
     try:
         return CONTROLLERS[name.lower()]
     except KeyError:

@@ -14,10 +14,12 @@ from .explore import ReferenceScene
 def s0_open_cell(client: Any, seed: int = 1) -> ReferenceScene:
     """Two tables with boxes on and under them, a cabinet and a drum in front
     of the IRB 4600; about 29 % of the region hidden after the initial scans."""
-    return client.reference_scene("s0_open_cell", seed=seed)
+    scene: ReferenceScene = client.reference_scene("s0_open_cell", seed=seed)
+    return scene
 
 
 def s0_walled_cell(client: Any, seed: int = 1) -> ReferenceScene:
     """Clutter inside a 1.5 m high wall; over 80 % of the region hidden after
     the initial scans."""
-    return client.reference_scene("s0_walled_cell", seed=seed)
+    scene: ReferenceScene = client.reference_scene("s0_walled_cell", seed=seed)
+    return scene

@@ -10,7 +10,7 @@ installed. Units: metres, radians, seconds (see proto/kinplan/v1/scoring.proto).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -60,9 +60,15 @@ class Series:
 
     @classmethod
     def from_proto(cls, s: scoring_pb2.ScoreSeries) -> "Series":
-        arr = lambda v: np.asarray(v, dtype=float)  # noqa: E731
-        opt = lambda v: arr(v) if len(v) else None  # noqa: E731
-        peaks = lambda ps: [Peak(p.index, p.height, p.slowdown) for p in ps]  # noqa: E731
+        def arr(v: Any) -> np.ndarray:
+            return np.asarray(v, dtype=float)
+
+        def opt(v: Any) -> Optional[np.ndarray]:
+            return arr(v) if len(v) else None
+
+        def peaks(ps: Any) -> List[Peak]:
+            return [Peak(p.index, p.height, p.slowdown) for p in ps]
+
         return cls(
             cd=arr(s.cd),
             jd=arr(s.jd),
@@ -116,7 +122,7 @@ class CycleTime:
         )
 
 
-class Scores(dict):
+class Scores(Dict[str, float]):
     """The criteria of one trajectory, ``{name: value}``, plus details:
     ``waypoints``, ``joint_peak_count``, ``cartesian_peak_count``,
     ``robot_points`` (points per waypoint behind RDM), ``cycle_time``
@@ -193,7 +199,7 @@ class Comparison:
     def __getitem__(self, label: str) -> Dict[str, Dict[str, Any]]:
         return self.stats[label]
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[str]:
         return iter(self.labels)
 
     def __len__(self) -> int:
@@ -211,7 +217,7 @@ class Comparison:
     def to_dict(self) -> Dict[str, Dict[str, Dict[str, Any]]]:
         return {label: {k: dict(v) for k, v in crit.items()} for label, crit in self.stats.items()}
 
-    def to_pandas(self, criterion: Optional[str] = None):
+    def to_pandas(self, criterion: Optional[str] = None) -> Any:
         """A pandas DataFrame (needs pandas: ``pip install kinplan[table]``)."""
         try:
             import pandas as pd
@@ -343,7 +349,7 @@ class ScoringMixin:
             self.__dict__["_scoring_stub"] = stub
         return stub
 
-    def _robot_of(self, robot: Any):
+    def _robot_of(self, robot: Any) -> Any:
         if robot is None:
             raise ValueError("robot= is required (a name or client.robot(...))")
         return self.robot(robot) if isinstance(robot, str) else robot  # type: ignore[attr-defined]
