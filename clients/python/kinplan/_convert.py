@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import struct
 from typing import Any, List, Tuple
 
 import numpy as np
@@ -139,6 +140,37 @@ def _quat_of_rows(r: List[List[float]]) -> Tuple[float, float, float, float]:
     return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
 
 
+# A Pose on the wire: position (field 1: three doubles, 27 bytes) and
+# orientation (field 2: four doubles, 36 bytes), every double tagged.
+_POSE_WIRE = struct.Struct("<BBBdBdBdBBBdBdBdBd")
+
+
+def pose_bytes(t: Any) -> bytes:
+    """The encoded proto Pose of anything :func:`matrix_to_pose` takes; a 4x4
+    array is packed directly (the same quaternion, no message objects)."""
+    if isinstance(t, np.ndarray) and t.shape == (4, 4):
+        rows = t.tolist()
+        x, y, z, w = _quat_of_rows(rows)
+        return _POSE_WIRE.pack(
+            0x0A, 27, 0x09, rows[0][3], 0x11, rows[1][3], 0x19, rows[2][3],
+            0x12, 36, 0x09, x, 0x11, y, 0x19, z, 0x21, w,
+        )
+    out: bytes = matrix_to_pose(t).SerializeToString()
+    return out
+
+
+def length_delimited(field: int, payload: bytes) -> bytes:
+    """A length-delimited field (a message, bytes or a packed array) on the wire."""
+    return bytes([field << 3 | 2]) + _varint(len(payload)) + payload
+
+
+def packed_doubles(field: int, values: List[float]) -> bytes:
+    """A packed repeated double field (empty when there are no values)."""
+    if not values:
+        return b""
+    return length_delimited(field, struct.pack(f"<{len(values)}d", *values))
+
+
 def matrix_to_pose(t: np.ndarray) -> common_pb2.Pose:
     """Proto Pose of a 4x4 homogeneous matrix (or of a (position, quaternion
     x-y-z-w) pair, or of a pinocchio / spatialmath SE3)."""
@@ -164,4 +196,7 @@ def matrix_to_pose(t: np.ndarray) -> common_pb2.Pose:
 
 
 def matrix_from_proto(m: common_pb2.Matrix) -> np.ndarray:
-    return np.asarray(m.data, dtype=float).reshape(m.rows, m.cols)
+    data = m.data
+    # small: through a list (asarray's fixed cost dominates); large: asarray reads the buffer
+    arr = np.array(data[:], dtype=float) if len(data) <= 256 else np.asarray(data, dtype=float)
+    return arr.reshape(m.rows, m.cols)

@@ -255,6 +255,17 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
     def close(self) -> None:
         self._channel.close()
 
+    def _raw_unary(self, path: str, response: Any) -> Any:
+        """A unary method that sends an already-encoded request (bytes) and
+        decodes the answer as `response`: the fast path of hot calls."""
+        cache = self.__dict__.setdefault("_raw_methods", {})
+        method = cache.get(path)
+        if method is None:
+            method = cache[path] = self._channel.unary_unary(
+                path, request_serializer=None, response_deserializer=response.FromString
+            )
+        return method
+
     def _call(self, method: Callable[..., Any], request: Any, timeout: Optional[float]) -> Any:
         try:
             return method(request, timeout=self.timeout if timeout is None else timeout)

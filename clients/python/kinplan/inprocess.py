@@ -87,7 +87,8 @@ class _Unary:
 
     def __call__(self, request: Any, timeout: Optional[float] = None, **_: Any) -> Any:
         try:
-            answer = self._backend.unary(self._path, self._serialize(request), timeout)
+            wire = request if self._serialize is None else self._serialize(request)
+            answer = self._backend.unary(self._path, wire, timeout)
         except self._error as err:
             raise _rpc_error(err) from None
         return self._deserialize(answer)

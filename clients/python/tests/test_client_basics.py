@@ -222,3 +222,28 @@ def test_the_fast_quaternion_is_bit_identical_to_the_numpy_one():
         fast = np.array(_quat_of_rows(R.tolist()))
         assert min(np.abs(fast - q).max(), np.abs(fast + q).max()) < 1e-12
     assert branches == {1, 10, 11, 12}  # every branch was exercised
+
+
+def test_the_ik_request_encoded_by_hand_parses_as_the_message_built_one():
+    from kinplan.kinematics import _ik_options_wire, _target_wire, ik_options, target_to_pose
+    from kinplan._convert import length_delimited, packed_doubles
+    from kinplan.v1 import common_pb2, kinematics_pb2
+
+    rng = np.random.default_rng(3)
+    ref = common_pb2.RobotRef(name="ur5", tip_link="tool0")
+    for k in range(200):
+        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        T = np.eye(4)
+        T[:3, :3] = q * np.sign(np.linalg.det(q))
+        T[:3, 3] = rng.normal(size=3)
+        seed = rng.normal(size=6).tolist() if k % 2 else []
+        extra = {"max_iterations": 50, "rng_seed": k} if k % 3 else {}
+        wire = (length_delimited(1, ref.SerializeToString())
+                + length_delimited(2, _target_wire(T if k % 5 else (T[:3, 3], [0.0, 0.0, 0.0, 1.0])))
+                + packed_doubles(3, seed)
+                + length_delimited(4, _ik_options_wire("lm", "svd", 10, None, 1e-6, None, False, extra)))
+        expected = kinematics_pb2.SolveIkRequest(
+            robot=ref, target=target_to_pose(T if k % 5 else (T[:3, 3], [0.0, 0.0, 0.0, 1.0])), seed=seed,
+            options=ik_options("lm", "svd", max_restarts=10, position_tolerance=1e-6, **extra),
+        )
+        assert kinematics_pb2.SolveIkRequest.FromString(wire) == expected
