@@ -6,7 +6,7 @@ import json
 import socket
 import time
 import warnings
-from typing import Any, Callable, Dict, List, Optional, Sequence, Union
+from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import grpc
 import numpy as np
@@ -447,6 +447,14 @@ class Robot(RobotKinematicsMixin):
             timeout,
         )
         return str(r.urdf)
+
+    @overload
+    def fk(self, q: npt.ArrayLike, *, links: Literal[False] = False,
+           timeout: Optional[float] = None) -> npt.NDArray[np.float64]: ...
+
+    @overload
+    def fk(self, q: npt.ArrayLike, *, links: Literal[True],
+           timeout: Optional[float] = None) -> Tuple[npt.NDArray[np.float64], Dict[str, npt.NDArray[np.float64]]]: ...
 
     def fk(self, q: npt.ArrayLike, *, links: bool = False, timeout: Optional[float] = None) -> Any:
         """Tool pose (4x4, base frame, metres) for joint vector `q`; with

@@ -18,7 +18,7 @@ from __future__ import annotations
 import queue
 import threading
 from dataclasses import dataclass, field
-from typing import Any, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, Iterable, Iterator, List, Literal, Mapping, Optional, Sequence, Union
 
 import grpc
 import numpy as np
@@ -30,6 +30,13 @@ from .errors import KinplanError
 from .v1 import common_pb2, kinematics_pb2, kinematics_pb2_grpc
 
 #: IK methods by name (``None``: the server default, Levenberg-Marquardt).
+#: IK method names (aliases: "levenberg_marquardt", "ji").
+IkMethodName = Literal["lm", "levenberg_marquardt", "jacobian_inverse", "ji", "newton", "ccd", "fabrik",
+                       "length_relaxation"]
+#: Linear solver names of the Jacobian methods (aliases: "pinv", "rlxa", "rlxa_safeguarded").
+LinearSolverName = Literal["svd", "pinv", "angle_relaxation", "rlxa", "angle_relaxation_safeguarded",
+                           "rlxa_safeguarded"]
+
 METHODS = {
     None: kinematics_pb2.IK_METHOD_UNSPECIFIED,
     "lm": kinematics_pb2.IK_METHOD_LEVENBERG_MARQUARDT,
@@ -528,16 +535,25 @@ class RobotKinematicsMixin:
         self,
         T: Any,
         seed: Optional[npt.ArrayLike] = None,
-        method: Optional[str] = "lm",
-        linear_solver: Optional[str] = "svd",
+        method: Optional[IkMethodName] = "lm",
+        linear_solver: Optional[LinearSolverName] = "svd",
         *,
         max_restarts: Optional[int] = None,
         num_solutions: Optional[int] = None,
         position_tolerance: Optional[float] = None,
         orientation_tolerance: Optional[float] = None,
         position_only: bool = False,
+        max_iterations: Optional[int] = None,
+        damping: Optional[float] = None,
+        rng_seed: int = 0,
+        joint_limits: Optional[Literal["clamp", "ignore"]] = None,
+        time_budget: Optional[float] = None,
+        adaptive_damping: Optional[bool] = None,
+        max_step: Optional[float] = None,
+        distinct_tolerance: Optional[float] = None,
+        rlxa_max_iterations: Optional[int] = None,
+        history: bool = False,
         timeout: Optional[float] = None,
-        **options: Any,
     ) -> IkResult:
         """Joints that put the tool at ``T`` (4x4, or (position, quaternion
         xyzw), or a bare position 3-vector, which means ``position_only``),
@@ -565,6 +581,14 @@ class RobotKinematicsMixin:
         if _is_position(T):
             T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
             position_only = True
+        options = {
+            k: v for k, v in (
+                ("max_iterations", max_iterations), ("damping", damping), ("rng_seed", rng_seed),
+                ("joint_limits", joint_limits), ("time_budget", time_budget), ("adaptive_damping", adaptive_damping),
+                ("max_step", max_step), ("distinct_tolerance", distinct_tolerance),
+                ("rlxa_max_iterations", rlxa_max_iterations), ("history", history),
+            ) if v is not None
+        }
         options_wire = _ik_options_wire(
             method, linear_solver, max_restarts, num_solutions, position_tolerance, orientation_tolerance,
             position_only, options,
