@@ -8,6 +8,8 @@ seed=...)` against the generated stub called with a request built once, and
 the difference (the client's own overhead per call). Calls alternate, so
 drift in the machine's speed hits both alike.
 """
+from typing import Any
+
 import sys
 import time
 
@@ -18,7 +20,7 @@ from kinplan.kinematics import ik_options, target_to_pose
 from kinplan.v1 import kinematics_pb2, robot_pb2
 
 
-def interleaved_us(a, b, n):
+def interleaved_us(a: Any, b: Any, n: int) -> Any:
     """Mean µs of `a` and of `b`, called alternately so that drift in the
     machine's speed hits both alike."""
     for _ in range(50):
@@ -36,7 +38,7 @@ def interleaved_us(a, b, n):
     return ta / n * 1e6, tb / n * 1e6
 
 
-def main():
+def main() -> None:
     address = sys.argv[1] if len(sys.argv) > 1 else "127.0.0.1:50051"
     n = int(sys.argv[2]) if len(sys.argv) > 2 else 3000
     with kinplan.Client(address, timeout=10) as c:

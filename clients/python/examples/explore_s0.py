@@ -11,6 +11,8 @@ IRB 4600 and a simulated Kinect v2, and plot
 Needs matplotlib and a running `kinplan serve`; writes
 <out_prefix>_known_ratio.png, _criteria.png and _octree.png.
 """
+from typing import Any
+
 import sys
 
 import matplotlib
@@ -35,19 +37,19 @@ SETS = {
 }
 
 
-def run(client, scene, **kw):
+def run(client: Any, scene: Any, **kw: Any) -> Any:
     *steps, summary = client.explore(scene=scene, timeout=300, **kw)
     return steps, summary
 
 
-def main():
+def main() -> None:
     address = sys.argv[1] if len(sys.argv) > 1 else "localhost:50051"
     prefix = sys.argv[2] if len(sys.argv) > 2 else "explore_s0"
     client = kinplan.Client(address, timeout=300)
     scenes = {"s0_open_cell": kinplan.scenes.s0_open_cell, "s0_walled_cell": kinplan.scenes.s0_walled_cell}
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4), sharey=True)
-    last = None
+    last: Any = None
     for ax, (name, sets) in zip(axes, SETS.items()):
         scene = scenes[name](client)
         for w in sets:
@@ -86,6 +88,7 @@ def main():
     fig.tight_layout()
     fig.savefig(f"{prefix}_criteria.png", dpi=120)
 
+    assert last is not None, "no run finished"
     scene, summary = last
     cells = summary.octree.occupied_cells()
     lo, hi = scene.region

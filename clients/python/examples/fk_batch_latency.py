@@ -13,7 +13,7 @@ import numpy as np
 import kinplan
 
 
-def main():
+def main() -> None:
     address = sys.argv[1] if len(sys.argv) > 1 else "127.0.0.1:50051"
     n = int(sys.argv[2]) if len(sys.argv) > 2 else 10_000
     with kinplan.Client(address, timeout=30) as c:

@@ -5,6 +5,8 @@ Start a server (`cargo run --release -- serve`), then
 Prints median, p99 and mean in microseconds, for the numpy wrapper and for
 the raw generated stub.
 """
+from typing import Any
+
 import sys
 import time
 
@@ -17,7 +19,7 @@ address = sys.argv[1] if len(sys.argv) > 1 else "127.0.0.1:50051"
 calls = int(sys.argv[2]) if len(sys.argv) > 2 else 10000
 
 
-def report(label, samples):
+def report(label: str, samples: Any) -> None:
     us = np.array(samples) * 1e6
     print(f"python {label} ForwardKinematics x{len(us)}: median {np.median(us):.1f} µs, "
           f"p99 {np.percentile(us, 99):.1f} µs, mean {us.mean():.1f} µs")

@@ -9,6 +9,8 @@ seed 0.01 rad from the answer (warm), through robot.ik and through the raw
 generated stub; StreamIk along a 10 mm circle in lockstep (send, await the
 answer) and pipelined (send everything, read the answers), as targets/s.
 """
+from typing import Any
+
 import sys
 import time
 
@@ -23,7 +25,7 @@ calls = int(sys.argv[2]) if len(sys.argv) > 2 else 2000
 NAME = "kuka_kr210_r2700_extra"
 
 
-def report(label, samples, server_us=None, failures=0):
+def report(label: str, samples: Any, server_us: Any = None, failures: int = 0) -> None:
     us = np.array(samples) * 1e6
     extra = f"; server solve median {np.median(server_us):.1f} µs" if server_us is not None else ""
     print(f"python {label} x{len(us)}: median {np.median(us):.1f} µs, p99 {np.percentile(us, 99):.1f} µs, "

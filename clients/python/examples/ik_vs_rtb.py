@@ -18,6 +18,7 @@ Needs `pip install roboticstoolbox-python kinplan-native`.
 import sys
 import tempfile
 import time
+from typing import Any, Callable, Dict, List
 
 import numpy as np
 
@@ -28,14 +29,14 @@ from kinplan.v1 import kinematics_pb2
 ROBOT = "kuka_kr210_r2700_extra"
 
 
-def stats(label, times_s, ok):
+def stats(label: str, times_s: List[float], ok: List[bool]) -> float:
     us = np.array(times_s) * 1e6
     print(f"{label:<46} mean {us.mean():7.1f} µs  median {np.median(us):7.1f} µs  "
           f"p95 {np.percentile(us, 95):8.1f} µs  solved {100 * np.mean(ok):5.1f} %")
-    return us.mean()
+    return float(us.mean())
 
 
-def main():
+def main() -> None:
     address = sys.argv[1] if len(sys.argv) > 1 else "127.0.0.1:50051"
     n = int(sys.argv[2]) if len(sys.argv) > 2 else 500
     import roboticstoolbox as rtb
@@ -56,15 +57,15 @@ def main():
     for q, T in zip(qs[:20], targets[:20]):
         assert np.allclose(r.fkine(q).A, T, atol=1e-12), "roboticstoolbox reads another robot"
 
-    def solved(q):
+    def solved(q: Any, target: Any) -> bool:
         T = robot_local.fk(q)
         dp = np.linalg.norm(T[:3, 3] - target[:3, 3])
         c = (np.trace(T[:3, :3].T @ target[:3, :3]) - 1) / 2
-        return dp <= 1e-5 and np.arccos(np.clip(c, -1, 1)) <= 1e-5
+        return bool(dp <= 1e-5 and np.arccos(np.clip(c, -1, 1)) <= 1e-5)
 
     stub = remote._kinematics
     options = ik_options("lm", "svd")
-    runs = {
+    runs: Dict[str, Callable[[Any], Any]] = {
         "kinplan in-process  robot.ik (Client.local())": lambda T: robot_local.ik(T).q,
         "kinplan over gRPC   robot.ik": lambda T: robot_remote.ik(T).q,
         "kinplan over gRPC   raw generated stub": lambda T: np.array(
@@ -76,16 +77,16 @@ def main():
     }
     print(f"{n} KR 210 targets (TRAC-IK protocol), {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
     means = {}
-    global target
     for label, solve in runs.items():
         for target in targets[:20]:
             solve(target)
-        times, ok = [], []
+        times: List[float] = []
+        ok: List[bool] = []
         for target in targets:
             t0 = time.perf_counter()
             q = solve(target)
             times.append(time.perf_counter() - t0)
-            ok.append(bool(np.all(np.isfinite(q))) and solved(q))
+            ok.append(bool(np.all(np.isfinite(q))) and solved(q, target))
         means[label] = stats(label, times, ok)
     labels = list(runs)
     print(f"ratio in-process / rtb defaults: {means[labels[0]] / means[labels[3]]:.2f}; "

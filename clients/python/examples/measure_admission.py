@@ -1,18 +1,20 @@
 """Measures shed-rejection latency (200 calls, concurrent and sequential) and health
 latency under a saturated CPU pool, against a kinplan binary started here.
 Run from the repository root: python clients/python/examples/measure_admission.py target/release/kinplan"""
+from typing import Any
+
 import asyncio, os, socket, subprocess, sys, time, statistics
 import grpc
 sys.path.insert(0, "clients/python")
 from kinplan.v1 import kinematics_pb2, kinematics_pb2_grpc, robot_pb2, robot_pb2_grpc, common_pb2
 
-def free_port():
-    s = socket.socket(); s.bind(("127.0.0.1", 0)); p = s.getsockname()[1]; s.close(); return p
+def free_port() -> int:
+    s = socket.socket(); s.bind(("127.0.0.1", 0)); p = int(s.getsockname()[1]); s.close(); return p
 
-def pct(xs, p):
+def pct(xs: Any, p: float) -> Any:
     xs = sorted(xs); return xs[min(len(xs) - 1, int(p / 100 * len(xs)))]
 
-async def main(binary):
+async def main(binary: str) -> None:
     port = free_port()
     proc = subprocess.Popen([binary, "serve", "--listen", f"127.0.0.1:{port}", "--cpu-threads", "2",
                              "--concurrency-limit", "4"], stderr=subprocess.DEVNULL, stdout=subprocess.DEVNULL)
@@ -32,7 +34,7 @@ async def main(binary):
         for _ in range(100):
             t = time.perf_counter(); await check(b''); hl.append(time.perf_counter() - t)
         # 200-call burst, every call shed (4 in flight already)
-        async def one():
+        async def one() -> Any:
             t = time.perf_counter()
             try:
                 await robots.ListRobots(robot_pb2.ListRobotsRequest()); code = "OK"

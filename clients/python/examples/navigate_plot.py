@@ -9,6 +9,7 @@ disc at the start and the goal, both driven paths coloured by navigator mode
 (default navigate.png).
 """
 import sys
+from typing import Any, Dict, List
 
 import matplotlib.pyplot as plt
 from matplotlib.patches import Circle, Polygon
@@ -21,7 +22,7 @@ out = sys.argv[2] if len(sys.argv) > 2 else "navigate.png"
 RADIUS = 0.22
 start, goal = (0.0, 0.0, 0.0), (8.0, 1.0)
 # A U-shaped trap (concave: its mouth faces the start), a disc and a square.
-world = [
+world: List[Dict[str, Any]] = [
     {"polygon": [(3.0, -1.5), (4.0, -1.5), (4.0, 1.5), (3.0, 1.5), (3.0, 1.2), (3.7, 1.2), (3.7, -1.2), (3.0, -1.2)]},
     {"circle": (6.0, 1.6, 0.6)},
     {"polygon": [(6.2, -0.6), (7.0, -0.6), (7.0, 0.2), (6.2, 0.2)]},

@@ -7,6 +7,7 @@ The UR5 swings its base by 2.4 rad; the ball sits where the tool would pass
 halfway along the straight joint-space line, so every planner must go around.
 """
 import sys
+from typing import List
 
 import matplotlib
 
@@ -27,10 +28,10 @@ with kinplan.Client(address, timeout=60) as c:
     ball = kinplan.Sphere(0.12, centre, id="ball")
     fig = plt.figure(figsize=(7, 6))
     ax = fig.add_subplot(projection="3d")
-    for algorithm, options in [("rrt_connect", {}), ("stomp", {}), ("ccstomp", {"stomp": {"timesteps": 10}})]:
-        plan = c.plan(ur5, start=start, goal=goal, algorithm=algorithm, scene=[ball], seed=1, **options)
+    for algorithm, stomp in [("rrt_connect", None), ("stomp", None), ("ccstomp", {"timesteps": 10})]:
+        plan = c.plan(ur5, start=start, goal=goal, algorithm=algorithm, scene=[ball], seed=1, stomp=stomp)
         # the tool path at 0.02 rad joint steps
-        dense = []
+        dense: List[np.ndarray] = []
         for a, b in zip(plan.q[:-1], plan.q[1:]):
             n = max(1, int(np.ceil(np.abs(b - a).max() / 0.02)))
             dense.extend(a + (b - a) * k / n for k in range(n))

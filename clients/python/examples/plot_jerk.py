@@ -39,6 +39,7 @@ with kinplan.Client(address, timeout=10) as c:
     scores = c.score("kuka_kr210_r2700_extra", q, series=True)
 
 series = scores.series
+assert series is not None, "series=True returns the per-waypoint series"
 fig, (ax_j, ax_c) = plt.subplots(2, 1, sharex=True, figsize=(9, 6))
 for ax, values, peaks, unit, key in (
     (ax_j, series.joint_jerk, series.joint_peaks, "rad", "JJP"),

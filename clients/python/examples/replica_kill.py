@@ -15,7 +15,7 @@ import numpy as np
 import kinplan
 
 
-def main():
+def main() -> None:
     seconds = float(sys.argv[1]) if len(sys.argv) > 1 else 10.0
     threads = int(sys.argv[2]) if len(sys.argv) > 2 else 8
     servers = [kinplan.LocalServer(args=["--cpu-threads", "1"]).start() for _ in range(3)]
@@ -29,7 +29,7 @@ def main():
     t_start = time.perf_counter()
     stop_at = t_start + seconds
 
-    def caller(k):
+    def caller(k: int) -> None:
         local = []
         i = k
         while time.perf_counter() < stop_at:

@@ -7,6 +7,8 @@ Start a server (`cargo run --release -- serve`), then
 (defaults 127.0.0.1:50051, 30 and 10000). Prints median, p90 and mean in ms,
 and the share spent building the request in Python.
 """
+from typing import Any
+
 import sys
 import time
 
@@ -23,7 +25,7 @@ s = np.arange(n)[:, None] / n
 q = np.hstack([0.9 * s, -1.5 + 0.4 * s, 1.4 - 0.5 * s, 0.3 * np.sin(6 * s), 0.5 + 0.2 * s, -0.4 * s])
 
 
-def report(label, samples):
+def report(label: str, samples: Any) -> None:
     ms = np.array(samples) * 1e3
     print(f"python {label} x{n} waypoints, {len(ms)} calls: median {np.median(ms):.2f} ms, "
           f"p90 {np.percentile(ms, 90):.2f} ms, mean {ms.mean():.2f} ms")
