@@ -192,11 +192,12 @@ struct Args {
     stomp: usize,
     clamp: bool,
     resolution: f64,
+    shortcut_resolution: Option<f64>,
     out: PathBuf,
 }
 
 fn args() -> Result<Args, String> {
-    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--out PREFIX]";
+    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--out PREFIX]";
     let mut it = std::env::args().skip(1);
     let mut a = Args {
         root: PathBuf::new(),
@@ -204,6 +205,7 @@ fn args() -> Result<Args, String> {
         stomp: 0,
         clamp: false,
         resolution: CheckerParams::default().motion_resolution,
+        shortcut_resolution: None,
         out: PathBuf::from("target/mbm_bench"),
     };
     let mut root = None;
@@ -217,6 +219,13 @@ fn args() -> Result<Args, String> {
             "--passes" => a.passes = num("--passes")?.max(1),
             "--stomp" => a.stomp = num("--stomp")?,
             "--clamp-fingers" => a.clamp = true,
+            "--shortcut-resolution" => {
+                a.shortcut_resolution = Some(
+                    it.next()
+                        .and_then(|v| v.parse().ok())
+                        .ok_or(format!("--shortcut-resolution needs a number; {usage}"))?,
+                )
+            }
             "--resolution" => {
                 a.resolution = it
                     .next()
@@ -254,13 +263,23 @@ impl StateChecker for Counting<'_> {
     }
 }
 
-fn run_rrt<C: StateChecker>(chain: &Chain, checker: &C, s: &[f64], g: &[f64], seed: u64) -> RrtOutcome {
+fn run_rrt<C: StateChecker>(
+    chain: &Chain,
+    checker: &C,
+    s: &[f64],
+    g: &[f64],
+    seed: u64,
+    shortcut_resolution: Option<f64>,
+) -> RrtOutcome {
     rrt_connect(
         chain,
         checker,
         s,
         g,
-        &RrtParams::default(),
+        &RrtParams {
+            shortcut_resolution,
+            ..RrtParams::default()
+        },
         seed,
         Some(Instant::now() + DEADLINE),
     )
@@ -339,8 +358,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     inner: &checker,
                     states: AtomicUsize::new(0),
                 };
-                let counted = run_rrt(&chain, &counting, &start, &goal, seed);
-                let first = run_rrt(&chain, &checker, &start, &goal, seed);
+                let counted = run_rrt(&chain, &counting, &start, &goal, seed, a.shortcut_resolution);
+                let first = run_rrt(&chain, &checker, &start, &goal, seed, a.shortcut_resolution);
                 assert_eq!(
                     counted.path, first.path,
                     "{set} {k}: not deterministic for a seed"
@@ -348,7 +367,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 row.states = counting.states.load(Ordering::Relaxed);
                 let mut times = vec![first.search_ns as f64 / 1e3];
                 for _ in 1..a.passes {
-                    let again = run_rrt(&chain, &checker, &start, &goal, seed);
+                    let again = run_rrt(&chain, &checker, &start, &goal, seed, a.shortcut_resolution);
                     assert_eq!(again.path, first.path, "{set} {k}: not deterministic for a seed");
                     times.push(again.search_ns as f64 / 1e3);
                 }
@@ -412,8 +431,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // Per-set summary.
     println!(
         "RRT-Connect (RrtParams::default(): range 1.0, 100 shortcut attempts; seed = problem number), \
-         motion resolution {} rad, passes = {}, fingers {}",
+         motion resolution {} rad, shortcut resolution {:?}, passes = {}, fingers {}",
         a.resolution,
+        a.shortcut_resolution,
         a.passes,
         if a.clamp {
             "clamped to 0.04 m"
@@ -563,7 +583,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = json!({
         "planner": "kinplan RRT-Connect",
         "params": {"range": RrtParams::default().range, "shortcut_attempts": RrtParams::default().shortcut_attempts,
-                   "motion_resolution": a.resolution, "fine_check_step": FINE},
+                   "motion_resolution": a.resolution, "shortcut_resolution": a.shortcut_resolution, "fine_check_step": FINE},
         "passes": a.passes,
         "fingers_clamped": a.clamp,
         "sets": sets_json,

@@ -307,7 +307,9 @@ pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
                 path[..dof].copy_from_slice(start);
                 let last = path.len() - dof;
                 path[last..].copy_from_slice(goal);
-                let res = search.resolution;
+                let res = params
+                    .shortcut_resolution
+                    .map_or(search.resolution, |r| r.min(search.resolution));
                 let t1 = Instant::now();
                 shortcut(
                     checker,
