@@ -9,6 +9,7 @@ mod costs;
 mod entry;
 mod error;
 mod initial;
+mod kd_index;
 pub(crate) mod noise;
 mod params;
 mod rrt_connect;
@@ -20,7 +21,7 @@ pub use cartesian::{CartesianLine, Deviation, cartesian_cost, deviation, perturb
 pub use entry::{Algorithm, Goal, PlanControl, PlanRequest, PlanResult, PlanStatus, Timings, plan};
 pub use error::{PlanError, PlanField};
 pub use params::{CartesianParams, InitialTrajectory, RrtParams, StompParams};
-pub use rrt_connect::{RrtOutcome, RrtStop};
+pub use rrt_connect::{RrtOutcome, RrtStop, rrt_connect};
 pub use stomp::{IterationReport, StompOutcome, StompStop};
 pub use stomp_matrices::{ACCELERATION_STENCIL, PADDING, StompMatrices, finite_difference_matrix};
 pub use timing::{MIN_SEGMENT_TIME, TimingParams, time_parameterize};

@@ -232,6 +232,12 @@ pub struct RrtParams {
     pub max_samples: usize,
     /// Random shortcut attempts after the greedy pass (≥ 0). Default 100.
     pub shortcut_attempts: usize,
+    /// Resolution (rad or m, in (0, 1]) at which shortcutting checks the
+    /// motions it tries, when finer than the checker's; `None` (default):
+    /// the checker's. Shortcuts pull the path against obstacles, so a finer
+    /// check here removes most grazing contacts a later, finer re-check would
+    /// find, without slowing the search.
+    pub shortcut_resolution: Option<f64>,
 }
 
 impl Default for RrtParams {
@@ -240,6 +246,7 @@ impl Default for RrtParams {
             range: 1.0,
             max_samples: 100_000,
             shortcut_attempts: 100,
+            shortcut_resolution: None,
         }
     }
 }
@@ -264,6 +271,15 @@ impl RrtParams {
             PlanField::ShortcutAttempts,
             self.shortcut_attempts as f64,
             "must be <= 1e6",
-        )
+        )?;
+        match self.shortcut_resolution {
+            Some(r) => require(
+                r.is_finite() && r > 0.0 && r <= 1.0,
+                PlanField::ShortcutResolution,
+                r,
+                "must be in (0, 1]",
+            ),
+            None => Ok(()),
+        }
     }
 }

@@ -1,12 +1,16 @@
 //! RRT-Connect (Kuffner & LaValle 2000) in joint space, with shortcutting
 //! and resampling for STOMP's initial trajectory.
 
+use std::time::Instant;
+
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
 use super::RrtParams;
 use super::clock::{Clock, Interrupt};
 use super::costs::{interior_valid, resolution_of};
+use super::error::{PlanError, PlanField, check_vector};
+use super::kd_index::KdIndex;
 use super::noise::stream;
 use crate::collision::StateChecker;
 use crate::robot::{Chain, JointKind};
@@ -35,14 +39,20 @@ pub struct RrtOutcome {
     pub samples: usize,
     /// Nodes in both trees.
     pub nodes: usize,
+    /// Wall time of the search (straight-line test and tree growth), ns.
+    pub search_ns: u64,
+    /// Wall time of the shortcutting after a connection, ns (0 otherwise).
+    pub shortcut_ns: u64,
 }
 
 /// A tree of joint states: flat row-major storage and parent indices, so
-/// an extension appends to two `Vec`s and allocates nothing else.
+/// an extension appends to a few `Vec`s and allocates nothing else; nearest
+/// neighbours come from a [`KdIndex`] over the rows.
 struct Tree {
     q: Vec<f64>,
     parent: Vec<u32>,
     dof: usize,
+    index: KdIndex,
 }
 
 enum Extend {
@@ -55,10 +65,13 @@ impl Tree {
     fn new(root: &[f64], capacity: usize) -> Self {
         let mut q = Vec::with_capacity(capacity * root.len());
         q.extend_from_slice(root);
+        let mut index = KdIndex::with_capacity(capacity);
+        index.insert(&q, root.len());
         Self {
             q,
             parent: vec![u32::MAX],
             dof: root.len(),
+            index,
         }
     }
     fn len(&self) -> usize {
@@ -67,26 +80,16 @@ impl Tree {
     fn node(&self, i: usize) -> &[f64] {
         &self.q[i * self.dof..(i + 1) * self.dof]
     }
-    /// Nearest node by Euclidean joint distance: a linear scan over the flat
-    /// array with early exit on partial sums (trees stay small when the
-    /// answer is fast; the scan is cache-friendly and allocation-free).
-    fn nearest(&self, target: &[f64]) -> usize {
-        let mut best = 0;
-        let mut best_d = f64::INFINITY;
-        for (i, row) in self.q.chunks_exact(self.dof).enumerate() {
-            let mut d = 0.0;
-            for (a, b) in row.iter().zip(target) {
-                d += (a - b) * (a - b);
-                if d >= best_d {
-                    break;
-                }
-            }
-            if d < best_d {
-                best_d = d;
-                best = i;
-            }
-        }
-        best
+    fn push(&mut self, q: &[f64], parent: usize) -> usize {
+        self.q.extend_from_slice(q);
+        self.parent.push(parent as u32);
+        self.index.insert(&self.q, self.dof);
+        self.len() - 1
+    }
+    /// Nearest node by Euclidean joint distance (the first of equals, as a
+    /// linear scan would answer).
+    fn nearest(&mut self, target: &[f64]) -> usize {
+        self.index.nearest(&self.q, self.dof, target).unwrap_or(0)
     }
 }
 
@@ -129,9 +132,7 @@ impl<C: StateChecker + ?Sized> Search<'_, C> {
         {
             return Extend::Trapped;
         }
-        tree.q.extend_from_slice(&self.q_new);
-        tree.parent.push(near as u32);
-        let i = tree.len() - 1;
+        let i = tree.push(&self.q_new, near);
         if reached {
             Extend::Reached(i)
         } else {
@@ -172,6 +173,44 @@ pub(crate) fn sampling_bounds(chain: &Chain) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// RRT-Connect alone, as [`plan`](super::plan) runs it for
+/// `Algorithm::RrtConnect` but without the start/goal validity test, the
+/// re-check, the time parameterisation and the scoring — for benchmarks that
+/// time the search ([`RrtOutcome::search_ns`]) and the shortcutting
+/// ([`RrtOutcome::shortcut_ns`]) apart. `start` and `goal` should be valid
+/// states (the search assumes it); lengths and parameters are validated.
+pub fn rrt_connect<C: StateChecker + ?Sized>(
+    chain: &Chain,
+    checker: &C,
+    start: &[f64],
+    goal: &[f64],
+    params: &RrtParams,
+    seed: u64,
+    deadline: Option<Instant>,
+) -> Result<RrtOutcome, PlanError> {
+    let dof = chain.dof();
+    if dof == 0 {
+        return Err(PlanError::EmptyChain);
+    }
+    if checker.dof() != dof {
+        return Err(PlanError::CheckerDof {
+            chain: dof,
+            checker: checker.dof(),
+        });
+    }
+    check_vector(PlanField::Start, start, dof)?;
+    check_vector(PlanField::GoalJoints, goal, dof)?;
+    params.validate()?;
+    let clock = Clock {
+        start: Instant::now(),
+        deadline,
+        should_stop: &|| false,
+    };
+    Ok(rrt_connect_path(
+        chain, checker, start, goal, params, seed, &clock,
+    ))
+}
+
 /// RRT-Connect between two valid states, then shortcut.
 ///
 /// Trees grow from start and goal; each sample `q_rand` (uniform in the
@@ -207,17 +246,20 @@ pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
     let mut q_rand = vec![0.0; dof];
     let mut target = vec![0.0; dof];
     let mut samples = 0;
-    let outcome = |stop, path, a: &Tree, b: &Tree, samples| RrtOutcome {
+    let t0 = Instant::now();
+    let outcome = |stop, path, a: &Tree, b: &Tree, samples, shortcut_ns| RrtOutcome {
         path,
         stop,
         samples,
         nodes: a.len() + b.len(),
+        search_ns: (t0.elapsed().as_nanos() as u64).saturating_sub(shortcut_ns),
+        shortcut_ns,
     };
     // The straight motion first: free problems need no tree.
     if interior_valid(checker, start, goal, search.resolution, &mut search.buf, clock) == Some(true) {
         let mut path = start.to_vec();
         path.extend_from_slice(goal);
-        return outcome(RrtStop::Connected, path, &a, &b, 0);
+        return outcome(RrtStop::Connected, path, &a, &b, 0, 0);
     }
     while samples < params.max_samples {
         if let Some(i) = clock.interrupted() {
@@ -225,7 +267,7 @@ pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
                 Interrupt::Deadline => RrtStop::Deadline,
                 Interrupt::Cancelled => RrtStop::Cancelled,
             };
-            return outcome(stop, Vec::new(), &a, &b, samples);
+            return outcome(stop, Vec::new(), &a, &b, samples, 0);
         }
         samples += 1;
         for (v, &(lo, hi)) in q_rand.iter_mut().zip(&bounds) {
@@ -265,7 +307,10 @@ pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
                 path[..dof].copy_from_slice(start);
                 let last = path.len() - dof;
                 path[last..].copy_from_slice(goal);
-                let res = search.resolution;
+                let res = params
+                    .shortcut_resolution
+                    .map_or(search.resolution, |r| r.min(search.resolution));
+                let t1 = Instant::now();
                 shortcut(
                     checker,
                     &mut path,
@@ -275,13 +320,14 @@ pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
                     &mut rng,
                     clock,
                 );
-                return outcome(RrtStop::Connected, path, &a, &b, samples);
+                let shortcut_ns = t1.elapsed().as_nanos() as u64;
+                return outcome(RrtStop::Connected, path, &a, &b, samples, shortcut_ns);
             }
         }
         std::mem::swap(&mut a, &mut b);
         a_is_start = !a_is_start;
     }
-    outcome(RrtStop::SampleBudget, Vec::new(), &a, &b, samples)
+    outcome(RrtStop::SampleBudget, Vec::new(), &a, &b, samples, 0)
 }
 
 fn dist(a: &[f64], b: &[f64]) -> f64 {

@@ -480,3 +480,32 @@ fn ccstomp_from_the_cartesian_line_stays_on_it() {
             .all(|d| d.translation <= 0.02 && d.rotation <= 0.02)
     );
 }
+
+#[test]
+fn a_shortcut_resolution_outside_zero_to_one_is_an_error_naming_it() {
+    let chain = planar3();
+    let w = PlanarWorld::planar3_blocked();
+    for bad in [0.0, -0.01, 1.5, f64::NAN, f64::INFINITY] {
+        let mut req = blocked_request(Algorithm::RrtConnect);
+        req.rrt.shortcut_resolution = Some(bad);
+        let e = plan(&chain, &w, &req, PlanControl::default()).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                PlanError::InvalidParam {
+                    field: PlanField::ShortcutResolution,
+                    ..
+                }
+            ),
+            "{bad}: {e}"
+        );
+        assert!(e.to_string().contains("rrt.shortcut_resolution"), "{e}");
+    }
+    // A finer shortcut check still returns a valid path with the same ends.
+    let mut req = blocked_request(Algorithm::RrtConnect);
+    req.rrt.shortcut_resolution = Some(0.01);
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert_eq!(r.status, PlanStatus::Succeeded);
+    assert!(r.valid);
+    assert_eq!(&r.q[..3], &req.start[..]);
+}

@@ -237,6 +237,8 @@ fn plan_field(field: PlanField) -> &'static str {
         PlanField::RrtRange => "options.rrt_connect.range",
         PlanField::RrtMaxSamples => "options.rrt_connect.max_samples",
         PlanField::ShortcutAttempts => "options.rrt_connect.shortcut_attempts",
+        // not exposed in the proto; named as the core names it
+        PlanField::ShortcutResolution => "rrt.shortcut_resolution",
         PlanField::VelocityLimits => "options.timing.max_velocity",
         PlanField::AccelerationLimits => "options.timing.max_acceleration",
         PlanField::VelocityScale => "options.timing.velocity_scale",
