@@ -99,6 +99,8 @@ impl Compute {
             .thread_name(|i| format!("kinplan-cpu-{i}"))
             // Explicit, so recursion depth never depends on the platform default.
             .stack_size(CPU_STACK_BYTES)
+            // below the runtime's threads: admission and health stay prompt when every core computes
+            .start_handler(|_| super::priority::lower_this_thread())
             .build()
             .expect("the CPU pool starts");
         let limit = concurrency.max(1);

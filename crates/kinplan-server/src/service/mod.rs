@@ -21,6 +21,7 @@ mod mobile;
 mod models;
 mod planning;
 mod planning_convert;
+mod priority;
 mod robot;
 mod scene;
 mod scoring;
