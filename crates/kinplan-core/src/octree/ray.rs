@@ -153,22 +153,41 @@ impl Octree {
         for v in dir.iter_mut() {
             *v /= length;
         }
-        let mut dda = Dda::new(&ko, origin, &dir, self.resolution, true);
-        let mut k = ko;
+        let dda = Dda::new(&ko, origin, &dir, self.resolution, true);
         let length = length as f64;
+        // the DDA state in scalar locals (registers): an array indexed by the axis made
+        // each step wait on a partial store-to-load forward of the key
+        let [mut kx, mut ky, mut kz] = ko;
+        let [mut tx, mut ty, mut tz] = dda.t_max;
+        let [dx, dy, dz] = dda.t_delta;
+        let [sx, sy, sz] = dda.step.map(|s| s as u16); // ±1 as a wrapping u16 step
         // a beam between two keys in the cube crosses at most 3 · 65536 borders
         for _ in 0..3 * 65536 {
-            let a = dda.axis();
-            k[a] = (k[a] as i32 + dda.step[a]) as u16;
-            dda.t_max[a] += dda.t_delta[a];
-            if k == ke {
+            // axis of the smallest t_max, ties as in `Dda::axis`
+            if tx < ty {
+                if tx < tz {
+                    kx = kx.wrapping_add(sx);
+                    tx += dx;
+                } else {
+                    kz = kz.wrapping_add(sz);
+                    tz += dz;
+                }
+            } else if ty < tz {
+                ky = ky.wrapping_add(sy);
+                ty += dy;
+            } else {
+                kz = kz.wrapping_add(sz);
+                tz += dz;
+            }
+            if kx == ke[0] && ky == ke[1] && kz == ke[2] {
                 break;
             }
-            let dist = dda.t_max[0].min(dda.t_max[1]).min(dda.t_max[2]);
+            let m = if tx < ty { tx } else { ty };
+            let dist = if m < tz { m } else { tz };
             if dist > length {
                 break;
             }
-            visit(&k);
+            visit(&[kx, ky, kz]);
         }
         true
     }
