@@ -150,3 +150,41 @@ fn counts_on_trees_with_no_nodes_one_leaf_and_axis_aligned_views() {
     assert_eq!(KnownCellCounts::new(&empty).root(), 0);
     assert_eq!(KnownCellCounts::new(&one).root(), 1);
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Frontier cells against a test of every free cell of the region with its 26
+    /// neighbours looked up one by one.
+    #[test]
+    fn frontier_cells_equal_a_scan_of_every_free_cell(seed in 0u64..1_000_000, ratio in 0.01f64..0.9) {
+        let t = random_tree(seed);
+        let (min, max) = (Point3::new(-1.2, -1.5, -1.0), Point3::new(1.4, 1.1, 1.3));
+        let got = frontier_cells(&t, &min, &max, ratio, &|| false).unwrap();
+        let (lo, hi) = (t.key_of(&min).unwrap(), t.key_of(&max).unwrap());
+        let mut want = Vec::new();
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    if t.state_of_key(&[x, y, z]) != CellState::Free {
+                        continue;
+                    }
+                    let mut unknown = 0;
+                    for d in 0..27 {
+                        let o = [d % 3, d / 3 % 3, d / 9].map(|v: i32| v - 1);
+                        if o == [0, 0, 0] {
+                            continue;
+                        }
+                        let nb = [x as i32 + o[0], y as i32 + o[1], z as i32 + o[2]].map(|v| v as u16);
+                        unknown += (t.state_of_key(&nb) == CellState::Unknown) as usize;
+                    }
+                    if unknown > 0 && unknown as f64 / 26.0 >= ratio {
+                        want.push(([x, y, z], unknown as f64 / 26.0));
+                    }
+                }
+            }
+        }
+        let got: Vec<(OcKey, f64)> = got.iter().map(|f| (f.key, f.unknown_ratio)).collect();
+        prop_assert_eq!(got, want);
+    }
+}
