@@ -217,7 +217,8 @@ impl RowCounter<'_> {
     /// every plane in `mask`. Along a row (axis a, the others fixed) plane j is crossed
     /// at the real key `κ = K0 + Kb·k_b + Kc·k_c` (`n·c + d = 0` solved for the key with
     /// `c = (k − 32768 + ½)·res`); when `κ` is more than `tol` away from an integer its
-    /// floor settles the row without any per-cell test, else the per-cell test decides.
+    /// floor settles the row without any per-cell test (`κ` clamped to the row's range
+    /// ± 1), else the per-cell tests decide the row.
     fn count(&self, key: &OcKey, side: u32, mask: u8) -> u64 {
         let r: [(i64, i64); 3] = [0, 1, 2].map(|i| {
             (
@@ -271,46 +272,33 @@ impl RowCounter<'_> {
             k[c] = kc;
             for kb in r[b].0..=r[b].1 {
                 k[b] = kb;
+                // fast path: the floors of the crossings; a crossing within `tol` of an
+                // integer (rare) sends the row to the per-cell tests instead
                 let (mut first_in, mut last_in) = (alo, ahi);
-                for &(j, k0, cb, cc, tol, up) in lin[..nl].iter().flatten() {
-                    if first_in > last_in {
-                        break;
-                    }
+                let mut near = false;
+                let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
+                for &(_, k0, cb, cc, tol, up) in lin[..nl].iter().flatten() {
                     let kr = k0 + cb * kb as f64 + cc * kc as f64;
+                    let fl = floor_i64(kr.clamp(lo_f, hi_f));
+                    let frac = kr - fl as f64;
+                    near |= kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol);
                     if up {
-                        // inside for keys ≥ the crossing
-                        if kr <= alo as f64 - 0.5 {
-                            continue;
-                        }
-                        if kr > ahi as f64 + 0.5 {
-                            first_in = ahi + 1;
-                            continue;
-                        }
-                        let fl = floor_i64(kr);
-                        let frac = kr - fl as f64;
-                        let f = if frac > tol && frac < 1.0 - tol {
-                            fl + 1
-                        } else {
-                            self.first_inside(j, k, a, (fl + 1).clamp(alo, ahi + 1), alo, ahi)
-                        };
-                        first_in = first_in.max(f);
+                        first_in = first_in.max(fl + 1);
                     } else {
-                        // inside for keys ≤ the crossing
-                        if kr >= ahi as f64 + 0.5 {
-                            continue;
+                        last_in = last_in.min(fl);
+                    }
+                }
+                if near {
+                    (first_in, last_in) = (alo, ahi);
+                    for &(j, _, _, _, _, up) in lin[..nl].iter().flatten() {
+                        if first_in > last_in {
+                            break;
                         }
-                        if kr < alo as f64 - 0.5 {
-                            last_in = alo - 1;
-                            continue;
-                        }
-                        let fl = floor_i64(kr);
-                        let frac = kr - fl as f64;
-                        let l = if frac > tol && frac < 1.0 - tol {
-                            fl
+                        if up {
+                            first_in = first_in.max(self.first_inside(j, k, a, alo, alo, ahi));
                         } else {
-                            self.last_inside(j, k, a, fl.clamp(alo - 1, ahi), alo, ahi)
-                        };
-                        last_in = last_in.min(l);
+                            last_in = last_in.min(self.last_inside(j, k, a, ahi, alo, ahi));
+                        }
                     }
                 }
                 for &j in &exact[..ne] {
