@@ -268,6 +268,35 @@ impl RowCounter<'_> {
         }
         let mut total = 0u64;
         let mut k = [0i64; 3];
+        if nl == 1
+            && ne == 0
+            && let Some((j, k0, cb, cc, tol, up)) = lin[0]
+        {
+            // the common case, one cutting plane: the same rule in a tight loop
+            let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
+            for kc in r[c].0..=r[c].1 {
+                k[c] = kc;
+                for kb in r[b].0..=r[b].1 {
+                    let kr = k0 + cb * kb as f64 + cc * kc as f64;
+                    let fl = floor_i64(kr.clamp(lo_f, hi_f));
+                    let frac = kr - fl as f64;
+                    let n = if kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol) {
+                        k[b] = kb;
+                        if up {
+                            ahi - self.first_inside(j, k, a, alo, alo, ahi) + 1
+                        } else {
+                            self.last_inside(j, k, a, ahi, alo, ahi) - alo + 1
+                        }
+                    } else if up {
+                        ahi - (fl + 1).max(alo) + 1
+                    } else {
+                        fl.min(ahi) - alo + 1
+                    };
+                    total += n.max(0) as u64;
+                }
+            }
+            return total;
+        }
         for kc in r[c].0..=r[c].1 {
             k[c] = kc;
             for kb in r[b].0..=r[b].1 {
