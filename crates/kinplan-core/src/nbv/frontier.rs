@@ -46,8 +46,38 @@ pub fn frontier_cells(
     let stopped = AtomicBool::new(false);
     // one cell of the free cube [base, base + n): neighbours inside the cube are known
     // (free) without a lookup; the lookups stop once too many are known to qualify
-    let test = |k: OcKey, base: &OcKey, n: u32, cache: &mut SearchCache| -> Option<Frontier> {
+    // `sure`: bit `r0 + 3·r1 + 9·r2` set when the region r (0 below, 1 inside, 2 above the
+    // cube along each axis) is known throughout — the cube itself, or a same-size
+    // neighbour cube that is one leaf
+    let region = |v: i32, b: u16, n: u32| -> usize {
+        if v < b as i32 {
+            0
+        } else if v >= b as i32 + n as i32 {
+            2
+        } else {
+            1
+        }
+    };
+    let test = |k: OcKey, base: &OcKey, n: u32, sure: u32, cache: &mut SearchCache| -> Option<Frontier> {
         if (0..3).any(|i| k[i] < kmin[i] || k[i] > kmax[i]) {
+            return None;
+        }
+        let cell = |o: [i32; 3]| {
+            let nb = [0, 1, 2].map(|i| k[i] as i32 + o[i]);
+            let inside = nb.iter().all(|v| (0..65536).contains(v));
+            let r = region(nb[0], base[0], n) + 3 * region(nb[1], base[1], n) + 9 * region(nb[2], base[2], n);
+            (nb, inside, sure & (1 << r) != 0)
+        };
+        // neighbours that may be unknown: too few, and the cell cannot qualify
+        let mut possible = 0usize;
+        for d in 0..27 {
+            let o = [d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1];
+            if d != 13 {
+                let (_, inside, known) = cell(o);
+                possible += (inside && !known) as usize;
+            }
+        }
+        if possible < need {
             return None;
         }
         let mut unknown = 0usize;
@@ -62,10 +92,9 @@ pub fn frontier_cells(
                     if nb.iter().any(|v| !(0..65536).contains(v)) {
                         continue;
                     }
-                    let in_cube =
-                        (0..3).all(|i| nb[i] >= base[i] as i32 && nb[i] < base[i] as i32 + n as i32);
+                    let (_, _, sure_known) = cell([dx, dy, dz]);
                     let nb = [nb[0] as u16, nb[1] as u16, nb[2] as u16];
-                    if in_cube || tree.search_key_cached(&nb, cache).is_some() {
+                    if sure_known || tree.search_key_cached(&nb, cache).is_some() {
                         known += 1;
                         if known + need > 26 {
                             return None;
@@ -95,13 +124,29 @@ pub fn frontier_cells(
         if (0..3).any(|i| lo[i] > hi[i] || base[i] as u32 > kmax[i] as u32) {
             return;
         }
+        let mut sure = 1u32 << 13;
+        if n > 1 {
+            for r in 0..27u32 {
+                let o = [r % 3, r / 3 % 3, r / 9].map(|v| v as i64 - 1);
+                let nb = [0, 1, 2].map(|i| base[i] as i64 + o[i] * n as i64);
+                if r != 13 && nb.iter().all(|v| (0..65536).contains(v)) {
+                    let key = nb.map(|v| v as u16);
+                    if one_leaf(tree, &key, depth) {
+                        sure |= 1 << r;
+                    }
+                }
+            }
+            if sure == (1 << 27) - 1 {
+                return; // every cell around the cube is known: no frontier on it
+            }
+        }
         for dz in lo[2]..=hi[2] {
             for dy in lo[1]..=hi[1] {
                 let surface_yz = dz == 0 || dz == n - 1 || dy == 0 || dy == n - 1;
                 let mut visit = |dx: u32, out: &mut Vec<Frontier>| {
                     *polled += 1;
                     let k = [base[0] + dx as u16, base[1] + dy as u16, base[2] + dz as u16];
-                    out.extend(test(k, &base, n, cache));
+                    out.extend(test(k, &base, n, sure, cache));
                     if polled.is_multiple_of(256) && should_stop() {
                         stopped.store(true, Ordering::Relaxed);
                     }
@@ -144,6 +189,24 @@ pub fn frontier_cells(
     let mut out: Vec<Frontier> = parts.into_iter().flatten().collect();
     out.sort_by_key(|f| (f.key[2], f.key[1], f.key[0]));
     Ok(out)
+}
+
+/// True when the depth-`depth` cube with smallest key `key` lies inside one leaf (a
+/// known node without children at that depth or above).
+fn one_leaf(tree: &Octree, key: &OcKey, depth: u8) -> bool {
+    let Some(mut n) = tree.root_ref() else {
+        return false;
+    };
+    for d in 0..depth {
+        if !tree.has_children(n) {
+            return true;
+        }
+        match tree.child_ref(n, crate::octree::child_index(key, d)) {
+            Some(c) => n = c,
+            None => return false,
+        }
+    }
+    !tree.has_children(n)
 }
 
 /// Potential field at `p` (S0 eq. 4.1): `F = Σ F_p − Σ F_o` over the space within
