@@ -3,7 +3,7 @@
 //! and the exact frustum count on the resulting tree. Seeded, deterministic.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use kinplan_core::nbv::{CameraModel, Frustum, frustum_unknown_count, look_along};
+use kinplan_core::nbv::{CameraModel, Frustum, FrustumCounter, frustum_unknown_count, look_along};
 use kinplan_core::octree::{Octree, OctreeLimits, RayParams, ScanParams};
 use nalgebra::{Point3, Vector3};
 
@@ -45,7 +45,10 @@ fn bench(c: &mut Criterion) {
     let cam = CameraModel::default();
     let pose = look_along(&Point3::new(0.0, -1.0, 1.2), &Vector3::new(0.3, 1.0, -0.1)).unwrap();
     let f = Frustum::new(&cam, &pose);
-    c.bench_function("nbv/frustum_unknown_count_5cm", |b| {
+    // per view with the tree's known-cell counts built once, and the one-off build
+    let counter = FrustumCounter::new(&t);
+    c.bench_function("nbv/frustum_count_per_view_5cm", |b| b.iter(|| counter.count(&f)));
+    c.bench_function("nbv/frustum_count_with_build_5cm", |b| {
         b.iter(|| frustum_unknown_count(&t, &f))
     });
 }

@@ -8,8 +8,8 @@
 use std::time::Instant;
 
 use kinplan_core::nbv::{
-    CameraModel, Frustum, GainMethod, GainWorkspace, NbvParams, frustum_unknown_count, look_along,
-    next_best_view, ray_gain,
+    CameraModel, Frustum, FrustumCounter, GainMethod, GainWorkspace, NbvParams, look_along, next_best_view,
+    ray_gain,
 };
 use kinplan_core::octree::{CellState, Octree, OctreeLimits, ScanParams};
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -54,16 +54,21 @@ fn views(t: &Octree, lo: [f64; 3], hi: [f64; 3], seed: u64) -> Vec<Isometry3<f64
     out
 }
 
-fn row(name: &str, t: &Octree, vs: &[Isometry3<f64>], cam: &CameraModel) {
+fn row(name: &str, t: &Octree, vs: &[Isometry3<f64>], cam: &CameraModel, no_rays: bool) {
     let mut ws = GainWorkspace::default();
     let mut sums = [0.0f64; 5];
     let mut times = [0.0f64; 5];
     let mut steps = 0u64;
+    // the tree's known-cell counts, built once per tree (reported beside the row)
+    let s = Instant::now();
+    let counter = FrustumCounter::new(t);
+    let build_ms = s.elapsed().as_secs_f64() * 1e3;
     for pose in vs {
         let s = Instant::now();
-        sums[0] += frustum_unknown_count(t, &Frustum::new(cam, pose)) as f64;
+        sums[0] += counter.count(&Frustum::new(cam, pose)) as f64;
         times[0] += s.elapsed().as_secs_f64();
-        for (i, f) in [1.0, 0.5, 0.25, 0.1].into_iter().enumerate() {
+        let fractions: &[f64] = if no_rays { &[] } else { &[1.0, 0.5, 0.25, 0.1] };
+        for (i, &f) in fractions.iter().enumerate() {
             let s = Instant::now();
             let g = ray_gain(t, cam, pose, GainMethod::Rays { fraction: f }, &mut ws, &|| false);
             times[i + 1] += s.elapsed().as_secs_f64();
@@ -76,7 +81,7 @@ fn row(name: &str, t: &Octree, vs: &[Isometry3<f64>], cam: &CameraModel) {
     let n = vs.len() as f64;
     let pct = |i: usize| 100.0 * sums[i] / sums[1];
     println!(
-        "| {name} | {:.1} % | {:.2} % | {:.2} % | {:.2} % | {:.0} | {:.2} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
+        "| {name} | {:.1} % | {:.2} % | {:.2} % | {:.2} % | {:.0} | {:.3} ({build_ms:.2} build) | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
         pct(0),
         pct(2),
         pct(3),
@@ -92,6 +97,10 @@ fn row(name: &str, t: &Octree, vs: &[Isometry3<f64>], cam: &CameraModel) {
 }
 
 fn main() {
+    // --no-rays: intersection column only (ray columns print NaN); --nbv-only: skip Tab. 5.1
+    let args: Vec<String> = std::env::args().collect();
+    let no_rays = args.iter().any(|a| a == "--no-rays");
+    let nbv_only = args.iter().any(|a| a == "--nbv-only");
     let cam = CameraModel::default();
     println!(
         "camera: Kinect v2 model, {}x{} rays, fov {:.1}°x{:.1}°, range {}–{} m; {VIEWS} seeded views per row; rayon threads {}",
@@ -103,30 +112,33 @@ fn main() {
         cam.far,
         rayon::current_num_threads()
     );
-    println!();
-    println!(
-        "| scene @ res | intersection | 50 % rays | 25 % rays | 10 % rays | cells by 100 % rays (mean) | ms/view intersection | 100 % | 50 % | 25 % | 10 % | M steps/s (100 % rays, 1 thread) |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for res in [0.05, 0.075, 0.1, 0.125, 0.15] {
-        let t = room_tree(res);
-        let vs = views(&t, [-2.5, -2.0, 0.4], [2.5, 2.0, 2.6], 11);
-        row(
-            &format!("room @ {res} m ({} nodes)", t.num_nodes()),
-            &t,
-            &vs,
-            &cam,
+    if !nbv_only {
+        println!();
+        println!(
+            "| scene @ res | intersection | 50 % rays | 25 % rays | 10 % rays | cells by 100 % rays (mean) | ms/view intersection (ms to build the counts once per tree) | 100 % | 50 % | 25 % | 10 % | M steps/s (100 % rays, 1 thread) |"
         );
-    }
-    let geb = "/usr/share/doc/liboctomap-dev/examples/data/geb079.bt";
-    match std::fs::read(geb) {
-        Ok(b) => {
-            let t = Octree::read_bt(&b, &OctreeLimits::default()).unwrap();
-            let (lo, hi) = t.known_bounds().unwrap();
-            let vs = views(&t, lo.coords.into(), hi.coords.into(), 12);
-            row("geb079 @ 0.08 m", &t, &vs, &cam);
+        println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+        for res in [0.05, 0.075, 0.1, 0.125, 0.15] {
+            let t = room_tree(res);
+            let vs = views(&t, [-2.5, -2.0, 0.4], [2.5, 2.0, 2.6], 11);
+            row(
+                &format!("room @ {res} m ({} nodes)", t.num_nodes()),
+                &t,
+                &vs,
+                &cam,
+                no_rays,
+            );
         }
-        Err(_) => println!("| geb079 | SKIPPED: {geb} not present | | | | | | | | | | |"),
+        let geb = "/usr/share/doc/liboctomap-dev/examples/data/geb079.bt";
+        match std::fs::read(geb) {
+            Ok(b) => {
+                let t = Octree::read_bt(&b, &OctreeLimits::default()).unwrap();
+                let (lo, hi) = t.known_bounds().unwrap();
+                let vs = views(&t, lo.coords.into(), hi.coords.into(), 12);
+                row("geb079 @ 0.08 m", &t, &vs, &cam, no_rays);
+            }
+            Err(_) => println!("| geb079 | SKIPPED: {geb} not present | | | | | | | | | | |"),
+        }
     }
 
     // NBV end to end at 5 cm
@@ -163,6 +175,9 @@ fn main() {
         ),
     ];
     for (name, p) in cfgs {
+        if no_rays && !matches!(p.gain, GainMethod::Intersection) {
+            continue;
+        }
         let s = Instant::now();
         let r = next_best_view(&t, &p, &cam, &current, Some(&chain), &|| false).unwrap();
         let total = s.elapsed().as_secs_f64() * 1e3;

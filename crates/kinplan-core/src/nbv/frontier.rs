@@ -1,7 +1,10 @@
 //! Candidate views from frontier cells and the potential field (ALGORITHMS.md §5
 //! step 1, S0 §4.1 eq. 4.1).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use nalgebra::{Isometry3, Point3, Vector3};
+use rayon::prelude::*;
 
 use super::camera::look_along;
 use crate::octree::{CellState, OcKey, Octree, SearchCache, StateFilter, TREE_DEPTH};
@@ -19,7 +22,8 @@ pub struct Frontier {
 /// Frontier cells inside the box `[min, max]` (m): free depth-16 cells (including the
 /// surface cells of pruned free cubes) whose 26 neighbours are unknown in a share of at
 /// least `min_unknown_ratio`. Sorted by key (x fastest) so the result is deterministic.
-/// `should_stop` is polled every 256 cells; the cells found so far are returned.
+/// Cubes are scanned in parallel chunks (rayon); `should_stop` is polled every 256
+/// cells of a chunk; the cells found so far are returned.
 pub fn frontier_cells(
     tree: &Octree,
     min: &Point3<f64>,
@@ -35,69 +39,129 @@ pub fn frontier_cells(
     };
     tree.for_each_in_box(min, max, TREE_DEPTH, free, |c| cubes.push((c.key, c.depth)))?;
     let (kmin, kmax) = (tree.key_of(min)?, tree.key_of(max)?);
-    let mut out = Vec::new();
-    let mut polled = 0usize;
-    let test = |k: OcKey, out: &mut Vec<Frontier>| {
-        if (0..3).any(|i| k[i] < kmin[i] || k[i] > kmax[i]) {
-            return;
+    // unknown neighbours needed: the least u with u/26 ≥ the ratio (same test as below)
+    let need = (1..=26usize)
+        .find(|&u| u as f64 / 26.0 >= min_unknown_ratio)
+        .unwrap_or(27);
+    let stopped = AtomicBool::new(false);
+    // one cell of the free cube [base, base + n): neighbours inside the cube are known
+    // (free) without a lookup; the lookups stop once too many are known to qualify
+    // `sure`: bit `r0 + 3·r1 + 9·r2` set when the region r (0 below, 1 inside, 2 above the
+    // cube along each axis) is known throughout — the cube itself, or a same-size
+    // neighbour cube that is one leaf
+    let region = |v: i32, b: u16, n: u32| -> usize {
+        if v < b as i32 {
+            0
+        } else if v >= b as i32 + n as i32 {
+            2
+        } else {
+            1
         }
-        // the 26 neighbours, looked up through one path cache (no allocation)
-        let mut cache = SearchCache::default();
+    };
+    let test = |k: OcKey, base: &OcKey, n: u32, sure: u32, cache: &mut SearchCache| -> Option<Frontier> {
+        if (0..3).any(|i| k[i] < kmin[i] || k[i] > kmax[i]) {
+            return None;
+        }
+        let cell = |o: [i32; 3]| {
+            let nb = [0, 1, 2].map(|i| k[i] as i32 + o[i]);
+            let inside = nb.iter().all(|v| (0..65536).contains(v));
+            let r = region(nb[0], base[0], n) + 3 * region(nb[1], base[1], n) + 9 * region(nb[2], base[2], n);
+            (nb, inside, sure & (1 << r) != 0)
+        };
+        // neighbours that may be unknown: too few, and the cell cannot qualify
+        let mut possible = 0usize;
+        for d in 0..27 {
+            let o = [d % 3 - 1, d / 3 % 3 - 1, d / 9 - 1];
+            if d != 13 {
+                let (_, inside, known) = cell(o);
+                possible += (inside && !known) as usize;
+            }
+        }
+        if possible < need {
+            return None;
+        }
         let mut unknown = 0usize;
+        let mut known = 0usize;
         for dz in -1..=1i32 {
             for dy in -1..=1i32 {
                 for dx in -1..=1i32 {
                     if dx == 0 && dy == 0 && dz == 0 {
                         continue;
                     }
-                    let n = [k[0] as i32 + dx, k[1] as i32 + dy, k[2] as i32 + dz];
-                    if n.iter().any(|v| !(0..65536).contains(v)) {
+                    let nb = [k[0] as i32 + dx, k[1] as i32 + dy, k[2] as i32 + dz];
+                    if nb.iter().any(|v| !(0..65536).contains(v)) {
                         continue;
                     }
-                    let n = [n[0] as u16, n[1] as u16, n[2] as u16];
-                    if tree.search_key_cached(&n, &mut cache).is_none() {
+                    let (_, _, sure_known) = cell([dx, dy, dz]);
+                    let nb = [nb[0] as u16, nb[1] as u16, nb[2] as u16];
+                    if sure_known || tree.search_key_cached(&nb, cache).is_some() {
+                        known += 1;
+                        if known + need > 26 {
+                            return None;
+                        }
+                    } else {
                         unknown += 1;
                     }
                 }
             }
         }
         let ratio = unknown as f64 / 26.0;
-        if unknown > 0 && ratio >= min_unknown_ratio {
-            out.push(Frontier {
-                key: k,
-                center: tree.key_center(&k, TREE_DEPTH),
-                unknown_ratio: ratio,
-            });
-        }
+        (unknown > 0 && ratio >= min_unknown_ratio).then(|| Frontier {
+            key: k,
+            center: tree.key_center(&k, TREE_DEPTH),
+            unknown_ratio: ratio,
+        })
     };
-    'cubes: for (base, depth) in cubes {
+    // the surface cells of each free cube (only they can border anything but the cube),
+    // clipped to the region's keys; cubes in parallel chunks, results in cube order
+    let scan_cube = |&(base, depth): &(OcKey, u8),
+                     out: &mut Vec<Frontier>,
+                     cache: &mut SearchCache,
+                     polled: &mut usize| {
         let n = 1u32 << (TREE_DEPTH - depth);
-        // offsets of the cube clipped to the region's keys
         let lo = [0, 1, 2].map(|i| (kmin[i] as u32).saturating_sub(base[i] as u32));
         let hi = [0, 1, 2].map(|i| (n - 1).min((kmax[i] as u32).saturating_sub(base[i] as u32)));
         if (0..3).any(|i| lo[i] > hi[i] || base[i] as u32 > kmax[i] as u32) {
-            continue;
+            return;
         }
-        // only cells on the cube's surface can border anything but the cube itself
+        let mut sure = 1u32 << 13;
+        if n > 1 {
+            for r in 0..27u32 {
+                let o = [r % 3, r / 3 % 3, r / 9].map(|v| v as i64 - 1);
+                let nb = [0, 1, 2].map(|i| base[i] as i64 + o[i] * n as i64);
+                if r != 13 && nb.iter().all(|v| (0..65536).contains(v)) {
+                    let key = nb.map(|v| v as u16);
+                    if one_leaf(tree, &key, depth) {
+                        sure |= 1 << r;
+                    }
+                }
+            }
+            if sure == (1 << 27) - 1 {
+                return; // every cell around the cube is known: no frontier on it
+            }
+        }
         for dz in lo[2]..=hi[2] {
             for dy in lo[1]..=hi[1] {
                 let surface_yz = dz == 0 || dz == n - 1 || dy == 0 || dy == n - 1;
                 let mut visit = |dx: u32, out: &mut Vec<Frontier>| {
-                    polled += 1;
+                    *polled += 1;
                     let k = [base[0] + dx as u16, base[1] + dy as u16, base[2] + dz as u16];
-                    test(k, out);
-                    polled.is_multiple_of(256) && should_stop()
+                    out.extend(test(k, &base, n, sure, cache));
+                    if polled.is_multiple_of(256) && should_stop() {
+                        stopped.store(true, Ordering::Relaxed);
+                    }
+                    stopped.load(Ordering::Relaxed)
                 };
                 if surface_yz {
                     for dx in lo[0]..=hi[0] {
-                        if visit(dx, &mut out) {
-                            break 'cubes;
+                        if visit(dx, out) {
+                            return;
                         }
                     }
                 } else {
                     for dx in [0, n - 1] {
-                        if (lo[0]..=hi[0]).contains(&dx) && visit(dx, &mut out) {
-                            break 'cubes;
+                        if (lo[0]..=hi[0]).contains(&dx) && visit(dx, out) {
+                            return;
                         }
                         if n == 1 {
                             break;
@@ -106,9 +170,43 @@ pub fn frontier_cells(
                 }
             }
         }
-    }
+    };
+    let parts: Vec<Vec<Frontier>> = cubes
+        .par_chunks(64)
+        .map(|chunk| {
+            let mut out = Vec::new();
+            let mut cache = SearchCache::default();
+            let mut polled = 0usize;
+            for c in chunk {
+                if stopped.load(Ordering::Relaxed) {
+                    break;
+                }
+                scan_cube(c, &mut out, &mut cache, &mut polled);
+            }
+            out
+        })
+        .collect();
+    let mut out: Vec<Frontier> = parts.into_iter().flatten().collect();
     out.sort_by_key(|f| (f.key[2], f.key[1], f.key[0]));
     Ok(out)
+}
+
+/// True when the depth-`depth` cube with smallest key `key` lies inside one leaf (a
+/// known node without children at that depth or above).
+fn one_leaf(tree: &Octree, key: &OcKey, depth: u8) -> bool {
+    let Some(mut n) = tree.root_ref() else {
+        return false;
+    };
+    for d in 0..depth {
+        if !tree.has_children(n) {
+            return true;
+        }
+        match tree.child_ref(n, crate::octree::child_index(key, d)) {
+            Some(c) => n = c,
+            None => return false,
+        }
+    }
+    !tree.has_children(n)
 }
 
 /// Potential field at `p` (S0 eq. 4.1): `F = Σ F_p − Σ F_o` over the space within

@@ -4,7 +4,8 @@
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::camera::{CameraModel, Frustum};
-use crate::octree::{CellState, OcKey, Octree, SearchCache, TREE_DEPTH};
+use super::count::FrustumCounter;
+use crate::octree::{CellState, OcKey, Octree, SearchCache};
 
 /// How the gain of a view is computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,10 +57,9 @@ pub struct GainWorkspace {
 }
 
 /// Unknown depth-16 cells of `tree` whose centres lie inside `frustum` (ALGORITHMS.md §5
-/// step 3, S0 eq. 4.2's c). Iterative over the tree with an explicit stack: a cube
-/// whose cell centres are all outside one plane is dropped, a cube with all centres
-/// inside every plane adds `8^(16−d)` if unknown, a known leaf adds nothing, anything
-/// else is split (absent space virtually) down to single cells.
+/// step 3, S0 eq. 4.2's c), counted exactly by culling octree cubes against the six
+/// planes ([`FrustumCounter`], which see). Builds the tree's known-cell counts on every
+/// call; for many views of one tree build one [`FrustumCounter`] and reuse it.
 ///
 /// ```
 /// use kinplan_core::nbv::{CameraModel, Frustum, frustum_unknown_count, look_along};
@@ -73,99 +73,13 @@ pub struct GainWorkspace {
 /// assert!((c / v - 1.0).abs() < 0.1);
 /// ```
 pub fn frustum_unknown_count(tree: &Octree, frustum: &Frustum) -> u64 {
-    frustum_unknown_count_in(tree, frustum, None)
+    FrustumCounter::new(tree).count(frustum)
 }
 
 /// [`frustum_unknown_count`] restricted to the depth-16 cells whose keys lie in
-/// the inclusive key box `keys` (`None`: no restriction). Cubes reaching out
-/// of the box are split like cubes crossing a plane.
+/// the inclusive key box `keys` (`None`: no restriction).
 pub fn frustum_unknown_count_in(tree: &Octree, frustum: &Frustum, keys: Option<(OcKey, OcKey)>) -> u64 {
-    let res = tree.resolution();
-    let planes = &frustum.planes;
-    let norm1: [f64; 6] = planes.map(|(n, _)| n.x.abs() + n.y.abs() + n.z.abs());
-    // cube of depth d with smallest key k: cell centres span [lo + res/2, lo + size − res/2]
-    let classify = |key: &OcKey, depth: u8| -> (bool, bool) {
-        let size = tree.node_size(depth);
-        let half_span = (size - res) / 2.0;
-        let c = [0, 1, 2].map(|i| (key[i] as f64 - 32768.0) * res + size / 2.0);
-        let mut all_in = true;
-        for (j, (n, d)) in planes.iter().enumerate() {
-            let s = n.x * c[0] + n.y * c[1] + n.z * c[2] + d;
-            let r = half_span * norm1[j];
-            if s + r < 0.0 {
-                return (false, false);
-            }
-            if s - r < 0.0 {
-                all_in = false;
-            }
-        }
-        (true, all_in)
-    };
-    // box of keys covering the frustum corners
-    let mut lo = [u16::MAX; 3];
-    let mut hi = [0u16; 3];
-    for c in &frustum.corners {
-        let Ok(k) = tree.key_of(c) else {
-            // a corner outside the tree's cube: clamp to the cube
-            for i in 0..3 {
-                lo[i] = 0;
-                hi[i] = u16::MAX;
-            }
-            continue;
-        };
-        for i in 0..3 {
-            lo[i] = lo[i].min(k[i]);
-            hi[i] = hi[i].max(k[i]);
-        }
-    }
-    if let Some((a, b)) = keys {
-        for i in 0..3 {
-            lo[i] = lo[i].max(a[i]);
-            hi[i] = hi[i].min(b[i]);
-            if lo[i] > hi[i] {
-                return 0;
-            }
-        }
-    }
-    let overlaps = |key: &OcKey, depth: u8| {
-        let span = (1u32 << (TREE_DEPTH - depth)) - 1;
-        (0..3).all(|i| key[i] as u32 <= hi[i] as u32 && key[i] as u32 + span >= lo[i] as u32)
-    };
-    let within = |key: &OcKey, depth: u8| {
-        let span = (1u32 << (TREE_DEPTH - depth)) - 1;
-        (0..3).all(|i| key[i] >= lo[i] && key[i] as u32 + span <= hi[i] as u32)
-    };
-    let mut count = 0u64;
-    // stack entries: (key, depth, known node value or None for unknown)
-    let mut stack: Vec<(OcKey, u8, Option<crate::octree::NodeRef>)> = Vec::with_capacity(8 * 17);
-    stack.push(([0; 3], 0, tree.root_ref()));
-    while let Some((key, depth, node)) = stack.pop() {
-        if !overlaps(&key, depth) {
-            continue;
-        }
-        if let Some(n) = node
-            && !tree.has_children(n)
-        {
-            continue; // known leaf: no unknown cells
-        }
-        let (touch, inside) = classify(&key, depth);
-        if !touch {
-            continue;
-        }
-        if node.is_none() && inside && within(&key, depth) {
-            count += 1u64 << (3 * (TREE_DEPTH - depth) as u32);
-            continue;
-        }
-        if depth == TREE_DEPTH {
-            continue; // unknown single cell partly "inside" cannot happen: classify is exact here
-        }
-        for i in 0..8 {
-            let ck = crate::octree::child_key(&key, depth, i);
-            let child = node.and_then(|n| tree.child_ref(n, i));
-            stack.push((ck, depth + 1, child));
-        }
-    }
-    count
+    FrustumCounter::new(tree).count_in(frustum, keys)
 }
 
 /// Binary entropy (nats).

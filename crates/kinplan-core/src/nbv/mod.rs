@@ -3,6 +3,7 @@
 //! casting, utility and IK reachability (ALGORITHMS.md §5, S0 §4).
 
 mod camera;
+mod count;
 mod error;
 mod frontier;
 mod gain;
@@ -10,9 +11,12 @@ mod params;
 mod select;
 
 #[cfg(test)]
+mod count_tests;
+#[cfg(test)]
 mod tests;
 
 pub use camera::{CameraModel, Frustum, look_along};
+pub use count::FrustumCounter;
 pub use error::NbvError;
 pub use frontier::{Frontier, candidate_pose, frontier_cells, potential_field};
 pub use gain::{

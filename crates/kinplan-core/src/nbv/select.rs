@@ -10,8 +10,9 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use super::camera::{CameraModel, Frustum};
+use super::count::FrustumCounter;
 use super::frontier::{candidate_pose, frontier_cells, potential_field};
-use super::gain::{GainMethod, GainWorkspace, frustum_unknown_count_in, ray_gain};
+use super::gain::{GainMethod, GainWorkspace, ray_gain};
 use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
 use crate::octree::{CellState, Octree};
@@ -284,6 +285,8 @@ pub fn next_best_view(
         _ => None,
     };
     let c_max = camera.frustum_volume() / tree.resolution().powi(3);
+    // the tree's known-cell counts, built once and shared by every candidate's count
+    let counter = matches!(params.gain, GainMethod::Intersection).then(|| FrustumCounter::new(tree));
     let gains: Vec<Option<(f64, f64, u64)>> = kept
         .par_iter()
         .map_init(GainWorkspace::default, |ws, (pose, _)| {
@@ -292,7 +295,8 @@ pub fn next_best_view(
             }
             Some(match params.gain {
                 GainMethod::Intersection => {
-                    let c = frustum_unknown_count_in(tree, &Frustum::new(camera, pose), gain_keys) as f64;
+                    let counter = counter.as_ref().expect("built for the intersection gain");
+                    let c = counter.count_in(&Frustum::new(camera, pose), gain_keys) as f64;
                     (c, c / c_max, 0)
                 }
                 m => {

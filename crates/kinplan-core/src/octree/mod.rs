@@ -1,6 +1,7 @@
 //! OctoMap-compatible occupancy octree: keys, arena nodes, `.bt`/`.ot`/ROS-message IO,
 //! queries, ray casting and scan integration (ALGORITHMS.md §5).
 
+mod counts;
 mod error;
 mod header;
 mod io;
@@ -16,6 +17,7 @@ mod ray_tests;
 #[cfg(test)]
 mod tests;
 
+pub use counts::KnownCellCounts;
 pub use error::OctreeError;
 pub use header::{BT_FIRST_LINE, OT_FIRST_LINE};
 pub use key::{

@@ -141,34 +141,81 @@ impl Octree {
         end: &[f32; 3],
         mut visit: impl FnMut(&OcKey),
     ) -> bool {
+        self.visit_ray_cells(origin, end, &[0; 3], [0; 3], |k, _| visit(k))
+    }
+
+    /// [`visit_ray_keys`](Self::visit_ray_keys) handing each key with its linear index
+    /// `Σ (k_i − lo_i)·strides_i` into a dense grid over a key box starting at `lo`,
+    /// kept up to date by one add per step (the beam must lie inside that box).
+    #[inline]
+    pub(crate) fn visit_ray_cells(
+        &self,
+        origin: &[f32; 3],
+        end: &[f32; 3],
+        lo: &OcKey,
+        strides: [usize; 3],
+        mut visit: impl FnMut(&OcKey, usize),
+    ) -> bool {
         let (Some(ko), Some(ke)) = (self.key_of_f32(origin), self.key_of_f32(end)) else {
             return false;
         };
         if ko == ke {
             return true;
         }
-        visit(&ko);
+        let mut idx = (0..3).fold(0usize, |a, i| {
+            a.wrapping_add(
+                (ko[i] as usize)
+                    .wrapping_sub(lo[i] as usize)
+                    .wrapping_mul(strides[i]),
+            )
+        });
+        visit(&ko, idx);
         let mut dir = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
         let length = f32_norm(&dir) as f32;
         for v in dir.iter_mut() {
             *v /= length;
         }
-        let mut dda = Dda::new(&ko, origin, &dir, self.resolution, true);
-        let mut k = ko;
+        let dda = Dda::new(&ko, origin, &dir, self.resolution, true);
         let length = length as f64;
+        // the DDA state in scalar locals (registers): an array indexed by the axis made
+        // each step wait on a partial store-to-load forward of the key
+        let [mut kx, mut ky, mut kz] = ko;
+        let [mut tx, mut ty, mut tz] = dda.t_max;
+        let [dx, dy, dz] = dda.t_delta;
+        let [sx, sy, sz] = dda.step.map(|s| s as u16); // ±1 as a wrapping u16 step
+        // index change per step along each axis (±stride, wrapping)
+        let [ix, iy, iz] = [0, 1, 2].map(|i| (dda.step[i] as isize as usize).wrapping_mul(strides[i]));
         // a beam between two keys in the cube crosses at most 3 · 65536 borders
         for _ in 0..3 * 65536 {
-            let a = dda.axis();
-            k[a] = (k[a] as i32 + dda.step[a]) as u16;
-            dda.t_max[a] += dda.t_delta[a];
-            if k == ke {
+            // axis of the smallest t_max, ties as in `Dda::axis`
+            if tx < ty {
+                if tx < tz {
+                    kx = kx.wrapping_add(sx);
+                    tx += dx;
+                    idx = idx.wrapping_add(ix);
+                } else {
+                    kz = kz.wrapping_add(sz);
+                    tz += dz;
+                    idx = idx.wrapping_add(iz);
+                }
+            } else if ty < tz {
+                ky = ky.wrapping_add(sy);
+                ty += dy;
+                idx = idx.wrapping_add(iy);
+            } else {
+                kz = kz.wrapping_add(sz);
+                tz += dz;
+                idx = idx.wrapping_add(iz);
+            }
+            if kx == ke[0] && ky == ke[1] && kz == ke[2] {
                 break;
             }
-            let dist = dda.t_max[0].min(dda.t_max[1]).min(dda.t_max[2]);
+            let m = if tx < ty { tx } else { ty };
+            let dist = if m < tz { m } else { tz };
             if dist > length {
                 break;
             }
-            visit(&k);
+            visit(&[kx, ky, kz], idx);
         }
         true
     }

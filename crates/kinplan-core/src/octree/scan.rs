@@ -332,6 +332,7 @@ impl Octree {
         let index = |k: &OcKey| {
             ((k[2] - lo[2]) as usize * dims[1] + (k[1] - lo[1]) as usize) * dims[0] + (k[0] - lo[0]) as usize
         };
+        let strides = [1, dims[0], dims[0] * dims[1]];
         let this = &*self;
         type Acc = (Vec<u64>, Vec<u64>, usize, bool);
         let empty = || -> Acc { (vec![0u64; words], vec![0u64; words], 0, false) };
@@ -350,12 +351,11 @@ impl Octree {
                     let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
                     let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
                     let free = &mut acc.0;
-                    let mut mark = |k: &OcKey| {
-                        let i = index(k);
+                    let mut mark = |_: &OcKey, i: usize| {
                         free[i >> 6] |= 1 << (i & 63);
                     };
                     if max_range < 0.0 || norm <= max_range {
-                        this.visit_ray_keys(origin, p, &mut mark);
+                        this.visit_ray_cells(origin, p, &lo, strides, &mut mark);
                         match this.key_of_f32(p) {
                             Some(k) => {
                                 let i = index(&k);
@@ -366,7 +366,7 @@ impl Octree {
                     } else {
                         let (n, m) = (norm as f32, max_range as f32);
                         let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                        this.visit_ray_keys(origin, &e, &mut mark);
+                        this.visit_ray_cells(origin, &e, &lo, strides, &mut mark);
                     }
                 }
                 acc

@@ -1,0 +1,401 @@
+//! The exact frustum count of unknown cells (ALGORITHMS.md §5 step 3, S0 eq. 4.2's c):
+//! octree culling against the frustum's planes with per-node known-cell counts, and
+//! boundary cubes of unknown space counted row by row.
+
+use nalgebra::Vector3;
+
+use super::camera::Frustum;
+use crate::octree::{KnownCellCounts, NodeRef, OcKey, Octree, TREE_DEPTH, child_key, key_to_coord_axis};
+
+/// Unknown cubes of at most `2^ROW_LOG` cells a side that a plane cuts are counted row
+/// by row instead of being split further.
+const ROW_LOG: u8 = 4;
+/// Plane-test margin (m): a cube counts as inside (outside) a plane only when all its
+/// cell centres clear it by more than this, far above the rounding of the test, so the
+/// culled answer equals the per-cell test; cubes in the band are counted exactly.
+const EPS: f64 = 1e-9;
+/// DFS stack bound: eight children pushed per level below the root.
+const STACK: usize = 8 * TREE_DEPTH as usize + 1;
+
+#[derive(Clone, Copy)]
+struct Entry {
+    key: OcKey,
+    depth: u8,
+    /// Planes (bits 0–5) that may still cut this cube.
+    mask: u8,
+    node: Option<NodeRef>,
+    /// Known depth-16 cells below `node` (0 when absent).
+    known: u64,
+}
+
+/// Counts unknown depth-16 cells inside view frusta for one tree: the tree's per-node
+/// known-cell counts ([`KnownCellCounts`]) are built once in [`FrustumCounter::new`]
+/// (one pass over the nodes) and shared by every view (and thread) after that.
+///
+/// Per view, a depth-first walk from the root (a fixed-size stack, no allocation):
+/// - a cube whose cell centres all lie outside one plane, or outside the key box, is
+///   dropped; a known leaf holds no unknown cells;
+/// - a cube inside every plane (planes already cleared by an ancestor are not tested
+///   again) and inside the key box adds `8^(16−d) − known(node)` cells, in closed form;
+/// - an unknown (absent) cube of at most `2^ROW_LOG` cells a side cut by planes is
+///   counted row by row: along the row axis each cutting plane `n·c + d ≥ 0` bounds the
+///   cells to one interval, found from the crossing `x* = −(n_b·c_b + n_c·c_c + d)/n_a`
+///   and then confirmed with the per-cell test itself (the test is monotone along a
+///   row), so the count equals the count of every cell centre;
+/// - anything else is split into its eight children (absent space virtually).
+///
+/// The cube test uses the centre `c` of the cube's cell centres and their half span
+/// `h = (size − res)/2`: all inside plane j when `n·c + d − h·‖n‖₁ ≥ ε`, all outside when
+/// `n·c + d + h·‖n‖₁ < −ε`.
+#[derive(Debug, Clone)]
+pub struct FrustumCounter<'a> {
+    tree: &'a Octree,
+    known: KnownCellCounts,
+}
+
+impl<'a> FrustumCounter<'a> {
+    /// Builds the per-node known-cell counts of `tree` (one pass over its nodes).
+    pub fn new(tree: &'a Octree) -> Self {
+        Self {
+            tree,
+            known: KnownCellCounts::new(tree),
+        }
+    }
+
+    /// Unknown depth-16 cells whose centres lie inside `frustum` (see
+    /// [`frustum_unknown_count`](super::frustum_unknown_count)).
+    pub fn count(&self, frustum: &Frustum) -> u64 {
+        self.count_in(frustum, None)
+    }
+
+    /// [`count`](Self::count) restricted to the cells whose keys lie in the inclusive
+    /// key box `keys` (`None`: no restriction besides the frustum corners' key box).
+    pub fn count_in(&self, frustum: &Frustum, keys: Option<(OcKey, OcKey)>) -> u64 {
+        let tree = self.tree;
+        let res = tree.resolution();
+        let planes = &frustum.planes;
+        let norm1: [f64; 6] = planes.map(|(n, _)| n.x.abs() + n.y.abs() + n.z.abs());
+        // box of keys covering the frustum corners (the whole key space when one is out)
+        let mut lo = [u16::MAX; 3];
+        let mut hi = [0u16; 3];
+        for c in &frustum.corners {
+            match tree.key_of(c) {
+                Ok(k) => {
+                    for i in 0..3 {
+                        lo[i] = lo[i].min(k[i]);
+                        hi[i] = hi[i].max(k[i]);
+                    }
+                }
+                Err(_) => {
+                    lo = [0; 3];
+                    hi = [u16::MAX; 3];
+                }
+            }
+        }
+        if let Some((a, b)) = keys {
+            for i in 0..3 {
+                lo[i] = lo[i].max(a[i]);
+                hi[i] = hi[i].min(b[i]);
+                if lo[i] > hi[i] {
+                    return 0;
+                }
+            }
+        }
+        let rows = RowCounter { planes, res, lo, hi };
+        let mut stack = [Entry {
+            key: [0; 3],
+            depth: 0,
+            mask: 0,
+            node: None,
+            known: 0,
+        }; STACK];
+        stack[0] = Entry {
+            key: [0; 3],
+            depth: 0,
+            mask: 0b11_1111,
+            node: tree.root_ref(),
+            known: self.known.root(),
+        };
+        let mut len = 1usize;
+        let mut count = 0u64;
+        while len > 0 {
+            len -= 1;
+            let e = stack[len];
+            if let Some(n) = e.node
+                && !tree.has_children(n)
+            {
+                continue; // a known leaf: no unknown cells
+            }
+            let side = 1u32 << (TREE_DEPTH - e.depth);
+            let (mut overlaps, mut within) = (true, true);
+            for i in 0..3 {
+                let (a, b) = (e.key[i] as u32, e.key[i] as u32 + side - 1);
+                overlaps &= a <= hi[i] as u32 && b >= lo[i] as u32;
+                within &= a >= lo[i] as u32 && b <= hi[i] as u32;
+            }
+            if !overlaps {
+                continue;
+            }
+            // plane tests for the planes an ancestor has not cleared
+            let mut mask = 0u8;
+            if e.mask != 0 {
+                let size = res * side as f64;
+                let half_span = (size - res) / 2.0;
+                let c = Vector3::from(e.key.map(|k| (k as f64 - 32768.0) * res + size / 2.0));
+                let mut out = false;
+                for (j, (n, d)) in planes.iter().enumerate() {
+                    if e.mask & (1 << j) == 0 {
+                        continue;
+                    }
+                    let s = n.dot(&c) + d;
+                    let r = half_span * norm1[j];
+                    if s + r < -EPS {
+                        out = true;
+                        break;
+                    }
+                    if s - r < EPS {
+                        mask |= 1 << j;
+                    }
+                }
+                if out {
+                    continue;
+                }
+            }
+            if mask == 0 && within {
+                count += (1u64 << (3 * (TREE_DEPTH - e.depth) as u32)) - e.known;
+                continue;
+            }
+            if e.node.is_none() && e.depth >= TREE_DEPTH - ROW_LOG {
+                count += rows.count(&e.key, side, mask);
+                continue;
+            }
+            for i in 0..8 {
+                let (node, known) = match e.node {
+                    Some(n) => match tree.child_ref(n, i) {
+                        Some(c) => (Some(c), self.known.child(n, i)),
+                        None => (None, 0),
+                    },
+                    None => (None, 0),
+                };
+                stack[len] = Entry {
+                    key: child_key(&e.key, e.depth, i),
+                    depth: e.depth + 1,
+                    mask,
+                    node,
+                    known,
+                };
+                len += 1;
+            }
+        }
+        count
+    }
+}
+
+/// Row-by-row count of the cells of an unknown cube inside the key box and the planes.
+struct RowCounter<'f> {
+    planes: &'f [(Vector3<f64>, f64); 6],
+    res: f64,
+    lo: [u16; 3],
+    hi: [u16; 3],
+}
+
+impl RowCounter<'_> {
+    /// The per-cell test, written exactly as [`Frustum::contains`] evaluates it at the
+    /// cell centre `key_center(k, 16)`.
+    #[inline]
+    fn inside(&self, j: usize, k: [i64; 3]) -> bool {
+        let (n, d) = &self.planes[j];
+        let p = Vector3::new(
+            key_to_coord_axis(k[0] as u16, self.res),
+            key_to_coord_axis(k[1] as u16, self.res),
+            key_to_coord_axis(k[2] as u16, self.res),
+        );
+        n.dot(&p) + d >= 0.0
+    }
+
+    /// Cells of the cube `[key, key + side)³` inside the key box whose centres pass
+    /// every plane in `mask`. Along a row (axis a, the others fixed) plane j is crossed
+    /// at the real key `κ = K0 + Kb·k_b + Kc·k_c` (`n·c + d = 0` solved for the key with
+    /// `c = (k − 32768 + ½)·res`); when `κ` is more than `tol` away from an integer its
+    /// floor settles the row without any per-cell test (`κ` clamped to the row's range
+    /// ± 1), else the per-cell tests decide the row.
+    fn count(&self, key: &OcKey, side: u32, mask: u8) -> u64 {
+        let r: [(i64, i64); 3] = [0, 1, 2].map(|i| {
+            (
+                (key[i] as i64).max(self.lo[i] as i64),
+                (key[i] as i64 + side as i64 - 1).min(self.hi[i] as i64),
+            )
+        });
+        if r.iter().any(|(a, b)| a > b) {
+            return 0;
+        }
+        if mask == 0 {
+            return r.iter().map(|(a, b)| (b - a + 1) as u64).product();
+        }
+        // rows along the axis the first cutting plane is steepest in
+        let first = mask.trailing_zeros() as usize;
+        let n0 = self.planes[first].0;
+        let a = (0..3)
+            .max_by(|&i, &j| n0[i].abs().total_cmp(&n0[j].abs()))
+            .unwrap_or(0);
+        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+        let (alo, ahi) = r[a];
+        let res = self.res;
+        // per cutting plane: crossing coefficients and tolerance (None: per-cell tests)
+        let mut lin = [None::<(usize, f64, f64, f64, f64, bool)>; 6];
+        let mut exact = [usize::MAX; 6];
+        let (mut nl, mut ne) = (0, 0);
+        for j in 0..6 {
+            if mask & (1 << j) == 0 {
+                continue;
+            }
+            let (n, d) = &self.planes[j];
+            let scale = (n[0].abs() + n[1].abs() + n[2].abs()) / n[a].abs();
+            // key-unit error bound of κ and of the per-cell test near the crossing,
+            // with a safety factor of about 10^6 over f64 rounding
+            let tol = 1e-9 * scale * (32768.0 + (32768.0 * res + d.abs()) / res);
+            if n[a] == 0.0 || tol.is_nan() || tol >= 0.25 {
+                exact[ne] = j;
+                ne += 1;
+                continue;
+            }
+            // κ = −(n_b·c_b + n_c·c_c + d)/(n_a·res) + 32767.5, c_i = (k_i − 32767.5)·res
+            let kb = -n[b] / n[a];
+            let kc = -n[c] / n[a];
+            let k0 = -d / (n[a] * res) - (kb + kc) * 32767.5 + 32767.5;
+            lin[nl] = Some((j, k0, kb, kc, tol, n[a] > 0.0));
+            nl += 1;
+        }
+        let mut total = 0u64;
+        let mut k = [0i64; 3];
+        if nl == 1
+            && ne == 0
+            && let Some((j, k0, cb, cc, tol, up)) = lin[0]
+        {
+            // the common case, one cutting plane: the same rule in a tight loop
+            let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
+            for kc in r[c].0..=r[c].1 {
+                k[c] = kc;
+                for kb in r[b].0..=r[b].1 {
+                    let kr = k0 + cb * kb as f64 + cc * kc as f64;
+                    let fl = floor_i64(kr.clamp(lo_f, hi_f));
+                    let frac = kr - fl as f64;
+                    let n = if kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol) {
+                        k[b] = kb;
+                        if up {
+                            ahi - self.first_inside(j, k, a, alo, alo, ahi) + 1
+                        } else {
+                            self.last_inside(j, k, a, ahi, alo, ahi) - alo + 1
+                        }
+                    } else if up {
+                        ahi - (fl + 1).max(alo) + 1
+                    } else {
+                        fl.min(ahi) - alo + 1
+                    };
+                    total += n.max(0) as u64;
+                }
+            }
+            return total;
+        }
+        for kc in r[c].0..=r[c].1 {
+            k[c] = kc;
+            for kb in r[b].0..=r[b].1 {
+                k[b] = kb;
+                // fast path: the floors of the crossings; a crossing within `tol` of an
+                // integer (rare) sends the row to the per-cell tests instead
+                let (mut first_in, mut last_in) = (alo, ahi);
+                let mut near = false;
+                let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
+                for &(_, k0, cb, cc, tol, up) in lin[..nl].iter().flatten() {
+                    let kr = k0 + cb * kb as f64 + cc * kc as f64;
+                    let fl = floor_i64(kr.clamp(lo_f, hi_f));
+                    let frac = kr - fl as f64;
+                    near |= kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol);
+                    if up {
+                        first_in = first_in.max(fl + 1);
+                    } else {
+                        last_in = last_in.min(fl);
+                    }
+                }
+                if near {
+                    (first_in, last_in) = (alo, ahi);
+                    for &(j, _, _, _, _, up) in lin[..nl].iter().flatten() {
+                        if first_in > last_in {
+                            break;
+                        }
+                        if up {
+                            first_in = first_in.max(self.first_inside(j, k, a, alo, alo, ahi));
+                        } else {
+                            last_in = last_in.min(self.last_inside(j, k, a, ahi, alo, ahi));
+                        }
+                    }
+                }
+                for &j in &exact[..ne] {
+                    if first_in > last_in {
+                        break;
+                    }
+                    let (n, _) = &self.planes[j];
+                    if n[a] == 0.0 {
+                        k[a] = alo;
+                        if !self.inside(j, k) {
+                            last_in = first_in - 1;
+                        }
+                    } else if n[a] > 0.0 {
+                        first_in = first_in.max(self.first_inside(j, k, a, alo, alo, ahi));
+                    } else {
+                        last_in = last_in.min(self.last_inside(j, k, a, ahi, alo, ahi));
+                    }
+                }
+                if last_in >= first_in {
+                    total += (last_in - first_in + 1) as u64;
+                }
+            }
+        }
+        total
+    }
+
+    /// The first key in `[alo, ahi]` (or `ahi + 1`) along axis `a` inside plane `j`
+    /// (with `n_a > 0` the test is monotone along the row), searched from `guess`.
+    fn first_inside(&self, j: usize, mut k: [i64; 3], a: usize, guess: i64, alo: i64, ahi: i64) -> i64 {
+        let mut f = guess;
+        while f > alo && {
+            k[a] = f - 1;
+            self.inside(j, k)
+        } {
+            f -= 1;
+        }
+        while f <= ahi && {
+            k[a] = f;
+            !self.inside(j, k)
+        } {
+            f += 1;
+        }
+        f
+    }
+
+    /// The last key in `[alo, ahi]` (or `alo − 1`) along axis `a` inside plane `j`
+    /// (`n_a < 0`), searched from `guess`.
+    fn last_inside(&self, j: usize, mut k: [i64; 3], a: usize, guess: i64, alo: i64, ahi: i64) -> i64 {
+        let mut l = guess;
+        while l < ahi && {
+            k[a] = l + 1;
+            self.inside(j, k)
+        } {
+            l += 1;
+        }
+        while l >= alo && {
+            k[a] = l;
+            !self.inside(j, k)
+        } {
+            l -= 1;
+        }
+        l
+    }
+}
+
+/// `⌊x⌋` for |x| well inside the i64 range, without a libm call.
+#[inline]
+fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t - 1 } else { t }
+}

@@ -1,0 +1,190 @@
+//! The culled frustum count against a count of every cell, over random trees (pruned
+//! free cubes, occupied cells, holes) and random frusta, with and without key boxes.
+
+use nalgebra::{Point3, Vector3};
+use proptest::prelude::*;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::*;
+use crate::octree::{CellState, KnownCellCounts, OcKey, Octree, TREE_DEPTH};
+
+/// A tree at 0.1 m around the origin: aligned free cubes (pruned to one leaf each),
+/// scattered occupied and free cells, and a few unknown holes punched back out of
+/// nothing (cells left absent between updates).
+fn random_tree(seed: u64) -> Octree {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut t = Octree::new(0.1).unwrap();
+    let m = t.sensor_model().log_odds();
+    for _ in 0..rng.random_range(1..5) {
+        // an aligned cube of 2^s cells a side, every cell updated free: pruned
+        let s = rng.random_range(1..4u32);
+        let base = [0; 3].map(|_| (32768 - 16 + rng.random_range(0..32u16)) & !((1 << s) - 1));
+        for x in 0..1u16 << s {
+            for y in 0..1u16 << s {
+                for z in 0..1u16 << s {
+                    for _ in 0..3 {
+                        t.update_key(&[base[0] + x, base[1] + y, base[2] + z], m.miss);
+                    }
+                }
+            }
+        }
+    }
+    for _ in 0..rng.random_range(500..4000) {
+        let k = [0; 3].map(|_| 32768u16 - 20 + rng.random_range(0..40u16));
+        t.update_key(&k, if rng.random_bool(0.3) { m.hit } else { m.miss });
+    }
+    t
+}
+
+/// Every cell of the key box `[lo, hi]`: unknown and centre inside the frustum.
+fn brute(t: &Octree, f: &Frustum, lo: OcKey, hi: OcKey) -> u64 {
+    let mut n = 0;
+    for x in lo[0]..=hi[0] {
+        for y in lo[1]..=hi[1] {
+            for z in lo[2]..=hi[2] {
+                let k = [x, y, z];
+                if t.state_of_key(&k) == CellState::Unknown && f.contains(&t.key_center(&k, 16)) {
+                    n += 1;
+                }
+            }
+        }
+    }
+    n
+}
+
+fn corner_box(t: &Octree, f: &Frustum) -> (OcKey, OcKey) {
+    let ks: Vec<OcKey> = f.corners.iter().map(|c| t.key_of(c).unwrap()).collect();
+    (
+        [0, 1, 2].map(|i| ks.iter().map(|k| k[i]).min().unwrap()),
+        [0, 1, 2].map(|i| ks.iter().map(|k| k[i]).max().unwrap()),
+    )
+}
+
+/// Known cells by an independent walk: every leaf at depth d covers 8^(16−d) cells.
+fn known_cells(t: &Octree) -> u64 {
+    let mut total = 0u64;
+    let mut stack: Vec<_> = t.root_ref().map(|r| (r, 0u8)).into_iter().collect();
+    while let Some((n, d)) = stack.pop() {
+        if !t.has_children(n) {
+            total += 1u64 << (3 * (TREE_DEPTH - d) as u32);
+            continue;
+        }
+        for i in 0..8 {
+            if let Some(c) = t.child_ref(n, i) {
+                stack.push((c, d + 1));
+            }
+        }
+    }
+    total
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    #[test]
+    fn culled_count_equals_the_count_of_every_cell(
+        seed in 0u64..1_000_000,
+        pos in prop::array::uniform3(-1.5f64..1.5),
+        dir in prop::array::uniform3(-1.0f64..1.0),
+        hfov in 0.3f64..2.0,
+        vfov in 0.3f64..1.6,
+        near in 0.01f64..0.5,
+        depth in 0.3f64..2.5,
+        boxed in any::<bool>(),
+    ) {
+        let t = random_tree(seed);
+        let cam = CameraModel { hfov, vfov, near, far: near + depth, width: 8, height: 6 };
+        let Some(pose) = look_along(&Point3::from(pos), &Vector3::from(dir)) else {
+            return Ok(());
+        };
+        let f = Frustum::new(&cam, &pose);
+        let counter = FrustumCounter::new(&t);
+        let (lo, hi) = corner_box(&t, &f);
+        if boxed {
+            // a key box cutting through the frustum's corner box
+            let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xb0c5);
+            let a = [0, 1, 2].map(|i| rng.random_range(lo[i]..=hi[i]));
+            let b = [0, 1, 2].map(|i| rng.random_range(a[i]..=hi[i]));
+            prop_assert_eq!(counter.count_in(&f, Some((a, b))), brute(&t, &f, a, b));
+            prop_assert_eq!(frustum_unknown_count_in(&t, &f, Some((a, b))), brute(&t, &f, a, b));
+        } else {
+            prop_assert_eq!(counter.count(&f), brute(&t, &f, lo, hi));
+        }
+    }
+
+    #[test]
+    fn known_counts_sum_the_leaves(seed in 0u64..1_000_000) {
+        let t = random_tree(seed);
+        prop_assert_eq!(KnownCellCounts::new(&t).root(), known_cells(&t));
+    }
+}
+
+#[test]
+fn counts_on_trees_with_no_nodes_one_leaf_and_axis_aligned_views() {
+    let cam = CameraModel {
+        hfov: 1.0,
+        vfov: 0.8,
+        near: 0.05,
+        far: 1.5,
+        width: 8,
+        height: 6,
+    };
+    // axis-aligned views put plane normals with zero components along the row axes
+    let dirs = [Vector3::x(), -Vector3::y(), Vector3::z(), -Vector3::z()];
+    let empty = Octree::new(0.1).unwrap();
+    let mut one = Octree::new(0.1).unwrap();
+    let m = one.sensor_model().log_odds();
+    one.update_key(&[32768, 32768, 32768], m.hit);
+    let t = random_tree(7);
+    for tree in [&empty, &one, &t] {
+        let counter = FrustumCounter::new(tree);
+        for d in &dirs {
+            let pose = look_along(&Point3::new(0.05, -0.05, 0.15), d).unwrap();
+            let f = Frustum::new(&cam, &pose);
+            let (lo, hi) = corner_box(tree, &f);
+            assert_eq!(counter.count(&f), brute(tree, &f, lo, hi), "{d:?}");
+        }
+    }
+    // known cells: none in an empty tree, one in a tree of one cell
+    assert_eq!(KnownCellCounts::new(&empty).root(), 0);
+    assert_eq!(KnownCellCounts::new(&one).root(), 1);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// Frontier cells against a test of every free cell of the region with its 26
+    /// neighbours looked up one by one.
+    #[test]
+    fn frontier_cells_equal_a_scan_of_every_free_cell(seed in 0u64..1_000_000, ratio in 0.01f64..0.9) {
+        let t = random_tree(seed);
+        let (min, max) = (Point3::new(-1.2, -1.5, -1.0), Point3::new(1.4, 1.1, 1.3));
+        let got = frontier_cells(&t, &min, &max, ratio, &|| false).unwrap();
+        let (lo, hi) = (t.key_of(&min).unwrap(), t.key_of(&max).unwrap());
+        let mut want = Vec::new();
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    if t.state_of_key(&[x, y, z]) != CellState::Free {
+                        continue;
+                    }
+                    let mut unknown = 0;
+                    for d in 0..27 {
+                        let o = [d % 3, d / 3 % 3, d / 9].map(|v: i32| v - 1);
+                        if o == [0, 0, 0] {
+                            continue;
+                        }
+                        let nb = [x as i32 + o[0], y as i32 + o[1], z as i32 + o[2]].map(|v| v as u16);
+                        unknown += (t.state_of_key(&nb) == CellState::Unknown) as usize;
+                    }
+                    if unknown > 0 && unknown as f64 / 26.0 >= ratio {
+                        want.push(([x, y, z], unknown as f64 / 26.0));
+                    }
+                }
+            }
+        }
+        let got: Vec<(OcKey, f64)> = got.iter().map(|f| (f.key, f.unknown_ratio)).collect();
+        prop_assert_eq!(got, want);
+    }
+}
