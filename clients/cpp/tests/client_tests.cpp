@@ -255,7 +255,7 @@ void bad_input_is_the_documented_error(kinplan::Client& c) {
   kinplan::Robot kr210 = c.robot(kKr210);
   Isometry3d nan_pose = kr210.fk(VectorXd::Zero(6));
   nan_pose.translation().x() = std::nan("");
-  expect_error("NaN target", grpc::StatusCode::INVALID_ARGUMENT, "target.position",
+  expect_error("NaN target", grpc::StatusCode::INVALID_ARGUMENT, "target.position.x: must be finite",
                [&] { kr210.ik(nan_pose); });
   expect_error("NaN joint", grpc::StatusCode::INVALID_ARGUMENT, "joint_positions",
                [&] { kr210.fk(vec({0, 0, std::nan(""), 0, 0, 0})); });
