@@ -125,6 +125,23 @@ void ik_round_trip(kinplan::Client& c) {
   const kinplan::IkResult p = kr210.ik(target, q + VectorXd::Constant(6, 0.2), options);
   CHECK(p.success);
   CHECK((kr210.fk(p.joints).translation() - target.translation()).norm() < 2e-5);
+  // the method travels: FABRIK solves position targets (and refuses full poses)
+  kinplan::IkOptions fabrik;
+  fabrik.method = kinplan::IkMethod::Fabrik;
+  fabrik.position_only = true;
+  fabrik.position_tolerance = 1e-4;
+  fabrik.max_iterations = 1000;
+  const kinplan::IkResult f = kr210.ik(target, q + VectorXd::Constant(6, 0.05), fabrik);
+  CHECK(f.success);
+  CHECK((kr210.fk(f.joints).translation() - target.translation()).norm() < 2e-4);
+  fabrik.position_only = false;
+  try {
+    kr210.ik(target, q, fabrik);
+    CHECK(!"FABRIK with a full pose target was accepted");
+  } catch (const kinplan::Error& e) {
+    CHECK(e.code() == grpc::StatusCode::INVALID_ARGUMENT);
+    CHECK(e.details().find("options.method") != std::string::npos);
+  }
 }
 
 void jacobian_matches_finite_differences(kinplan::Client& c) {
