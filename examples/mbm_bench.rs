@@ -42,64 +42,26 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use kinplan_core::collision::{
-    AcmParams, AllowedCollisions, CheckerParams, MotionCheck, RobotModel, SceneChecker, SceneGeometry,
-    SceneLimits, StateChecker, attached_bodies, parse_joint_request, parse_planning_scene,
+    CheckerParams, MotionCheck, SceneChecker, SceneGeometry, SceneLimits, StateChecker, parse_joint_request,
+    parse_planning_scene,
 };
 use kinplan_core::plan::{
     Algorithm, Goal, PlanControl, PlanRequest, PlanStatus, RrtOutcome, RrtParams, RrtStop, plan, rrt_connect,
 };
-use kinplan_core::robot::{Chain, builtin_chain, builtin_urdf};
+use kinplan_core::robot::{Chain, builtin_chain};
 use serde_json::json;
 
-const SETS: [&str; 7] = [
-    "table_pick",
-    "table_under_pick",
-    "box",
-    "bookshelf_small",
-    "bookshelf_tall",
-    "bookshelf_thin",
-    "cage",
-];
 const FINE: f64 = 0.01;
 const DEADLINE: Duration = Duration::from_secs(10);
-
-type Model = (Arc<RobotModel>, AllowedCollisions);
-
-fn model(chain: &Arc<Chain>, opening: f64, cache: &mut BTreeMap<u64, Model>) -> Model {
-    cache
-        .entry(opening.to_bits())
-        .or_insert_with(|| {
-            let urdf = builtin_urdf("franka_panda_hand").unwrap();
-            let fingers = [("panda_finger_joint1", opening), ("panda_finger_joint2", opening)];
-            let attached = attached_bodies(urdf, chain, &fingers).unwrap();
-            let model = Arc::new(RobotModel::with_parts(chain.clone(), &attached, &[]).unwrap());
-            let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
-            (model, acm)
-        })
-        .clone()
-}
-
-fn arm(joints: &[(String, f64)], field: &str) -> Result<Vec<f64>, String> {
-    let mut q = vec![f64::NAN; 7];
-    for (name, v) in joints {
-        if let Some(i) = name
-            .strip_prefix("panda_joint")
-            .and_then(|s| s.parse::<usize>().ok())
-            && (1..=7).contains(&i)
-        {
-            q[i - 1] = *v;
-        }
-    }
-    if q.iter().any(|v| v.is_nan()) {
-        return Err(format!("{field}: missing panda_joint1..7"));
-    }
-    Ok(q)
-}
 
 /// Every state along every segment of `path` at ≤ `step` per joint, in
 /// order, both ends included — deliberately not the planner's bisection walk.
 /// Returns whether all are valid and the deepest penetration (m, ≥ 0) among
 /// the invalid ones (0 when the only failures are joint limits).
+#[path = "common/mbm_panda.rs"]
+mod mbm_panda;
+use mbm_panda::{SETS, arm, model};
+
 fn fine_check(checker: &SceneChecker, path: &[f64], dof: usize, step: f64) -> (bool, f64) {
     let rows: Vec<&[f64]> = path.chunks_exact(dof).collect();
     if rows.len() < 2 {

@@ -20,54 +20,13 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use kinplan_core::collision::{
-    AcmParams, AllowedCollisions, CheckerParams, Part, RobotModel, SceneChecker, SceneGeometry, SceneLimits,
-    attached_bodies, parse_joint_request, parse_planning_scene,
+    CheckerParams, Part, SceneChecker, SceneGeometry, SceneLimits, parse_joint_request, parse_planning_scene,
 };
-use kinplan_core::robot::{builtin_chain, builtin_urdf};
+use kinplan_core::robot::builtin_chain;
 
-const SETS: [&str; 7] = [
-    "table_pick",
-    "table_under_pick",
-    "box",
-    "bookshelf_small",
-    "bookshelf_tall",
-    "bookshelf_thin",
-    "cage",
-];
-
-type Model = (Arc<RobotModel>, AllowedCollisions);
-
-fn model(opening: f64, cache: &mut BTreeMap<u64, Model>) -> Model {
-    cache
-        .entry(opening.to_bits())
-        .or_insert_with(|| {
-            let chain = builtin_chain("franka_panda_hand").unwrap();
-            let urdf = builtin_urdf("franka_panda_hand").unwrap();
-            let fingers = [("panda_finger_joint1", opening), ("panda_finger_joint2", opening)];
-            let attached = attached_bodies(urdf, &chain, &fingers).unwrap();
-            let model = Arc::new(RobotModel::with_parts(chain, &attached, &[]).unwrap());
-            let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
-            (model, acm)
-        })
-        .clone()
-}
-
-fn arm(joints: &[(String, f64)], field: &str) -> Result<[f64; 7], String> {
-    let mut q = [f64::NAN; 7];
-    for (name, v) in joints {
-        if let Some(i) = name
-            .strip_prefix("panda_joint")
-            .and_then(|s| s.parse::<usize>().ok())
-            && (1..=7).contains(&i)
-        {
-            q[i - 1] = *v;
-        }
-    }
-    if q.iter().any(|v| v.is_nan()) {
-        return Err(format!("{field}: missing panda_joint1..7"));
-    }
-    Ok(q)
-}
+#[path = "common/mbm_panda.rs"]
+mod mbm_panda;
+use mbm_panda::{SETS, arm, model};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = PathBuf::from(
@@ -76,6 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .ok_or("usage: mbm_validity <problems dir> [--clamp-fingers]")?,
     );
     let clamp = std::env::args().any(|a| a == "--clamp-fingers");
+    let chain = Arc::new(builtin_chain("franka_panda_hand")?);
     let mut cache = BTreeMap::new();
     println!(
         "| set | problems | invalid starts | invalid goals | depth median / max (mm) | colliding pairs (count) |"
@@ -103,7 +63,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .find(|(n, _)| n == "panda_finger_joint1")
                 .map_or(0.04, |(_, v)| *v);
             let opening = if clamp { opening.clamp(0.0, 0.04) } else { opening };
-            let (model, acm) = model(opening, &mut cache);
+            let (model, acm) = model(&chain, opening, &mut cache);
             let world = Arc::new(SceneGeometry::build(&scene)?);
             let checker = SceneChecker::new(model, &acm, world, CheckerParams::default())?;
             for (which, joints) in [("start", &request.start), ("goal", &request.goal)] {
