@@ -10,7 +10,7 @@
 use std::future::Future;
 use std::time::Instant;
 
-use kinplan_server::service::pb::{self, mobile_service_client::MobileServiceClient};
+use kinplan_client::pb::{self, mobile_service_client::MobileServiceClient};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -75,7 +75,9 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let address = args.next().unwrap_or_else(|| "127.0.0.1:50051".into());
     let calls: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(200);
-    let client = MobileServiceClient::connect(format!("http://{address}")).await?;
+    // the typed client's connection (address forms, keep-alive); navigation calls
+    // are not wrapped, so the generated stub runs on its channel
+    let client = MobileServiceClient::new(kinplan_client::Client::connect(&address).await?.channel());
     let navigate = pb::NavigateRequest {
         start: Some(pb::Pose2D::default()),
         goal: Some(pb::Point2D { x: 10.0, y: 0.0 }),

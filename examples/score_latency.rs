@@ -9,7 +9,7 @@
 
 use std::time::Instant;
 
-use kinplan_server::service::pb::{self, robot_ref::Source, scoring_service_client::ScoringServiceClient};
+use kinplan_client::pb::{self, robot_ref::Source, scoring_service_client::ScoringServiceClient};
 
 #[tokio::main(flavor = "current_thread")]
 async fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -17,8 +17,8 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     let address = args.next().unwrap_or_else(|| "127.0.0.1:50051".into());
     let calls: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(50);
     let n: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(10_000);
-    let mut client = ScoringServiceClient::connect(format!("http://{address}"))
-        .await?
+    // the typed client's connection; scoring is not wrapped, so the generated stub runs on it
+    let mut client = ScoringServiceClient::new(kinplan_client::Client::connect(&address).await?.channel())
         .max_decoding_message_size(64 * 1024 * 1024)
         .max_encoding_message_size(64 * 1024 * 1024);
     let points = (0..n)
