@@ -307,16 +307,28 @@ async fn bad_input_and_missed_deadlines_are_typed_errors() {
         .unwrap_err();
     assert_eq!(e.code(), Code::InvalidArgument, "FABRIK needs position_only: {e}");
 
-    // 1,000 distinct solutions of an unreachable pose cannot finish in 1 ms
-    let slow = client.with_timeout(Duration::from_millis(1)).robot(KR210);
-    let many = IkOptions {
-        num_solutions: Some(1000),
+    // IK fits its time budget inside the deadline: an unreachable pose under a
+    // 200 ms deadline answers the best attempt, flagged, before the deadline
+    let short = client.with_timeout(Duration::from_millis(200)).robot(KR210);
+    let endless = IkOptions {
         max_restarts: Some(1_000_000),
-        time_budget: Some(Duration::from_secs(5)),
         ..IkOptions::default()
     };
-    let e = slow
-        .ik(&Isometry3::translation(9.0, 0.0, 1.0), &[], &many)
+    let answer = short
+        .ik(&Isometry3::translation(9.0, 0.0, 1.0), &[], &endless)
+        .await
+        .unwrap();
+    assert!(!answer.success);
+    assert_eq!(answer.status, kinplan_client::IkStatus::TimeBudget);
+
+    // work that cannot fit: FK of 200,000 states in 1 ms is DEADLINE_EXCEEDED
+    let states: Vec<DVector<f64>> = (0..200_000)
+        .map(|i| DVector::from_element(6, 1e-6 * f64::from(i)))
+        .collect();
+    let e = client
+        .with_timeout(Duration::from_millis(1))
+        .robot("ur5")
+        .fk_batch(&states)
         .await
         .unwrap_err();
     assert_eq!(e.code(), Code::DeadlineExceeded, "{e}");
