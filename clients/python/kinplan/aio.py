@@ -26,7 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
-from .client import DEFAULT_TIMEOUT, Robot, RobotDescription, _channel_options, _pem, normalize_target
+from .client import DEFAULT_TIMEOUT, JointLimits, Robot, RobotDescription, _channel_options, _pem, normalize_target
 from .errors import KinplanError, error_for, invalid_argument
 from .kinematics import IkBatchResult, IkResult, _is_position, _targets, ik_options, target_to_pose
 from .planning import Obstacle, Plan, PlanningMixin, StateChecks, scene_to_proto
@@ -160,7 +160,7 @@ class Client:
         """As :meth:`kinplan.Client.score`."""
         r = self._robot_of(robot)
         limits = await r._limits()
-        _check_trajectory_limits(_LimitChecker(r, limits), q)
+        _check_trajectory_limits(lambda states, field: limits.check(states, field, r.strict), q)
         traj = trajectory_to_proto(q, timestamps)
         options = score_options(weights, series, robot_points, max_velocity, max_acceleration, jerk_peaks,
                                 potential_tolerance)
@@ -170,23 +170,6 @@ class Client:
             timeout,
         )
         return Scores.from_proto(reply)
-
-
-class _LimitChecker:
-    """The blocking robot's joint-limit check, over limits already fetched."""
-
-    def __init__(self, robot: "AsyncRobot", limits: Any):
-        self._robot, self._limits_value = robot, limits
-
-    def check_limits(self, q: Any, field_name: str = "q") -> None:
-        Robot.check_limits(self, q, field_name)  # type: ignore[arg-type]
-
-    @property
-    def strict(self) -> bool:
-        return self._robot.strict
-
-    def _limits(self) -> Any:
-        return self._limits_value
 
 
 class AsyncRobot:
@@ -220,18 +203,17 @@ class AsyncRobot:
             self.model_id = model_id
         return reply
 
-    async def _limits(self) -> Any:
+    async def _limits(self) -> JointLimits:
         cache = self.client.__dict__.setdefault("_limits_cache", {})
-        key = (self.name, None if self.urdf_text is None else hash(self.urdf_text), self.base_link, self.tip_link)
+        key = Robot.limits_key(self)  # type: ignore[arg-type]  # the same fields as Robot's
         if key not in cache:
-            d = await self.describe()
-            lower, upper = d.lower - 1e-9, d.upper + 1e-9
-            cache[key] = (lower, upper, d.joint_names, list(zip(lower.tolist(), upper.tolist())))
-        return cache[key]
+            cache[key] = JointLimits(await self.describe())
+        limits: JointLimits = cache[key]
+        return limits
 
     async def check_limits(self, q: Any, field_name: str = "q") -> None:
         """As :meth:`kinplan.Robot.check_limits` (warns, or raises when strict)."""
-        _LimitChecker(self, await self._limits()).check_limits(q, field_name)
+        (await self._limits()).check(q, field_name, self.strict)
 
     async def describe(self, *, timeout: Optional[float] = None) -> RobotDescription:
         r = await self._call(self.client._robots.DescribeRobot,

@@ -349,6 +349,40 @@ class RobotDescription:
         )
 
 
+class JointLimits:
+    """A chain's joint limits for the client-side guard against degrees: a
+    value outside [lower, upper] (1e-9 of slack) warns, or raises when strict."""
+
+    def __init__(self, d: RobotDescription):
+        self.lower = d.lower - 1e-9
+        self.upper = d.upper + 1e-9
+        self.names = d.joint_names
+        self._pairs = list(zip(self.lower.tolist(), self.upper.tolist()))
+
+    def check(self, q: Any, field_name: str, strict: bool) -> None:
+        if isinstance(q, list) and len(q) == len(self._pairs):
+            # one state as floats (fk, jacobian): a plain loop is the cheapest test
+            if all(lo <= v <= hi for v, (lo, hi) in zip(q, self._pairs)):
+                return
+        arr = np.asarray(q, dtype=float)
+        if arr.ndim == 0 or arr.shape[-1] != len(self.lower):
+            return  # the server names a wrong length
+        outside = (arr < self.lower) | (arr > self.upper)
+        if not outside.any():
+            return
+        where = np.argwhere(outside)[0]
+        j = int(where[-1])
+        value = float(arr[tuple(where)])
+        message = (
+            f"{int(outside.sum())} joint value(s) outside the limits, e.g. {self.names[j]} = {value:.6g} not in "
+            f"[{self.lower[j] + 1e-9:.6g}, {self.upper[j] - 1e-9:.6g}]; kinplan takes radians (m for prismatic "
+            "joints): degrees? use np.radians(...)"
+        )
+        if strict:
+            raise invalid_argument(field_name, message)
+        warnings.warn(f"{field_name}: {message}", JointLimitWarning, stacklevel=4)
+
+
 class Robot(RobotKinematicsMixin):
     """A robot on a server. Inline URDFs are sent once, then referred to by
     the content hash the server returns; if a replica does not hold it
@@ -364,44 +398,25 @@ class Robot(RobotKinematicsMixin):
         self.strict = strict
         self.model_id: bytes = b""
 
-    def _limits(self) -> Any:
-        """(lower, upper) joint limits, fetched once per model and chain per client."""
+    def _limits(self) -> "JointLimits":
+        """The chain's joint limits, fetched once per model and chain per client."""
         cache = self.client.__dict__.setdefault("_limits_cache", {})
-        key = (self.name, None if self.urdf_text is None else hash(self.urdf_text), self.base_link, self.tip_link)
-        limits = cache.get(key)
+        key = self.limits_key()
+        limits: Optional[JointLimits] = cache.get(key)
         if limits is None:
-            d = self.describe()
-            lower, upper = d.lower - 1e-9, d.upper + 1e-9
-            limits = cache[key] = (lower, upper, d.joint_names, list(zip(lower.tolist(), upper.tolist())))
+            limits = cache[key] = JointLimits(self.describe())
         return limits
+
+    def limits_key(self) -> Any:
+        """What identifies this robot's chain in a client's cache."""
+        return (self.name, None if self.urdf_text is None else hash(self.urdf_text), self.base_link, self.tip_link)
 
     def check_limits(self, q: Any, field_name: str = "q") -> None:
         """Warns with :class:`kinplan.JointLimitWarning` (raises
         :class:`kinplan.InvalidArgument` when the robot is strict) if a joint
         value of `q` (one state or rows of states) lies outside the limits:
         kinplan takes radians, and degrees are the usual cause."""
-        lower, upper, names, pairs = self._limits()
-        if isinstance(q, list) and len(q) == len(pairs):
-            # one state as floats (fk, jacobian): a plain loop is the cheapest test
-            if all(lo <= v <= hi for v, (lo, hi) in zip(q, pairs)):
-                return
-        arr = np.asarray(q, dtype=float)
-        if arr.ndim == 0 or arr.shape[-1] != len(lower):
-            return  # the server names a wrong length
-        outside = (arr < lower) | (arr > upper)
-        if not outside.any():
-            return
-        where = np.argwhere(outside)[0]
-        j = int(where[-1])
-        value = float(arr[tuple(where)])
-        message = (
-            f"{int(outside.sum())} joint value(s) outside the limits, e.g. {names[j]} = {value:.6g} not in "
-            f"[{lower[j] + 1e-9:.6g}, {upper[j] - 1e-9:.6g}]; kinplan takes radians (m for prismatic joints): "
-            "degrees? use np.radians(...)"
-        )
-        if self.strict:
-            raise invalid_argument(field_name, message)
-        warnings.warn(f"{field_name}: {message}", JointLimitWarning, stacklevel=3)
+        self._limits().check(q, field_name, self.strict)
 
     def _ref(self, inline: bool = False) -> common_pb2.RobotRef:
         ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link)

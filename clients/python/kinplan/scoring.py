@@ -272,8 +272,8 @@ def _encode_rows(arr: np.ndarray, ts: Optional[np.ndarray]) -> common_pb2.JointT
     return common_pb2.JointTrajectory.FromString(buf.tobytes())
 
 
-def _check_trajectory_limits(robot: Any, q: Any) -> None:
-    """The joint-limit (degrees) guard of a robot, for a rectangular trajectory."""
+def _check_trajectory_limits(check: Any, q: Any) -> None:
+    """The joint-limit (degrees) guard `check(states, field)` on a rectangular trajectory."""
     if isinstance(q, common_pb2.JointTrajectory):
         return
     try:
@@ -281,7 +281,7 @@ def _check_trajectory_limits(robot: Any, q: Any) -> None:
     except ValueError:  # ragged rows: the server names the bad one
         return
     if arr.ndim == 2 and arr.size:
-        robot.check_limits(arr, "q")
+        check(arr, "q")
 
 
 def trajectory_to_proto(q: Trajectory, timestamps: Optional[Iterable[float]] = None) -> common_pb2.JointTrajectory:
@@ -382,7 +382,7 @@ class ScoringMixin:
         fields, e.g. ``{"joint_log_gain": 3, "slowdown_floor": 0}``.
         """
         r = self._robot_of(robot)
-        _check_trajectory_limits(r, q)
+        _check_trajectory_limits(r.check_limits, q)
         traj = trajectory_to_proto(q, timestamps)
         options = score_options(weights, series, robot_points, max_velocity, max_acceleration, jerk_peaks, potential_tolerance)
         reply = r._call(
