@@ -22,7 +22,8 @@ use super::server::{ServerConfig, kinplan_routes};
 /// Length of gRPC's message prefix: a compression flag and a 4-byte length.
 const PREFIX: usize = 5;
 
-/// The kinplan services, ready to be called without a server.
+/// The kinplan services, ready to be called without a server. Clones share them.
+#[derive(Clone)]
 pub struct InProcess {
     service: Guard<tonic::service::Routes>,
     max_message_bytes: usize,
@@ -95,11 +96,7 @@ impl InProcess {
         let frames = ReceiverStream::new(receiver)
             .map(|message| Ok::<_, std::convert::Infallible>(http_body::Frame::data(frame(&message))));
         let body = Body::new(http_body_util::StreamBody::new(frames));
-        let call = InProcess {
-            service: self.service.clone(),
-            max_message_bytes: self.max_message_bytes,
-            _cut: self._cut.clone(),
-        };
+        let call = self.clone();
         let path = path.to_owned();
         let starting = tokio::spawn(async move { call.call(&path, body, timeout).await });
         let answers = ResponseStream {
