@@ -1,5 +1,7 @@
-//! Domain errors turned into `tonic::Status`, with `google.rpc.BadRequest`
-//! details naming the offending field.
+//! Every domain error turned into `tonic::Status`, with `google.rpc.BadRequest`
+//! details naming the offending field: the generic constructors here, one
+//! submodule per domain room. Only this module turns domain field identifiers
+//! into proto field paths.
 
 use tonic::{Code, Status};
 use tonic_types::{ErrorDetails, StatusExt};
