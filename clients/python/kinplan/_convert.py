@@ -20,7 +20,12 @@ def joints(q: npt.ArrayLike, name: str = "q") -> List[float]:
     return out
 
 
+_SMALL_VARINTS = [bytes((n,)) for n in range(128)]
+
+
 def _varint(n: int) -> bytes:
+    if n < 128:
+        return _SMALL_VARINTS[n]
     out = bytearray()
     while True:
         b = n & 0x7F
@@ -161,7 +166,10 @@ def pose_bytes(t: Any) -> bytes:
 
 def length_delimited(field: int, payload: bytes) -> bytes:
     """A length-delimited field (a message, bytes or a packed array) on the wire."""
-    return bytes([field << 3 | 2]) + _varint(len(payload)) + payload
+    n = len(payload)
+    if n < 128:  # tag and length in one two-byte header
+        return bytes((field << 3 | 2, n)) + payload
+    return bytes((field << 3 | 2,)) + _varint(n) + payload
 
 
 def packed_doubles(field: int, values: List[float]) -> bytes:

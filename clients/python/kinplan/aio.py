@@ -26,7 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
-from .client import DEFAULT_TIMEOUT, JointLimits, Robot, RobotDescription, _channel_options, _pem, normalize_target
+from .client import DEFAULT_TIMEOUT, JointLimits, Robot, RobotDescription, RobotRefs, _channel_options, _pem, normalize_target
 from .errors import KinplanError, error_for, invalid_argument
 from .kinematics import IkBatchResult, IkResult, _is_position, _targets, ik_options, target_to_pose
 from .planning import Obstacle, Plan, PlanningMixin, StateChecks, scene_to_proto
@@ -172,7 +172,7 @@ class Client:
         return Scores.from_proto(reply)
 
 
-class AsyncRobot:
+class AsyncRobot(RobotRefs):
     """A robot on a server, for asyncio: the model-id rule of
     :class:`kinplan.Robot` (inline URDFs sent once, resent on NOT_FOUND)."""
 
@@ -186,9 +186,6 @@ class AsyncRobot:
 
     def __repr__(self) -> str:
         return f"kinplan.aio.AsyncRobot({self.name or 'urdf'!r})"
-
-    def _ref(self, inline: bool = False) -> common_pb2.RobotRef:
-        return Robot._ref(self, inline)  # type: ignore[arg-type]  # the same fields as Robot's
 
     async def _call(self, method: Callable[..., Any], build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
         try:

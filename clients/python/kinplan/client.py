@@ -12,7 +12,7 @@ import grpc
 import numpy as np
 import numpy.typing as npt
 
-from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
+from ._convert import joints, length_delimited, matrix_from_proto, matrix_to_proto, pose_to_matrix
 from .errors import JointLimitWarning, KinplanError, error_for, invalid_argument
 from .kinematics import KinematicsMixin, RobotKinematicsMixin
 from .mobile import MobileMixin
@@ -383,7 +383,50 @@ class JointLimits:
         warnings.warn(f"{field_name}: {message}", JointLimitWarning, stacklevel=4)
 
 
-class Robot(RobotKinematicsMixin):
+class RobotRefs:
+    """How a robot names itself in requests (shared by :class:`Robot` and
+    :class:`kinplan.aio.AsyncRobot`): by name, by model id once the server
+    has given one, else (or when resending) the URDF text."""
+
+    name: Optional[str]
+    urdf_text: Optional[str]
+    base_link: str
+    tip_link: str
+    model_id: bytes
+
+    def _ref(self, inline: bool = False) -> common_pb2.RobotRef:
+        """The RobotRef of this robot's next request: by name, by model id once
+        the server has given one, else (or with `inline`) the URDF text.
+        Cached while the model id stays the same; callers copy it, never change it."""
+        key = (inline, self.model_id)
+        cached = self.__dict__.get("_ref_cache")
+        if cached is not None and cached[0] == key:
+            ref: common_pb2.RobotRef = cached[1]
+            return ref
+        ref = self._new_ref(inline)
+        self.__dict__["_ref_cache"] = (key, ref, length_delimited(1, ref.SerializeToString()))
+        return ref
+
+    def _ref_field(self, ref: common_pb2.RobotRef) -> bytes:
+        """`ref` (from :meth:`_ref`) encoded as field 1 of a request, cached with it."""
+        cached = self.__dict__.get("_ref_cache")
+        if cached is not None and cached[1] is ref:
+            encoded: bytes = cached[2]
+            return encoded
+        return length_delimited(1, ref.SerializeToString())
+
+    def _new_ref(self, inline: bool) -> common_pb2.RobotRef:
+        ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link)
+        if self.name is not None:
+            ref.name = self.name
+        elif self.model_id and not inline:
+            ref.model_id = self.model_id
+        else:
+            ref.urdf = self.urdf_text or ""
+        return ref
+
+
+class Robot(RobotRefs, RobotKinematicsMixin):
     """A robot on a server. Inline URDFs are sent once, then referred to by
     the content hash the server returns; if a replica does not hold it
     (NOT_FOUND), the URDF is sent again by itself."""
@@ -417,16 +460,6 @@ class Robot(RobotKinematicsMixin):
         value of `q` (one state or rows of states) lies outside the limits:
         kinplan takes radians, and degrees are the usual cause."""
         self._limits().check(q, field_name, self.strict)
-
-    def _ref(self, inline: bool = False) -> common_pb2.RobotRef:
-        ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link)
-        if self.name is not None:
-            ref.name = self.name
-        elif self.model_id and not inline:
-            ref.model_id = self.model_id
-        else:
-            ref.urdf = self.urdf_text or ""
-        return ref
 
     def _call(self, method: Callable[..., Any], build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
         try:

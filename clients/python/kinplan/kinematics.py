@@ -115,11 +115,12 @@ def _target_wire(T: Any) -> bytes:
 _IK_OPTIONS_WIRE: Dict[Any, bytes] = {}
 
 
-def _ik_options_wire(method: Any, linear_solver: Any, max_restarts: Any, num_solutions: Any,
+def _ik_options_field(method: Any, linear_solver: Any, max_restarts: Any, num_solutions: Any,
                      position_tolerance: Any, orientation_tolerance: Any, position_only: Any,
                      options: Dict[str, Any]) -> bytes:
-    """The encoded IkOptions of :meth:`RobotKinematicsMixin.ik`'s arguments,
-    cached per distinct set (the same message as :func:`ik_options` builds)."""
+    """The encoded IkOptions of :meth:`RobotKinematicsMixin.ik`'s arguments as
+    field 4 of a SolveIkRequest, cached per distinct set (the same message as
+    :func:`ik_options` builds)."""
     try:
         key: Any = (method, linear_solver, max_restarts, num_solutions, position_tolerance,
                     orientation_tolerance, position_only, tuple(sorted(options.items())))
@@ -132,6 +133,7 @@ def _ik_options_wire(method: Any, linear_solver: Any, max_restarts: Any, num_sol
             position_tolerance=position_tolerance, orientation_tolerance=orientation_tolerance,
             position_only=position_only, **options,
         ).SerializeToString()
+        cached = length_delimited(4, cached)
         if key is not None and len(_IK_OPTIONS_WIRE) < 256:
             _IK_OPTIONS_WIRE[key] = cached
     return cached
@@ -589,7 +591,7 @@ class RobotKinematicsMixin:
                 ("rlxa_max_iterations", rlxa_max_iterations), ("history", history),
             ) if v is not None
         }
-        options_wire = _ik_options_wire(
+        options_field = _ik_options_field(
             method, linear_solver, max_restarts, num_solutions, position_tolerance, orientation_tolerance,
             position_only, options,
         )
@@ -597,11 +599,11 @@ class RobotKinematicsMixin:
         body = (
             length_delimited(2, _target_wire(T))
             + packed_doubles(3, [] if seed is None else joints(seed, "seed"))
-            + length_delimited(4, options_wire)
+            + options_field
         )
         reply = self._call(  # type: ignore[attr-defined]
             self.client._raw_unary(_SOLVE_IK, kinematics_pb2.SolveIkResponse),  # type: ignore[attr-defined]
-            lambda ref: length_delimited(1, ref.SerializeToString()) + body,
+            lambda ref: self._ref_field(ref) + body,  # type: ignore[attr-defined]
             timeout,
         )
         return IkResult.from_proto(reply)

@@ -225,13 +225,16 @@ def test_the_fast_quaternion_is_bit_identical_to_the_numpy_one():
 
 
 def test_the_ik_request_encoded_by_hand_parses_as_the_message_built_one():
-    from kinplan.kinematics import _ik_options_wire, _target_wire, ik_options, target_to_pose
+    from kinplan.kinematics import _ik_options_field, _target_wire, ik_options, target_to_pose
     from kinplan._convert import length_delimited, packed_doubles
     from kinplan.v1 import common_pb2, kinematics_pb2
 
     rng = np.random.default_rng(3)
-    ref = common_pb2.RobotRef(name="ur5", tip_link="tool0")
+    short_ref = common_pb2.RobotRef(name="ur5", tip_link="tool0")
+    # a reference over 127 bytes: its length takes a two-byte varint
+    long_ref = common_pb2.RobotRef(urdf="<robot name='r'>" + " " * 300 + "</robot>", tip_link="tool0")
     for k in range(200):
+        ref = long_ref if k % 7 == 0 else short_ref
         q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
         T = np.eye(4)
         T[:3, :3] = q * np.sign(np.linalg.det(q))
@@ -241,7 +244,7 @@ def test_the_ik_request_encoded_by_hand_parses_as_the_message_built_one():
         wire = (length_delimited(1, ref.SerializeToString())
                 + length_delimited(2, _target_wire(T if k % 5 else (T[:3, 3], [0.0, 0.0, 0.0, 1.0])))
                 + packed_doubles(3, seed)
-                + length_delimited(4, _ik_options_wire("lm", "svd", 10, None, 1e-6, None, False, extra)))
+                + _ik_options_field("lm", "svd", 10, None, 1e-6, None, False, extra))
         expected = kinematics_pb2.SolveIkRequest(
             robot=ref, target=target_to_pose(T if k % 5 else (T[:3, 3], [0.0, 0.0, 0.0, 1.0])), seed=seed,
             options=ik_options("lm", "svd", max_restarts=10, position_tolerance=1e-6, **extra),

@@ -84,14 +84,30 @@ type BoxFuture<T> = Pin<Box<dyn Future<Output = T> + Send>>;
 
 /// What a finished call is recorded under.
 #[derive(Clone)]
-struct CallLabels {
+pub(crate) struct CallLabels {
     service: String,
     method: String,
     started: Instant,
 }
 
 impl CallLabels {
-    fn record(&self, code: &str) {
+    /// The labels of a call to `path` ("/package.Service/Method"), started now.
+    pub(crate) fn for_path(path: &str) -> CallLabels {
+        let (service, method) = path
+            .trim_start_matches('/')
+            .split_once('/')
+            .map_or(("unknown".into(), "unknown".into()), |(s, m)| {
+                (s.to_string(), m.to_string())
+            });
+        CallLabels {
+            service,
+            method,
+            started: Instant::now(),
+        }
+    }
+
+    /// Records the call as finished with `code` (a gRPC code name).
+    pub(crate) fn record(&self, code: &str) {
         let labels = [
             ("grpc_service", self.service.clone()),
             ("grpc_method", self.method.clone()),
@@ -104,7 +120,7 @@ impl CallLabels {
     }
 }
 
-fn panic_status(labels: &CallLabels, payload: &(dyn std::any::Any + Send)) -> Status {
+pub(crate) fn panic_status(labels: &CallLabels, payload: &(dyn std::any::Any + Send)) -> Status {
     let what = payload
         .downcast_ref::<&str>()
         .map(|s| s.to_string())
@@ -119,7 +135,20 @@ fn panic_status(labels: &CallLabels, payload: &(dyn std::any::Any + Send)) -> St
     Status::internal("the server failed unexpectedly while handling this call")
 }
 
-fn deadline_status() -> Status {
+/// INTERNAL for an OK reply that carried a non-finite number, logged with
+/// the call and the field numbers that lead to it.
+pub(crate) fn non_finite_status(labels: Option<&CallLabels>, at: &super::finite::NonFinite) -> Status {
+    let (service, method) = labels.map_or(("?", "?"), |l| (l.service.as_str(), l.method.as_str()));
+    tracing::error!(
+        service,
+        method,
+        field_numbers = ?at.0,
+        "an OK reply carried a non-finite number; answering INTERNAL"
+    );
+    Status::internal("the server computed a non-finite number; this is a bug")
+}
+
+pub(crate) fn deadline_status() -> Status {
     Status::deadline_exceeded("the request's deadline passed before the work finished")
 }
 
@@ -138,19 +167,7 @@ where
     }
 
     fn call(&mut self, mut request: http::Request<B>) -> Self::Future {
-        let (service, method) = request
-            .uri()
-            .path()
-            .trim_start_matches('/')
-            .split_once('/')
-            .map_or(("unknown".into(), "unknown".into()), |(s, m)| {
-                (s.to_string(), m.to_string())
-            });
-        let labels = CallLabels {
-            service,
-            method,
-            started: Instant::now(),
-        };
+        let labels = CallLabels::for_path(request.uri().path());
         let header = grpc_timeout(request.headers());
         let deadline = effective_timeout(header, self.default_timeout).and_then(deadline_after);
         request.extensions_mut().insert(RequestDeadline(deadline));
@@ -289,20 +306,8 @@ impl GuardedBody {
             if header[0] == 0
                 && let Err(at) = super::finite::check(reply_type, message)
             {
-                let (service, method) = self
-                    .labels
-                    .as_ref()
-                    .map_or(("?", "?"), |l| (l.service.as_str(), l.method.as_str()));
-                tracing::error!(
-                    service,
-                    method,
-                    field_numbers = ?at.0,
-                    "an OK reply carried a non-finite number; answering INTERNAL"
-                );
                 self.pending.clear();
-                return Err(Status::internal(
-                    "the server computed a non-finite number; this is a bug",
-                ));
+                return Err(non_finite_status(self.labels.as_ref(), &at));
             }
             complete += 5 + len;
         }

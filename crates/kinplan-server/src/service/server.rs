@@ -127,7 +127,7 @@ pub async fn serve(
     listener: TcpListener,
     shutdown: impl Future<Output = ()> + Send + 'static,
 ) -> Result<(), BoxError> {
-    let (routes, services) = kinplan_routes(&config);
+    let (routes, services) = kinplan_routes(&kinplan_shared(&config), &config);
     let (health, health_service) = tonic_health::server::health_reporter();
     for name in services {
         health.set_service_status(name, ServingStatus::Serving).await;
@@ -225,7 +225,8 @@ impl Shared {
 /// layers) over one model cache and CPU pool, with the message size
 /// limits, and their names. `serve` puts them behind a listener;
 /// [`super::InProcess`] calls them without one.
-pub(crate) fn kinplan_routes(config: &ServerConfig) -> (tonic::service::Routes, [&'static str; 6]) {
+/// The state every kinplan service adapter shares, built from `config`.
+pub(crate) fn kinplan_shared(config: &ServerConfig) -> Shared {
     let mut compute = Compute::new(
         config.cpu_threads,
         config.concurrency_limit,
@@ -234,7 +235,7 @@ pub(crate) fn kinplan_routes(config: &ServerConfig) -> (tonic::service::Routes, 
     .with_running_counter(config.running_jobs.clone());
     compute.stream_idle_timeout = config.stream_idle_timeout;
     compute.inline = config.inline_compute;
-    let shared = Shared {
+    Shared {
         models: Arc::new(ModelStore::new(
             UrdfLimits {
                 max_bytes: config.max_urdf_bytes,
@@ -248,7 +249,39 @@ pub(crate) fn kinplan_routes(config: &ServerConfig) -> (tonic::service::Routes, 
             config.model_cache_entries,
             config.acm_samples,
         )),
-    };
+    }
+}
+
+/// The six kinplan service adapters over one shared state, for callers that
+/// invoke the handlers directly (the in-process backend's unary calls).
+pub(crate) struct Apis {
+    pub robot: RobotApi,
+    pub scoring: ScoringApi,
+    pub mobile: MobileApi,
+    pub kinematics: KinematicsApi,
+    pub planning: PlanningApi,
+    pub exploration: ExplorationApi,
+}
+
+impl Apis {
+    pub(crate) fn new(shared: &Shared) -> Apis {
+        Apis {
+            robot: RobotApi::new(shared.clone()),
+            scoring: ScoringApi::new(shared.clone()),
+            mobile: MobileApi::new(shared.clone()),
+            kinematics: KinematicsApi::new(shared.clone()),
+            planning: PlanningApi::new(shared.clone()),
+            exploration: ExplorationApi::new(shared.clone()),
+        }
+    }
+}
+
+/// The kinplan services as routes, with the message size limits, and their names.
+pub(crate) fn kinplan_routes(
+    shared: &Shared,
+    config: &ServerConfig,
+) -> (tonic::service::Routes, [&'static str; 6]) {
+    let apis = Apis::new(shared);
     let limit = config.max_message_bytes;
     // Each kinplan service: its adapter, with the message size limits.
     macro_rules! service {
@@ -258,12 +291,12 @@ pub(crate) fn kinplan_routes(config: &ServerConfig) -> (tonic::service::Routes, 
                 .max_encoding_message_size(limit)
         };
     }
-    let robot = service!(RobotServiceServer, RobotApi::new(shared.clone()));
-    let scoring = service!(ScoringServiceServer, ScoringApi::new(shared.clone()));
-    let mobile = service!(MobileServiceServer, MobileApi::new(shared.clone()));
-    let kinematics = service!(KinematicsServiceServer, KinematicsApi::new(shared.clone()));
-    let planning = service!(PlanningServiceServer, PlanningApi::new(shared.clone()));
-    let exploration = service!(ExplorationServiceServer, ExplorationApi::new(shared));
+    let robot = service!(RobotServiceServer, apis.robot);
+    let scoring = service!(ScoringServiceServer, apis.scoring);
+    let mobile = service!(MobileServiceServer, apis.mobile);
+    let kinematics = service!(KinematicsServiceServer, apis.kinematics);
+    let planning = service!(PlanningServiceServer, apis.planning);
+    let exploration = service!(ExplorationServiceServer, apis.exploration);
     let names = [
         name_of(&robot),
         name_of(&scoring),

@@ -17,7 +17,9 @@ use tonic::body::Body;
 use tower::{Layer, ServiceExt};
 
 use super::guard::{Guard, GuardLayer};
-use super::server::{ServerConfig, kinplan_routes};
+use super::server::{Apis, ServerConfig, kinplan_routes, kinplan_shared};
+
+mod direct;
 
 /// Length of gRPC's message prefix: a compression flag and a 4-byte length.
 const PREFIX: usize = 5;
@@ -26,6 +28,10 @@ const PREFIX: usize = 5;
 #[derive(Clone)]
 pub struct InProcess {
     service: Guard<tonic::service::Routes>,
+    /// The same adapters over the same shared state, for unary calls made
+    /// without the router ([`direct`]).
+    apis: Arc<Apis>,
+    limits: Arc<direct::Limits>,
     max_message_bytes: usize,
     /// Shutdown never cuts in-process streams; the guard only needs a receiver.
     _cut: Arc<watch::Sender<bool>>,
@@ -46,10 +52,16 @@ impl InProcess {
     /// The services with `config`'s pool, cache and limits (its network and
     /// TLS settings do not apply). Call from inside a tokio runtime.
     pub fn new(config: &ServerConfig) -> InProcess {
-        let (routes, _) = kinplan_routes(config);
+        let shared = kinplan_shared(config);
+        let (routes, _) = kinplan_routes(&shared, config);
         let (cut, cut_rx) = watch::channel(false);
         InProcess {
             service: GuardLayer::new(cut_rx, config.request_timeout).layer(routes),
+            apis: Arc::new(Apis::new(&shared)),
+            limits: Arc::new(direct::Limits {
+                max_message_bytes: config.max_message_bytes,
+                default_timeout: config.request_timeout,
+            }),
             max_message_bytes: config.max_message_bytes,
             _cut: Arc::new(cut),
         }
@@ -58,6 +70,20 @@ impl InProcess {
     /// A unary call: `path` is "/kinplan.v1.RobotService/ForwardKinematics",
     /// `message` the encoded request; answers the encoded response.
     pub async fn unary(
+        &self,
+        path: &str,
+        message: &[u8],
+        timeout: Option<Duration>,
+    ) -> Result<Bytes, Status> {
+        if let Some(answer) = direct::unary(&self.apis, &self.limits, path, message, timeout).await {
+            return answer;
+        }
+        self.routed_unary(path, message, timeout).await
+    }
+
+    /// A unary call through the router, the guard layer and tonic's codec,
+    /// as over the network.
+    pub async fn routed_unary(
         &self,
         path: &str,
         message: &[u8],
@@ -320,6 +346,146 @@ mod tests {
             .await
             .unwrap_err();
         assert_eq!(garbage.code(), tonic::Code::Internal, "{garbage:?}");
+    }
+
+    /// Every unary kinplan method, as the proto declares them.
+    const UNARY_PATHS: [&str; 21] = [
+        "/kinplan.v1.RobotService/ListRobots",
+        "/kinplan.v1.RobotService/DescribeRobot",
+        "/kinplan.v1.RobotService/ForwardKinematics",
+        "/kinplan.v1.RobotService/Jacobian",
+        "/kinplan.v1.RobotService/ForwardKinematicsBatch",
+        "/kinplan.v1.KinematicsService/SolveIk",
+        "/kinplan.v1.KinematicsService/SolveIkBatch",
+        "/kinplan.v1.KinematicsService/TrackPath",
+        "/kinplan.v1.KinematicsService/SolveLinearSystem",
+        "/kinplan.v1.ScoringService/ScoreTrajectory",
+        "/kinplan.v1.ScoringService/CompareTrajectories",
+        "/kinplan.v1.MobileService/WheelKinematics",
+        "/kinplan.v1.MobileService/ControlStep",
+        "/kinplan.v1.MobileService/FollowPath",
+        "/kinplan.v1.MobileService/Navigate",
+        "/kinplan.v1.PlanningService/Plan",
+        "/kinplan.v1.PlanningService/CheckState",
+        "/kinplan.v1.ExplorationService/NextBestView",
+        "/kinplan.v1.ExplorationService/InsertScan",
+        "/kinplan.v1.ExplorationService/OctreeInfo",
+        "/kinplan.v1.ExplorationService/ReferenceScene",
+    ];
+
+    /// The direct answer and the routed one (the network's path: router,
+    /// guard layer, tonic's codec) to the same request.
+    async fn both(
+        local: &InProcess,
+        path: &str,
+        message: &[u8],
+        timeout: Option<Duration>,
+    ) -> (Result<Bytes, Status>, Result<Bytes, Status>) {
+        let direct = direct::unary(&local.apis, &local.limits, path, message, timeout)
+            .await
+            .expect("a unary kinplan method is answered directly");
+        (direct, local.routed_unary(path, message, timeout).await)
+    }
+
+    #[tokio::test]
+    async fn direct_unary_calls_answer_as_the_routed_ones() {
+        let local = InProcess::new(&ServerConfig::default());
+        // an empty request to every method: the same code and message either way
+        for path in UNARY_PATHS {
+            let (direct, routed) = both(&local, path, &[], Some(Duration::from_secs(5))).await;
+            match (direct, routed) {
+                (Ok(a), Ok(b)) => assert_eq!(a, b, "{path}"),
+                (Err(a), Err(b)) => {
+                    assert_eq!((a.code(), a.message()), (b.code(), b.message()), "{path}");
+                    assert_eq!(a.details(), b.details(), "{path}");
+                }
+                (a, b) => panic!("{path}: direct {a:?}, routed {b:?}"),
+            }
+        }
+        // deterministic answers are byte-identical
+        let fk = pb::ForwardKinematicsRequest {
+            robot: kr210(),
+            joint_positions: vec![0.1, -1.5, 1.4, 0.2, 0.3, 0.4],
+            include_links: true,
+        }
+        .encode_to_vec();
+        let jacobian = pb::JacobianRequest {
+            robot: kr210(),
+            joint_positions: vec![0.1, -1.5, 1.4, 0.2, 0.3, 0.4],
+        }
+        .encode_to_vec();
+        for (path, message) in [
+            ("/kinplan.v1.RobotService/ForwardKinematics", fk),
+            ("/kinplan.v1.RobotService/Jacobian", jacobian),
+        ] {
+            let (direct, routed) = both(&local, path, &message, None).await;
+            assert_eq!(direct.unwrap(), routed.unwrap(), "{path}");
+        }
+        // garbage bytes: tonic's codec answers INTERNAL, so does the direct path
+        let (direct, routed) = both(
+            &local,
+            "/kinplan.v1.RobotService/ForwardKinematics",
+            &[0xff, 0xff, 0xff],
+            None,
+        )
+        .await;
+        assert_eq!(direct.unwrap_err().code(), routed.unwrap_err().code());
+        // streams and unknown methods are not answered directly
+        for path in [
+            "/kinplan.v1.KinematicsService/StreamIk",
+            "/kinplan.v1.RobotService/Nope",
+        ] {
+            assert!(
+                direct::unary(&local.apis, &local.limits, path, &[], None)
+                    .await
+                    .is_none()
+            );
+        }
+    }
+
+    #[tokio::test]
+    async fn a_direct_call_keeps_its_deadline_and_the_message_limit() {
+        let config = ServerConfig {
+            max_message_bytes: 4 << 20,
+            ..ServerConfig::default()
+        };
+        let local = InProcess::new(&config);
+        // 40,000 FK states cannot be answered in 200 µs
+        let batch = pb::ForwardKinematicsBatchRequest {
+            robot: kr210(),
+            joint_positions: Some(pb::Matrix {
+                rows: 40_000,
+                cols: 6,
+                data: vec![0.1; 240_000],
+            }),
+            ..Default::default()
+        }
+        .encode_to_vec();
+        let started = std::time::Instant::now();
+        let status = local
+            .unary(
+                "/kinplan.v1.RobotService/ForwardKinematicsBatch",
+                &batch,
+                Some(Duration::from_micros(200)),
+            )
+            .await
+            .unwrap_err();
+        assert_eq!(status.code(), tonic::Code::DeadlineExceeded, "{status:?}");
+        assert!(
+            started.elapsed() < Duration::from_millis(500),
+            "{:?}",
+            started.elapsed()
+        );
+        // a request over the message limit is refused before decoding
+        let status = local
+            .unary(
+                "/kinplan.v1.RobotService/ForwardKinematics",
+                &vec![0u8; (4 << 20) + 1],
+                None,
+            )
+            .await
+            .unwrap_err();
+        assert_eq!(status.code(), tonic::Code::OutOfRange, "{status:?}");
     }
 
     #[tokio::test]
