@@ -155,11 +155,12 @@ struct Args {
     clamp: bool,
     resolution: f64,
     shortcut_resolution: Option<f64>,
+    padded: bool,
     out: PathBuf,
 }
 
 fn args() -> Result<Args, String> {
-    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--out PREFIX]";
+    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--out PREFIX]";
     let mut it = std::env::args().skip(1);
     let mut a = Args {
         root: PathBuf::new(),
@@ -168,6 +169,7 @@ fn args() -> Result<Args, String> {
         clamp: false,
         resolution: CheckerParams::default().motion_resolution,
         shortcut_resolution: None,
+        padded: false,
         out: PathBuf::from("target/mbm_bench"),
     };
     let mut root = None;
@@ -181,6 +183,7 @@ fn args() -> Result<Args, String> {
             "--passes" => a.passes = num("--passes")?.max(1),
             "--stomp" => a.stomp = num("--stomp")?,
             "--clamp-fingers" => a.clamp = true,
+            "--padded" => a.padded = true,
             "--shortcut-resolution" => {
                 a.shortcut_resolution = Some(
                     it.next()
@@ -219,6 +222,10 @@ impl StateChecker for Counting<'_> {
     }
     fn clearance(&self, q: &[f64], max_distance: f64) -> f64 {
         self.inner.clearance(q, max_distance)
+    }
+    fn padded_valid(&self, q: &[f64], half_step: &[f64]) -> Option<bool> {
+        self.states.fetch_add(1, Ordering::Relaxed);
+        self.inner.padded_valid(q, half_step)
     }
     fn motion_check(&self) -> MotionCheck {
         self.inner.motion_check()
@@ -300,6 +307,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 world,
                 CheckerParams {
                     motion_resolution: a.resolution,
+                    padded_motion: a.padded,
                 },
             )?;
             let build_us = t.elapsed().as_secs_f64() * 1e6;
@@ -393,8 +401,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // Per-set summary.
     println!(
         "RRT-Connect (RrtParams::default(): range 1.0, 100 shortcut attempts; seed = problem number), \
-         motion resolution {} rad, shortcut resolution {:?}, passes = {}, fingers {}",
+         motion resolution {} rad{}, shortcut resolution {:?}, passes = {}, fingers {}",
         a.resolution,
+        if a.padded { " padded (conservative)" } else { "" },
         a.shortcut_resolution,
         a.passes,
         if a.clamp {

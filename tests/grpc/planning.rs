@@ -563,3 +563,50 @@ async fn bad_input_is_named_by_field() {
         );
     }
 }
+
+#[tokio::test]
+async fn padded_motions_plan_around_the_sphere_and_an_unbounded_robot_is_refused() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let ball = blocking_sphere(&mut robots).await;
+    let mut req = request(pb::PlanAlgorithm::RrtConnect, vec![ball.clone()]);
+    req.options = Some(pb::PlanOptions {
+        padded_motion: true,
+        ..Default::default()
+    });
+    let r = planning.plan(req).await.unwrap().into_inner();
+    assert_eq!(r.status, pb::PlanStatus::Succeeded as i32, "{}", r.message);
+    assert_path_valid(&mut planning, &[ball], r.trajectory.as_ref().unwrap(), 0.002).await;
+
+    // a telescope on a turntable: its links can move arbitrarily far
+    let telescope = r#"<robot name="t"><link name="base"/><link name="turn"/>
+      <link name="tip"><collision><geometry><sphere radius="0.02"/></geometry></collision></link>
+      <joint name="r" type="revolute"><parent link="base"/><child link="turn"/><axis xyz="0 0 1"/>
+        <limit lower="-3" upper="3" effort="0" velocity="1"/></joint>
+      <joint name="p" type="prismatic"><parent link="turn"/><child link="tip"/><axis xyz="1 0 0"/>
+        <limit lower="-inf" upper="inf" effort="0" velocity="1"/></joint></robot>"#;
+    let req = pb::PlanRequest {
+        robot: Some(pb::RobotRef {
+            source: Some(pb::robot_ref::Source::Urdf(telescope.into())),
+            ..Default::default()
+        }),
+        start: vec![0.0, 0.5],
+        goal: Some(Goal::GoalJoints(pb::JointState {
+            positions: vec![1.0, 0.5],
+        })),
+        scene: None,
+        algorithm: pb::PlanAlgorithm::RrtConnect as i32,
+        options: Some(pb::PlanOptions {
+            padded_motion: true,
+            ..Default::default()
+        }),
+        seed: 1,
+    };
+    let status = planning.plan(req).await.unwrap_err();
+    assert_eq!(status.code(), Code::InvalidArgument, "{status:?}");
+    assert!(
+        status.message().starts_with("options.padded_motion"),
+        "{status:?}"
+    );
+}

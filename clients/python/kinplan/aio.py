@@ -128,12 +128,12 @@ class Client:
     async def plan(self, robot: Any, *, start: Any, goal: Any = None, pose: Any = None,
                    algorithm: str = "rrt_connect", scene: Optional[Sequence[Obstacle]] = None, seed: int = 0,
                    time_budget: Optional[float] = None, motion_resolution: Optional[float] = None,
-                   return_cost_history: bool = True, stomp: Any = None, cartesian: Any = None,
+                   padded_motion: bool = False, return_cost_history: bool = True, stomp: Any = None, cartesian: Any = None,
                    rrt_connect: Any = None, timing: Any = None, timeout: Optional[float] = None) -> Plan:
         """As :meth:`kinplan.Client.plan`."""
         build = PlanningMixin._plan_request(
             self,  # type: ignore[arg-type]  # it reads no attribute of self
-            robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution,
+            robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution, padded_motion,
             return_cost_history, stomp, cartesian, rrt_connect, timing,
         )
         return Plan.from_proto(await self._robot_of(robot)._call(self._planning.Plan, build, timeout))

@@ -322,6 +322,7 @@ class PlanningMixin:
         seed: int,
         time_budget: Optional[float],
         motion_resolution: Optional[float],
+        padded_motion: bool,
         return_cost_history: bool,
         stomp: Optional[Mapping[str, Any]],
         cartesian: Optional[Mapping[str, Any]],
@@ -343,6 +344,7 @@ class PlanningMixin:
             options.time_budget = float(time_budget)
         if motion_resolution is not None:
             options.motion_resolution = float(motion_resolution)
+        options.padded_motion = bool(padded_motion)
         proto_scene = scene_to_proto(scene)
 
         def build(ref: common_pb2.RobotRef) -> planning_pb2.PlanRequest:
@@ -374,6 +376,7 @@ class PlanningMixin:
         seed: int = 0,
         time_budget: Optional[float] = None,
         motion_resolution: Optional[float] = None,
+        padded_motion: bool = False,
         return_cost_history: bool = True,
         stomp: Optional[Mapping[str, Any]] = None,
         cartesian: Optional[Mapping[str, Any]] = None,
@@ -386,10 +389,13 @@ class PlanningMixin:
         "ccstomp". ``stomp``, ``cartesian``, ``rrt_connect`` and ``timing`` take
         the fields of the proto messages of those names (e.g.
         ``stomp={"timesteps": 10}``, ``cartesian={"translation_tolerance": 1.0}``);
-        unset fields take the documented defaults. The same ``seed`` gives the
+        unset fields take the documented defaults. ``padded_motion=True``
+        checks motions conservatively (no state of an accepted motion
+        collides; slower); by default states ``motion_resolution`` apart are
+        checked (an obstacle thinner than one step can be grazed). The same ``seed`` gives the
         same answer."""
         build = self._plan_request(
-            robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution,
+            robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution, padded_motion,
             return_cost_history, stomp, cartesian, rrt_connect, timing,
         )
         reply = robot._call(self._planning().Plan, build, timeout)
@@ -403,7 +409,8 @@ class PlanningMixin:
         are those of :meth:`plan`."""
         build = self._plan_request(
             robot, start, goal, pose, algorithm, scene, seed, options.pop("time_budget", None),
-            options.pop("motion_resolution", None), options.pop("return_cost_history", True),
+            options.pop("motion_resolution", None), options.pop("padded_motion", False),
+            options.pop("return_cost_history", True),
             options.pop("stomp", None), options.pop("cartesian", None), options.pop("rrt_connect", None),
             options.pop("timing", None),
         )

@@ -47,6 +47,14 @@ def test_a_plan_goes_around_the_ball_within_the_speed_limits(client, ur5, algori
     assert "SUCCEEDED" in repr(plan)
 
 
+def test_padded_motions_give_a_path_free_at_a_fine_resolution(client, ur5):
+    ball = blocking_ball(ur5)
+    plan = client.plan(ur5, start=START, goal=GOAL, algorithm="rrt_connect", scene=[ball], seed=5,
+                       padded_motion=True)
+    assert plan.success and plan.valid, plan.message
+    assert client.check_states(ur5, interpolate(plan.q, 0.002), [ball]).valid.all()
+
+
 def test_a_pose_goal_ends_at_the_pose(client, ur5):
     T = ur5.fk(GOAL)
     plan = client.plan(ur5, start=START, pose=T, algorithm="rrt_connect")

@@ -113,7 +113,7 @@ class TimingOptions(_message.Message):
     def __init__(self, max_velocity: _Optional[_Iterable[float]] = ..., max_acceleration: _Optional[_Iterable[float]] = ..., default_velocity: _Optional[float] = ..., velocity_scale: _Optional[float] = ...) -> None: ...
 
 class PlanOptions(_message.Message):
-    __slots__ = ("stomp", "cartesian", "rrt_connect", "timing", "motion_resolution", "time_budget", "return_cost_history")
+    __slots__ = ("stomp", "cartesian", "rrt_connect", "timing", "motion_resolution", "time_budget", "return_cost_history", "padded_motion")
     STOMP_FIELD_NUMBER: _ClassVar[int]
     CARTESIAN_FIELD_NUMBER: _ClassVar[int]
     RRT_CONNECT_FIELD_NUMBER: _ClassVar[int]
@@ -121,6 +121,7 @@ class PlanOptions(_message.Message):
     MOTION_RESOLUTION_FIELD_NUMBER: _ClassVar[int]
     TIME_BUDGET_FIELD_NUMBER: _ClassVar[int]
     RETURN_COST_HISTORY_FIELD_NUMBER: _ClassVar[int]
+    PADDED_MOTION_FIELD_NUMBER: _ClassVar[int]
     stomp: StompOptions
     cartesian: CartesianOptions
     rrt_connect: RrtConnectOptions
@@ -128,7 +129,8 @@ class PlanOptions(_message.Message):
     motion_resolution: float
     time_budget: float
     return_cost_history: bool
-    def __init__(self, stomp: _Optional[_Union[StompOptions, _Mapping]] = ..., cartesian: _Optional[_Union[CartesianOptions, _Mapping]] = ..., rrt_connect: _Optional[_Union[RrtConnectOptions, _Mapping]] = ..., timing: _Optional[_Union[TimingOptions, _Mapping]] = ..., motion_resolution: _Optional[float] = ..., time_budget: _Optional[float] = ..., return_cost_history: _Optional[bool] = ...) -> None: ...
+    padded_motion: bool
+    def __init__(self, stomp: _Optional[_Union[StompOptions, _Mapping]] = ..., cartesian: _Optional[_Union[CartesianOptions, _Mapping]] = ..., rrt_connect: _Optional[_Union[RrtConnectOptions, _Mapping]] = ..., timing: _Optional[_Union[TimingOptions, _Mapping]] = ..., motion_resolution: _Optional[float] = ..., time_budget: _Optional[float] = ..., return_cost_history: _Optional[bool] = ..., padded_motion: _Optional[bool] = ...) -> None: ...
 
 class JointState(_message.Message):
     __slots__ = ("positions",)

@@ -2,6 +2,8 @@
 //! is checked: the robot-and-scene checker implements them with parry3d, and
 //! tests implement them with closed-form toy worlds.
 
+use super::padded::padded_motion_valid;
+
 /// Validity queries on joint states of one robot in one scene.
 ///
 /// Joint values are radians (revolute) or metres (prismatic), one per joint
@@ -28,6 +30,15 @@ pub trait StateChecker: Sync {
         interpolate_motion_valid(self, a, b, self.motion_check())
     }
 
+    /// True when `q` is within the limits and every state `q + d` with
+    /// `|d_j| ≤ half_step[j]` for each joint is free of collisions (the
+    /// robot's bodies padded by how far they can move); `None` when this
+    /// checker cannot bound its bodies' motion (the default).
+    fn padded_valid(&self, q: &[f64], half_step: &[f64]) -> Option<bool> {
+        let _ = (q, half_step);
+        None
+    }
+
     /// How [`StateChecker::motion_valid`] checks a motion. Default: states
     /// interpolated at most 0.05 rad (or m) apart on every joint.
     fn motion_check(&self) -> MotionCheck {
@@ -42,6 +53,26 @@ pub enum MotionCheck {
     /// on every joint (rad or m, > 0), both ends included. Not conservative:
     /// an obstacle thinner than the swept distance of one step can be missed.
     Interpolated { resolution: f64 },
+    /// Conservative: pieces of at most `resolution` per joint, each accepted
+    /// when its midpoint is free with every robot body padded by the
+    /// farthest any of its points can move within the piece
+    /// ([`super::SweepBound`]), else halved (see [`padded_motion_valid`]). An
+    /// accepted motion collides nowhere.
+    Padded { resolution: f64 },
+}
+
+impl MotionCheck {
+    /// The largest joint step between checked states (rad or m).
+    pub fn resolution(self) -> f64 {
+        match self {
+            MotionCheck::Interpolated { resolution } | MotionCheck::Padded { resolution } => resolution,
+        }
+    }
+
+    /// True for [`MotionCheck::Padded`].
+    pub fn is_padded(self) -> bool {
+        matches!(self, MotionCheck::Padded { .. })
+    }
 }
 
 /// Checks `a → b` at evenly spaced states no more than `resolution` apart on
@@ -49,7 +80,8 @@ pub enum MotionCheck {
 /// equal steps, visited in bisection order (midpoint first, then quarter
 /// points, …) so a collision in the middle of a long motion is found after few
 /// checks. Both end states are checked. At most 17 joints
-/// (`MAX_DOF`); longer chains are rejected as invalid.
+/// (`MAX_DOF`); longer chains are rejected as invalid. A padded check runs
+/// [`padded_motion_valid`] between the two checked ends.
 pub fn interpolate_motion_valid<C: StateChecker + ?Sized>(
     checker: &C,
     a: &[f64],
@@ -57,13 +89,16 @@ pub fn interpolate_motion_valid<C: StateChecker + ?Sized>(
     check: MotionCheck,
 ) -> bool {
     const MAX_DOF: usize = 17;
-    let MotionCheck::Interpolated { resolution } = check;
+    let resolution = check.resolution();
     let n = a.len();
     if n != b.len() || n > MAX_DOF || resolution.is_nan() || resolution <= 0.0 {
         return false;
     }
     if !checker.is_valid(a) || !checker.is_valid(b) {
         return false;
+    }
+    if check.is_padded() {
+        return padded_motion_valid(checker, a, b, resolution, || false) == Some(true);
     }
     let span = a
         .iter()

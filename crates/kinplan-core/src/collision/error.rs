@@ -40,6 +40,11 @@ pub enum CollisionError {
     UnknownName { field: String, name: String },
     #[error("{field}: could not parse: {reason}")]
     Parse { field: String, reason: String },
+    #[error(
+        "motions of this robot cannot be padded: a prismatic joint without limits after a revolute one \
+         can move its links arbitrarily far"
+    )]
+    CannotPad,
     #[error("{field} = {value} is outside [{lower}, {upper}]")]
     OutOfRange {
         field: String,

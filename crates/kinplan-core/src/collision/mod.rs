@@ -13,7 +13,11 @@
 //! Semantics: touching counts as collision; scene meshes are surfaces
 //! (a robot part wholly inside a closed mesh does not touch it); robot
 //! meshes are used as convex hulls; motions are checked at interpolated
-//! states at most 0.05 rad apart (not conservative between states).
+//! states at most 0.05 rad apart — by default each state as it is (not
+//! conservative between states), or piece by piece with every body padded
+//! by how far it can move within the piece ([`MotionCheck::Padded`],
+//! conservative: no state of an accepted motion collides; see
+//! [`padded_motion_valid`] and [`SweepBound`]).
 //! Narrow phase: closed forms for robot spheres/capsules against spheres,
 //! capsules, boxes and cells (cylinders bracketed by capsules), parry for
 //! the rest and for every distance query.
@@ -34,8 +38,10 @@ mod model;
 mod moveit;
 mod narrow;
 mod octree_cells;
+mod padded;
 mod scene;
 mod scene_checker;
+mod sweep;
 mod world;
 
 pub use acm::{AcmParams, AllowReason, AllowedCollisions};
@@ -45,8 +51,10 @@ pub use error::CollisionError;
 pub use model::{AttachedBody, InlineMesh, MAX_BODIES, MAX_LINKS, RobotModel};
 pub use moveit::{JointRequest, MAX_YAML_BYTES, parse_joint_request, parse_planning_scene};
 pub use octree_cells::octree_cells;
+pub use padded::{MAX_CHECKS_PER_PIECE, MIN_PIECE, padded_motion_valid};
 pub use scene::{Geometry, Obstacle, Scene, SceneLimits};
 pub use scene_checker::{CheckerParams, Part, Proximity, SceneChecker, StateReport};
+pub use sweep::SweepBound;
 pub use world::SceneGeometry;
 
 #[cfg(test)]

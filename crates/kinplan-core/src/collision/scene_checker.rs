@@ -19,6 +19,7 @@ use super::model::{MAX_BODIES, RobotModel};
 use super::narrow::{
     Witness, body_body_contact, body_body_intersect, body_leaf_contact, body_leaf_intersect, sphere_center,
 };
+use super::sweep::SweepBound;
 use super::world::SceneGeometry;
 use super::{CollisionError, MotionCheck, StateChecker};
 
@@ -28,12 +29,17 @@ pub struct CheckerParams {
     /// Largest joint step (rad or m) between states checked along a motion
     /// (default 0.05, the coarsest allowed resolution).
     pub motion_resolution: f64,
+    /// Check each state of a motion with every body padded by how far it can
+    /// move in half a step ([`MotionCheck::Padded`], conservative); `false`
+    /// checks the states as they are ([`MotionCheck::Interpolated`]).
+    pub padded_motion: bool,
 }
 
 impl Default for CheckerParams {
     fn default() -> Self {
         CheckerParams {
             motion_resolution: 0.05,
+            padded_motion: false,
         }
     }
 }
@@ -149,6 +155,8 @@ pub struct SceneChecker {
     /// Body pairs tested for self-collision, `a < b`.
     self_pairs: Vec<(u16, u16)>,
     params: CheckerParams,
+    /// How far bodies move per joint step (`None`: unbounded, cannot pad).
+    sweep: Option<SweepBound>,
 }
 
 impl SceneChecker {
@@ -169,11 +177,16 @@ impl SceneChecker {
             });
         }
         let self_pairs = acm.checked_pairs().map(|(a, b)| (a as u16, b as u16)).collect();
+        let sweep = SweepBound::new(&model);
+        if params.padded_motion && sweep.is_none() {
+            return Err(CollisionError::CannotPad);
+        }
         Ok(SceneChecker {
             model,
             world,
             self_pairs,
             params,
+            sweep,
         })
     }
 
@@ -213,6 +226,35 @@ impl SceneChecker {
         self.self_pairs.iter().any(|&(a, b)| {
             let (a, b) = (a as usize, b as usize);
             body_body_intersect(&bodies[a], &poses[a], &bodies[b], &poses[b])
+        })
+    }
+
+    /// True when some body comes closer than its pad to an obstacle, or two
+    /// checked bodies closer than the sum of their pads (touching included):
+    /// with `pads[b]` the farthest body `b` can move, no state within that
+    /// motion of `q` collides when this is false. `q` must hold `dof` finite
+    /// values.
+    pub fn in_collision_padded(&self, q: &[f64], pads: &[f64; MAX_BODIES]) -> bool {
+        let mut poses = [Isometry3::identity(); MAX_BODIES];
+        self.model.body_poses(q, &mut poses);
+        let bodies = &self.model.bodies;
+        // A zero pad still counts touching: contacts are reported below the margin.
+        let margin = |pad: f64| pad.max(f64::MIN_POSITIVE);
+        for (b, body) in bodies.iter().enumerate().rev() {
+            let c = sphere_center(body, &poses[b]);
+            let m = margin(pads[b]);
+            let query = Aabb::around_sphere(&c, body.radius + m);
+            let free = self.world.bvh.for_each_overlap(&query, |leaf| {
+                body_leaf_contact(body, &poses[b], &c, &self.world.leaves[leaf as usize], m).is_none()
+            });
+            if !free {
+                return true;
+            }
+        }
+        self.self_pairs.iter().any(|&(a, b)| {
+            let (a, b) = (a as usize, b as usize);
+            let m = margin(pads[a] + pads[b]);
+            body_body_contact(&bodies[a], &poses[a], &bodies[b], &poses[b], m).is_some()
         })
     }
 
@@ -368,9 +410,23 @@ impl StateChecker for SceneChecker {
             .map_or(max_distance, |(w, _, _)| w.distance.min(max_distance))
     }
 
+    /// Within the limits and, every body padded by its [`SweepBound`] over
+    /// `half_step`, free of collisions; `None` without a finite bound.
+    fn padded_valid(&self, q: &[f64], half_step: &[f64]) -> Option<bool> {
+        let sweep = self.sweep.as_ref()?;
+        if !self.within_limits(q) || half_step.len() != q.len() {
+            return Some(false);
+        }
+        let mut pads = [0.0; MAX_BODIES];
+        sweep.pads(half_step, &mut pads);
+        Some(!self.in_collision_padded(q, &pads))
+    }
+
     fn motion_check(&self) -> MotionCheck {
-        MotionCheck::Interpolated {
-            resolution: self.params.motion_resolution,
+        let resolution = self.params.motion_resolution;
+        match self.params.padded_motion {
+            false => MotionCheck::Interpolated { resolution },
+            true => MotionCheck::Padded { resolution },
         }
     }
 }

@@ -10,6 +10,7 @@ use super::*;
 use crate::robot::{ChainSpec, UrdfLimits, parse_chain};
 
 mod robot;
+mod sweep;
 
 /// URDF of the xyz probe whose link carries `geometry` (URDF XML).
 pub(super) fn probe_urdf(geometry: &str) -> String {

@@ -7,7 +7,7 @@ use super::cartesian::{CartesianLine, Deviation, cartesian_cost, deviation, viol
 use super::clock::Clock;
 use super::stomp_matrices::ACCELERATION_STENCIL;
 use super::{CartesianParams, StompParams};
-use crate::collision::{MotionCheck, StateChecker};
+use crate::collision::{StateChecker, padded_motion_valid};
 use crate::robot::Chain;
 
 /// Everything that stays fixed while one trajectory is optimised.
@@ -74,7 +74,9 @@ impl Evaluation {
 
 /// True when every state strictly between `a` and `b`, at most `resolution`
 /// apart per joint (max-norm), is valid — the ends are not checked; states
-/// visited in bisection order (`2^k ≥ span/resolution` equal steps).
+/// visited in bisection order (`2^k ≥ span/resolution` equal steps). Under a
+/// padded motion check ([`crate::collision::MotionCheck::Padded`]) the whole motion is proved
+/// free by [`padded_motion_valid`] instead.
 /// `None` when `clock` was interrupted (checked every 32 states).
 pub(crate) fn interior_valid<C: StateChecker + ?Sized>(
     checker: &C,
@@ -84,6 +86,9 @@ pub(crate) fn interior_valid<C: StateChecker + ?Sized>(
     buf: &mut [f64],
     clock: &Clock<'_>,
 ) -> Option<bool> {
+    if checker.motion_check().is_padded() {
+        return padded_motion_valid(checker, a, b, resolution, || clock.interrupted().is_some());
+    }
     let span = a
         .iter()
         .zip(b)
@@ -145,8 +150,7 @@ pub(crate) fn path_valid<C: StateChecker + ?Sized>(
 
 /// The check resolution of `checker` (rad or m).
 pub(crate) fn resolution_of<C: StateChecker + ?Sized>(checker: &C) -> f64 {
-    let MotionCheck::Interpolated { resolution } = checker.motion_check();
-    resolution
+    checker.motion_check().resolution()
 }
 
 impl<C: StateChecker + ?Sized> CostModel<'_, C> {

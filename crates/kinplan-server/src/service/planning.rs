@@ -23,7 +23,7 @@ use super::scene::scene_in;
 use super::server::Shared;
 use super::status::invalid;
 use super::{Budget, models::Resolved};
-use kinplan_core::collision::{CheckerParams, SceneChecker, SceneGeometry, SceneLimits};
+use kinplan_core::collision::{CheckerParams, CollisionError, SceneChecker, SceneGeometry, SceneLimits};
 use kinplan_core::plan::{Goal, IterationReport, PlanControl, PlanStatus, plan};
 
 /// Most states one CheckState request may ask about.
@@ -123,9 +123,12 @@ fn checker_for(
     world: Arc<SceneGeometry>,
     params: CheckerParams,
 ) -> Result<SceneChecker, Status> {
-    SceneChecker::new(setup.model.clone(), &setup.acm, world, params).map_err(|e| {
-        tracing::error!(error = %e, "collision checker rejected service-built input");
-        Status::internal(format!("collision checker: {e}"))
+    SceneChecker::new(setup.model.clone(), &setup.acm, world, params).map_err(|e| match e {
+        CollisionError::CannotPad => invalid("options.padded_motion", e.to_string()),
+        e => {
+            tracing::error!(error = %e, "collision checker rejected service-built input");
+            Status::internal(format!("collision checker: {e}"))
+        }
     })
 }
 

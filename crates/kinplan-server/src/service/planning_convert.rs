@@ -198,6 +198,7 @@ pub fn plan_input(req: &pb::PlanRequest) -> Result<PlanInput, Status> {
         }
         checker.motion_resolution = res;
     }
+    checker.padded_motion = options.padded_motion;
     let time_budget = optional_seconds("options.time_budget", options.time_budget)?;
     Ok(PlanInput {
         request,

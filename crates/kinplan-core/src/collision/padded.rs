@@ -1,0 +1,116 @@
+//! The conservative motion check, [`super::MotionCheck::Padded`].
+
+use super::StateChecker;
+
+/// Most joints the check handles (stack buffers): as many as a chain with a
+/// collision model can have.
+const MAX_DOF: usize = super::MAX_LINKS;
+/// A piece whose largest joint span is below this (rad or m) is not halved
+/// further: the motion is refused (it grazes an obstacle, or touches it).
+pub const MIN_PIECE: f64 = 1e-5;
+/// Most padded states checked per initial piece before the motion is
+/// refused: bounds the cost of a motion that runs along an obstacle.
+pub const MAX_CHECKS_PER_PIECE: usize = 64;
+
+/// True when no state of the straight motion `a → b` collides, proved piece
+/// by piece (conservative advancement over joint space, Schwarzer, Saha and
+/// Latombe's idea with the distance test replaced by a padded overlap test):
+///
+/// the motion is cut into `2^k ≥ span/resolution` equal pieces; a piece
+/// `[s, t]` with midpoint `m` and joint half-extent `h = |b − a|·(t − s)/2`
+/// is accepted when the robot at `q(m)` is within its limits and free with
+/// every body padded by its sweep bound `δ_b(h)` — every state of the piece
+/// is within `h` of `q(m)`, so no point of body `b` is farther than `δ_b(h)`
+/// from where it is at `q(m)`. A piece that fails is refused if `q(m)`
+/// itself collides, else halved. Pieces below [`MIN_PIECE`] or more than
+/// [`MAX_CHECKS_PER_PIECE`] checks per initial piece refuse the motion.
+///
+/// The ends are not checked here (a straight motion between two states
+/// within the limits stays within them). `None` when `interrupted()` says so
+/// (asked every 32 checks); `Some(false)` as well when the checker cannot
+/// pad or the chain has more than `MAX_LINKS` joints.
+pub fn padded_motion_valid<C: StateChecker + ?Sized>(
+    checker: &C,
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+    mut interrupted: impl FnMut() -> bool,
+) -> Option<bool> {
+    let n = a.len();
+    if n != b.len() || n > MAX_DOF || resolution.is_nan() || resolution <= 0.0 {
+        return Some(false);
+    }
+    let mut delta = [0.0; MAX_DOF];
+    for (d, (x, y)) in delta.iter_mut().zip(a.iter().zip(b)) {
+        *d = y - x;
+    }
+    let delta = &delta[..n];
+    let span = delta.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+    if !span.is_finite() {
+        return Some(false);
+    }
+    let pieces = (span / resolution).ceil().max(1.0);
+    if pieces > 1e7 {
+        return Some(false);
+    }
+    let pieces = (pieces as usize).next_power_of_two();
+    let (mut q, mut half) = ([0.0; MAX_DOF], [0.0; MAX_DOF]);
+    let mut checks = 0usize;
+    // Pieces in bisection order (the middle one first), each proved by
+    // halving where needed; a stack of parameter intervals.
+    let mut stack: Vec<(f64, f64)> = Vec::new();
+    for index in bisection_order(pieces) {
+        let mut budget = MAX_CHECKS_PER_PIECE;
+        stack.clear();
+        stack.push((index as f64 / pieces as f64, (index + 1) as f64 / pieces as f64));
+        while let Some((s, t)) = stack.pop() {
+            checks += 1;
+            if checks.is_multiple_of(32) && interrupted() {
+                return None;
+            }
+            if budget == 0 {
+                return Some(false);
+            }
+            budget -= 1;
+            let m = 0.5 * (s + t);
+            for j in 0..n {
+                q[j] = a[j] + m * delta[j];
+                half[j] = 0.5 * (t - s) * delta[j].abs();
+            }
+            match checker.padded_valid(&q[..n], &half[..n]) {
+                None => return Some(false),
+                Some(true) => continue,
+                Some(false) => {}
+            }
+            if (t - s) * span < MIN_PIECE || !checker.is_valid(&q[..n]) {
+                return Some(false);
+            }
+            stack.push((m, t));
+            stack.push((s, m));
+        }
+    }
+    Some(true)
+}
+
+/// `0..count` (a power of two) in bisection order: 0, then the odd
+/// multiples of count/2, of count/4, … (8: 0, 4, 2, 6, 1, 3, 5, 7).
+fn bisection_order(count: usize) -> impl Iterator<Item = usize> {
+    let strides = std::iter::successors(Some(count), |s| (*s > 1).then_some(s / 2)).take_while(|s| *s > 1);
+    std::iter::once(0).chain(strides.flat_map(move |stride| (stride / 2..count).step_by(stride)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::bisection_order;
+
+    #[test]
+    fn bisection_order_visits_every_piece_once() {
+        for count in [1usize, 2, 4, 8, 64] {
+            let mut seen: Vec<usize> = bisection_order(count).collect();
+            assert_eq!(seen.len(), count, "{count}: {seen:?}");
+            seen.sort_unstable();
+            assert_eq!(seen, (0..count).collect::<Vec<_>>());
+        }
+        assert_eq!(bisection_order(8).collect::<Vec<_>>(), [0, 4, 2, 6, 1, 3, 5, 7]);
+    }
+}

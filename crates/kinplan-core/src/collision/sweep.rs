@@ -1,0 +1,87 @@
+//! How far a robot body can move when the joints move: the bound behind the
+//! padded (conservative) motion check, [`super::MotionCheck::Padded`].
+//!
+//! While joint `j` turns by `|Δq_j|`, a point at distance `r` from its axis
+//! moves at most `|Δq_j| · r`; a prismatic joint moves every point after it
+//! by `|Δq_j|`. Along a straight joint-space motion the velocities add, so a
+//! point of body `b` moves at most
+//!
+//! ```text
+//! δ_b(Δq) = Σ_{j moves b} |Δq_j| · L_{j,b}
+//! ```
+//!
+//! where `L_{j,b}` bounds the distance from joint `j`'s axis of every point
+//! of `b` in every configuration: `1` for a prismatic `j`, and for a revolute
+//! `j` the distance from its frame origin (on the axis) to the body's bounding
+//! sphere, through the chain — `Σ_{i>j} (|t(O_i)| + e_i) + |c_b| + r_b`, with
+//! `O_i` the fixed origin of joint `i`, `e_i` a prismatic joint's largest
+//! travel `max(|lower|, |upper|)` (0 for a revolute one), `c_b` the bounding
+//! sphere's centre in the frame of the last joint moving `b` and `r_b` its
+//! radius. Rotations keep lengths, so the bound holds for every `q`.
+
+use nalgebra::Point3;
+
+use super::model::{MAX_BODIES, RobotModel};
+use crate::robot::JointKind;
+
+/// The lever arms `L_{j,b}` of a robot model (see the module doc).
+#[derive(Debug, Clone)]
+pub struct SweepBound {
+    dof: usize,
+    /// `levers[b * dof + j] = L_{j,b}`, 0 where joint `j` does not move body `b`.
+    levers: Vec<f64>,
+}
+
+impl SweepBound {
+    /// The bound of `model`'s bodies; `None` when a lever is infinite (a
+    /// prismatic joint without limits before a revolute one).
+    pub fn new(model: &RobotModel) -> Option<SweepBound> {
+        let chain = model.chain();
+        let (joints, links) = (chain.joints(), chain.links());
+        let dof = joints.len();
+        let mut levers = vec![0.0; model.bodies.len() * dof];
+        for (b, body) in model.bodies.iter().enumerate() {
+            let link = &links[body.link];
+            let Some(last) = link.after_joint else {
+                continue; // fixed to the base: nothing moves it
+            };
+            let centre = (link.offset * body.offset).transform_point(&Point3::from(body.center));
+            // Distance from joint j's origin to the sphere's far side, built
+            // from the last joint moving the body back to the first.
+            let mut reach = centre.coords.norm() + body.radius;
+            for j in (0..=last.min(dof - 1)).rev() {
+                let joint = &joints[j];
+                levers[b * dof + j] = match joint.kind {
+                    JointKind::Prismatic => 1.0,
+                    JointKind::Revolute | JointKind::Continuous => reach,
+                };
+                let travel = match joint.kind {
+                    JointKind::Prismatic => joint.lower.abs().max(joint.upper.abs()),
+                    JointKind::Revolute | JointKind::Continuous => 0.0,
+                };
+                reach += travel + joint.origin.translation.vector.norm();
+            }
+        }
+        levers
+            .iter()
+            .all(|v| v.is_finite())
+            .then_some(SweepBound { dof, levers })
+    }
+
+    /// `δ_b(Δq)` for every body into `pads[..bodies]`, with `Δq = step`
+    /// (absolute values are taken).
+    pub fn pads(&self, step: &[f64], pads: &mut [f64; MAX_BODIES]) {
+        if self.dof == 0 {
+            pads.fill(0.0);
+            return;
+        }
+        for (pad, levers) in pads.iter_mut().zip(self.levers.chunks_exact(self.dof)) {
+            *pad = levers.iter().zip(step).map(|(l, d)| l * d.abs()).sum();
+        }
+    }
+
+    /// `L_{j,b}` (m per rad, or 1 for a prismatic joint).
+    pub fn lever(&self, body: usize, joint: usize) -> f64 {
+        self.levers[body * self.dof + joint]
+    }
+}

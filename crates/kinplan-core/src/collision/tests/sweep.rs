@@ -1,0 +1,334 @@
+//! The sweep bound and the padded motion check: levers derived by hand, the
+//! bound against the true motion of body points, and padded motions against
+//! a fine interpolated check.
+
+use std::sync::Arc;
+
+use nalgebra::{Isometry3, Point3, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::super::*;
+use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
+
+/// Two revolute z joints: joint 1 at the base, joint 2 1 m along link 1's x.
+/// Link 1 carries a 0.1 m sphere 0.5 m out, link 2 a 0.05 m sphere 0.3 m out.
+const TWO_LINK: &str = r#"<robot name="two">
+  <link name="base"/>
+  <link name="l1"><collision><origin xyz="0.5 0 0"/><geometry><sphere radius="0.1"/></geometry></collision></link>
+  <link name="l2"><collision><origin xyz="0.3 0 0"/><geometry><sphere radius="0.05"/></geometry></collision></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="0" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="0" velocity="1"/></joint>
+</robot>"#;
+
+/// One revolute z joint swinging a 1 cm sphere at 1 m.
+const SWING: &str = r#"<robot name="swing">
+  <link name="base"/>
+  <link name="arm"><collision><origin xyz="1 0 0"/><geometry><sphere radius="0.01"/></geometry></collision></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="0" velocity="1"/></joint>
+</robot>"#;
+
+fn model_of(urdf: &str) -> Arc<RobotModel> {
+    let chain = Arc::new(parse_chain(urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
+    Arc::new(RobotModel::new(chain).unwrap())
+}
+
+fn checker_with(model: Arc<RobotModel>, obstacles: Vec<Obstacle>, padded: bool) -> SceneChecker {
+    // the Panda's neighbours of neighbours always touch: sample which pairs never or always do
+    let acm = match model.body_count() > 2 {
+        true => AllowedCollisions::sampled(
+            &model,
+            &AcmParams {
+                samples: 2000,
+                ..AcmParams::default()
+            },
+        )
+        .unwrap(),
+        false => AllowedCollisions::adjacent(&model),
+    };
+    let scene = Scene::new(obstacles, &SceneLimits::default()).unwrap();
+    let world = Arc::new(SceneGeometry::build(&scene).unwrap());
+    let params = CheckerParams {
+        padded_motion: padded,
+        ..CheckerParams::default()
+    };
+    SceneChecker::new(model, &acm, world, params).unwrap()
+}
+
+/// Every state `resolution` apart or closer along `a → b` valid (brute force).
+fn fine_motion_valid(c: &SceneChecker, a: &[f64], b: &[f64], resolution: f64) -> bool {
+    let span = a.iter().zip(b).map(|(x, y)| (y - x).abs()).fold(0.0, f64::max);
+    let n = (span / resolution).ceil().max(1.0) as usize;
+    (0..n).all(|i| {
+        let t = i as f64 / n as f64;
+        let q: Vec<f64> = a.iter().zip(b).map(|(x, y)| x + t * (y - x)).collect();
+        c.is_valid(&q)
+    }) && c.is_valid(b) // the end exactly: a + 1·(b − a) may round past a limit
+}
+
+/// Twelve thin posts and plates 0.35–0.8 m from the Panda's base axis.
+fn posts(rng: &mut ChaCha8Rng) -> Vec<Obstacle> {
+    (0..12)
+        .map(|k| {
+            let (angle, radius): (f64, f64) = (
+                rng.random_range(0.0..std::f64::consts::TAU),
+                rng.random_range(0.35..0.8),
+            );
+            let p = Vector3::new(
+                radius * angle.cos(),
+                radius * angle.sin(),
+                rng.random_range(0.0..1.0),
+            );
+            let h = Vector3::new(rng.random_range(0.003..0.05), rng.random_range(0.003..0.05), 0.2);
+            Obstacle::new(
+                format!("b{k}"),
+                Isometry3::translation(p.x, p.y, p.z),
+                Geometry::Box { half_extents: h },
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn levers_of_a_two_link_arm_are_the_hand_derived_reaches() {
+    let sweep = SweepBound::new(&model_of(TWO_LINK)).unwrap();
+    // body 0 = l1: 0.5 + 0.1 from joint 1, untouched by joint 2
+    assert!((sweep.lever(0, 0) - 0.6).abs() < 1e-12);
+    assert_eq!(sweep.lever(0, 1), 0.0);
+    // body 1 = l2: 0.3 + 0.05 from joint 2; from joint 1 also the 1 m link
+    assert!((sweep.lever(1, 1) - 0.35).abs() < 1e-12);
+    assert!((sweep.lever(1, 0) - 1.35).abs() < 1e-12);
+    let mut pads = [0.0; MAX_BODIES];
+    sweep.pads(&[0.1, -0.2], &mut pads);
+    assert!((pads[0] - 0.06).abs() < 1e-12);
+    assert!((pads[1] - (0.135 + 0.07)).abs() < 1e-12);
+}
+
+#[test]
+fn no_point_of_a_panda_body_moves_farther_than_its_pad() {
+    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let sweep = SweepBound::new(&model).unwrap();
+    let joints = model.chain().joints().to_vec();
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let (mut at_a, mut at_t) = (
+        [Isometry3::identity(); MAX_BODIES],
+        [Isometry3::identity(); MAX_BODIES],
+    );
+    let mut tightest = 0.0_f64;
+    for _ in 0..300 {
+        let q: Vec<f64> = joints
+            .iter()
+            .map(|j| rng.random_range(j.lower..j.upper))
+            .collect();
+        let dq: Vec<f64> = (0..q.len()).map(|_| rng.random_range(-0.1..0.1)).collect();
+        let mut pads = [0.0; MAX_BODIES];
+        sweep.pads(&dq, &mut pads);
+        model.body_poses(&q, &mut at_a);
+        for s in 1..=20 {
+            let t = f64::from(s) / 20.0;
+            let qt: Vec<f64> = q.iter().zip(&dq).map(|(x, d)| x + t * d).collect();
+            model.body_poses(&qt, &mut at_t);
+            for (b, body) in model.bodies.iter().enumerate() {
+                // the bounding sphere's centre and its six poles
+                let mut points = vec![Point3::from(body.center)];
+                for axis in 0..3 {
+                    for sign in [-1.0, 1.0] {
+                        let mut p = body.center;
+                        p[axis] += sign * body.radius;
+                        points.push(Point3::from(p));
+                    }
+                }
+                for p in points {
+                    let moved = (at_t[b] * p - at_a[b] * p).norm();
+                    assert!(
+                        moved <= pads[b] + 1e-12,
+                        "body {b}: moved {moved} > pad {}",
+                        pads[b]
+                    );
+                    if pads[b] > 0.0 {
+                        tightest = tightest.max(moved / pads[b]);
+                    }
+                }
+            }
+        }
+    }
+    // the bound is not vacuous: some point comes within a factor 3 of it
+    assert!(tightest > 0.33, "tightest ratio {tightest}");
+}
+
+#[test]
+fn a_padded_check_finds_the_graze_between_two_checked_states() {
+    // A 2 mm cube where the swinging sphere passes at θ = 0; the motion
+    // θ = -0.025 → 0.025 (one 0.05 rad step) has free end states.
+    let cube = Obstacle::new(
+        "cube",
+        Isometry3::translation(1.0, 0.0, 0.0),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.001),
+        },
+    );
+    let (a, b) = ([-0.025], [0.025]);
+    let plain = checker_with(model_of(SWING), vec![cube.clone()], false);
+    let padded = checker_with(model_of(SWING), vec![cube], true);
+    assert!(plain.is_valid(&a) && plain.is_valid(&b));
+    assert!(
+        !fine_motion_valid(&plain, &a, &b, 1e-4),
+        "the motion does collide"
+    );
+    assert!(plain.motion_valid(&a, &b), "0.05 rad interpolation misses it");
+    assert!(!padded.motion_valid(&a, &b), "padding catches it");
+    assert_eq!(padded.motion_check(), MotionCheck::Padded { resolution: 0.05 });
+    // swinging on the far side is free for both
+    assert!(plain.motion_valid(&[2.0], &[3.0]) && padded.motion_valid(&[2.0], &[3.0]));
+}
+
+#[test]
+fn every_motion_a_padded_panda_check_accepts_is_free_at_a_fine_resolution() {
+    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let obstacles = posts(&mut rng);
+    let plain = checker_with(model.clone(), obstacles.clone(), false);
+    let padded = checker_with(model.clone(), obstacles, true);
+    let joints = model.chain().joints().to_vec();
+    let (mut accepted, mut plain_misses) = (0, 0);
+    for _ in 0..400 {
+        let a: Vec<f64> = joints
+            .iter()
+            .map(|j| rng.random_range(j.lower..j.upper))
+            .collect();
+        let b: Vec<f64> = a
+            .iter()
+            .zip(&joints)
+            .map(|(x, j)| (x + rng.random_range(-0.3..0.3)).clamp(j.lower, j.upper))
+            .collect();
+        let truth = fine_motion_valid(&plain, &a, &b, 0.002);
+        if padded.motion_valid(&a, &b) {
+            accepted += 1;
+            assert!(truth, "a padded check accepted a colliding motion {a:?} → {b:?}");
+        }
+        if plain.motion_valid(&a, &b) && !truth {
+            plain_misses += 1;
+        }
+    }
+    // the padded check still accepts free motions (it is not vacuous)
+    assert!(accepted > 40, "accepted {accepted}");
+    eprintln!("padded accepted {accepted}; plain interpolation missed {plain_misses} collisions");
+}
+
+#[test]
+fn an_unlimited_prismatic_joint_after_a_revolute_one_cannot_be_padded() {
+    // A prismatic probe moves each point by |Δq| per joint, limits or not.
+    let probe = super::probe_urdf(r#"<sphere radius="0.02"/>"#)
+        .replace(r#"lower="-10" upper="10""#, r#"lower="-inf" upper="inf""#);
+    let probe = model_of(&probe);
+    assert!(probe.chain().joints().iter().all(|j| !j.upper.is_finite()));
+    let mut pads = [0.0; MAX_BODIES];
+    SweepBound::new(&probe)
+        .unwrap()
+        .pads(&[0.01, -0.02, 0.03], &mut pads);
+    assert!((pads[0] - 0.06).abs() < 1e-15);
+    // A telescope on a turntable: the turntable's lever is unbounded.
+    let telescope = r#"<robot name="t"><link name="base"/><link name="turn"/>
+      <link name="tip"><collision><geometry><sphere radius="0.02"/></geometry></collision></link>
+      <joint name="r" type="revolute"><parent link="base"/><child link="turn"/><axis xyz="0 0 1"/>
+        <limit lower="-3" upper="3" effort="0" velocity="1"/></joint>
+      <joint name="p" type="prismatic"><parent link="turn"/><child link="tip"/><axis xyz="1 0 0"/>
+        <limit lower="-inf" upper="inf" effort="0" velocity="1"/></joint></robot>"#;
+    let model = model_of(telescope);
+    assert!(SweepBound::new(&model).is_none());
+    let acm = AllowedCollisions::adjacent(&model);
+    let world = Arc::new(SceneGeometry::build(&Scene::empty()).unwrap());
+    let params = CheckerParams {
+        padded_motion: true,
+        ..CheckerParams::default()
+    };
+    let err = SceneChecker::new(model.clone(), &acm, world.clone(), params).unwrap_err();
+    assert_eq!(err, CollisionError::CannotPad);
+    // an unpadded checker of the same robot works, and fails padded states
+    let plain = SceneChecker::new(model, &acm, world, CheckerParams::default()).unwrap();
+    assert!(plain.is_valid(&[0.0, 0.5]));
+    assert_eq!(plain.padded_valid(&[0.0, 0.5], &[0.01, 0.01]), None);
+    assert_eq!(
+        padded_motion_valid(&plain, &[0.0, 0.5], &[0.1, 0.6], 0.05, || false),
+        Some(false)
+    );
+    assert!(plain.motion_valid(&[0.0, 0.5], &[0.1, 0.6]));
+}
+
+#[test]
+fn rrt_connect_with_padded_motions_returns_paths_free_at_a_fine_resolution() {
+    use crate::plan::{Algorithm, Goal, PlanControl, PlanRequest, PlanStatus, plan};
+    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let obstacles = posts(&mut rng);
+    let plain = checker_with(model.clone(), obstacles.clone(), false);
+    let padded = checker_with(model.clone(), obstacles, true);
+    let joints = model.chain().joints().to_vec();
+    let mut random_valid = || loop {
+        let q: Vec<f64> = joints
+            .iter()
+            .map(|j| rng.random_range(j.lower..j.upper))
+            .collect();
+        if padded.padded_valid(&q, &[0.0; 7]) == Some(true) {
+            return q;
+        }
+    };
+    let mut solved = 0;
+    for seed in 0..6 {
+        let (start, goal) = (random_valid(), random_valid());
+        let request = PlanRequest {
+            start: start.clone(),
+            goal: Goal::Joints(goal.clone()),
+            algorithm: Algorithm::RrtConnect,
+            seed,
+            ..Default::default()
+        };
+        let r = plan(model.chain(), &padded, &request, PlanControl::default()).unwrap();
+        if r.status != PlanStatus::Succeeded {
+            continue;
+        }
+        solved += 1;
+        assert!(r.valid);
+        for w in r.q.chunks_exact(7).collect::<Vec<_>>().windows(2) {
+            assert!(
+                fine_motion_valid(&plain, w[0], w[1], 0.002),
+                "seed {seed}: a segment collides"
+            );
+        }
+    }
+    assert!(solved >= 4, "solved {solved} of 6");
+}
+
+#[test]
+fn pieces_are_halved_along_a_near_wall_until_their_pads_fit() {
+    // The xyz probe (a 2 cm sphere) slides 5 cm along x beside a wall.
+    let wall_at = |gap: f64| {
+        Obstacle::new(
+            "wall",
+            Isometry3::translation(0.0, 0.02 + gap + 0.005, 0.0),
+            Geometry::Box {
+                half_extents: Vector3::new(1.0, 0.005, 1.0),
+            },
+        )
+    };
+    let probe = || model_of(&super::probe_urdf(r#"<sphere radius="0.02"/>"#));
+    let (a, b) = ([0.0, 0.0, 0.0], [0.05, 0.0, 0.0]);
+    // 5 mm away: one 5 cm piece pads 2.5 cm; halved three times it pads
+    // 3.1 mm < 5 mm, so the motion is proved free
+    let padded = checker_with(probe(), vec![wall_at(0.005)], true);
+    assert!(padded.motion_valid(&a, &b));
+    // 0.1 mm away it would take pieces of 0.1 mm: more than the budget
+    let padded = checker_with(probe(), vec![wall_at(0.0001)], true);
+    let plain = checker_with(probe(), vec![wall_at(0.0001)], false);
+    assert!(plain.motion_valid(&a, &b) && fine_motion_valid(&plain, &a, &b, 1e-4));
+    assert!(
+        !padded.motion_valid(&a, &b),
+        "refused: conservative within its budget"
+    );
+    // touching: refused
+    let padded = checker_with(probe(), vec![wall_at(0.0)], true);
+    assert!(!padded.motion_valid(&a, &b));
+}
