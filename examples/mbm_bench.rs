@@ -76,7 +76,8 @@ fn fine_check(checker: &SceneChecker, path: &[f64], dof: usize, step: f64) -> (b
         for i in 0..=n {
             let t = i as f64 / n as f64;
             for j in 0..dof {
-                q[j] = a[j] + t * (b[j] - a[j]);
+                // the ends exactly: a + 1·(b − a) may round past a joint limit
+                q[j] = if i == n { b[j] } else { a[j] + t * (b[j] - a[j]) };
             }
             if !checker.is_valid(&q) {
                 ok = false;

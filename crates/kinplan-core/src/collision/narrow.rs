@@ -13,13 +13,13 @@
 //! reported as colliding: the safe answer for a planner.
 
 use nalgebra::{Isometry3, Point3, Vector3};
-use parry3d_f64::math::Pose;
+use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query;
-use parry3d_f64::shape::SharedShape;
+use parry3d_f64::shape::{Cuboid, SharedShape};
 
 use super::convert::{point_from_parry, pose_to_parry};
-use super::fast::{distance, distance_robot, overlap, overlap_robot};
-use super::model::Body;
+use super::fast::{RobotFast, distance, distance_robot, overlap, overlap_robot};
+use super::model::{Body, BodyShape};
 use super::world::Leaf;
 
 /// The closest (or deepest) pair of points between two shapes.
@@ -181,4 +181,84 @@ pub(crate) fn closer(a: Option<Witness>, b: Option<Witness>) -> Option<Witness> 
         (x, None) => x,
         (None, y) => y,
     }
+}
+
+/// `shape` grown by `margin`: a swept sphere exactly (radius + margin).
+fn grown(shape: &RobotFast, margin: f64) -> RobotFast {
+    match *shape {
+        RobotFast::Swept { a, b, r } => RobotFast::Swept { a, b, r: r + margin },
+        RobotFast::None => RobotFast::None,
+    }
+}
+
+/// True when body shape `s` at `pose` (world), grown by `margin`, overlaps
+/// `other` at `other_pose`: a cuboid grows to half extents + margin (a box
+/// around the rounded one, so never smaller), anything else by parry's
+/// contact within `margin`.
+fn parry_within(s: &BodyShape, pose: &Pose, other_pose: &Pose, other: &SharedShape, margin: f64) -> bool {
+    match s.shape.as_cuboid() {
+        Some(c) => {
+            let big = Cuboid::new(c.half_extents + Vector::splat(margin));
+            query::intersection_test(pose, &big, other_pose, &**other).map_or(true, |i| i.intersecting)
+        }
+        None => contact(pose, &s.shape, other_pose, other, margin).is_some(),
+    }
+}
+
+/// True when a body at `pa`, grown by `margin` (m, > 0), overlaps a scene
+/// leaf — conservative: whenever some point of the body is within `margin`
+/// of the leaf. Swept spheres grow exactly and use the closed forms; other
+/// shapes as [`parry_within`] says.
+pub(crate) fn body_leaf_within(
+    a: &Body,
+    pa: &Isometry3<f64>,
+    center: &Vector3<f64>,
+    leaf: &Leaf,
+    margin: f64,
+) -> bool {
+    let r = a.radius + margin;
+    if leaf.aabb.distance_squared(center) > r * r {
+        return false;
+    }
+    a.shapes
+        .iter()
+        .any(|sa| match overlap(&grown(&sa.fast, margin), pa, &leaf.fast) {
+            Some(hit) => hit,
+            None => parry_within(
+                sa,
+                &pose_to_parry(&(pa * sa.offset)),
+                &leaf.pose,
+                &leaf.shape,
+                margin,
+            ),
+        })
+}
+
+/// True when body `a` at `pa` comes within `margin` (m, > 0) of body `b` at
+/// `pb` (conservative, as [`body_leaf_within`]).
+pub(crate) fn body_body_within(
+    a: &Body,
+    pa: &Isometry3<f64>,
+    b: &Body,
+    pb: &Isometry3<f64>,
+    margin: f64,
+) -> bool {
+    let r = a.radius + b.radius + margin;
+    if (sphere_center(a, pa) - sphere_center(b, pb)).norm_squared() > r * r {
+        return false;
+    }
+    a.shapes.iter().any(|sa| {
+        b.shapes.iter().any(
+            |sb| match overlap_robot(&grown(&sa.fast, margin), pa, &sb.fast, pb) {
+                Some(hit) => hit,
+                None => {
+                    let (qa, qb) = (pose_to_parry(&(pa * sa.offset)), pose_to_parry(&(pb * sb.offset)));
+                    match sb.shape.as_cuboid() {
+                        Some(_) => parry_within(sb, &qb, &qa, &sa.shape, margin),
+                        None => parry_within(sa, &qa, &qb, &sb.shape, margin),
+                    }
+                }
+            },
+        )
+    })
 }

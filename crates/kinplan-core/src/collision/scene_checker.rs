@@ -17,7 +17,8 @@ use super::acm::AllowedCollisions;
 use super::bvh::Aabb;
 use super::model::{MAX_BODIES, RobotModel};
 use super::narrow::{
-    Witness, body_body_contact, body_body_intersect, body_leaf_contact, body_leaf_intersect, sphere_center,
+    Witness, body_body_contact, body_body_intersect, body_body_within, body_leaf_contact,
+    body_leaf_intersect, body_leaf_within, sphere_center,
 };
 use super::sweep::SweepBound;
 use super::world::SceneGeometry;
@@ -238,14 +239,13 @@ impl SceneChecker {
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
         let bodies = &self.model.bodies;
-        // A zero pad still counts touching: contacts are reported below the margin.
+        // A zero pad still counts touching: growing by a hair keeps `≤ 0` a hit.
         let margin = |pad: f64| pad.max(f64::MIN_POSITIVE);
         for (b, body) in bodies.iter().enumerate().rev() {
             let c = sphere_center(body, &poses[b]);
             let m = margin(pads[b]);
-            let query = Aabb::around_sphere(&c, body.radius + m);
-            let free = self.world.bvh.for_each_overlap(&query, |leaf| {
-                body_leaf_contact(body, &poses[b], &c, &self.world.leaves[leaf as usize], m).is_none()
+            let free = self.world.bvh.for_each_near(&c, body.radius + m, |leaf| {
+                !body_leaf_within(body, &poses[b], &c, &self.world.leaves[leaf as usize], m)
             });
             if !free {
                 return true;
@@ -253,8 +253,13 @@ impl SceneChecker {
         }
         self.self_pairs.iter().any(|&(a, b)| {
             let (a, b) = (a as usize, b as usize);
-            let m = margin(pads[a] + pads[b]);
-            body_body_contact(&bodies[a], &poses[a], &bodies[b], &poses[b], m).is_some()
+            body_body_within(
+                &bodies[a],
+                &poses[a],
+                &bodies[b],
+                &poses[b],
+                margin(pads[a] + pads[b]),
+            )
         })
     }
 

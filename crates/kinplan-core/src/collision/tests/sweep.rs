@@ -332,3 +332,40 @@ fn pieces_are_halved_along_a_near_wall_until_their_pads_fit() {
     let padded = checker_with(probe(), vec![wall_at(0.0)], true);
     assert!(!padded.motion_valid(&a, &b));
 }
+
+#[test]
+fn a_grown_shape_hits_whatever_is_within_the_margin_and_little_beyond() {
+    // Every probe shape against every obstacle kind, at random positions:
+    // a clearance below the margin must be a padded hit, and a padded hit
+    // is at most √3 margins away (a box grows into the box around the
+    // rounded one; everything else grows exactly).
+    let mut rng = ChaCha8Rng::seed_from_u64(9);
+    for (probe, geometry, _, meshes) in super::probes() {
+        for (obstacle, shape, _, _) in super::obstacles() {
+            let c = super::checker(
+                &super::probe_urdf(&geometry),
+                &meshes,
+                vec![Obstacle::new("o", Isometry3::identity(), shape)],
+            );
+            for _ in 0..60 {
+                let q = [
+                    rng.random_range(-0.6..0.6),
+                    rng.random_range(-0.6..0.6),
+                    rng.random_range(-0.6..0.6),
+                ];
+                let d = c.clearance(&q, 1.0);
+                for margin in [0.005, 0.02, 0.05] {
+                    let hit = c.in_collision_padded(&q, &[margin; MAX_BODIES]);
+                    assert!(
+                        d >= margin || hit,
+                        "{probe} vs {obstacle} at {q:?}: clearance {d} < {margin}, no hit"
+                    );
+                    assert!(
+                        !hit || d <= margin * 3f64.sqrt() + 1e-9,
+                        "{probe} vs {obstacle} at {q:?}: hit at clearance {d} > √3·{margin}"
+                    );
+                }
+            }
+        }
+    }
+}
