@@ -92,51 +92,38 @@ where
     Fut: Future<Output = Result<tonic::Response<Resp>, Status>>,
 {
     let labels = CallLabels::for_path(path);
-    let answer = answer(limits, &labels, path, message, timeout, handler).await;
+    let answer: Result<Bytes, Status> = async {
+        let deadline = effective_timeout(timeout, limits.default_timeout).and_then(deadline_after);
+        within_limit("request", message.len(), limits.max_message_bytes)?;
+        let decoded = Req::decode(message)
+            .map_err(|e| Status::internal(format!("failed to decode Protobuf message: {e}")))?;
+        let mut request = tonic::Request::new(decoded);
+        request.extensions_mut().insert(RequestDeadline(deadline));
+        let future = std::panic::catch_unwind(AssertUnwindSafe(|| handler(request)))
+            .map_err(|panic| panic_status(&labels, &*panic))?;
+        let guarded = catch_unwind(future);
+        let outcome = match deadline {
+            Some(d) => tokio::time::timeout_at(d.into(), guarded)
+                .await
+                .map_err(|_| deadline_status())?,
+            None => guarded.await,
+        };
+        let reply = outcome
+            .map_err(|panic| panic_status(&labels, &*panic))??
+            .into_inner();
+        let encoded = reply.encode_to_vec();
+        within_limit("reply", encoded.len(), limits.max_message_bytes)?;
+        if let Some(reply_type) = finite::reply_type(path) {
+            finite::check(reply_type, &encoded).map_err(|at| non_finite_status(Some(&labels), &at))?;
+        }
+        Ok(Bytes::from(encoded))
+    }
+    .await;
     labels.record(match &answer {
         Ok(_) => "OK",
         Err(status) => code_name(status.code() as i32),
     });
     answer
-}
-
-async fn answer<Req, Resp, Fut>(
-    limits: &Limits,
-    labels: &CallLabels,
-    path: &str,
-    message: &[u8],
-    timeout: Option<Duration>,
-    handler: impl FnOnce(tonic::Request<Req>) -> Fut,
-) -> Result<Bytes, Status>
-where
-    Req: Message + Default,
-    Resp: Message,
-    Fut: Future<Output = Result<tonic::Response<Resp>, Status>>,
-{
-    let deadline = effective_timeout(timeout, limits.default_timeout).and_then(deadline_after);
-    within_limit("request", message.len(), limits.max_message_bytes)?;
-    let decoded = Req::decode(message)
-        .map_err(|e| Status::internal(format!("failed to decode Protobuf message: {e}")))?;
-    let mut request = tonic::Request::new(decoded);
-    request.extensions_mut().insert(RequestDeadline(deadline));
-    let future = std::panic::catch_unwind(AssertUnwindSafe(|| handler(request)))
-        .map_err(|panic| panic_status(labels, &*panic))?;
-    let guarded = catch_unwind(future);
-    let outcome = match deadline {
-        Some(d) => tokio::time::timeout_at(d.into(), guarded)
-            .await
-            .map_err(|_| deadline_status())?,
-        None => guarded.await,
-    };
-    let reply = outcome
-        .map_err(|panic| panic_status(labels, &*panic))??
-        .into_inner();
-    let encoded = reply.encode_to_vec();
-    within_limit("reply", encoded.len(), limits.max_message_bytes)?;
-    if let Some(reply_type) = finite::reply_type(path) {
-        finite::check(reply_type, &encoded).map_err(|at| non_finite_status(Some(labels), &at))?;
-    }
-    Ok(Bytes::from(encoded))
 }
 
 /// OUT_OF_RANGE for a message over the limit, as tonic's codec answers it.
