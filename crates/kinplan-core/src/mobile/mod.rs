@@ -4,6 +4,7 @@
 mod angle;
 mod chassis;
 mod error;
+mod field;
 mod goal_seeking;
 mod grid_astar;
 mod lyapunov;
@@ -22,6 +23,10 @@ pub use chassis::{
     CarParams, Chassis, ChassisStep, DifferentialParams, OmniParams, Saturation, TricycleParams,
 };
 pub use error::MobileError;
+pub use field::{
+    AstarField, ChassisKind, ChassisParam, Component, FollowField, FollowParam, LyapunovParam, MobileField,
+    ObstaclePart, PurePursuitParam, SensorField, SimField, SteeringParam, VdfField, WheelField,
+};
 pub use goal_seeking::{SteeringCommand, SteeringParams, goal_seeking_finished, goal_seeking_step};
 pub use grid_astar::{GridAstarParams, plan_grid_astar, plan_grid_astar_until};
 pub use lyapunov::{LyapunovCommand, LyapunovParams, lyapunov_step, lyapunov_value};

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::angle::wrap_angle;
 use super::error::{MobileError, check_positive, check_range};
+use super::field::{Component, FollowField, FollowParam, MobileField};
 use super::goal_seeking::{SteeringParams, goal_seeking_step};
 use super::lyapunov::{LyapunovParams, lyapunov_step_unchecked};
 use super::pose::{Point2, Pose, Twist};
@@ -96,10 +97,16 @@ impl PathFollowParams {
 
     /// Positive distances and tolerances; nested parameter sets valid.
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive("follow.switching_distance", self.switching_distance)?;
-        check_positive("follow.goal_tolerance", self.goal_tolerance)?;
+        check_positive(
+            MobileField::Follow(FollowField::Own(FollowParam::SwitchingDistance)),
+            self.switching_distance,
+        )?;
+        check_positive(
+            MobileField::Follow(FollowField::Own(FollowParam::GoalTolerance)),
+            self.goal_tolerance,
+        )?;
         check_range(
-            "follow.heading_tolerance",
+            MobileField::Follow(FollowField::Own(FollowParam::HeadingTolerance)),
             self.heading_tolerance,
             1e-9,
             std::f64::consts::PI,
@@ -139,9 +146,15 @@ pub fn validate_path(path: &[PathNode]) -> Result<(), MobileError> {
         if n.x.is_finite() && n.y.is_finite() && n.heading.is_none_or(f64::is_finite) {
             continue;
         }
-        n.point().validate(&format!("path[{i}]"))?;
+        n.point().validate(|part| MobileField::Path { index: i, part })?;
         if let Some(h) = n.heading {
-            super::error::check_finite(&format!("path[{i}].heading"), h)?;
+            super::error::check_finite(
+                MobileField::Path {
+                    index: i,
+                    part: Component::Heading,
+                },
+                h,
+            )?;
         }
     }
     Ok(())
@@ -172,9 +185,9 @@ pub fn path_follow_step(
     params: &PathFollowParams,
 ) -> Result<PathFollowStep, MobileError> {
     params.validate()?;
-    state.validate("state")?;
+    state.validate(MobileField::State)?;
     validate_path(path)?;
-    check_positive("dt", dt)?;
+    check_positive(MobileField::Dt, dt)?;
     Ok(path_follow_unchecked(
         state,
         path,

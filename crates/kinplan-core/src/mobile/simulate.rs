@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::chassis::Chassis;
 use super::error::{MobileError, check_positive};
+use super::field::{MobileField, SimField};
 use super::grid_astar::{GridAstarParams, plan_grid_astar_until};
 use super::path_follow::{PathFollowParams, PathFollowState, PathNode, path_follow_unchecked, validate_path};
 use super::pose::{Point2, Pose, Twist, integrate_twist};
@@ -102,11 +103,16 @@ impl Default for SimParams {
 impl SimParams {
     /// Positive radius, dt and time; dt ≤ max_time; at most 10⁷ steps.
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive("sim.robot_radius", self.robot_radius)?;
-        check_positive("sim.dt", self.dt)?;
-        check_positive("sim.max_time", self.max_time)?;
-        super::error::check_range("sim.dt", self.dt, 0.0, self.max_time)?;
-        super::error::check_range("sim.max_time / sim.dt", self.max_time / self.dt, 0.0, MAX_STEPS)
+        check_positive(MobileField::Sim(SimField::RobotRadius), self.robot_radius)?;
+        check_positive(MobileField::Sim(SimField::Dt), self.dt)?;
+        check_positive(MobileField::Sim(SimField::MaxTime), self.max_time)?;
+        super::error::check_range(MobileField::Sim(SimField::Dt), self.dt, 0.0, self.max_time)?;
+        super::error::check_range(
+            MobileField::Sim(SimField::Steps),
+            self.max_time / self.dt,
+            0.0,
+            MAX_STEPS,
+        )
     }
 }
 
@@ -215,7 +221,7 @@ pub fn follow_path(
     should_stop: &dyn Fn() -> bool,
 ) -> Result<SimRun, MobileError> {
     chassis.validate()?;
-    start.validate("start")?;
+    start.validate(MobileField::Start)?;
     validate_path(path)?;
     follow.validate()?;
     sim.validate()?;
@@ -303,8 +309,8 @@ pub fn navigate(
     should_stop: &dyn Fn() -> bool,
 ) -> Result<SimRun, MobileError> {
     chassis.validate()?;
-    start.validate("start")?;
-    goal.validate("goal")?;
+    start.validate(MobileField::Start)?;
+    goal.validate(MobileField::Goal)?;
     params.sim.validate()?;
     params.vdf.validate()?;
     let sim = &params.sim;
@@ -366,7 +372,7 @@ pub fn navigate_astar(
     sim: &SimParams,
     should_stop: &dyn Fn() -> bool,
 ) -> Result<SimRun, MobileError> {
-    start.validate("start")?;
+    start.validate(MobileField::Start)?;
     sim.validate()?;
     start_check(Some(world), start, sim.robot_radius)?;
     let Some(points) = plan_grid_astar_until(world, start.point(), goal, astar, should_stop)? else {

@@ -9,6 +9,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
 
 use super::angle::wrap_angle;
 use super::error::{MobileError, check_count, check_finite, check_positive, check_range};
+use super::field::{MobileField, VdfField};
 use super::pose::{MAX_COORDINATE, MAX_RATE, Point2, Pose, Twist};
 use super::sensors::RangeSensorParams;
 
@@ -145,28 +146,38 @@ impl Default for VdfParams {
 impl VdfParams {
     /// Positive distances, gains and limits; decay in (0, 1); turn gain ≥ 1; n, m ≥ 1.
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive("vdf.safe_distance", self.safe_distance)?;
-        check_positive("vdf.magnitude", self.magnitude)?;
-        check_range("vdf.weight_decay", self.weight_decay, 1e-6, 1.0 - 1e-6)?;
-        check_range("vdf.turn_gain", self.turn_gain, 1.0, 1e6)?;
+        check_positive(MobileField::Vdf(VdfField::SafeDistance), self.safe_distance)?;
+        check_positive(MobileField::Vdf(VdfField::Magnitude), self.magnitude)?;
         check_range(
-            "vdf.release_distance",
+            MobileField::Vdf(VdfField::WeightDecay),
+            self.weight_decay,
+            1e-6,
+            1.0 - 1e-6,
+        )?;
+        check_range(MobileField::Vdf(VdfField::TurnGain), self.turn_gain, 1.0, 1e6)?;
+        check_range(
+            MobileField::Vdf(VdfField::ReleaseDistance),
             self.release_distance,
             self.safe_distance,
             1e6,
         )?;
-        check_positive("vdf.max_speed", self.max_speed)?;
-        check_positive("vdf.max_yaw_rate", self.max_yaw_rate)?;
-        check_positive("vdf.heading_gain", self.heading_gain)?;
-        check_positive("vdf.slow_distance", self.slow_distance)?;
-        check_count("vdf.progress_steps", self.progress_steps, 1)?;
-        check_range("vdf.progress_min", self.progress_min, -1e6, 1e6)?;
-        check_count("vdf.no_path_steps", self.no_path_steps, 1)?;
-        check_range("vdf.no_path_min", self.no_path_min, 0.0, 1e6)?;
-        check_positive("vdf.leave_tolerance", self.leave_tolerance)?;
-        check_positive("vdf.hit_radius", self.hit_radius)?;
-        check_range("vdf.wall_gain", self.wall_gain, 0.0, 1e6)?;
-        check_positive("vdf.goal_tolerance", self.goal_tolerance)
+        check_positive(MobileField::Vdf(VdfField::MaxSpeed), self.max_speed)?;
+        check_positive(MobileField::Vdf(VdfField::MaxYawRate), self.max_yaw_rate)?;
+        check_positive(MobileField::Vdf(VdfField::HeadingGain), self.heading_gain)?;
+        check_positive(MobileField::Vdf(VdfField::SlowDistance), self.slow_distance)?;
+        check_count(MobileField::Vdf(VdfField::ProgressSteps), self.progress_steps, 1)?;
+        check_range(
+            MobileField::Vdf(VdfField::ProgressMin),
+            self.progress_min,
+            -1e6,
+            1e6,
+        )?;
+        check_count(MobileField::Vdf(VdfField::NoPathSteps), self.no_path_steps, 1)?;
+        check_range(MobileField::Vdf(VdfField::NoPathMin), self.no_path_min, 0.0, 1e6)?;
+        check_positive(MobileField::Vdf(VdfField::LeaveTolerance), self.leave_tolerance)?;
+        check_positive(MobileField::Vdf(VdfField::HitRadius), self.hit_radius)?;
+        check_range(MobileField::Vdf(VdfField::WallGain), self.wall_gain, 0.0, 1e6)?;
+        check_positive(MobileField::Vdf(VdfField::GoalTolerance), self.goal_tolerance)
     }
 }
 
@@ -240,7 +251,10 @@ impl VdfState {
         if !distance_ok(self.hit_distance) {
             return Err(bad("hit distance not finite, negative or out of range"));
         }
-        if self.hit_point.is_some_and(|h| h.validate("hit_point").is_err()) {
+        if self
+            .hit_point
+            .is_some_and(|h| h.validate(MobileField::Goal).is_err())
+        {
             return Err(bad("hit point not finite or out of the world"));
         }
         if self.history.len() > MAX_TOKEN_HISTORY || !self.history.iter().all(|d| distance_ok(*d)) {
@@ -340,18 +354,18 @@ pub fn vdf_step(
 ) -> Result<(VdfState, VdfOutput), MobileError> {
     params.validate()?;
     sensors.validate()?;
-    pose.validate("pose")?;
-    goal.validate("goal")?;
+    pose.validate(MobileField::State)?;
+    goal.validate(MobileField::Goal)?;
     if readings.len() != sensors.count {
         return Err(MobileError::TooFew {
-            field: "readings".into(),
+            field: MobileField::Readings,
             min: sensors.count,
             got: readings.len(),
         });
     }
     for (i, r) in readings.iter().enumerate() {
         if !r.is_finite() {
-            check_finite(&format!("readings[{i}]"), *r)?;
+            check_finite(MobileField::Reading(i), *r)?;
         }
     }
     let mut next = state.clone();

@@ -12,10 +12,11 @@ use tonic::{Request, Response, Status};
 use super::pb::{self, mobile_service_server::MobileService};
 use super::server::Shared;
 use super::status::invalid;
+use super::status::mobile::{mobile_error, token_failure};
 use kinplan_core::mobile::{
-    CarParams, Chassis, ControllerKind, DifferentialParams, GridAstarParams, MobileError, NavMode,
-    NavigateParams, NoPathReason, Obstacle, OmniParams, Outcome, PathFollowParams, PathFollowState, PathNode,
-    Point2, Pose, RangeSensorParams, RangeSensors, Saturation, SimParams, SimRun, TricycleParams,
+    CarParams, Chassis, ControllerKind, DifferentialParams, GridAstarParams, MobileError, MobileField,
+    NavMode, NavigateParams, NoPathReason, Obstacle, OmniParams, Outcome, PathFollowParams, PathFollowState,
+    PathNode, Point2, Pose, RangeSensorParams, RangeSensors, Saturation, SimParams, SimRun, TricycleParams,
     TurnPreference, Twist, VdfEvent, VdfParams, VdfState, WheelState, World, follow_path, navigate,
     navigate_astar, path_follow_step, validate_path, vdf_step,
 };
@@ -218,7 +219,7 @@ fn control_step(
             if !(radius.is_finite() && radius > 0.0) {
                 return Err(invalid("robot_radius", format!("must be positive, got {radius}")));
             }
-            state.validate("state").map_err(mobile_error)?;
+            state.validate(MobileField::State).map_err(mobile_error)?;
             let mut ring = RangeSensors::new(sensors, req.seed).map_err(mobile_error)?;
             let mut out = vec![0.0; sensors.count];
             if !ring.sense_until(&world, state, radius, &mut out, should_stop) {
@@ -288,60 +289,6 @@ fn control_step(
         target_node: s.next.target as u32,
         ..Default::default()
     })
-}
-
-/// A controller state the server could not encode: a server bug, never an
-/// empty token the client would take for a fresh start.
-fn token_failure(err: MobileError) -> Status {
-    tracing::error!(%err, "a controller state could not be encoded");
-    Status::internal("the controller state could not be encoded")
-}
-
-/// INVALID_ARGUMENT naming the request field that a [`MobileError`] is about.
-fn mobile_error(err: MobileError) -> Status {
-    let text = err.to_string();
-    let field = match &err {
-        MobileError::NotFinite { field, .. }
-        | MobileError::NotPositive { field, .. }
-        | MobileError::OutOfRange { field, .. }
-        | MobileError::TooFew { field, .. } => proto_field(field),
-        MobileError::EmptyPath => "path".into(),
-        MobileError::BadToken { .. } => "state_token".into(),
-        MobileError::StartInCollision { .. } => "start".into(),
-        MobileError::WheelMismatch { .. } => "wheels".into(),
-    };
-    invalid(field, text)
-}
-
-/// The domain names fields after its own parameter structs; the proto nests them.
-fn proto_field(domain: &str) -> String {
-    for chassis in ["tricycle.", "car.", "omni.", "differential."] {
-        if domain.starts_with(chassis) {
-            return format!("chassis.{domain}");
-        }
-    }
-    for nested in ["lyapunov.", "pure_pursuit.", "steering."] {
-        if domain.starts_with(nested) {
-            return format!("follow.{domain}");
-        }
-    }
-    if domain == "sim.max_time / sim.dt" {
-        return "sim.max_time".into();
-    }
-    if let Some(rest) = domain.strip_prefix("pose") {
-        return format!("state{rest}");
-    }
-    if let Some(rest) = domain.strip_prefix("world[")
-        && let Some((index, member)) = rest.split_once("].")
-    {
-        let shape = if member.starts_with("vertices") {
-            "polygon"
-        } else {
-            "circle"
-        };
-        return format!("world[{index}].{shape}.{member}");
-    }
-    domain.to_owned()
 }
 
 fn pose_in(p: Option<&pb::Pose2D>) -> Pose {
@@ -748,25 +695,5 @@ fn run_out(run: SimRun) -> pb::MobileRun {
             min_clearance: run.metrics.min_clearance.filter(|c| c.is_finite()),
             steps: run.metrics.steps as u32,
         }),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn domain_fields_become_request_fields() {
-        assert_eq!(proto_field("omni.wheel_radius"), "chassis.omni.wheel_radius");
-        assert_eq!(proto_field("lyapunov.gamma"), "follow.lyapunov.gamma");
-        assert_eq!(proto_field("sim.max_time / sim.dt"), "sim.max_time");
-        assert_eq!(proto_field("pose.x"), "state.x");
-        assert_eq!(proto_field("world[3].radius"), "world[3].circle.radius");
-        assert_eq!(
-            proto_field("world[2].vertices[1].y"),
-            "world[2].polygon.vertices[1].y"
-        );
-        assert_eq!(proto_field("vdf.safe_distance"), "vdf.safe_distance");
-        assert_eq!(proto_field("path[4].heading"), "path[4].heading");
     }
 }
