@@ -55,6 +55,13 @@ pub enum MobileError {
         /// Why decoding failed.
         reason: String,
     },
+    /// A controller state that a token may not carry (a bug, not bad input): encoding refuses
+    /// it rather than hand out an empty token.
+    #[error("the controller state could not be encoded: {reason}")]
+    TokenEncoding {
+        /// Why encoding failed.
+        reason: String,
+    },
     /// The start pose already overlaps an obstacle.
     #[error("start pose collides with obstacle {obstacle} (clearance {clearance} m)")]
     StartInCollision {
@@ -82,6 +89,7 @@ impl MobileError {
             | MobileError::TooFew { field, .. } => Some(*field),
             MobileError::EmptyPath
             | MobileError::BadToken { .. }
+            | MobileError::TokenEncoding { .. }
             | MobileError::StartInCollision { .. }
             | MobileError::WheelMismatch { .. } => None,
         }

@@ -11,6 +11,7 @@ use super::lyapunov::{LyapunovParams, lyapunov_step_unchecked};
 use super::pose::{Point2, Pose, Twist};
 use super::pure_pursuit::{PurePursuitParams, pure_pursuit_unchecked};
 use super::shortest_path::shortest_path_step;
+use super::token::ControllerMemory;
 
 /// A nodal point of a path: position (m) and an optional heading (rad) to reach it with.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -124,6 +125,19 @@ pub struct PathFollowState {
     pub target: usize,
     /// Nearest polyline segment (pure pursuit).
     pub segment: usize,
+}
+
+impl ControllerMemory for PathFollowState {
+    /// The path's length: both indices must name one of its nodes.
+    type Context = usize;
+
+    fn check(&self, path_len: &usize) -> Result<(), &'static str> {
+        if self.target < *path_len && self.segment < *path_len {
+            Ok(())
+        } else {
+            Err("the token points beyond the path's last node")
+        }
+    }
 }
 
 /// Output of [`path_follow_step`].

@@ -10,9 +10,11 @@ use kinplan_core::mobile::{
     AstarField, ChassisKind, Component, FollowField, MobileError, MobileField, ObstaclePart, SimField,
 };
 
-/// INVALID_ARGUMENT naming the request field that a [`MobileError`] is about.
+/// INVALID_ARGUMENT naming the request field that a [`MobileError`] is about; INTERNAL
+/// ([`token_failure`]) for a state the server could not encode.
 pub fn mobile_error(err: MobileError) -> Status {
     let field = match &err {
+        MobileError::TokenEncoding { .. } => return token_failure(err),
         MobileError::NotFinite { field, .. }
         | MobileError::NotPositive { field, .. }
         | MobileError::OutOfRange { field, .. }
@@ -27,7 +29,7 @@ pub fn mobile_error(err: MobileError) -> Status {
 
 /// A controller state the server could not encode: a server bug, never an
 /// empty token the client would take for a fresh start.
-pub fn token_failure(err: MobileError) -> Status {
+fn token_failure(err: MobileError) -> Status {
     tracing::error!(%err, "a controller state could not be encoded");
     Status::internal("the controller state could not be encoded")
 }

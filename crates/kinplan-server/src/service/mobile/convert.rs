@@ -1,305 +1,32 @@
-//! `MobileService`: chassis wheel kinematics, one controller step, and simulated path
-//! following and navigation (ALGORITHMS.md §6, [`kinplan_core::mobile`]).
-//!
-//! Thin adapter: admit → proto messages into domain values (unset fields: the domain's
-//! defaults; sizes bounded) → the domain function → reply. Simulations run on the CPU pool and
-//! stop when the request's budget says so; [`MobileError`]s become INVALID_ARGUMENT naming the
-//! request field. The service keeps no state: a controller's memory between `ControlStep`
-//! calls travels to the caller and back as an opaque token.
+//! Proto messages into domain values and back for `MobileService`: unset fields take the
+//! domain's defaults, sizes are bounded by the server's limits ([`super`]), and parameter sets
+//! are validated as they are built.
 
-use tonic::{Request, Response, Status};
+use tonic::Status;
 
-use super::pb::{self, mobile_service_server::MobileService};
-use super::server::Shared;
-use super::status::invalid;
-use super::status::mobile::{mobile_error, token_failure};
+use super::{
+    MAX_OBSTACLES, MAX_PATH_NODES, MAX_POLYGON_VERTICES, MAX_RAYS_PER_BEAM, MAX_SENSORS, MAX_STEPS,
+    MAX_WORLD_VERTICES,
+};
+use crate::service::pb;
+use crate::service::status::invalid;
+use crate::service::status::mobile::mobile_error;
 use kinplan_core::mobile::{
-    CarParams, Chassis, ControllerKind, DifferentialParams, GridAstarParams, MobileError, MobileField,
-    NavMode, NavigateParams, NoPathReason, Obstacle, OmniParams, Outcome, PathFollowParams, PathFollowState,
-    PathNode, Point2, Pose, RangeSensorParams, RangeSensors, Saturation, SimParams, SimRun, TricycleParams,
-    TurnPreference, Twist, VdfEvent, VdfParams, VdfState, WheelState, World, follow_path, navigate,
-    navigate_astar, path_follow_step, validate_path, vdf_step,
+    CarParams, Chassis, ControlStep, ControllerKind, DifferentialParams, GridAstarParams, NavMode,
+    NoPathReason, Obstacle, OmniParams, Outcome, PathFollowParams, PathNode, Point2, Pose, RangeSensorParams,
+    Saturation, SimParams, SimRun, StepReport, TricycleParams, TurnPreference, Twist, VdfEvent, VdfParams,
+    WheelState, World,
 };
 
-/// Largest simulation accepted: `sim.max_time / sim.dt` steps.
-pub const MAX_STEPS: f64 = 100_000.0;
-/// Largest world accepted, obstacles.
-pub const MAX_OBSTACLES: usize = 10_000;
-/// Largest polygon accepted, vertices.
-pub const MAX_POLYGON_VERTICES: usize = 1_000;
-/// Most polygon vertices in one world: bounds the cost of one ray cast or
-/// distance query (the unit between cancellation checks).
-pub const MAX_WORLD_VERTICES: usize = 100_000;
-/// Longest path accepted, nodes.
-pub const MAX_PATH_NODES: usize = 10_000;
-/// Largest sensor ring accepted.
-pub const MAX_SENSORS: u32 = 360;
-/// Most rays per sensor beam accepted.
-pub const MAX_RAYS_PER_BEAM: u32 = 100;
-/// Largest state token accepted, bytes.
-pub const MAX_TOKEN_BYTES: usize = 1 << 20;
-
-pub struct MobileApi {
-    shared: Shared,
-}
-
-impl MobileApi {
-    pub fn new(shared: Shared) -> Self {
-        Self { shared }
-    }
-}
-
-#[tonic::async_trait]
-impl MobileService for MobileApi {
-    async fn wheel_kinematics(
-        &self,
-        request: Request<pb::WheelKinematicsRequest>,
-    ) -> Result<Response<pb::WheelKinematicsResponse>, Status> {
-        let _admitted = self.shared.compute.admit(&request)?;
-        let req = request.into_inner();
-        let chassis = chassis_in(req.chassis.as_ref());
-        use pb::wheel_kinematics_request::Input;
-        let reply = match req.input {
-            None => {
-                return Err(invalid(
-                    "input",
-                    "give either twist (inverse) or wheels (forward)",
-                ));
-            }
-            Some(Input::Twist(t)) => {
-                let (wheels, sat) = chassis.inverse_kinematics(twist_in(&t)).map_err(mobile_error)?;
-                let (applied, _) = chassis.saturate(twist_in(&t));
-                pb::WheelKinematicsResponse {
-                    twist: Some(twist_out(applied)),
-                    wheels: Some(wheels_out(&wheels)),
-                    saturation: Some(saturation_out(sat)),
-                }
-            }
-            Some(Input::Wheels(w)) => {
-                let wheels = wheels_in(&w)?;
-                let twist = chassis.forward_kinematics(&wheels).map_err(mobile_error)?;
-                pb::WheelKinematicsResponse {
-                    twist: Some(twist_out(twist)),
-                    wheels: Some(w),
-                    saturation: Some(saturation_out(Saturation::NONE)),
-                }
-            }
-        };
-        Ok(Response::new(reply))
-    }
-
-    async fn control_step(
-        &self,
-        request: Request<pb::ControlStepRequest>,
-    ) -> Result<Response<pb::ControlStepResponse>, Status> {
-        let (_permit, budget) = self.shared.compute.admit(&request)?;
-        let req = request.into_inner();
-        if req.state_token.len() > MAX_TOKEN_BYTES {
-            return Err(invalid(
-                "state_token",
-                format!("{} bytes, at most {MAX_TOKEN_BYTES}", req.state_token.len()),
-            ));
-        }
-        // Sensing a world costs up to obstacles × rays: the CPU pool; the rest inline.
-        if req.world.is_empty() {
-            control_step(req, &|| false).map(Response::new)
-        } else {
-            self.shared
-                .compute
-                .run(&budget, move |b| control_step(req, &|| b.should_stop()))
-                .await?
-                .map(Response::new)
-        }
-    }
-
-    async fn follow_path(
-        &self,
-        request: Request<pb::FollowPathRequest>,
-    ) -> Result<Response<pb::MobileRun>, Status> {
-        let (_permit, budget) = self.shared.compute.admit(&request)?;
-        let req = request.into_inner();
-        let chassis = chassis_in(req.chassis.as_ref());
-        let start = pose_in(req.start.as_ref());
-        let path = path_in(&req.path)?;
-        let follow = follow_in(req.controller, req.follow.as_ref(), "controller")?;
-        let world = if req.world.is_empty() {
-            None
-        } else {
-            Some(world_in(&req.world)?)
-        };
-        let sim = sim_in(req.sim.as_ref())?;
-        let run = self
-            .shared
-            .compute
-            .run(&budget, move |b| {
-                follow_path(&chassis, start, &path, world.as_ref(), &follow, &sim, &|| {
-                    b.should_stop()
-                })
-            })
-            .await?
-            .map_err(mobile_error)?;
-        Ok(Response::new(run_out(run)))
-    }
-
-    async fn navigate(
-        &self,
-        request: Request<pb::NavigateRequest>,
-    ) -> Result<Response<pb::MobileRun>, Status> {
-        let (_permit, budget) = self.shared.compute.admit(&request)?;
-        let req = request.into_inner();
-        let chassis = chassis_in(req.chassis.as_ref());
-        let start = pose_in(req.start.as_ref());
-        let goal = point_in(req.goal.as_ref());
-        let world = world_in(&req.world)?;
-        let sim = sim_in(req.sim.as_ref())?;
-        let navigator = pb::Navigator::try_from(req.navigator)
-            .map_err(|_| invalid("navigator", format!("unknown navigator {}", req.navigator)))?;
-        let run = match navigator {
-            pb::Navigator::Unspecified | pb::Navigator::VectorDistance => {
-                let params = NavigateParams {
-                    sim,
-                    sensors: sensors_in(req.sensors.as_ref())?,
-                    vdf: vdf_in(req.vdf.as_ref())?,
-                    seed: req.seed,
-                };
-                self.shared
-                    .compute
-                    .run(&budget, move |b| {
-                        navigate(&chassis, start, goal, &world, &params, &|| b.should_stop())
-                    })
-                    .await?
-            }
-            pb::Navigator::GridAstar => {
-                let controller = if req.controller == pb::Controller::Unspecified as i32 {
-                    pb::Controller::PurePursuit as i32
-                } else {
-                    req.controller
-                };
-                let follow = follow_in(controller, req.follow.as_ref(), "controller")?;
-                let astar = astar_in(req.astar.as_ref())?;
-                self.shared
-                    .compute
-                    .run(&budget, move |b| {
-                        navigate_astar(&chassis, start, goal, &world, &astar, &follow, &sim, &|| {
-                            b.should_stop()
-                        })
-                    })
-                    .await?
-            }
-        }
-        .map_err(mobile_error)?;
-        let grid = navigator == pb::Navigator::GridAstar;
-        let mut out = run_out(run);
-        if grid && out.outcome == pb::Outcome::NoPath as i32 {
-            out.no_path_reason = pb::NoPathReason::NoGridPath as i32;
-        }
-        Ok(Response::new(out))
-    }
-}
-
-/// One controller step: vector distance with its `VdfState` token, or a path-following
-/// controller with its `PathFollowState` token (JSON).
-fn control_step(
-    req: pb::ControlStepRequest,
-    should_stop: &dyn Fn() -> bool,
-) -> Result<pb::ControlStepResponse, Status> {
-    let chassis = chassis_in(req.chassis.as_ref());
-    chassis.validate().map_err(mobile_error)?;
-    let state = pose_in(req.state.as_ref());
-    let dt = req.dt.unwrap_or(0.05);
-    if req.controller == pb::Controller::VectorDistance as i32 {
-        let sensors = sensors_in(req.sensors.as_ref())?;
-        let vdf = vdf_in(req.vdf.as_ref())?;
-        let memory = VdfState::from_token(&req.state_token).map_err(mobile_error)?;
-        let readings = if !req.readings.is_empty() || req.world.is_empty() {
-            req.readings
-        } else {
-            let world = world_in(&req.world)?;
-            let radius = req.robot_radius.unwrap_or(SimParams::default().robot_radius);
-            if !(radius.is_finite() && radius > 0.0) {
-                return Err(invalid("robot_radius", format!("must be positive, got {radius}")));
-            }
-            state.validate(MobileField::State).map_err(mobile_error)?;
-            let mut ring = RangeSensors::new(sensors, req.seed).map_err(mobile_error)?;
-            let mut out = vec![0.0; sensors.count];
-            if !ring.sense_until(&world, state, radius, &mut out, should_stop) {
-                return Err(Status::deadline_exceeded(
-                    "the request's deadline passed before the work finished",
-                ));
-            }
-            out
-        };
-        let goal = point_in(req.goal.as_ref());
-        let (next, out) = vdf_step(&memory, state, goal, &readings, &sensors, &vdf).map_err(mobile_error)?;
-        let (applied, sat) = chassis.saturate(out.twist);
-        let (mut hit, mut leave, mut no_path, mut reached) = (None, None, false, false);
-        match out.event {
-            Some(VdfEvent::Reached) => reached = true,
-            Some(VdfEvent::Hit(h)) => hit = Some(point_out(h)),
-            Some(VdfEvent::Leave(l)) => leave = Some(point_out(l)),
-            Some(VdfEvent::NoPath(_)) => no_path = true,
-            None => {}
-        }
-        return Ok(pb::ControlStepResponse {
-            command: Some(twist_out(out.twist)),
-            applied: Some(twist_out(applied)),
-            saturation: Some(saturation_out(sat)),
-            reached,
-            state_token: next.to_token().map_err(token_failure)?,
-            target_node: 0,
-            mode: mode_out(out.mode) as i32,
-            readings,
-            force: Some(point_out(out.force)),
-            hit_point: hit,
-            leave_point: leave,
-            no_path,
-        });
-    }
-    let path = path_in(&req.path)?;
-    validate_path(&path).map_err(mobile_error)?;
-    let follow = follow_in(req.controller, req.follow.as_ref(), "controller")?.for_chassis(&chassis);
-    let progress: PathFollowState = if req.state_token.is_empty() {
-        PathFollowState::default()
-    } else {
-        serde_json::from_slice(&req.state_token)
-            .map_err(|e| invalid("state_token", format!("controller token is invalid: {e}")))?
-    };
-    if progress.target >= path.len() || progress.segment >= path.len() {
-        return Err(invalid(
-            "state_token",
-            format!(
-                "token points at node {} of a {}-node path",
-                progress.target.max(progress.segment),
-                path.len()
-            ),
-        ));
-    }
-    let s = path_follow_step(state, &path, progress, dt, &follow).map_err(mobile_error)?;
-    let (applied, sat) = chassis.saturate(s.twist);
-    Ok(pb::ControlStepResponse {
-        command: Some(twist_out(s.twist)),
-        applied: Some(twist_out(applied)),
-        saturation: Some(saturation_out(sat)),
-        reached: s.reached,
-        state_token: serde_json::to_vec(&s.next).map_err(|e| {
-            token_failure(MobileError::BadToken {
-                reason: e.to_string(),
-            })
-        })?,
-        target_node: s.next.target as u32,
-        ..Default::default()
-    })
-}
-
-fn pose_in(p: Option<&pb::Pose2D>) -> Pose {
+pub(super) fn pose_in(p: Option<&pb::Pose2D>) -> Pose {
     p.map_or(Pose::default(), |p| Pose::new(p.x, p.y, p.theta))
 }
 
-fn point_in(p: Option<&pb::Point2D>) -> Point2 {
+pub(super) fn point_in(p: Option<&pb::Point2D>) -> Point2 {
     p.map_or(Point2::new(0.0, 0.0), |p| Point2::new(p.x, p.y))
 }
 
-fn twist_in(t: &pb::Twist2D) -> Twist {
+pub(super) fn twist_in(t: &pb::Twist2D) -> Twist {
     Twist {
         vx: t.vx,
         vy: t.vy,
@@ -307,7 +34,7 @@ fn twist_in(t: &pb::Twist2D) -> Twist {
     }
 }
 
-fn pose_out(p: &Pose) -> pb::Pose2D {
+pub(super) fn pose_out(p: &Pose) -> pb::Pose2D {
     pb::Pose2D {
         x: p.x,
         y: p.y,
@@ -315,11 +42,11 @@ fn pose_out(p: &Pose) -> pb::Pose2D {
     }
 }
 
-fn point_out(p: Point2) -> pb::Point2D {
+pub(super) fn point_out(p: Point2) -> pb::Point2D {
     pb::Point2D { x: p.x, y: p.y }
 }
 
-fn twist_out(t: Twist) -> pb::Twist2D {
+pub(super) fn twist_out(t: Twist) -> pb::Twist2D {
     pb::Twist2D {
         vx: t.vx,
         vy: t.vy,
@@ -327,7 +54,7 @@ fn twist_out(t: Twist) -> pb::Twist2D {
     }
 }
 
-fn saturation_out(s: Saturation) -> pb::Saturation {
+pub(super) fn saturation_out(s: Saturation) -> pb::Saturation {
     pb::Saturation {
         speed_scale: s.speed_scale,
         steering_clamped: s.steering_clamped,
@@ -337,7 +64,7 @@ fn saturation_out(s: Saturation) -> pb::Saturation {
 
 /// Unset chassis: differential drive; unset parameters: the kind's defaults (MOBIL-II for the
 /// car, OMR-III for the omni base). Validation happens in the domain functions.
-fn chassis_in(c: Option<&pb::Chassis>) -> Chassis {
+pub(super) fn chassis_in(c: Option<&pb::Chassis>) -> Chassis {
     use pb::chassis::Kind;
     match c.and_then(|c| c.kind.as_ref()) {
         None => Chassis::default(),
@@ -380,7 +107,7 @@ fn chassis_in(c: Option<&pb::Chassis>) -> Chassis {
     }
 }
 
-fn wheels_in(w: &pb::WheelState) -> Result<WheelState, Status> {
+pub(super) fn wheels_in(w: &pb::WheelState) -> Result<WheelState, Status> {
     use pb::wheel_state::Kind;
     Ok(match &w.kind {
         None => return Err(invalid("wheels", "give the wheel state of the chassis")),
@@ -410,7 +137,7 @@ fn wheels_in(w: &pb::WheelState) -> Result<WheelState, Status> {
     })
 }
 
-fn wheels_out(w: &WheelState) -> pb::WheelState {
+pub(super) fn wheels_out(w: &WheelState) -> pb::WheelState {
     use pb::wheel_state::Kind;
     let kind = match *w {
         WheelState::Tricycle { speed, steer } => Kind::Tricycle(pb::TricycleWheels { speed, steer }),
@@ -435,7 +162,7 @@ fn wheels_out(w: &WheelState) -> pb::WheelState {
     pb::WheelState { kind: Some(kind) }
 }
 
-fn path_in(path: &[pb::PathNode]) -> Result<Vec<PathNode>, Status> {
+pub(super) fn path_in(path: &[pb::PathNode]) -> Result<Vec<PathNode>, Status> {
     if path.len() > MAX_PATH_NODES {
         return Err(invalid(
             "path",
@@ -452,7 +179,7 @@ fn path_in(path: &[pb::PathNode]) -> Result<Vec<PathNode>, Status> {
         .collect())
 }
 
-fn world_in(obstacles: &[pb::Obstacle]) -> Result<World, Status> {
+pub(super) fn world_in(obstacles: &[pb::Obstacle]) -> Result<World, Status> {
     use pb::obstacle::Shape;
     if obstacles.len() > MAX_OBSTACLES {
         return Err(invalid(
@@ -497,7 +224,7 @@ fn world_in(obstacles: &[pb::Obstacle]) -> Result<World, Status> {
     World::new(out).map_err(mobile_error)
 }
 
-fn sim_in(s: Option<&pb::SimOptions>) -> Result<SimParams, Status> {
+pub(super) fn sim_in(s: Option<&pb::SimOptions>) -> Result<SimParams, Status> {
     let d = SimParams::default();
     let sim = s.map_or(d, |s| SimParams {
         robot_radius: s.robot_radius.unwrap_or(d.robot_radius),
@@ -515,7 +242,7 @@ fn sim_in(s: Option<&pb::SimOptions>) -> Result<SimParams, Status> {
     Ok(sim)
 }
 
-fn sensors_in(s: Option<&pb::RangeSensorParams>) -> Result<RangeSensorParams, Status> {
+pub(super) fn sensors_in(s: Option<&pb::RangeSensorParams>) -> Result<RangeSensorParams, Status> {
     let d = RangeSensorParams::default();
     let Some(s) = s else { return Ok(d) };
     let count = s.count.unwrap_or(d.count as u32);
@@ -543,7 +270,7 @@ fn sensors_in(s: Option<&pb::RangeSensorParams>) -> Result<RangeSensorParams, St
     Ok(p)
 }
 
-fn vdf_in(v: Option<&pb::VectorDistanceParams>) -> Result<VdfParams, Status> {
+pub(super) fn vdf_in(v: Option<&pb::VectorDistanceParams>) -> Result<VdfParams, Status> {
     let d = VdfParams::default();
     let Some(v) = v else { return Ok(d) };
     let turn = match pb::TurnPreference::try_from(v.turn) {
@@ -579,7 +306,7 @@ fn vdf_in(v: Option<&pb::VectorDistanceParams>) -> Result<VdfParams, Status> {
     Ok(p)
 }
 
-fn astar_in(a: Option<&pb::GridAstarOptions>) -> Result<GridAstarParams, Status> {
+pub(super) fn astar_in(a: Option<&pb::GridAstarOptions>) -> Result<GridAstarParams, Status> {
     let d = GridAstarParams::default();
     let p = a.map_or(d, |a| GridAstarParams {
         resolution: a.resolution.unwrap_or(d.resolution),
@@ -594,7 +321,7 @@ fn astar_in(a: Option<&pb::GridAstarOptions>) -> Result<GridAstarParams, Status>
 }
 
 /// Path-follower parameters; `controller` must be a path-following one.
-fn follow_in(
+pub(super) fn follow_in(
     controller: i32,
     f: Option<&pb::FollowOptions>,
     controller_field: &str,
@@ -658,7 +385,7 @@ fn follow_in(
     Ok(p)
 }
 
-fn mode_out(m: NavMode) -> pb::NavMode {
+pub(super) fn mode_out(m: NavMode) -> pb::NavMode {
     match m {
         NavMode::Rotate => pb::NavMode::Rotate,
         NavMode::Lock => pb::NavMode::Lock,
@@ -666,7 +393,7 @@ fn mode_out(m: NavMode) -> pb::NavMode {
     }
 }
 
-fn run_out(run: SimRun) -> pb::MobileRun {
+pub(super) fn run_out(run: SimRun) -> pb::MobileRun {
     let outcome = match run.outcome {
         Outcome::Reached => pb::Outcome::Reached,
         Outcome::NoPath => pb::Outcome::NoPath,
@@ -678,6 +405,7 @@ fn run_out(run: SimRun) -> pb::MobileRun {
         None => pb::NoPathReason::Unspecified,
         Some(NoPathReason::ReturnedToHit) => pb::NoPathReason::ReturnedToHit,
         Some(NoPathReason::NoProgress) => pb::NoPathReason::NoProgress,
+        Some(NoPathReason::NoGridPath) => pb::NoPathReason::NoGridPath,
     };
     pb::MobileRun {
         outcome: outcome as i32,
@@ -696,4 +424,35 @@ fn run_out(run: SimRun) -> pb::MobileRun {
             steps: run.metrics.steps as u32,
         }),
     }
+}
+
+pub(super) fn step_out(step: ControlStep) -> pb::ControlStepResponse {
+    let mut reply = pb::ControlStepResponse {
+        command: Some(twist_out(step.command)),
+        applied: Some(twist_out(step.applied)),
+        saturation: Some(saturation_out(step.saturation)),
+        reached: step.reached,
+        state_token: step.token,
+        ..Default::default()
+    };
+    match step.report {
+        StepReport::VectorDistance {
+            mode,
+            readings,
+            force,
+            event,
+        } => {
+            reply.mode = mode_out(mode) as i32;
+            reply.readings = readings;
+            reply.force = Some(point_out(force));
+            match event {
+                Some(VdfEvent::Hit(h)) => reply.hit_point = Some(point_out(h)),
+                Some(VdfEvent::Leave(l)) => reply.leave_point = Some(point_out(l)),
+                Some(VdfEvent::NoPath(_)) => reply.no_path = true,
+                Some(VdfEvent::Reached) | None => {}
+            }
+        }
+        StepReport::FollowPath { target_node } => reply.target_node = target_node as u32,
+    }
+    reply
 }
