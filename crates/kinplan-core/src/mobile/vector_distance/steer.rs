@@ -145,3 +145,75 @@ pub(super) fn first_free(see: &Percept, from: f64, side: TurnSide, p: &VdfParams
     }
     from
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mobile::pose::Pose;
+    use std::f64::consts::SQRT_2;
+
+    /// F written out term by term: Σ f_i w_i (cos β_i, sin β_i) for sensors at β_i = iπ/4.
+    fn sum(terms: [(f64, f64); 8]) -> (f64, f64) {
+        terms.iter().enumerate().fold((0.0, 0.0), |(x, y), (i, (f, w))| {
+            let beta = i as f64 * PI / 4.0;
+            (x + f * w * beta.cos(), y + f * w * beta.sin())
+        })
+    }
+
+    /// R mode, all free, goal ahead: weights 0.6^k for the k-th sensor from the front (k ≤ 4),
+    /// F = (1 + 1.2·cos45° + 0.432·cos135° − 0.1296, 0): drive straight at v_max = 0.5 (the gap
+    /// ahead, 2 m, exceeds the slow-down distance).
+    #[test]
+    fn free_rotate_mode_drives_at_the_goal() {
+        let p = VdfParams::default();
+        let free = [2.0; 8];
+        let see = Percept::new(Pose::default(), Point2::new(5.0, 0.0), &free);
+        let (twist, force) = steer(&VdfState::default(), &see, &p);
+        let want_x = 1.0 + 1.2 * SQRT_2 / 2.0 - 0.432 * SQRT_2 / 2.0 - 0.1296;
+        assert!((force.x - want_x).abs() < 1e-12, "{force:?}");
+        assert!(force.y.abs() < 1e-12);
+        assert!(
+            (twist.vx - 0.5).abs() < 1e-12 && twist.omega.abs() < 1e-12,
+            "{twist:?}"
+        );
+    }
+
+    /// T mode, left turning side, the nearest gap 0.24 m = 0.8·d_sa at sensor 6 (−90°): the
+    /// boundary tangent is −90° + 90° = 0. Weights 0.6^k, raised on the left by
+    /// 1 + 0.5·sin Δ; sensor 6 repels (gap < d_sa). ψ = arg F points at a free sensor, so the
+    /// command is v = 0.5·cos ψ (gap ahead 2 m), ω = clamp(3ψ, ±2).
+    #[test]
+    fn track_mode_follows_the_boundary_on_its_side() {
+        let p = VdfParams::default();
+        let mut r = [2.0; 8];
+        r[6] = 0.24;
+        let see = Percept::new(Pose::default(), Point2::new(5.0, 0.0), &r);
+        let s = VdfState {
+            mode: NavMode::Track,
+            side: TurnSide::Left,
+            ..VdfState::default()
+        };
+        let (twist, force) = steer(&s, &see, &p);
+        let lift = 1.0 + 0.5 * SQRT_2 / 2.0;
+        let (fx, fy) = sum([
+            (1.0, 1.0),
+            (1.0, 0.6 * lift),
+            (1.0, 0.36 * 1.5),
+            (1.0, 0.216 * lift),
+            (1.0, 0.1296),
+            (1.0, 0.216),
+            (-1.0, 0.36),
+            (1.0, 0.6),
+        ]);
+        assert!(
+            (force.x - fx).abs() < 1e-9 && (force.y - fy).abs() < 1e-9,
+            "{force:?} vs {fx}, {fy}"
+        );
+        let psi = fy.atan2(fx);
+        assert!((twist.vx - 0.5 * psi.cos()).abs() < 1e-9, "{twist:?}");
+        assert!(
+            (twist.omega - (3.0 * psi).clamp(-2.0, 2.0)).abs() < 1e-9,
+            "{twist:?}"
+        );
+    }
+}

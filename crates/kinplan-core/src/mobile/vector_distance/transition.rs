@@ -162,3 +162,158 @@ fn line_distance(p: Point2, a: Point2, b: Point2) -> f64 {
     }
     ((p.x - a.x) * dy - (p.y - a.y) * dx).abs() / l
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mobile::pose::Pose;
+    use std::collections::VecDeque;
+    use std::f64::consts::FRAC_PI_4;
+
+    const GOAL: Point2 = Point2::new(5.0, 0.0);
+
+    fn blocked(sensors: &[usize]) -> [f64; 8] {
+        let mut r = [2.0; 8];
+        for &i in sensors {
+            r[i] = 0.1;
+        }
+        r
+    }
+
+    /// R→L with the goal direction blocked. Auto side: left and right sums
+    /// Σ_{k=1..3} 0.6^k·min(gap, 4·0.3) are equal when only the front is blocked (tie → left),
+    /// and w'_0 locks onto the first free sensor direction to the left, π/4. Blocking the
+    /// front-left sensor too makes the left sum 0.6·0.1 + 0.36·1.2 + 0.216·1.2 smaller than the
+    /// right one (0.6 + 0.36 + 0.216)·1.2: right side, lock at −π/4.
+    #[test]
+    fn a_blocked_goal_direction_locks_towards_the_freer_side() {
+        let p = VdfParams::default();
+        let front = blocked(&[0]);
+        let see = Percept::new(Pose::default(), GOAL, &front);
+        let (s, event) = transition(VdfState::default(), &see, &p);
+        assert_eq!((s.mode, s.side, event), (NavMode::Lock, TurnSide::Left, None));
+        assert!(s.side_chosen);
+        assert!((s.locked_direction - FRAC_PI_4).abs() < 1e-12);
+        assert_eq!(
+            (s.steps_in_mode, s.history.clone()),
+            (0, VecDeque::from(vec![5.0]))
+        );
+
+        let front_left = blocked(&[0, 1]);
+        let see = Percept::new(Pose::default(), GOAL, &front_left);
+        let (s, _) = transition(VdfState::default(), &see, &p);
+        assert_eq!((s.mode, s.side), (NavMode::Lock, TurnSide::Right));
+        assert!((s.locked_direction + FRAC_PI_4).abs() < 1e-12);
+    }
+
+    /// L→T: with n = 3, a fourth distance of 5 m after three of 5 m is no progress
+    /// (5 − 5 < c1 = 0.05): H is set here, at |HG| = 5, and the best-distance watch starts.
+    #[test]
+    fn a_stalled_lock_starts_tracking_at_a_hit_point() {
+        let p = VdfParams {
+            progress_steps: 3,
+            ..VdfParams::default()
+        };
+        let s = VdfState {
+            mode: NavMode::Lock,
+            locked_direction: FRAC_PI_4,
+            side_chosen: true,
+            history: VecDeque::from(vec![5.0, 5.0, 5.0]),
+            steps_in_mode: 3,
+            ..VdfState::default()
+        };
+        let front = blocked(&[0]);
+        let see = Percept::new(Pose::default(), GOAL, &front);
+        let (s, event) = transition(s, &see, &p);
+        assert_eq!(s.mode, NavMode::Track);
+        assert_eq!(event, Some(VdfEvent::Hit(Point2::new(0.0, 0.0))));
+        assert_eq!(s.hit_point, Some(Point2::new(0.0, 0.0)));
+        assert_eq!(
+            (s.hit_distance, s.best_distance, s.steps_since_progress),
+            (5.0, Some(5.0), 0)
+        );
+        assert!(!s.left_hit_zone);
+        assert_eq!(s.history.len(), 4);
+    }
+
+    /// L→R when the gap towards the goal (2 m) exceeds the release distance (0.6 m); T→R with a
+    /// leave point when every gap exceeds d_sa; T kept with an obstacle beside the robot off
+    /// the line H–G (0.5 m from it, tolerance 0.1 m).
+    #[test]
+    fn lock_and_track_end_when_the_way_opens() {
+        let p = VdfParams::default();
+        let free = [2.0; 8];
+        let see = Percept::new(Pose::default(), GOAL, &free);
+        let lock = VdfState {
+            mode: NavMode::Lock,
+            locked_direction: FRAC_PI_4,
+            ..VdfState::default()
+        };
+        let (s, event) = transition(lock, &see, &p);
+        assert_eq!((s.mode, event), (NavMode::Rotate, None));
+
+        let track = VdfState {
+            mode: NavMode::Track,
+            hit_point: Some(Point2::new(0.0, 0.0)),
+            hit_distance: 5.0,
+            ..VdfState::default()
+        };
+        let (s, event) = transition(track.clone(), &see, &p);
+        assert_eq!(
+            (s.mode, event),
+            (NavMode::Rotate, Some(VdfEvent::Leave(Point2::new(0.0, 0.0))))
+        );
+
+        let beside = blocked(&[2]);
+        let off_line = Percept::new(Pose::new(0.0, 0.5, 0.0), GOAL, &beside);
+        let (s, event) = transition(track, &off_line, &p);
+        assert_eq!((s.mode, event), (NavMode::Track, None));
+    }
+
+    /// The no-path watch, by hand with H = (0, 0), |HG| = 5, best 5, hit radius 0.25 (zone
+    /// 0.75), c2 = 0.05: at (0.1, 0) after leaving the zone, z = 4.9 improves the best (4.9 <
+    /// 4.95) but the robot is back within 0.25 of H → ReturnedToHit. At (0, 1) the robot is
+    /// 1 > 0.75 from H: the zone is left, z = √26 does not improve, one step is counted. At
+    /// (3, 0), z = 2 < 5 − 0.05 − 0.75: past H's obstacle, the watch is dropped and the event
+    /// passes through. Without H nothing changes.
+    #[test]
+    fn the_no_path_watch_by_hand() {
+        let p = VdfParams::default();
+        let free = [2.0; 8];
+        let watched = VdfState {
+            mode: NavMode::Track,
+            hit_point: Some(Point2::new(0.0, 0.0)),
+            hit_distance: 5.0,
+            best_distance: Some(5.0),
+            steps_since_progress: 7,
+            ..VdfState::default()
+        };
+        let back = VdfState {
+            left_hit_zone: true,
+            ..watched.clone()
+        };
+        let see = Percept::new(Pose::new(0.1, 0.0, 0.0), GOAL, &free);
+        let (s, event) = watch_no_path(back, &see, None, &p);
+        assert_eq!(event, Some(VdfEvent::NoPath(NoPathReason::ReturnedToHit)));
+        assert_eq!((s.best_distance, s.steps_since_progress), (Some(4.9), 0));
+
+        let see = Percept::new(Pose::new(0.0, 1.0, 0.0), GOAL, &free);
+        let (s, event) = watch_no_path(watched.clone(), &see, None, &p);
+        assert_eq!(event, None);
+        assert!(s.left_hit_zone);
+        assert_eq!((s.best_distance, s.steps_since_progress), (Some(5.0), 8));
+
+        let past = Point2::new(3.0, 0.0);
+        let see = Percept::new(Pose::new(past.x, past.y, 0.0), GOAL, &free);
+        let leave = Some(VdfEvent::Leave(past));
+        let (s, event) = watch_no_path(watched, &see, leave, &p);
+        assert_eq!(event, leave);
+        assert_eq!(
+            (s.hit_point, s.best_distance, s.steps_since_progress),
+            (None, None, 0)
+        );
+
+        let (s, event) = watch_no_path(VdfState::default(), &see, leave, &p);
+        assert_eq!((s, event), (VdfState::default(), leave));
+    }
+}
