@@ -3,9 +3,10 @@
 //!
 //! Thin adapter: admit → proto messages into domain values (unset fields: the domain's
 //! defaults; sizes bounded) → the domain function → reply. Simulations run on the CPU pool and
-//! stop when the request's budget says so; [`MobileError`]s become INVALID_ARGUMENT naming the
-//! request field. The service keeps no state: a controller's memory between `ControlStep`
-//! calls travels to the caller and back as an opaque token.
+//! stop when the request's budget says so; domain errors become INVALID_ARGUMENT naming the
+//! request field (`status::mobile`). The service keeps no state: a controller's memory between
+//! `ControlStep` calls travels to the caller and back as an opaque token (the domain's
+//! [`kinplan_core::mobile::control_step`] decodes and encodes it). Conversions: `convert`.
 
 use tonic::{Request, Response, Status};
 

@@ -201,4 +201,142 @@ mod tests {
             assert_eq!(proto_path(field), path, "{field:?}");
         }
     }
+
+    /// Walks a field path (`a.b[3].c`) through the proto's message descriptors from `root`.
+    fn resolves(set: &prost_types::FileDescriptorSet, root: &str, path: &str) -> bool {
+        let messages: std::collections::HashMap<String, &prost_types::DescriptorProto> = set
+            .file
+            .iter()
+            .flat_map(|f| {
+                let package = f.package().to_string();
+                f.message_type
+                    .iter()
+                    .map(move |m| (format!(".{package}.{}", m.name()), m))
+            })
+            .collect();
+        let mut message = messages.get(root).copied();
+        for segment in path.split('.') {
+            let name = segment.split('[').next().unwrap_or(segment);
+            let Some(m) = message else { return false };
+            let Some(field) = m.field.iter().find(|f| f.name() == name) else {
+                return false;
+            };
+            message = messages.get(field.type_name()).copied();
+        }
+        true
+    }
+
+    /// Every proto path the mapping produces names a real field of one of the mobile requests
+    /// (read from the compiled descriptor set), except the two names clients have always seen
+    /// that are not paths: `wheels.<value>` (the proto nests the value under the chassis kind)
+    /// and `astar grid cells`.
+    #[test]
+    fn every_mapped_path_exists_in_the_proto() {
+        use prost::Message;
+        let set = prost_types::FileDescriptorSet::decode(crate::service::pb::FILE_DESCRIPTOR_SET).unwrap();
+        let roots = [
+            ".kinplan.v1.WheelKinematicsRequest",
+            ".kinplan.v1.ControlStepRequest",
+            ".kinplan.v1.FollowPathRequest",
+            ".kinplan.v1.NavigateRequest",
+        ];
+        use ChassisParam as P;
+        let chassis = [
+            (
+                ChassisKind::Tricycle,
+                &[P::Wheelbase, P::WheelRadius, P::MaxSpeed, P::MaxSteer][..],
+            ),
+            (
+                ChassisKind::Car,
+                &[P::Wheelbase, P::Track, P::WheelRadius, P::MaxSpeed, P::MaxSteer],
+            ),
+            (
+                ChassisKind::Omni,
+                &[
+                    P::WheelRadius,
+                    P::CenterDistance,
+                    P::MaxWheelSpeed,
+                    P::FirstWheelAngle,
+                ],
+            ),
+            (
+                ChassisKind::Differential,
+                &[P::WheelRadius, P::Track, P::MaxWheelSpeed],
+            ),
+        ];
+        let mut fields: Vec<MobileField> = chassis
+            .iter()
+            .flat_map(|(kind, params)| {
+                params
+                    .iter()
+                    .map(|&param| MobileField::Chassis { kind: *kind, param })
+            })
+            .collect();
+        let xy = [Component::X, Component::Y];
+        let pose = [Component::X, Component::Y, Component::Theta];
+        fields.extend(pose.map(MobileField::State));
+        fields.extend(pose.map(MobileField::Start));
+        fields.extend(xy.map(MobileField::Goal));
+        fields.extend([Component::Vx, Component::Vy, Component::Omega].map(MobileField::Twist));
+        fields.extend(
+            [Component::X, Component::Y, Component::Heading].map(|part| MobileField::Path { index: 2, part }),
+        );
+        fields.extend(xy.map(|c| MobileField::Obstacle {
+            index: 1,
+            part: ObstaclePart::Center(c),
+        }));
+        fields.extend(xy.map(|part| MobileField::Obstacle {
+            index: 1,
+            part: ObstaclePart::Vertex { index: 2, part },
+        }));
+        fields.extend(
+            [ObstaclePart::Radius, ObstaclePart::Vertices]
+                .map(|part| MobileField::Obstacle { index: 0, part }),
+        );
+        fields.extend(
+            FollowParam::ALL
+                .iter()
+                .map(|&p| MobileField::Follow(FollowField::Own(p))),
+        );
+        fields.extend(
+            LyapunovParam::ALL
+                .iter()
+                .map(|&p| MobileField::Follow(FollowField::Lyapunov(p))),
+        );
+        fields.extend(
+            PurePursuitParam::ALL
+                .iter()
+                .map(|&p| MobileField::Follow(FollowField::PurePursuit(p))),
+        );
+        fields.extend(
+            SteeringParam::ALL
+                .iter()
+                .map(|&p| MobileField::Follow(FollowField::Steering(p))),
+        );
+        fields.extend(SimField::ALL.iter().map(|&p| MobileField::Sim(p)));
+        fields.extend(VdfField::ALL.iter().map(|&p| MobileField::Vdf(p)));
+        fields.extend(SensorField::ALL.iter().map(|&p| MobileField::Sensors(p)));
+        fields.extend(AstarField::ALL.iter().map(|&p| MobileField::Astar(p)));
+        fields.extend([
+            MobileField::Readings,
+            MobileField::Reading(3),
+            MobileField::Dt,
+            MobileField::RobotRadius,
+        ]);
+        let mut missing = Vec::new();
+        for field in fields {
+            let path = proto_path(field);
+            if field == MobileField::Astar(AstarField::GridCells) {
+                continue;
+            }
+            if !roots.iter().any(|root| resolves(&set, root, &path)) {
+                missing.push(path);
+            }
+        }
+        assert!(missing.is_empty(), "{missing:?}");
+        // The wheel values are one level short of a path.
+        for w in WheelField::ALL {
+            assert!(!resolves(&set, roots[0], &proto_path(MobileField::Wheel(*w))));
+        }
+    }
 }
