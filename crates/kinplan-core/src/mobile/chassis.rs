@@ -195,146 +195,43 @@ impl Chassis {
 
     /// Checks every dimension and limit (positive and finite; steering limit in (0, 90°)).
     pub fn validate(&self) -> Result<(), MobileError> {
+        let field = |kind, param| MobileField::Chassis { kind, param };
+        let steer_limit = FRAC_PI_2 - 1e-6;
         match self {
             Chassis::Tricycle(p) => {
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Tricycle,
-                        param: ChassisParam::Wheelbase,
-                    },
-                    p.wheelbase,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Tricycle,
-                        param: ChassisParam::WheelRadius,
-                    },
-                    p.wheel_radius,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Tricycle,
-                        param: ChassisParam::MaxSpeed,
-                    },
-                    p.max_speed,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Tricycle,
-                        param: ChassisParam::MaxSteer,
-                    },
-                    p.max_steer,
-                )?;
-                check_range(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Tricycle,
-                        param: ChassisParam::MaxSteer,
-                    },
-                    p.max_steer,
-                    0.0,
-                    FRAC_PI_2 - 1e-6,
-                )
+                let f = |param| field(ChassisKind::Tricycle, param);
+                check_positive(f(ChassisParam::Wheelbase), p.wheelbase)?;
+                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_positive(f(ChassisParam::MaxSpeed), p.max_speed)?;
+                check_positive(f(ChassisParam::MaxSteer), p.max_steer)?;
+                check_range(f(ChassisParam::MaxSteer), p.max_steer, 0.0, steer_limit)
             }
             Chassis::Car(p) => {
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Car,
-                        param: ChassisParam::Wheelbase,
-                    },
-                    p.wheelbase,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Car,
-                        param: ChassisParam::Track,
-                    },
-                    p.track,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Car,
-                        param: ChassisParam::WheelRadius,
-                    },
-                    p.wheel_radius,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Car,
-                        param: ChassisParam::MaxSpeed,
-                    },
-                    p.max_speed,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Car,
-                        param: ChassisParam::MaxSteer,
-                    },
-                    p.max_steer,
-                )?;
-                check_range(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Car,
-                        param: ChassisParam::MaxSteer,
-                    },
-                    p.max_steer,
-                    0.0,
-                    FRAC_PI_2 - 1e-6,
-                )
+                let f = |param| field(ChassisKind::Car, param);
+                check_positive(f(ChassisParam::Wheelbase), p.wheelbase)?;
+                check_positive(f(ChassisParam::Track), p.track)?;
+                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_positive(f(ChassisParam::MaxSpeed), p.max_speed)?;
+                check_positive(f(ChassisParam::MaxSteer), p.max_steer)?;
+                check_range(f(ChassisParam::MaxSteer), p.max_steer, 0.0, steer_limit)
             }
             Chassis::Omni(p) => {
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Omni,
-                        param: ChassisParam::WheelRadius,
-                    },
-                    p.wheel_radius,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Omni,
-                        param: ChassisParam::CenterDistance,
-                    },
-                    p.center_distance,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Omni,
-                        param: ChassisParam::MaxWheelSpeed,
-                    },
-                    p.max_wheel_speed,
-                )?;
+                let f = |param| field(ChassisKind::Omni, param);
+                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_positive(f(ChassisParam::CenterDistance), p.center_distance)?;
+                check_positive(f(ChassisParam::MaxWheelSpeed), p.max_wheel_speed)?;
                 check_range(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Omni,
-                        param: ChassisParam::FirstWheelAngle,
-                    },
+                    f(ChassisParam::FirstWheelAngle),
                     p.first_wheel_angle,
                     -2.0 * PI,
                     2.0 * PI,
                 )
             }
             Chassis::Differential(p) => {
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Differential,
-                        param: ChassisParam::WheelRadius,
-                    },
-                    p.wheel_radius,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Differential,
-                        param: ChassisParam::Track,
-                    },
-                    p.track,
-                )?;
-                check_positive(
-                    MobileField::Chassis {
-                        kind: ChassisKind::Differential,
-                        param: ChassisParam::MaxWheelSpeed,
-                    },
-                    p.max_wheel_speed,
-                )
+                let f = |param| field(ChassisKind::Differential, param);
+                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_positive(f(ChassisParam::Track), p.track)?;
+                check_positive(f(ChassisParam::MaxWheelSpeed), p.max_wheel_speed)
             }
         }
     }

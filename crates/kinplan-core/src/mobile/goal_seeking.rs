@@ -40,33 +40,18 @@ impl Default for SteeringParams {
 impl SteeringParams {
     /// Positive finite speed, wheelbase and ε; steering limit in (0, 90°); ≥ 2 candidates.
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive(
-            MobileField::Follow(FollowField::Steering(SteeringParam::Speed)),
-            self.speed,
-        )?;
-        check_positive(
-            MobileField::Follow(FollowField::Steering(SteeringParam::Wheelbase)),
-            self.wheelbase,
-        )?;
-        check_positive(
-            MobileField::Follow(FollowField::Steering(SteeringParam::MaxSteer)),
-            self.max_steer,
-        )?;
+        let field = |p| MobileField::Follow(FollowField::Steering(p));
+        check_positive(field(SteeringParam::Speed), self.speed)?;
+        check_positive(field(SteeringParam::Wheelbase), self.wheelbase)?;
+        check_positive(field(SteeringParam::MaxSteer), self.max_steer)?;
         check_range(
-            MobileField::Follow(FollowField::Steering(SteeringParam::MaxSteer)),
+            field(SteeringParam::MaxSteer),
             self.max_steer,
             0.0,
             PI / 2.0 - 1e-6,
         )?;
-        check_positive(
-            MobileField::Follow(FollowField::Steering(SteeringParam::Epsilon)),
-            self.epsilon,
-        )?;
-        super::error::check_count(
-            MobileField::Follow(FollowField::Steering(SteeringParam::Candidates)),
-            self.candidates,
-            2,
-        )
+        check_positive(field(SteeringParam::Epsilon), self.epsilon)?;
+        super::error::check_count(field(SteeringParam::Candidates), self.candidates, 2)
     }
 }
 

@@ -46,34 +46,23 @@ impl Default for PurePursuitParams {
 impl PurePursuitParams {
     /// Positive distances and speeds; rotate angle in (0, π].
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive(
-            MobileField::Follow(FollowField::PurePursuit(PurePursuitParam::Lookahead)),
-            self.lookahead,
-        )?;
-        check_positive(
-            MobileField::Follow(FollowField::PurePursuit(PurePursuitParam::DesiredSpeed)),
-            self.desired_speed,
-        )?;
-        check_positive(
-            MobileField::Follow(FollowField::PurePursuit(PurePursuitParam::ApproachDistance)),
-            self.approach_distance,
-        )?;
+        let field = |p| MobileField::Follow(FollowField::PurePursuit(p));
+        check_positive(field(PurePursuitParam::Lookahead), self.lookahead)?;
+        check_positive(field(PurePursuitParam::DesiredSpeed), self.desired_speed)?;
+        check_positive(field(PurePursuitParam::ApproachDistance), self.approach_distance)?;
         check_range(
-            MobileField::Follow(FollowField::PurePursuit(PurePursuitParam::MinApproachSpeed)),
+            field(PurePursuitParam::MinApproachSpeed),
             self.min_approach_speed,
             0.0,
             self.desired_speed,
         )?;
         check_range(
-            MobileField::Follow(FollowField::PurePursuit(PurePursuitParam::RotateMinAngle)),
+            field(PurePursuitParam::RotateMinAngle),
             self.rotate_min_angle,
             1e-6,
             std::f64::consts::PI,
         )?;
-        check_positive(
-            MobileField::Follow(FollowField::PurePursuit(PurePursuitParam::RotateYawRate)),
-            self.rotate_yaw_rate,
-        )
+        check_positive(field(PurePursuitParam::RotateYawRate), self.rotate_yaw_rate)
     }
 }
 
