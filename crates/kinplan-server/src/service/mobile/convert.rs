@@ -5,8 +5,8 @@
 use tonic::Status;
 
 use super::{
-    MAX_OBSTACLES, MAX_PATH_NODES, MAX_POLYGON_VERTICES, MAX_RAYS_PER_BEAM, MAX_SENSORS, MAX_STEPS,
-    MAX_WORLD_VERTICES,
+    MAX_OBSTACLES, MAX_PATH_NODES, MAX_POLYGON_VERTICES, MAX_RAYS_PER_BEAM, MAX_SENSORS,
+    MAX_STEERING_CANDIDATES, MAX_STEPS, MAX_WORLD_VERTICES,
 };
 use crate::service::pb;
 use crate::service::status::invalid;
@@ -320,28 +320,28 @@ pub(super) fn astar_in(a: Option<&pb::GridAstarOptions>) -> Result<GridAstarPara
     Ok(p)
 }
 
-/// Path-follower parameters; `controller` must be a path-following one.
+/// Path-follower parameters; `controller` must be a path-following one; unset: `unset` (the
+/// domain's default for the caller: [`PathFollowParams::default`] or
+/// [`GRID_PATH_CONTROLLER`](kinplan_core::mobile::GRID_PATH_CONTROLLER)).
 pub(super) fn follow_in(
     controller: i32,
     f: Option<&pb::FollowOptions>,
-    controller_field: &str,
+    unset: ControllerKind,
 ) -> Result<PathFollowParams, Status> {
     let kind = match pb::Controller::try_from(controller) {
-        Ok(pb::Controller::Unspecified | pb::Controller::Lyapunov) => ControllerKind::Lyapunov,
+        Ok(pb::Controller::Unspecified) => unset,
+        Ok(pb::Controller::Lyapunov) => ControllerKind::Lyapunov,
         Ok(pb::Controller::PurePursuit) => ControllerKind::PurePursuit,
         Ok(pb::Controller::GoalSeeking) => ControllerKind::GoalSeeking,
         Ok(pb::Controller::ShortestPath) => ControllerKind::ShortestPath,
         Ok(pb::Controller::VectorDistance) => {
             return Err(invalid(
-                controller_field,
+                "controller",
                 "CONTROLLER_VECTOR_DISTANCE does not follow paths (use Navigate or ControlStep)",
             ));
         }
         Err(_) => {
-            return Err(invalid(
-                controller_field,
-                format!("unknown controller {controller}"),
-            ));
+            return Err(invalid("controller", format!("unknown controller {controller}")));
         }
     };
     let d = PathFollowParams::default();
@@ -378,7 +378,9 @@ pub(super) fn follow_in(
             p.steering.wheelbase = s.wheelbase.unwrap_or(d.wheelbase);
             p.steering.max_steer = s.max_steer.unwrap_or(d.max_steer);
             p.steering.epsilon = s.epsilon.unwrap_or(d.epsilon);
-            p.steering.candidates = s.candidates.map_or(d.candidates, |n| n.min(100_000) as usize);
+            p.steering.candidates = s
+                .candidates
+                .map_or(d.candidates, |n| n.min(MAX_STEERING_CANDIDATES) as usize);
         }
     }
     p.validate().map_err(mobile_error)?;

@@ -15,8 +15,8 @@ use super::server::Shared;
 use super::status::invalid;
 use super::status::mobile::mobile_error;
 use kinplan_core::mobile::{
-    GRID_PATH_CONTROLLER, NavigateParams, Saturation, StepController, StepOptions, follow_path, navigate,
-    navigate_astar,
+    GRID_PATH_CONTROLLER, NavigateParams, PathFollowParams, Saturation, StepController, StepOptions,
+    follow_path, navigate, navigate_astar,
 };
 
 mod convert;
@@ -41,6 +41,9 @@ pub const MAX_PATH_NODES: usize = 10_000;
 pub const MAX_SENSORS: u32 = 360;
 /// Most rays per sensor beam accepted.
 pub const MAX_RAYS_PER_BEAM: u32 = 100;
+/// Most steering candidates a goal-seeking / shortest-path step evaluates (larger requests
+/// are clamped to it).
+pub const MAX_STEERING_CANDIDATES: u32 = 100_000;
 /// Largest state token accepted, bytes.
 pub const MAX_TOKEN_BYTES: usize = 1 << 20;
 
@@ -126,7 +129,11 @@ impl MobileService for MobileApi {
         let chassis = chassis_in(req.chassis.as_ref());
         let start = pose_in(req.start.as_ref());
         let path = path_in(&req.path)?;
-        let follow = follow_in(req.controller, req.follow.as_ref(), "controller")?;
+        let follow = follow_in(
+            req.controller,
+            req.follow.as_ref(),
+            PathFollowParams::default().controller,
+        )?;
         let world = if req.world.is_empty() {
             None
         } else {
@@ -175,10 +182,7 @@ impl MobileService for MobileApi {
                     .await?
             }
             pb::Navigator::GridAstar => {
-                let mut follow = follow_in(req.controller, req.follow.as_ref(), "controller")?;
-                if req.controller == pb::Controller::Unspecified as i32 {
-                    follow.controller = GRID_PATH_CONTROLLER;
-                }
+                let follow = follow_in(req.controller, req.follow.as_ref(), GRID_PATH_CONTROLLER)?;
                 let astar = astar_in(req.astar.as_ref())?;
                 self.shared
                     .compute
@@ -228,7 +232,11 @@ fn control_step(
         path = path_in(&req.path)?;
         StepController::FollowPath {
             path: &path,
-            follow: follow_in(req.controller, req.follow.as_ref(), "controller")?,
+            follow: follow_in(
+                req.controller,
+                req.follow.as_ref(),
+                PathFollowParams::default().controller,
+            )?,
         }
     };
     let Some(step) = kinplan_core::mobile::control_step(
