@@ -444,9 +444,16 @@ async fn navigate_reaches_walled_in_is_no_path_and_collisions_are_reported() {
         100.0,
     );
     req.navigator = pb::Navigator::GridAstar as i32;
-    let run = client.navigate(req).await.unwrap().into_inner();
+    let run = client.navigate(req.clone()).await.unwrap().into_inner();
     assert_eq!(run.outcome, pb::Outcome::Reached as i32);
     assert!(run.metrics.unwrap().min_clearance.unwrap() >= 0.0);
+    // An unset controller follows the grid path with pure pursuit: the very same run.
+    req.controller = pb::Controller::PurePursuit as i32;
+    let pure_pursuit = client.navigate(req.clone()).await.unwrap().into_inner();
+    assert_eq!(run, pure_pursuit);
+    req.controller = pb::Controller::Lyapunov as i32;
+    let lyapunov = client.navigate(req).await.unwrap().into_inner();
+    assert_ne!(run.states, lyapunov.states);
 
     // The goal (6, 0) inside a closed ring of 28 touching discs: NO_PATH, with a hit point.
     let ring: Vec<pb::Obstacle> = (0..28)
