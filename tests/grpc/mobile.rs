@@ -444,9 +444,16 @@ async fn navigate_reaches_walled_in_is_no_path_and_collisions_are_reported() {
         100.0,
     );
     req.navigator = pb::Navigator::GridAstar as i32;
-    let run = client.navigate(req).await.unwrap().into_inner();
+    let run = client.navigate(req.clone()).await.unwrap().into_inner();
     assert_eq!(run.outcome, pb::Outcome::Reached as i32);
     assert!(run.metrics.unwrap().min_clearance.unwrap() >= 0.0);
+    // An unset controller follows the grid path with pure pursuit: the very same run.
+    req.controller = pb::Controller::PurePursuit as i32;
+    let pure_pursuit = client.navigate(req.clone()).await.unwrap().into_inner();
+    assert_eq!(run, pure_pursuit);
+    req.controller = pb::Controller::Lyapunov as i32;
+    let lyapunov = client.navigate(req).await.unwrap().into_inner();
+    assert_ne!(run.states, lyapunov.states);
 
     // The goal (6, 0) inside a closed ring of 28 touching discs: NO_PATH, with a hit point.
     let ring: Vec<pb::Obstacle> = (0..28)
@@ -628,6 +635,47 @@ async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
             },
             "path",
         ),
+        (
+            "NaN reading",
+            pb::ControlStepRequest {
+                readings: vec![2.0, 2.0, 2.0, f64::NAN, 2.0, 2.0, 2.0, 2.0],
+                ..vd(pose(0.0, 0.0, 0.0))
+            },
+            "readings[3]",
+        ),
+        (
+            "negative sensing radius",
+            pb::ControlStepRequest {
+                readings: vec![],
+                world: vec![circle(3.0, 0.0, 0.5)],
+                robot_radius: Some(-0.2),
+                ..vd(pose(0.0, 0.0, 0.0))
+            },
+            "robot_radius",
+        ),
+        (
+            "zero tricycle wheelbase",
+            pb::ControlStepRequest {
+                chassis: Some(pb::Chassis {
+                    kind: Some(pb::chassis::Kind::Tricycle(pb::TricycleChassis {
+                        wheelbase: Some(0.0),
+                        ..Default::default()
+                    })),
+                }),
+                ..vd(pose(0.0, 0.0, 0.0))
+            },
+            "chassis.tricycle.wheelbase",
+        ),
+        (
+            "forged path-follow token",
+            pb::ControlStepRequest {
+                controller: pb::Controller::PurePursuit as i32,
+                path: vec![node(1.0, 0.0, None), node(2.0, 0.0, None)],
+                state_token: br#"{"target":5,"segment":0}"#.to_vec(),
+                ..vd(pose(0.0, 0.0, 0.0))
+            },
+            "state_token",
+        ),
     ];
     for (what, req, field) in step_cases {
         check(what, client.control_step(req).await.unwrap_err(), field);
@@ -696,6 +744,61 @@ async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
             },
             "start",
         ),
+        (
+            "NaN node y",
+            follow(vec![node(1.0, 0.0, None), node(2.0, f64::NAN, None)], None),
+            "path[1].y",
+        ),
+        (
+            "car steering beyond 90 degrees",
+            pb::FollowPathRequest {
+                chassis: Some(pb::Chassis {
+                    kind: Some(pb::chassis::Kind::Car(pb::CarChassis {
+                        max_steer: Some(2.0),
+                        ..Default::default()
+                    })),
+                }),
+                ..follow(ok_path.clone(), None)
+            },
+            "chassis.car.max_steer",
+        ),
+        (
+            "negative lookahead",
+            pb::FollowPathRequest {
+                controller: pb::Controller::PurePursuit as i32,
+                follow: Some(pb::FollowOptions {
+                    pure_pursuit: Some(pb::PurePursuitGains {
+                        lookahead: Some(-1.0),
+                        ..Default::default()
+                    }),
+                    ..Default::default()
+                }),
+                ..follow(ok_path.clone(), None)
+            },
+            "follow.pure_pursuit.lookahead",
+        ),
+        (
+            "zero heading tolerance",
+            pb::FollowPathRequest {
+                follow: Some(pb::FollowOptions {
+                    heading_tolerance: Some(0.0),
+                    ..Default::default()
+                }),
+                ..follow(ok_path.clone(), None)
+            },
+            "follow.heading_tolerance",
+        ),
+        (
+            "negative robot radius",
+            follow(
+                ok_path.clone(),
+                Some(pb::SimOptions {
+                    robot_radius: Some(-0.1),
+                    ..Default::default()
+                }),
+            ),
+            "sim.robot_radius",
+        ),
     ];
     for (what, req, field) in follow_cases {
         check(what, client.follow_path(req).await.unwrap_err(), field);
@@ -745,6 +848,73 @@ async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
                 ..navigate(vec![], (4.0, 0.0), 10.0)
             },
             "sensors.count",
+        ),
+        (
+            "NaN circle centre",
+            navigate(vec![circle(f64::NAN, 0.0, 0.3)], (4.0, 0.0), 10.0),
+            "world[0].circle.center.x",
+        ),
+        (
+            "NaN polygon vertex",
+            navigate(
+                vec![
+                    circle(9.0, 9.0, 0.3),
+                    pb::Obstacle {
+                        shape: Some(pb::obstacle::Shape::Polygon(pb::Polygon {
+                            vertices: vec![
+                                pb::Point2D { x: 1.0, y: 1.0 },
+                                pb::Point2D { x: 2.0, y: f64::NAN },
+                                pb::Point2D { x: 2.0, y: 2.0 },
+                            ],
+                        })),
+                    },
+                ],
+                (4.0, 0.0),
+                10.0,
+            ),
+            "world[1].polygon.vertices[1].y",
+        ),
+        (
+            "far start heading",
+            pb::NavigateRequest {
+                start: pose(0.0, 0.0, 1e300),
+                ..navigate(vec![], (4.0, 0.0), 10.0)
+            },
+            "start.theta",
+        ),
+        (
+            "weight decay above one",
+            pb::NavigateRequest {
+                vdf: Some(pb::VectorDistanceParams {
+                    weight_decay: Some(1.5),
+                    ..Default::default()
+                }),
+                ..navigate(vec![], (4.0, 0.0), 10.0)
+            },
+            "vdf.weight_decay",
+        ),
+        (
+            "negative beam width",
+            pb::NavigateRequest {
+                sensors: Some(pb::RangeSensorParams {
+                    beam_width: Some(-1.0),
+                    ..Default::default()
+                }),
+                ..navigate(vec![], (4.0, 0.0), 10.0)
+            },
+            "sensors.beam_width",
+        ),
+        (
+            "zero grid resolution",
+            pb::NavigateRequest {
+                navigator: pb::Navigator::GridAstar as i32,
+                astar: Some(pb::GridAstarOptions {
+                    resolution: Some(0.0),
+                    ..Default::default()
+                }),
+                ..navigate(vec![circle(2.0, 0.0, 0.5)], (4.0, 0.0), 10.0)
+            },
+            "astar.resolution",
         ),
     ];
     for (what, req, field) in nav_cases {

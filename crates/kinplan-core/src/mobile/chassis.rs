@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use super::error::{MobileError, check_positive, check_range};
+use super::field::{ChassisKind, ChassisParam, MobileField};
 use super::pose::{Pose, Twist, integrate_twist};
 
 const DEG70: f64 = 70.0 * PI / 180.0;
@@ -194,32 +195,43 @@ impl Chassis {
 
     /// Checks every dimension and limit (positive and finite; steering limit in (0, 90°)).
     pub fn validate(&self) -> Result<(), MobileError> {
+        let field = |kind, param| MobileField::Chassis { kind, param };
+        let steer_limit = FRAC_PI_2 - 1e-6;
         match self {
             Chassis::Tricycle(p) => {
-                check_positive("tricycle.wheelbase", p.wheelbase)?;
-                check_positive("tricycle.wheel_radius", p.wheel_radius)?;
-                check_positive("tricycle.max_speed", p.max_speed)?;
-                check_positive("tricycle.max_steer", p.max_steer)?;
-                check_range("tricycle.max_steer", p.max_steer, 0.0, FRAC_PI_2 - 1e-6)
+                let f = |param| field(ChassisKind::Tricycle, param);
+                check_positive(f(ChassisParam::Wheelbase), p.wheelbase)?;
+                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_positive(f(ChassisParam::MaxSpeed), p.max_speed)?;
+                check_positive(f(ChassisParam::MaxSteer), p.max_steer)?;
+                check_range(f(ChassisParam::MaxSteer), p.max_steer, 0.0, steer_limit)
             }
             Chassis::Car(p) => {
-                check_positive("car.wheelbase", p.wheelbase)?;
-                check_positive("car.track", p.track)?;
-                check_positive("car.wheel_radius", p.wheel_radius)?;
-                check_positive("car.max_speed", p.max_speed)?;
-                check_positive("car.max_steer", p.max_steer)?;
-                check_range("car.max_steer", p.max_steer, 0.0, FRAC_PI_2 - 1e-6)
+                let f = |param| field(ChassisKind::Car, param);
+                check_positive(f(ChassisParam::Wheelbase), p.wheelbase)?;
+                check_positive(f(ChassisParam::Track), p.track)?;
+                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_positive(f(ChassisParam::MaxSpeed), p.max_speed)?;
+                check_positive(f(ChassisParam::MaxSteer), p.max_steer)?;
+                check_range(f(ChassisParam::MaxSteer), p.max_steer, 0.0, steer_limit)
             }
             Chassis::Omni(p) => {
-                check_positive("omni.wheel_radius", p.wheel_radius)?;
-                check_positive("omni.center_distance", p.center_distance)?;
-                check_positive("omni.max_wheel_speed", p.max_wheel_speed)?;
-                check_range("omni.first_wheel_angle", p.first_wheel_angle, -2.0 * PI, 2.0 * PI)
+                let f = |param| field(ChassisKind::Omni, param);
+                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_positive(f(ChassisParam::CenterDistance), p.center_distance)?;
+                check_positive(f(ChassisParam::MaxWheelSpeed), p.max_wheel_speed)?;
+                check_range(
+                    f(ChassisParam::FirstWheelAngle),
+                    p.first_wheel_angle,
+                    -2.0 * PI,
+                    2.0 * PI,
+                )
             }
             Chassis::Differential(p) => {
-                check_positive("differential.wheel_radius", p.wheel_radius)?;
-                check_positive("differential.track", p.track)?;
-                check_positive("differential.max_wheel_speed", p.max_wheel_speed)
+                let f = |param| field(ChassisKind::Differential, param);
+                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_positive(f(ChassisParam::Track), p.track)?;
+                check_positive(f(ChassisParam::MaxWheelSpeed), p.max_wheel_speed)
             }
         }
     }
@@ -327,9 +339,9 @@ impl Chassis {
     /// ```
     pub fn step(&self, state: Pose, cmd: Twist, dt: f64) -> Result<ChassisStep, MobileError> {
         self.validate()?;
-        state.validate("state")?;
-        cmd.validate("command")?;
-        check_positive("dt", dt)?;
+        state.validate(MobileField::State)?;
+        cmd.validate(MobileField::Command)?;
+        check_positive(MobileField::Dt, dt)?;
         Ok(self.step_unchecked(state, cmd, dt))
     }
 
@@ -393,7 +405,7 @@ mod tests {
             ..DifferentialParams::default()
         });
         assert!(
-            matches!(bad.validate(), Err(MobileError::NotPositive { field, .. }) if field == "differential.wheel_radius")
+            matches!(bad.validate(), Err(MobileError::NotPositive { field, .. }) if field == MobileField::Chassis { kind: ChassisKind::Differential, param: ChassisParam::WheelRadius })
         );
         let nan = c.saturate(Twist::unicycle(f64::NAN, 0.0));
         assert_eq!(nan.0, Twist::ZERO);

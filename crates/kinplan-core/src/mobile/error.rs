@@ -2,6 +2,8 @@
 
 use thiserror::Error;
 
+use super::field::MobileField;
+
 /// Invalid input to a mobile-robot function. Outcomes such as "no path" or
 /// "collision" are not errors: they are statuses inside a run result.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -9,24 +11,24 @@ pub enum MobileError {
     /// A number that must be finite is NaN or infinite.
     #[error("{field} must be finite, got {value}")]
     NotFinite {
-        /// Name of the field, e.g. `"state.x"`.
-        field: String,
+        /// The offending input, e.g. `MobileField::State(Component::X)`.
+        field: MobileField,
         /// The value received.
         value: f64,
     },
     /// A number that must be strictly positive is not.
     #[error("{field} must be positive, got {value}")]
     NotPositive {
-        /// Name of the field.
-        field: String,
+        /// The offending input.
+        field: MobileField,
         /// The value received.
         value: f64,
     },
     /// A number lies outside its allowed closed interval.
     #[error("{field} = {value} is outside [{min}, {max}]")]
     OutOfRange {
-        /// Name of the field.
-        field: String,
+        /// The offending input.
+        field: MobileField,
         /// The value received.
         value: f64,
         /// Lower bound (inclusive).
@@ -37,8 +39,8 @@ pub enum MobileError {
     /// A list or count is too short.
     #[error("{field} needs at least {min} entries, got {got}")]
     TooFew {
-        /// Name of the field.
-        field: String,
+        /// The offending input.
+        field: MobileField,
         /// Minimum length.
         min: usize,
         /// Length received.
@@ -51,6 +53,13 @@ pub enum MobileError {
     #[error("controller token is invalid: {reason}")]
     BadToken {
         /// Why decoding failed.
+        reason: String,
+    },
+    /// A controller state that a token may not carry (a bug, not bad input): encoding refuses
+    /// it rather than hand out an empty token.
+    #[error("the controller state could not be encoded: {reason}")]
+    TokenEncoding {
+        /// Why encoding failed.
         reason: String,
     },
     /// The start pose already overlaps an obstacle.
@@ -69,36 +78,48 @@ pub enum MobileError {
     },
 }
 
-pub(crate) fn check_finite(field: &str, value: f64) -> Result<(), MobileError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(MobileError::NotFinite {
-            field: field.to_owned(),
-            value,
-        })
+impl MobileError {
+    /// The input a field-specific error names (`None` for the errors that are about a whole
+    /// input: the path, the token, the start pose, the wheel state).
+    pub fn field(&self) -> Option<MobileField> {
+        match self {
+            MobileError::NotFinite { field, .. }
+            | MobileError::NotPositive { field, .. }
+            | MobileError::OutOfRange { field, .. }
+            | MobileError::TooFew { field, .. } => Some(*field),
+            MobileError::EmptyPath
+            | MobileError::BadToken { .. }
+            | MobileError::TokenEncoding { .. }
+            | MobileError::StartInCollision { .. }
+            | MobileError::WheelMismatch { .. } => None,
+        }
     }
 }
 
-pub(crate) fn check_positive(field: &str, value: f64) -> Result<(), MobileError> {
+pub(crate) fn check_finite(field: MobileField, value: f64) -> Result<(), MobileError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(MobileError::NotFinite { field, value })
+    }
+}
+
+pub(crate) fn check_positive(field: MobileField, value: f64) -> Result<(), MobileError> {
     check_finite(field, value)?;
     if value > 0.0 {
         Ok(())
     } else {
-        Err(MobileError::NotPositive {
-            field: field.to_owned(),
-            value,
-        })
+        Err(MobileError::NotPositive { field, value })
     }
 }
 
-pub(crate) fn check_range(field: &str, value: f64, min: f64, max: f64) -> Result<(), MobileError> {
+pub(crate) fn check_range(field: MobileField, value: f64, min: f64, max: f64) -> Result<(), MobileError> {
     check_finite(field, value)?;
     if (min..=max).contains(&value) {
         Ok(())
     } else {
         Err(MobileError::OutOfRange {
-            field: field.to_owned(),
+            field,
             value,
             min,
             max,
@@ -106,14 +127,10 @@ pub(crate) fn check_range(field: &str, value: f64, min: f64, max: f64) -> Result
     }
 }
 
-pub(crate) fn check_count(field: &str, got: usize, min: usize) -> Result<(), MobileError> {
+pub(crate) fn check_count(field: MobileField, got: usize, min: usize) -> Result<(), MobileError> {
     if got >= min {
         Ok(())
     } else {
-        Err(MobileError::TooFew {
-            field: field.to_owned(),
-            min,
-            got,
-        })
+        Err(MobileError::TooFew { field, min, got })
     }
 }

@@ -6,6 +6,7 @@ use std::f64::consts::PI;
 
 use super::angle::wrap_angle;
 use super::error::{MobileError, check_positive, check_range};
+use super::field::{FollowField, MobileField, SteeringParam};
 use super::pose::{Point2, Pose, Twist};
 
 /// Parameters of [`goal_seeking_step`] and [`shortest_path_step`](super::shortest_path_step).
@@ -39,12 +40,18 @@ impl Default for SteeringParams {
 impl SteeringParams {
     /// Positive finite speed, wheelbase and ε; steering limit in (0, 90°); ≥ 2 candidates.
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive("steering.speed", self.speed)?;
-        check_positive("steering.wheelbase", self.wheelbase)?;
-        check_positive("steering.max_steer", self.max_steer)?;
-        check_range("steering.max_steer", self.max_steer, 0.0, PI / 2.0 - 1e-6)?;
-        check_positive("steering.epsilon", self.epsilon)?;
-        super::error::check_count("steering.candidates", self.candidates, 2)
+        let field = |p| MobileField::Follow(FollowField::Steering(p));
+        check_positive(field(SteeringParam::Speed), self.speed)?;
+        check_positive(field(SteeringParam::Wheelbase), self.wheelbase)?;
+        check_positive(field(SteeringParam::MaxSteer), self.max_steer)?;
+        check_range(
+            field(SteeringParam::MaxSteer),
+            self.max_steer,
+            0.0,
+            PI / 2.0 - 1e-6,
+        )?;
+        check_positive(field(SteeringParam::Epsilon), self.epsilon)?;
+        super::error::check_count(field(SteeringParam::Candidates), self.candidates, 2)
     }
 }
 
@@ -78,9 +85,9 @@ pub fn goal_seeking_step(
     params: &SteeringParams,
 ) -> Result<SteeringCommand, MobileError> {
     params.validate()?;
-    state.validate("state")?;
-    goal.validate("goal")?;
-    check_positive("dt", dt)?;
+    state.validate(MobileField::State)?;
+    goal.validate(MobileField::Goal)?;
+    check_positive(MobileField::Dt, dt)?;
     let z = state.point().distance(goal);
     let omega_dir = (goal.y - state.y).atan2(goal.x - state.x);
     let delta = if z > 0.0 {

@@ -7,6 +7,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use super::error::{MobileError, check_positive, check_range};
+use super::field::{AstarField, MobileField};
 use super::pose::Point2;
 use super::world::World;
 
@@ -38,10 +39,15 @@ impl Default for GridAstarParams {
 impl GridAstarParams {
     /// Positive resolution; non-negative inflation and padding; at least 4 cells.
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive("astar.resolution", self.resolution)?;
-        check_range("astar.inflation", self.inflation, 0.0, 1e6)?;
-        check_range("astar.padding", self.padding, 0.0, 1e6)?;
-        super::error::check_count("astar.max_cells", self.max_cells, 4)
+        check_positive(MobileField::Astar(AstarField::Resolution), self.resolution)?;
+        check_range(
+            MobileField::Astar(AstarField::Inflation),
+            self.inflation,
+            0.0,
+            1e6,
+        )?;
+        check_range(MobileField::Astar(AstarField::Padding), self.padding, 0.0, 1e6)?;
+        super::error::check_count(MobileField::Astar(AstarField::MaxCells), self.max_cells, 4)
     }
 }
 
@@ -125,8 +131,8 @@ pub fn plan_grid_astar_until(
     should_stop: &dyn Fn() -> bool,
 ) -> Result<Option<Vec<Point2>>, MobileError> {
     params.validate()?;
-    start.validate("start")?;
-    goal.validate("goal")?;
+    start.validate(MobileField::Start)?;
+    goal.validate(MobileField::Goal)?;
     let (mut lo, mut hi) = (
         Point2::new(start.x.min(goal.x), start.y.min(goal.y)),
         Point2::new(start.x.max(goal.x), start.y.max(goal.y)),
@@ -147,7 +153,7 @@ pub fn plan_grid_astar_until(
     // NaN (from infinite inputs) is refused too.
     if cells.is_nan() || cells > params.max_cells as f64 {
         return Err(MobileError::OutOfRange {
-            field: "astar grid cells".into(),
+            field: MobileField::Astar(AstarField::GridCells),
             value: cells,
             min: 4.0,
             max: params.max_cells as f64,

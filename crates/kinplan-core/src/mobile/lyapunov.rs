@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::angle::{sinc, wrap_angle};
 use super::error::{MobileError, check_positive, check_range};
+use super::field::{FollowField, LyapunovParam, MobileField};
 use super::pose::{Pose, Twist};
 
 /// Gains of the Aicardi controller. S1 recommends γ, λ, h ∈ (0, 1) and k ∈ (0, 6);
@@ -42,12 +43,30 @@ impl LyapunovParams {
     /// All gains and limits positive and at most 1e6 (so no product overflows).
     pub fn validate(&self) -> Result<(), MobileError> {
         for (f, v) in [
-            ("lyapunov.gamma", self.gamma),
-            ("lyapunov.k", self.k),
-            ("lyapunov.h", self.h),
-            ("lyapunov.lambda", self.lambda),
-            ("lyapunov.max_speed", self.max_speed),
-            ("lyapunov.max_yaw_rate", self.max_yaw_rate),
+            (
+                MobileField::Follow(FollowField::Lyapunov(LyapunovParam::Gamma)),
+                self.gamma,
+            ),
+            (
+                MobileField::Follow(FollowField::Lyapunov(LyapunovParam::K)),
+                self.k,
+            ),
+            (
+                MobileField::Follow(FollowField::Lyapunov(LyapunovParam::H)),
+                self.h,
+            ),
+            (
+                MobileField::Follow(FollowField::Lyapunov(LyapunovParam::Lambda)),
+                self.lambda,
+            ),
+            (
+                MobileField::Follow(FollowField::Lyapunov(LyapunovParam::MaxSpeed)),
+                self.max_speed,
+            ),
+            (
+                MobileField::Follow(FollowField::Lyapunov(LyapunovParam::MaxYawRate)),
+                self.max_yaw_rate,
+            ),
         ] {
             check_positive(f, v)?;
             check_range(f, v, 0.0, 1e6)?;
@@ -101,8 +120,8 @@ pub fn lyapunov_step(
     params: &LyapunovParams,
 ) -> Result<LyapunovCommand, MobileError> {
     params.validate()?;
-    state.validate("state")?;
-    goal.validate("goal")?;
+    state.validate(MobileField::State)?;
+    goal.validate(MobileField::Goal)?;
     Ok(lyapunov_step_unchecked(state, goal, params))
 }
 
@@ -190,7 +209,7 @@ mod tests {
             ..LyapunovParams::default()
         };
         assert!(
-            matches!(lyapunov_step(Pose::new(1.0, 0.0, 0.0), g, &zero_k), Err(MobileError::NotPositive { field, .. }) if field == "lyapunov.k")
+            matches!(lyapunov_step(Pose::new(1.0, 0.0, 0.0), g, &zero_k), Err(MobileError::NotPositive { field, .. }) if field == MobileField::Follow(FollowField::Lyapunov(LyapunovParam::K)))
         );
         let huge = LyapunovParams {
             gamma: 1e300,

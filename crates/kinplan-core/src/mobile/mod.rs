@@ -3,7 +3,9 @@
 
 mod angle;
 mod chassis;
+mod control_step;
 mod error;
+mod field;
 mod goal_seeking;
 mod grid_astar;
 mod lyapunov;
@@ -13,6 +15,7 @@ mod pure_pursuit;
 mod sensors;
 mod shortest_path;
 mod simulate;
+mod token;
 mod vector_distance;
 mod wheel_kinematics;
 mod world;
@@ -21,7 +24,12 @@ pub use angle::{sinc, wrap_angle};
 pub use chassis::{
     CarParams, Chassis, ChassisStep, DifferentialParams, OmniParams, Saturation, TricycleParams,
 };
+pub use control_step::{ControlStep, StepController, StepOptions, StepReport, control_step};
 pub use error::MobileError;
+pub use field::{
+    AstarField, ChassisKind, ChassisParam, Component, FollowField, FollowParam, LyapunovParam, MobileField,
+    ObstaclePart, PurePursuitParam, SensorField, SimField, SteeringParam, VdfField, WheelField,
+};
 pub use goal_seeking::{SteeringCommand, SteeringParams, goal_seeking_finished, goal_seeking_step};
 pub use grid_astar::{GridAstarParams, plan_grid_astar, plan_grid_astar_until};
 pub use lyapunov::{LyapunovCommand, LyapunovParams, lyapunov_step, lyapunov_value};
@@ -34,10 +42,13 @@ pub use pure_pursuit::{PurePursuitCommand, PurePursuitParams, pure_pursuit_step}
 pub use sensors::{RangeSensorParams, RangeSensors};
 pub use shortest_path::shortest_path_step;
 pub use simulate::{
-    NavigateParams, Outcome, RunMetrics, SimParams, SimRun, follow_path, navigate, navigate_astar,
+    GRID_PATH_CONTROLLER, NavigateParams, Outcome, RunMetrics, SimParams, SimRun, follow_path, navigate,
+    navigate_astar,
 };
+pub use token::{ControllerMemory, decode_token, encode_token};
 pub use vector_distance::{
-    NavMode, NoPathReason, TurnPreference, TurnSide, VdfEvent, VdfOutput, VdfParams, VdfState, vdf_step,
+    MAX_TOKEN_STEPS, NavMode, NoPathReason, TurnPreference, TurnSide, VdfEvent, VdfOutput, VdfParams,
+    VdfState, vdf_step,
 };
 pub use wheel_kinematics::WheelState;
 pub use world::{Obstacle, World};

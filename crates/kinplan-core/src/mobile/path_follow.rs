@@ -5,11 +5,13 @@ use serde::{Deserialize, Serialize};
 
 use super::angle::wrap_angle;
 use super::error::{MobileError, check_positive, check_range};
+use super::field::{Component, FollowField, FollowParam, MobileField};
 use super::goal_seeking::{SteeringParams, goal_seeking_step};
 use super::lyapunov::{LyapunovParams, lyapunov_step_unchecked};
 use super::pose::{Point2, Pose, Twist};
 use super::pure_pursuit::{PurePursuitParams, pure_pursuit_unchecked};
 use super::shortest_path::shortest_path_step;
+use super::token::ControllerMemory;
 
 /// A nodal point of a path: position (m) and an optional heading (rad) to reach it with.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -96,10 +98,16 @@ impl PathFollowParams {
 
     /// Positive distances and tolerances; nested parameter sets valid.
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive("follow.switching_distance", self.switching_distance)?;
-        check_positive("follow.goal_tolerance", self.goal_tolerance)?;
+        check_positive(
+            MobileField::Follow(FollowField::Own(FollowParam::SwitchingDistance)),
+            self.switching_distance,
+        )?;
+        check_positive(
+            MobileField::Follow(FollowField::Own(FollowParam::GoalTolerance)),
+            self.goal_tolerance,
+        )?;
         check_range(
-            "follow.heading_tolerance",
+            MobileField::Follow(FollowField::Own(FollowParam::HeadingTolerance)),
             self.heading_tolerance,
             1e-9,
             std::f64::consts::PI,
@@ -117,6 +125,19 @@ pub struct PathFollowState {
     pub target: usize,
     /// Nearest polyline segment (pure pursuit).
     pub segment: usize,
+}
+
+impl ControllerMemory for PathFollowState {
+    /// The path's length: both indices must name one of its nodes.
+    type Context = usize;
+
+    fn check(&self, path_len: &usize) -> Result<(), &'static str> {
+        if self.target < *path_len && self.segment < *path_len {
+            Ok(())
+        } else {
+            Err("the token points beyond the path's last node")
+        }
+    }
 }
 
 /// Output of [`path_follow_step`].
@@ -139,9 +160,15 @@ pub fn validate_path(path: &[PathNode]) -> Result<(), MobileError> {
         if n.x.is_finite() && n.y.is_finite() && n.heading.is_none_or(f64::is_finite) {
             continue;
         }
-        n.point().validate(&format!("path[{i}]"))?;
+        n.point().validate(|part| MobileField::Path { index: i, part })?;
         if let Some(h) = n.heading {
-            super::error::check_finite(&format!("path[{i}].heading"), h)?;
+            super::error::check_finite(
+                MobileField::Path {
+                    index: i,
+                    part: Component::Heading,
+                },
+                h,
+            )?;
         }
     }
     Ok(())
@@ -172,9 +199,9 @@ pub fn path_follow_step(
     params: &PathFollowParams,
 ) -> Result<PathFollowStep, MobileError> {
     params.validate()?;
-    state.validate("state")?;
+    state.validate(MobileField::State)?;
     validate_path(path)?;
-    check_positive("dt", dt)?;
+    check_positive(MobileField::Dt, dt)?;
     Ok(path_follow_unchecked(
         state,
         path,

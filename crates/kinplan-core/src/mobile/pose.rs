@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use super::angle::{sinc, versinc, wrap_angle};
 use super::error::{MobileError, check_range};
+use super::field::{Component, MobileField};
 
 /// Largest magnitude of a world coordinate, m: bounded so that distances,
 /// grids and control laws stay finite (a 1e308 coordinate overflowed them).
@@ -11,7 +12,7 @@ pub const MAX_COORDINATE: f64 = 1e6;
 /// Largest magnitude of a heading (rad) or a twist component (m/s, rad/s).
 pub const MAX_RATE: f64 = 1e6;
 
-fn bounded(field: &str, value: f64, bound: f64) -> Result<(), MobileError> {
+fn bounded(field: MobileField, value: f64, bound: f64) -> Result<(), MobileError> {
     check_range(field, value, -bound, bound)
 }
 
@@ -36,12 +37,12 @@ impl Point2 {
     }
 
     /// Rejects NaN, infinite or out-of-world (beyond [`MAX_COORDINATE`]) coordinates.
-    pub fn validate(&self, field: &str) -> Result<(), MobileError> {
+    pub fn validate(&self, field: impl Fn(Component) -> MobileField) -> Result<(), MobileError> {
         if self.x.abs() <= MAX_COORDINATE && self.y.abs() <= MAX_COORDINATE {
             return Ok(());
         }
-        bounded(&format!("{field}.x"), self.x, MAX_COORDINATE)?;
-        bounded(&format!("{field}.y"), self.y, MAX_COORDINATE)
+        bounded(field(Component::X), self.x, MAX_COORDINATE)?;
+        bounded(field(Component::Y), self.y, MAX_COORDINATE)
     }
 }
 
@@ -70,13 +71,13 @@ impl Pose {
 
     /// Rejects NaN, infinite or out-of-world components (coordinates beyond
     /// [`MAX_COORDINATE`], headings beyond [`MAX_RATE`]).
-    pub fn validate(&self, field: &str) -> Result<(), MobileError> {
+    pub fn validate(&self, field: impl Fn(Component) -> MobileField) -> Result<(), MobileError> {
         if self.x.abs() <= MAX_COORDINATE && self.y.abs() <= MAX_COORDINATE && self.theta.abs() <= MAX_RATE {
             return Ok(());
         }
-        bounded(&format!("{field}.x"), self.x, MAX_COORDINATE)?;
-        bounded(&format!("{field}.y"), self.y, MAX_COORDINATE)?;
-        bounded(&format!("{field}.theta"), self.theta, MAX_RATE)
+        bounded(field(Component::X), self.x, MAX_COORDINATE)?;
+        bounded(field(Component::Y), self.y, MAX_COORDINATE)?;
+        bounded(field(Component::Theta), self.theta, MAX_RATE)
     }
 }
 
@@ -119,13 +120,13 @@ impl Twist {
     }
 
     /// Rejects NaN, infinite or absurd (beyond [`MAX_RATE`]) components.
-    pub fn validate(&self, field: &str) -> Result<(), MobileError> {
+    pub fn validate(&self, field: impl Fn(Component) -> MobileField) -> Result<(), MobileError> {
         if self.vx.abs() <= MAX_RATE && self.vy.abs() <= MAX_RATE && self.omega.abs() <= MAX_RATE {
             return Ok(());
         }
-        bounded(&format!("{field}.vx"), self.vx, MAX_RATE)?;
-        bounded(&format!("{field}.vy"), self.vy, MAX_RATE)?;
-        bounded(&format!("{field}.omega"), self.omega, MAX_RATE)
+        bounded(field(Component::Vx), self.vx, MAX_RATE)?;
+        bounded(field(Component::Vy), self.vy, MAX_RATE)?;
+        bounded(field(Component::Omega), self.omega, MAX_RATE)
     }
 }
 

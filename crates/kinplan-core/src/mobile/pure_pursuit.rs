@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::angle::wrap_angle;
 use super::error::{MobileError, check_positive, check_range};
+use super::field::{FollowField, MobileField, PurePursuitParam};
 use super::pose::{Point2, Pose, Twist};
 
 /// Parameters (defaults = Nav2 `RegulatedPurePursuitController`).
@@ -45,22 +46,23 @@ impl Default for PurePursuitParams {
 impl PurePursuitParams {
     /// Positive distances and speeds; rotate angle in (0, π].
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive("pure_pursuit.lookahead", self.lookahead)?;
-        check_positive("pure_pursuit.desired_speed", self.desired_speed)?;
-        check_positive("pure_pursuit.approach_distance", self.approach_distance)?;
+        let field = |p| MobileField::Follow(FollowField::PurePursuit(p));
+        check_positive(field(PurePursuitParam::Lookahead), self.lookahead)?;
+        check_positive(field(PurePursuitParam::DesiredSpeed), self.desired_speed)?;
+        check_positive(field(PurePursuitParam::ApproachDistance), self.approach_distance)?;
         check_range(
-            "pure_pursuit.min_approach_speed",
+            field(PurePursuitParam::MinApproachSpeed),
             self.min_approach_speed,
             0.0,
             self.desired_speed,
         )?;
         check_range(
-            "pure_pursuit.rotate_min_angle",
+            field(PurePursuitParam::RotateMinAngle),
             self.rotate_min_angle,
             1e-6,
             std::f64::consts::PI,
         )?;
-        check_positive("pure_pursuit.rotate_yaw_rate", self.rotate_yaw_rate)
+        check_positive(field(PurePursuitParam::RotateYawRate), self.rotate_yaw_rate)
     }
 }
 
@@ -112,13 +114,13 @@ pub fn pure_pursuit_step(
     params: &PurePursuitParams,
 ) -> Result<PurePursuitCommand, MobileError> {
     params.validate()?;
-    state.validate("state")?;
+    state.validate(MobileField::State)?;
     if path.is_empty() {
         return Err(MobileError::EmptyPath);
     }
     for (i, p) in path.iter().enumerate() {
         if !(p.x.is_finite() && p.y.is_finite()) {
-            p.validate(&format!("path[{i}]"))?;
+            p.validate(|part| MobileField::Path { index: i, part })?;
         }
     }
     Ok(pure_pursuit_unchecked(state, path, from_segment, params))

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 
 use super::error::{MobileError, check_count, check_positive, check_range};
+use super::field::{MobileField, SensorField};
 use super::pose::{Point2, Pose};
 use super::world::World;
 
@@ -40,11 +41,25 @@ impl Default for RangeSensorParams {
 impl RangeSensorParams {
     /// count ≥ 3, rays ≥ 1, positive range, beam width in [0, 2π], noise ≥ 0.
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_count("sensors.count", self.count, 3)?;
-        check_count("sensors.rays_per_beam", self.rays_per_beam, 1)?;
-        check_positive("sensors.max_range", self.max_range)?;
-        check_range("sensors.beam_width", self.beam_width, 0.0, TAU)?;
-        check_range("sensors.noise_sigma", self.noise_sigma, 0.0, f64::MAX)
+        check_count(MobileField::Sensors(SensorField::Count), self.count, 3)?;
+        check_count(
+            MobileField::Sensors(SensorField::RaysPerBeam),
+            self.rays_per_beam,
+            1,
+        )?;
+        check_positive(MobileField::Sensors(SensorField::MaxRange), self.max_range)?;
+        check_range(
+            MobileField::Sensors(SensorField::BeamWidth),
+            self.beam_width,
+            0.0,
+            TAU,
+        )?;
+        check_range(
+            MobileField::Sensors(SensorField::NoiseSigma),
+            self.noise_sigma,
+            0.0,
+            f64::MAX,
+        )
     }
 
     /// Direction of sensor `i` in the robot frame, rad: 2π i / count (counter-clockwise).

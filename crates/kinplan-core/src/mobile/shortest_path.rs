@@ -2,6 +2,7 @@
 //! step of length ds and keep the one that ends nearest the goal.
 
 use super::error::{MobileError, check_positive};
+use super::field::MobileField;
 use super::goal_seeking::{SteeringCommand, SteeringParams};
 use super::pose::{Point2, Pose, Twist};
 
@@ -22,9 +23,9 @@ pub fn shortest_path_step(
     params: &SteeringParams,
 ) -> Result<SteeringCommand, MobileError> {
     params.validate()?;
-    state.validate("state")?;
-    goal.validate("goal")?;
-    check_positive("dt", dt)?;
+    state.validate(MobileField::State)?;
+    goal.validate(MobileField::Goal)?;
+    check_positive(MobileField::Dt, dt)?;
     let z = state.point().distance(goal);
     let ds = (params.speed * dt).min(z);
     let n = params.candidates;

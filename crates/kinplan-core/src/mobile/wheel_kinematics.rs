@@ -6,6 +6,7 @@ use std::f64::consts::PI;
 
 use super::chassis::{Chassis, Saturation};
 use super::error::{MobileError, check_finite};
+use super::field::{MobileField, WheelField};
 use super::pose::Twist;
 
 /// Wheel speeds (rad/s, positive rolls the robot forward / counter-clockwise for omni wheels)
@@ -74,7 +75,7 @@ impl Chassis {
     /// ```
     pub fn inverse_kinematics(&self, twist: Twist) -> Result<(WheelState, Saturation), MobileError> {
         self.validate()?;
-        twist.validate("twist")?;
+        twist.validate(MobileField::Twist)?;
         let (t, sat) = self.saturate(twist);
         let w = match self {
             Chassis::Tricycle(p) => {
@@ -128,8 +129,8 @@ impl Chassis {
         self.validate()?;
         match (self, wheels) {
             (Chassis::Tricycle(p), WheelState::Tricycle { speed, steer }) => {
-                check_finite("wheels.speed", *speed)?;
-                check_finite("wheels.steer", *steer)?;
+                check_finite(MobileField::Wheel(WheelField::Speed), *speed)?;
+                check_finite(MobileField::Wheel(WheelField::Steer), *steer)?;
                 let rim = p.wheel_radius * speed;
                 Ok(Twist::unicycle(
                     rim * steer.cos(),
@@ -146,10 +147,10 @@ impl Chassis {
                 },
             ) => {
                 for (f, v) in [
-                    ("wheels.rear_left", rear_left),
-                    ("wheels.rear_right", rear_right),
-                    ("wheels.steer_left", steer_left),
-                    ("wheels.steer_right", steer_right),
+                    (MobileField::Wheel(WheelField::RearLeft), rear_left),
+                    (MobileField::Wheel(WheelField::RearRight), rear_right),
+                    (MobileField::Wheel(WheelField::SteerLeft), steer_left),
+                    (MobileField::Wheel(WheelField::SteerRight), steer_right),
                 ] {
                     check_finite(f, *v)?;
                 }
@@ -162,7 +163,7 @@ impl Chassis {
             (Chassis::Omni(p), WheelState::Omni { speeds }) => {
                 let (mut sx, mut sy, mut sw) = (0.0, 0.0, 0.0);
                 for (i, u) in speeds.iter().enumerate() {
-                    check_finite("wheels.speeds", *u)?;
+                    check_finite(MobileField::Wheel(WheelField::Speeds), *u)?;
                     let phi = p.first_wheel_angle + i as f64 * 2.0 * PI / 3.0;
                     sx -= phi.sin() * u;
                     sy += phi.cos() * u;
@@ -176,8 +177,8 @@ impl Chassis {
                 })
             }
             (Chassis::Differential(p), WheelState::Differential { left, right }) => {
-                check_finite("wheels.left", *left)?;
-                check_finite("wheels.right", *right)?;
+                check_finite(MobileField::Wheel(WheelField::Left), *left)?;
+                check_finite(MobileField::Wheel(WheelField::Right), *right)?;
                 let r = p.wheel_radius;
                 Ok(Twist::unicycle(
                     0.5 * r * (left + right),

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::error::{MobileError, check_count, check_positive};
+use super::field::{MobileField, ObstaclePart};
 use super::pose::Point2;
 
 /// An obstacle.
@@ -148,13 +149,32 @@ impl World {
         for (i, o) in obstacles.iter().enumerate() {
             match o {
                 Obstacle::Circle { center, radius } => {
-                    center.validate(&format!("world[{i}].center"))?;
-                    check_positive(&format!("world[{i}].radius"), *radius)?;
+                    center.validate(|c| MobileField::Obstacle {
+                        index: i,
+                        part: ObstaclePart::Center(c),
+                    })?;
+                    check_positive(
+                        MobileField::Obstacle {
+                            index: i,
+                            part: ObstaclePart::Radius,
+                        },
+                        *radius,
+                    )?;
                 }
                 Obstacle::Polygon { vertices } => {
-                    check_count(&format!("world[{i}].vertices"), vertices.len(), 3)?;
+                    check_count(
+                        MobileField::Obstacle {
+                            index: i,
+                            part: ObstaclePart::Vertices,
+                        },
+                        vertices.len(),
+                        3,
+                    )?;
                     for (j, v) in vertices.iter().enumerate() {
-                        v.validate(&format!("world[{i}].vertices[{j}]"))?;
+                        v.validate(|part| MobileField::Obstacle {
+                            index: i,
+                            part: ObstaclePart::Vertex { index: j, part },
+                        })?;
                     }
                 }
             }

@@ -4,13 +4,21 @@
 //! can hand it to the caller as an opaque token.
 
 use serde::{Deserialize, Serialize};
-use std::collections::VecDeque;
-use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
+use std::f64::consts::TAU;
 
 use super::angle::wrap_angle;
 use super::error::{MobileError, check_count, check_finite, check_positive, check_range};
-use super::pose::{MAX_COORDINATE, MAX_RATE, Point2, Pose, Twist};
+use super::field::{MobileField, VdfField};
+use super::pose::{Point2, Pose, Twist};
 use super::sensors::RangeSensorParams;
+
+mod state;
+mod steer;
+mod transition;
+
+pub use state::{MAX_TOKEN_STEPS, VdfState};
+pub use steer::steer;
+pub use transition::{transition, watch_no_path};
 
 /// Navigation mode (S1 §3.5).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -145,116 +153,38 @@ impl Default for VdfParams {
 impl VdfParams {
     /// Positive distances, gains and limits; decay in (0, 1); turn gain ≥ 1; n, m ≥ 1.
     pub fn validate(&self) -> Result<(), MobileError> {
-        check_positive("vdf.safe_distance", self.safe_distance)?;
-        check_positive("vdf.magnitude", self.magnitude)?;
-        check_range("vdf.weight_decay", self.weight_decay, 1e-6, 1.0 - 1e-6)?;
-        check_range("vdf.turn_gain", self.turn_gain, 1.0, 1e6)?;
+        check_positive(MobileField::Vdf(VdfField::SafeDistance), self.safe_distance)?;
+        check_positive(MobileField::Vdf(VdfField::Magnitude), self.magnitude)?;
         check_range(
-            "vdf.release_distance",
+            MobileField::Vdf(VdfField::WeightDecay),
+            self.weight_decay,
+            1e-6,
+            1.0 - 1e-6,
+        )?;
+        check_range(MobileField::Vdf(VdfField::TurnGain), self.turn_gain, 1.0, 1e6)?;
+        check_range(
+            MobileField::Vdf(VdfField::ReleaseDistance),
             self.release_distance,
             self.safe_distance,
             1e6,
         )?;
-        check_positive("vdf.max_speed", self.max_speed)?;
-        check_positive("vdf.max_yaw_rate", self.max_yaw_rate)?;
-        check_positive("vdf.heading_gain", self.heading_gain)?;
-        check_positive("vdf.slow_distance", self.slow_distance)?;
-        check_count("vdf.progress_steps", self.progress_steps, 1)?;
-        check_range("vdf.progress_min", self.progress_min, -1e6, 1e6)?;
-        check_count("vdf.no_path_steps", self.no_path_steps, 1)?;
-        check_range("vdf.no_path_min", self.no_path_min, 0.0, 1e6)?;
-        check_positive("vdf.leave_tolerance", self.leave_tolerance)?;
-        check_positive("vdf.hit_radius", self.hit_radius)?;
-        check_range("vdf.wall_gain", self.wall_gain, 0.0, 1e6)?;
-        check_positive("vdf.goal_tolerance", self.goal_tolerance)
-    }
-}
-
-/// The navigator's modal state: everything a step needs from the past.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct VdfState {
-    /// Current mode.
-    pub mode: NavMode,
-    /// Current turning side.
-    pub side: TurnSide,
-    /// World direction of w'_0 locked in L mode, rad.
-    pub locked_direction: f64,
-    /// Hit point H of the current T episode.
-    pub hit_point: Option<Point2>,
-    /// |HG| when H was set, m.
-    pub hit_distance: f64,
-    /// The robot has moved away from H since the hit.
-    pub left_hit_zone: bool,
-    /// A turning side has been chosen before (it is kept through short R episodes).
-    pub side_chosen: bool,
-    /// Steps spent in the current mode.
-    pub steps_in_mode: u64,
-    /// Distances to the goal over the last n + 1 steps (L mode), m.
-    pub history: VecDeque<f64>,
-    /// Best distance to the goal in the current T episode, m.
-    pub best_distance: Option<f64>,
-    /// Steps since `best_distance` last improved by c2.
-    pub steps_since_progress: u64,
-    /// The other turning side has been tried for the current H ([`VdfParams::retry_other_side`]).
-    #[serde(default)]
-    pub side_retried: bool,
-}
-
-const MAX_TOKEN_HISTORY: usize = 100_000;
-/// Largest step counter a token may carry: counters saturate, and a forged
-/// `u64::MAX` is refused rather than trusted.
-pub const MAX_TOKEN_STEPS: u64 = 1 << 40;
-
-impl VdfState {
-    /// Serialises to an opaque token (JSON bytes). Fails (never an empty
-    /// token) if the state holds a value a token cannot carry.
-    pub fn to_token(&self) -> Result<Vec<u8>, MobileError> {
-        self.check()?;
-        serde_json::to_vec(self).map_err(|e| MobileError::BadToken {
-            reason: format!("the state could not be encoded: {e}"),
-        })
-    }
-
-    /// Decodes and checks a token produced by [`VdfState::to_token`]: every
-    /// field within its bounds (finite angles and distances within the world,
-    /// non-negative distances, counters at most [`MAX_TOKEN_STEPS`]).
-    pub fn from_token(token: &[u8]) -> Result<Self, MobileError> {
-        if token.is_empty() {
-            return Ok(Self::default());
-        }
-        let s: Self = serde_json::from_slice(token).map_err(|e| MobileError::BadToken {
-            reason: e.to_string().chars().take(128).collect(),
-        })?;
-        s.check()?;
-        Ok(s)
-    }
-
-    fn check(&self) -> Result<(), MobileError> {
-        let bad = |r: &str| MobileError::BadToken { reason: r.to_owned() };
-        // Distances in a world of coordinates within ±MAX_COORDINATE.
-        let max_distance = 4.0 * MAX_COORDINATE;
-        let distance_ok = |d: f64| d.is_finite() && (0.0..=max_distance).contains(&d);
-        if !(self.locked_direction.is_finite() && self.locked_direction.abs() <= MAX_RATE) {
-            return Err(bad("locked direction not finite or out of range"));
-        }
-        if !distance_ok(self.hit_distance) {
-            return Err(bad("hit distance not finite, negative or out of range"));
-        }
-        if self.hit_point.is_some_and(|h| h.validate("hit_point").is_err()) {
-            return Err(bad("hit point not finite or out of the world"));
-        }
-        if self.history.len() > MAX_TOKEN_HISTORY || !self.history.iter().all(|d| distance_ok(*d)) {
-            return Err(bad(
-                "history too long, or a distance not finite, negative or out of range",
-            ));
-        }
-        if self.best_distance.is_some_and(|d| !distance_ok(d)) {
-            return Err(bad("best distance not finite, negative or out of range"));
-        }
-        if self.steps_in_mode > MAX_TOKEN_STEPS || self.steps_since_progress > MAX_TOKEN_STEPS {
-            return Err(bad("step counter out of range"));
-        }
-        Ok(())
+        check_positive(MobileField::Vdf(VdfField::MaxSpeed), self.max_speed)?;
+        check_positive(MobileField::Vdf(VdfField::MaxYawRate), self.max_yaw_rate)?;
+        check_positive(MobileField::Vdf(VdfField::HeadingGain), self.heading_gain)?;
+        check_positive(MobileField::Vdf(VdfField::SlowDistance), self.slow_distance)?;
+        check_count(MobileField::Vdf(VdfField::ProgressSteps), self.progress_steps, 1)?;
+        check_range(
+            MobileField::Vdf(VdfField::ProgressMin),
+            self.progress_min,
+            -1e6,
+            1e6,
+        )?;
+        check_count(MobileField::Vdf(VdfField::NoPathSteps), self.no_path_steps, 1)?;
+        check_range(MobileField::Vdf(VdfField::NoPathMin), self.no_path_min, 0.0, 1e6)?;
+        check_positive(MobileField::Vdf(VdfField::LeaveTolerance), self.leave_tolerance)?;
+        check_positive(MobileField::Vdf(VdfField::HitRadius), self.hit_radius)?;
+        check_range(MobileField::Vdf(VdfField::WallGain), self.wall_gain, 0.0, 1e6)?;
+        check_positive(MobileField::Vdf(VdfField::GoalTolerance), self.goal_tolerance)
     }
 }
 
@@ -279,6 +209,9 @@ pub enum NoPathReason {
     ReturnedToHit,
     /// No improvement of the best distance by c2 for m steps (eq. 3.60).
     NoProgress,
+    /// The global planner (grid A*, [`navigate_astar`](super::navigate_astar)) found no path
+    /// on its grid.
+    NoGridPath,
 }
 
 /// Output of one navigator step.
@@ -294,12 +227,50 @@ pub struct VdfOutput {
     pub event: Option<VdfEvent>,
 }
 
-/// Gap reading in world direction `beta`: the sensor whose beam centre is nearest.
-fn reading_at(readings: &[f64], theta: f64, beta: f64) -> f64 {
-    let n = readings.len();
-    let rel = wrap_angle(beta - theta).rem_euclid(TAU);
-    let i = (rel / (TAU / n as f64)).round() as usize % n;
-    readings[i]
+/// What the robot sees in one step: its pose, the goal, the range readings (sensor i at
+/// θ + 2πi/N), and the distance z and world direction of the goal.
+#[derive(Clone, Copy, Debug)]
+pub struct Percept<'a> {
+    /// Robot pose.
+    pub pose: Pose,
+    /// The goal.
+    pub goal: Point2,
+    /// Gaps, one per sensor, m.
+    pub readings: &'a [f64],
+    /// The robot's position.
+    pub me: Point2,
+    /// Distance to the goal z, m.
+    pub z: f64,
+    /// World direction of the goal, rad.
+    pub goal_dir: f64,
+}
+
+impl<'a> Percept<'a> {
+    /// What a robot at `pose` sees of `goal` with `readings` (at least one).
+    pub fn new(pose: Pose, goal: Point2, readings: &'a [f64]) -> Self {
+        let me = pose.point();
+        Self {
+            pose,
+            goal,
+            readings,
+            me,
+            z: me.distance(goal),
+            goal_dir: (goal.y - me.y).atan2(goal.x - me.x),
+        }
+    }
+
+    /// Gap reading in world direction `beta`: the sensor whose beam centre is nearest.
+    pub fn gap(&self, beta: f64) -> f64 {
+        let n = self.readings.len();
+        let rel = wrap_angle(beta - self.pose.theta).rem_euclid(TAU);
+        let i = (rel / (TAU / n as f64)).round() as usize % n;
+        self.readings[i]
+    }
+
+    /// The gap in direction `beta` is at least d_sa.
+    pub fn free(&self, beta: f64, p: &VdfParams) -> bool {
+        self.gap(beta) >= p.safe_distance
+    }
 }
 
 /// One step of the vector-distance navigator (S1 §4.2.4), pure: `state` in, next state out.
@@ -340,18 +311,18 @@ pub fn vdf_step(
 ) -> Result<(VdfState, VdfOutput), MobileError> {
     params.validate()?;
     sensors.validate()?;
-    pose.validate("pose")?;
-    goal.validate("goal")?;
+    pose.validate(MobileField::State)?;
+    goal.validate(MobileField::Goal)?;
     if readings.len() != sensors.count {
         return Err(MobileError::TooFew {
-            field: "readings".into(),
+            field: MobileField::Readings,
             min: sensors.count,
             got: readings.len(),
         });
     }
     for (i, r) in readings.iter().enumerate() {
         if !r.is_finite() {
-            check_finite(&format!("readings[{i}]"), *r)?;
+            check_finite(MobileField::Reading(i), *r)?;
         }
     }
     let mut next = state.clone();
@@ -359,7 +330,9 @@ pub fn vdf_step(
     Ok((next, out))
 }
 
-/// In-place variant of [`vdf_step`] without validation (simulation loops).
+/// In-place variant of [`vdf_step`] without validation (simulation loops): Reached within
+/// the goal tolerance, else [`transition`], [`watch_no_path`] (a NoPath verdict stops with a
+/// zero command) and [`steer`].
 pub(crate) fn vdf_step_mut(
     s: &mut VdfState,
     pose: Pose,
@@ -367,274 +340,36 @@ pub(crate) fn vdf_step_mut(
     readings: &[f64],
     p: &VdfParams,
 ) -> VdfOutput {
-    let me = pose.point();
-    let z = me.distance(goal);
+    let see = Percept::new(pose, goal, readings);
     let stop = |mode, event| VdfOutput {
         twist: Twist::ZERO,
         mode,
         force: Point2::default(),
         event: Some(event),
     };
-    if z <= p.goal_tolerance {
+    if see.z <= p.goal_tolerance {
         return stop(s.mode, VdfEvent::Reached);
     }
-    let n = readings.len();
-    let goal_dir = (goal.y - me.y).atan2(goal.x - me.x);
-    let free = |beta: f64| reading_at(readings, pose.theta, beta) >= p.safe_distance;
-    let goal_free = free(goal_dir);
-    let goal_open = reading_at(readings, pose.theta, goal_dir) >= p.release_distance;
-    s.history.push_back(z);
-    while s.history.len() > p.progress_steps + 1 {
-        s.history.pop_front();
+    let (next, event) = transition(std::mem::take(s), &see, p);
+    let (next, event) = watch_no_path(next, &see, event, p);
+    *s = next;
+    if let Some(VdfEvent::NoPath(reason)) = event {
+        return stop(s.mode, VdfEvent::NoPath(reason));
     }
-    s.steps_in_mode = s.steps_in_mode.saturating_add(1);
-    let stalled = s.history.len() == p.progress_steps + 1 && s.history[0] - z < p.progress_min;
-    let mut event = None;
-    match s.mode {
-        NavMode::Rotate => {
-            // Blocked goal direction, or no progress (S1: with symmetric weights the robot
-            // stops and "must turn left or right").
-            if !goal_free || stalled {
-                // A short R episode keeps the previous side (no flip-flopping at corners).
-                if !s.side_chosen || s.steps_in_mode as usize > p.progress_steps {
-                    s.side = choose_side(readings, pose.theta, goal_dir, p);
-                    s.side_chosen = true;
-                }
-                s.mode = NavMode::Lock;
-                s.locked_direction = first_free(readings, pose.theta, goal_dir, s.side, p);
-                s.steps_in_mode = 0;
-            }
-        }
-        NavMode::Lock => {
-            if stalled {
-                s.mode = NavMode::Track;
-                s.steps_in_mode = 0;
-                // A new hit point only when nearer the goal than the previous one (Bug2 rule);
-                // otherwise the robot is still going round the same obstacle.
-                if s.hit_point.is_none() || z < s.hit_distance - p.no_path_min {
-                    s.hit_point = Some(me);
-                    s.hit_distance = z;
-                    s.left_hit_zone = false;
-                }
-                if s.best_distance.is_none() {
-                    s.best_distance = Some(z);
-                    s.steps_since_progress = 0;
-                }
-                event = Some(VdfEvent::Hit(me));
-            } else if goal_open || !free(s.locked_direction) {
-                // Goal direction open again, or w'_0 sees an obstacle: release the lock.
-                s.mode = NavMode::Rotate;
-                s.steps_in_mode = 0;
-                if !goal_free {
-                    s.mode = NavMode::Lock;
-                    s.locked_direction = first_free(readings, pose.theta, goal_dir, s.side, p);
-                }
-            }
-        }
-        NavMode::Track => {
-            let h = s.hit_point.unwrap_or(me);
-            let all_clear = readings.iter().all(|&d| d > p.safe_distance);
-            let on_line =
-                line_distance(me, h, goal) < p.leave_tolerance && z < s.hit_distance - p.leave_tolerance;
-            if all_clear || (on_line && goal_open) {
-                s.mode = NavMode::Rotate;
-                s.steps_in_mode = 0;
-                event = Some(VdfEvent::Leave(me));
-            }
-        }
-    }
-    // "No path" (eq. 3.60 and the return to H), watched from the first hit on, in every mode
-    // so that circling an enclosure through several T episodes is caught too.
-    if let Some(h) = s.hit_point {
-        let dh = me.distance(h);
-        if dh > 3.0 * p.hit_radius {
-            s.left_hit_zone = true;
-        }
-        let best = s.best_distance.unwrap_or(z);
-        if z < best - p.no_path_min {
-            s.best_distance = Some(z);
-            s.steps_since_progress = 0;
-        } else {
-            s.steps_since_progress = s.steps_since_progress.saturating_add(1);
-        }
-        let give_up = if z < s.hit_distance - p.no_path_min - 3.0 * p.hit_radius {
-            // Clearly past the obstacle of H: forget it.
-            s.hit_point = None;
-            s.best_distance = None;
-            s.steps_since_progress = 0;
-            s.side_retried = false;
-            None
-        } else if s.left_hit_zone && dh < p.hit_radius {
-            Some(NoPathReason::ReturnedToHit)
-        } else if s.steps_since_progress >= p.no_path_steps as u64 {
-            Some(NoPathReason::NoProgress)
-        } else {
-            None
-        };
-        if let Some(reason) = give_up {
-            if !p.retry_other_side || s.side_retried {
-                return stop(s.mode, VdfEvent::NoPath(reason));
-            }
-            // Go round the other way from here, once.
-            s.side_retried = true;
-            s.side = match s.side {
-                TurnSide::Left => TurnSide::Right,
-                TurnSide::Right => TurnSide::Left,
-            };
-            s.side_chosen = true;
-            s.mode = NavMode::Track;
-            s.steps_in_mode = 0;
-            s.hit_point = Some(me);
-            s.hit_distance = z;
-            s.left_hit_zone = false;
-            s.best_distance = Some(z);
-            s.steps_since_progress = 0;
-            event = Some(VdfEvent::Hit(me));
-        }
-    }
-    let sign = match s.side {
-        TurnSide::Left => 1.0,
-        TurnSide::Right => -1.0,
-    };
-    let centre = match s.mode {
-        NavMode::Rotate => goal_dir,
-        NavMode::Lock => s.locked_direction,
-        NavMode::Track => {
-            let (imin, dmin) = readings
-                .iter()
-                .copied()
-                .enumerate()
-                .fold((0, f64::INFINITY), |a, (i, d)| if d < a.1 { (i, d) } else { a });
-            let obstacle_dir = pose.theta + TAU * imin as f64 / n as f64;
-            let target = 0.8 * p.safe_distance;
-            let off = (FRAC_PI_2 + p.wall_gain * (target - dmin)).clamp(FRAC_PI_4, 3.0 * FRAC_PI_4);
-            obstacle_dir + sign * off
-        }
-    };
-    let (fx, fy) = vector_sum(readings, pose.theta, centre, s.mode != NavMode::Rotate, s.side, p);
-    let raw = if fx.hypot(fy) > 1e-9 {
-        fy.atan2(fx)
-    } else {
-        centre + sign * FRAC_PI_2
-    };
-    // Deadlock guard: never steer into a blocked direction; turn towards the turning side
-    // until a free one is found (a potential-field local minimum otherwise parks the robot
-    // facing an obstacle with zero speed).
-    let psi = if p.avoid_blocked_heading && !free(raw) {
-        let side = if s.mode == NavMode::Rotate {
-            choose_side(readings, pose.theta, raw, p)
-        } else {
-            s.side
-        };
-        first_free(readings, pose.theta, raw, side, p)
-    } else {
-        raw
-    };
-    let eps = wrap_angle(psi - pose.theta);
-    let forward = !p.allow_reverse || eps.cos() >= 0.0;
-    let (axis_err, dir) = if forward {
-        (eps, 1.0)
-    } else {
-        (wrap_angle(eps + std::f64::consts::PI), -1.0)
-    };
-    let travel_dir = if forward {
-        pose.theta
-    } else {
-        pose.theta + std::f64::consts::PI
-    };
-    let gap = reading_at(readings, pose.theta, travel_dir);
-    let v = dir * p.max_speed * eps.cos().abs() * (gap / p.slow_distance).clamp(0.0, 1.0);
-    let v = if forward && eps.cos() < 0.0 { 0.0 } else { v };
-    let omega = (p.heading_gain * axis_err).clamp(-p.max_yaw_rate, p.max_yaw_rate);
+    let (twist, force) = steer(s, &see, p);
     VdfOutput {
-        twist: Twist::unicycle(v, omega),
+        twist,
         mode: s.mode,
-        force: Point2::new(fx, fy),
+        force,
         event,
     }
-}
-
-/// F = Σ f_i w'_i over the real sensors (eq. 3.50): f_i = ±K along sensor i's world
-/// direction β_i = θ + 2πi/N (+K when its gap ≥ d_sa); the weight depends continuously on the
-/// angle Δ_i = wrap(β_i − β_0) to the w'_0 direction, w'(Δ) = decay^(|Δ| / (2π/N)), times
-/// 1 + (turn_gain − 1)·max(0, ±sin Δ) on the turning side when `turning`. Weights that
-/// move continuously with β_0 avoid the chatter of snapping w'_0 to the nearest sensor.
-fn vector_sum(
-    readings: &[f64],
-    theta: f64,
-    centre: f64,
-    turning: bool,
-    side: TurnSide,
-    p: &VdfParams,
-) -> (f64, f64) {
-    let n = readings.len();
-    let step = TAU / n as f64;
-    let sign = if side == TurnSide::Left { 1.0 } else { -1.0 };
-    let (mut fx, mut fy) = (0.0, 0.0);
-    for (i, &d) in readings.iter().enumerate() {
-        let beta = theta + step * i as f64;
-        let delta = wrap_angle(beta - centre);
-        let mut w = p.weight_decay.powf(delta.abs() / step);
-        if turning {
-            w *= 1.0 + (p.turn_gain - 1.0) * (sign * delta.sin()).max(0.0);
-        }
-        let f = if d >= p.safe_distance {
-            p.magnitude
-        } else {
-            -p.magnitude
-        };
-        fx += f * w * beta.cos();
-        fy += f * w * beta.sin();
-    }
-    (fx, fy)
-}
-
-/// Turning side for L mode: compare free weighted directions left and right of the goal.
-fn choose_side(readings: &[f64], theta: f64, goal_dir: f64, p: &VdfParams) -> TurnSide {
-    match p.turn {
-        TurnPreference::Left => TurnSide::Left,
-        TurnPreference::Right => TurnSide::Right,
-        TurnPreference::Auto => {
-            let n = readings.len();
-            let (mut l, mut r) = (0.0, 0.0);
-            for k in 1..n.div_ceil(2) {
-                let w = p.weight_decay.powi(k as i32);
-                let a = TAU * k as f64 / n as f64;
-                l += w * reading_at(readings, theta, goal_dir + a).min(p.safe_distance * 4.0);
-                r += w * reading_at(readings, theta, goal_dir - a).min(p.safe_distance * 4.0);
-            }
-            if r > l { TurnSide::Right } else { TurnSide::Left }
-        }
-    }
-}
-
-/// The first free direction (gap ≥ d_sa) met when turning from the goal direction towards
-/// `side` in sensor steps; the goal direction itself if none is free.
-fn first_free(readings: &[f64], theta: f64, goal_dir: f64, side: TurnSide, p: &VdfParams) -> f64 {
-    let n = readings.len();
-    let sign = if side == TurnSide::Left { 1.0 } else { -1.0 };
-    for k in 1..=n / 2 {
-        let b = goal_dir + sign * TAU * k as f64 / n as f64;
-        if reading_at(readings, theta, b) >= p.safe_distance {
-            return wrap_angle(b);
-        }
-    }
-    goal_dir
-}
-
-/// Distance from p to the line through a and b (to a when a = b).
-fn line_distance(p: Point2, a: Point2, b: Point2) -> f64 {
-    let (dx, dy) = (b.x - a.x, b.y - a.y);
-    let l = dx.hypot(dy);
-    if l == 0.0 {
-        return p.distance(a);
-    }
-    ((p.x - a.x) * dy - (p.y - a.y) * dx).abs() / l
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::collections::VecDeque;
+    use std::f64::consts::FRAC_PI_4;
 
     fn sensors() -> RangeSensorParams {
         RangeSensorParams::default()
