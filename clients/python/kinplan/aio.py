@@ -29,7 +29,7 @@ from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
 from .client import DEFAULT_TIMEOUT, JointLimits, Robot, RobotDescription, RobotRefs, _channel_options, _pem, normalize_target
 from .errors import KinplanError, error_for, invalid_argument
 from .kinematics import IkBatchResult, IkResult, _is_position, _targets, ik_options, target_to_pose
-from .planning import Obstacle, Plan, PlanningMixin, StateChecks, scene_to_proto
+from .planning import Obstacle, Plan, StateChecks, _plan_request, scene_to_proto
 from .scoring import Scores, _check_trajectory_limits, score_options, trajectory_to_proto
 from .v1 import (
     common_pb2,
@@ -131,9 +131,8 @@ class Client:
                    padded_motion: bool = False, return_cost_history: bool = True, stomp: Any = None, cartesian: Any = None,
                    rrt_connect: Any = None, timing: Any = None, timeout: Optional[float] = None) -> Plan:
         """As :meth:`kinplan.Client.plan`."""
-        build = PlanningMixin._plan_request(
-            self,  # type: ignore[arg-type]  # it reads no attribute of self
-            robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution, padded_motion,
+        build = _plan_request(
+            start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution, padded_motion,
             return_cost_history, stomp, cartesian, rrt_connect, timing,
         )
         return Plan.from_proto(await self._robot_of(robot)._call(self._planning.Plan, build, timeout))
