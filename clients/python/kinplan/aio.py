@@ -6,7 +6,6 @@
         sols = await asyncio.gather(*(robot.ik(T_k) for T_k in targets))  # concurrent calls
         async with robot.stream_ik(seed=q) as s:
             answer = await s.solve(T)
-
         async for frame in c.plan_stream(ur5, start=q0, goal=q1):     # server streams: async iterators
             ...
 
