@@ -11,15 +11,15 @@
 
 Same names, arguments, results and errors as the blocking client
 (:class:`kinplan.Client`, :class:`kinplan.Robot`) for: ``ping``,
-``list_robots``, ``robot``, ``solve_linear``, ``plan``, ``plan_stream``,
-``check_states``, ``score``, ``compare``, ``mobile`` (``wheels``, ``step``,
-``follow``, ``navigate``), ``next_best_view``, ``insert_scan``,
-``octree_info``, ``reference_scene``, ``explore``; and on a robot
-``describe``, ``fk``, ``fk_batch``, ``jacobian``, ``ik``, ``ik_batch``,
-``track``, ``stream_ik``. Each method awaits its call; many calls can be in
-flight on one channel. ``plan_stream`` and ``explore`` are async iterators
-(``async for``). Requests and replies are built and read by the same
-functions as the blocking client's, so both give the same answers.
+``wait_for_ready``, ``list_robots``, ``robot``, ``solve_linear``, ``plan``,
+``plan_stream``, ``check_states``, ``score``, ``compare``, ``mobile``
+(``wheels``, ``step``, ``follow``, ``navigate``), ``next_best_view``,
+``insert_scan``, ``octree_info``, ``reference_scene``, ``explore``; and on a
+robot ``describe``, ``urdf``, ``fk``, ``fk_batch``, ``jacobian``, ``ik``,
+``ik_batch``, ``track``, ``stream_ik``. Each method awaits its call; many
+calls can be in flight on one channel. ``plan_stream`` and ``explore`` are
+async iterators (``async for``). Requests and replies are built and read by
+the same functions as the blocking client's, so both give the same answers.
 """
 from __future__ import annotations
 
@@ -33,7 +33,19 @@ import numpy.typing as npt
 
 from ._aio_mobile import AsyncMobile
 from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
-from .client import DEFAULT_TIMEOUT, JointLimits, Robot, RobotDescription, RobotRefs, _channel_options, _pem, normalize_target
+from .client import (
+    DEFAULT_TIMEOUT,
+    JointLimits,
+    Robot,
+    RobotDescription,
+    RobotRefs,
+    _channel_options,
+    _check_robot_args,
+    _no_server,
+    _pem,
+    _urdf_request,
+    normalize_target,
+)
 from .errors import KinplanError, error_for, invalid_argument
 from .exploration import (
     Octree,
@@ -162,6 +174,15 @@ class Client:
         finally:
             call.cancel()
 
+    async def wait_for_ready(self, timeout: Optional[float] = None) -> None:
+        """As :meth:`kinplan.Client.wait_for_ready`: waits until the channel
+        connects (at most `timeout` s, default the client's)."""
+        t = self.timeout if timeout is None else timeout
+        try:
+            await asyncio.wait_for(self._channel.channel_ready(), t)
+        except asyncio.TimeoutError:
+            raise _no_server(self.target, t) from None
+
     async def ping(self, *, timeout: Optional[float] = None) -> float:
         """Round-trip time (s) of the cheapest call."""
         t0 = asyncio.get_running_loop().time()
@@ -178,8 +199,7 @@ class Client:
     def robot(self, name: Optional[str] = None, *, urdf: Optional[str] = None, base_link: str = "",
               tip_link: str = "", strict: bool = False) -> "AsyncRobot":
         """As :meth:`kinplan.Client.robot`."""
-        if (name is None) == (urdf is None):
-            raise invalid_argument("name", "give exactly one of name or urdf=")
+        _check_robot_args(name, urdf)
         return AsyncRobot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link, strict=strict)
 
     def _robot_of(self, robot: Any) -> "AsyncRobot":
@@ -372,6 +392,12 @@ class AsyncRobot(RobotRefs):
         r = await self._call(self.client._robots.DescribeRobot,
                              lambda ref: robot_pb2.DescribeRobotRequest(robot=ref), timeout)
         return RobotDescription.from_proto(r)
+
+    async def urdf(self, *, keep_capsules: bool = False, timeout: Optional[float] = None) -> str:
+        """As :meth:`kinplan.Robot.urdf`."""
+        if self.urdf_text is not None:
+            return self.urdf_text
+        return str((await self._call(self.client._robots.DescribeRobot, _urdf_request(keep_capsules), timeout)).urdf)
 
     async def fk(self, q: npt.ArrayLike, *, links: bool = False, timeout: Optional[float] = None) -> Any:
         positions = joints(q)

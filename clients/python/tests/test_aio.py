@@ -2,6 +2,7 @@
 client, concurrent calls on one channel, a StreamIk session, typed errors."""
 import asyncio
 import math
+import socket
 
 import numpy as np
 import pytest
@@ -351,7 +352,7 @@ def test_the_asyncio_methods_take_the_blocking_methods_parameters():
     from kinplan._aio_mobile import AsyncMobile
     from kinplan.mobile import Mobile
 
-    not_yet = {"local", "wait_for_ready", "urdf", "limits_key"}
+    not_yet = {"local", "limits_key"}  # the in-process backend; a cache key
     # aio's ik takes the blocking ik's keyword options as **options
     differ = {"ik"}
     checked = []
@@ -368,10 +369,40 @@ def test_the_asyncio_methods_take_the_blocking_methods_parameters():
             params = [(p.name, p.kind, p.default) for p in inspect.signature(method).parameters.values()]
             assert params == [(p.name, p.kind, p.default) for p in inspect.signature(other).parameters.values()], name
             checked.append(name)
-    assert {"track", "solve_linear", "compare", "plan_stream", "explore", "navigate", "step"} <= set(checked)
+    assert {"track", "solve_linear", "compare", "plan_stream", "explore", "navigate", "step", "urdf",
+            "wait_for_ready"} <= set(checked)
 
     async def mobile_of_a_client():
         async with kinplan.aio.Client("127.0.0.1:1") as c:  # no call: no server needed
             return type(c.mobile)
 
     assert run(mobile_of_a_client()) is AsyncMobile
+
+
+def test_urdf_wait_for_ready_and_robot_arguments_as_the_blocking_client(server_address):
+    sync = kinplan.Client(server_address, timeout=10)
+    with socket.socket() as s:  # a port nobody listens on
+        s.bind(("127.0.0.1", 0))
+        nobody = f"127.0.0.1:{s.getsockname()[1]}"
+
+    async def main():
+        async with kinplan.aio.Client(server_address, timeout=10) as c:
+            await c.wait_for_ready()
+            text = await c.robot("ur5").urdf()
+            kept = await c.robot("ur5").urdf(keep_capsules=True)
+            inline = await c.robot(urdf=text).urdf()
+            with pytest.raises(kinplan.InvalidArgument, match="file path"):
+                c.robot(urdf="arm.urdf")
+        async with kinplan.aio.Client(nobody, timeout=10) as c:
+            with pytest.raises(kinplan.Unavailable, match="within 0.3 s"):
+                await c.wait_for_ready(0.3)
+        return text, kept, inline
+
+    text, kept, inline = run(main())
+    assert text == sync.robot("ur5").urdf() and kept == sync.robot("ur5").urdf(keep_capsules=True)
+    assert inline == text and text.lstrip().startswith("<") and "<robot" in text
+    with pytest.raises(kinplan.InvalidArgument, match="file path"):
+        sync.robot(urdf="arm.urdf")
+    with pytest.raises(kinplan.Unavailable, match="within 0.3 s"):
+        kinplan.Client(nobody, timeout=10).wait_for_ready(0.3)
+    sync.close()
