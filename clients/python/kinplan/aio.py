@@ -24,7 +24,7 @@ the same functions as the blocking client's, so both give the same answers.
 from __future__ import annotations
 
 import asyncio
-from typing import Any, AsyncIterator, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, AsyncIterator, Callable, Dict, Iterable, List, Literal, Mapping, Optional, Sequence, Tuple, Union
 
 import grpc
 import grpc.aio
@@ -68,7 +68,9 @@ from .explore import (
 )
 from .kinematics import (
     IkBatchResult,
+    IkMethodName,
     IkResult,
+    LinearSolverName,
     LinearSolution,
     TrackResult,
     _is_position,
@@ -438,13 +440,41 @@ class AsyncRobot(RobotRefs):
         )
         return matrix_from_proto(r.jacobian)
 
-    async def ik(self, T: Any, seed: Optional[npt.ArrayLike] = None, method: Optional[str] = "lm",
-                 linear_solver: Optional[str] = "svd", *, timeout: Optional[float] = None, **options: Any) -> IkResult:
+    async def ik(
+        self,
+        T: Any,
+        seed: Optional[npt.ArrayLike] = None,
+        method: Optional[IkMethodName] = "lm",
+        linear_solver: Optional[LinearSolverName] = "svd",
+        *,
+        max_restarts: Optional[int] = None,
+        num_solutions: Optional[int] = None,
+        position_tolerance: Optional[float] = None,
+        orientation_tolerance: Optional[float] = None,
+        position_only: bool = False,
+        max_iterations: Optional[int] = None,
+        damping: Optional[float] = None,
+        rng_seed: int = 0,
+        joint_limits: Optional[Literal["clamp", "ignore"]] = None,
+        time_budget: Optional[float] = None,
+        adaptive_damping: Optional[bool] = None,
+        max_step: Optional[float] = None,
+        distinct_tolerance: Optional[float] = None,
+        rlxa_max_iterations: Optional[int] = None,
+        history: bool = False,
+        timeout: Optional[float] = None,
+    ) -> IkResult:
         """As :meth:`kinplan.Robot.ik`."""
         if _is_position(T):
             T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
-            options["position_only"] = True
-        o = ik_options(method, linear_solver, **options)
+            position_only = True
+        o = ik_options(
+            method, linear_solver, position_tolerance=position_tolerance, orientation_tolerance=orientation_tolerance,
+            position_only=position_only, max_iterations=max_iterations, damping=damping, max_restarts=max_restarts,
+            num_solutions=num_solutions, rng_seed=rng_seed, joint_limits=joint_limits, time_budget=time_budget,
+            adaptive_damping=adaptive_damping, max_step=max_step, distinct_tolerance=distinct_tolerance,
+            rlxa_max_iterations=rlxa_max_iterations, history=history,
+        )
         target = target_to_pose(T)
         seed_list = [] if seed is None else joints(seed, "seed")
         reply = await self._call(

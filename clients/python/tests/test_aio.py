@@ -353,8 +353,6 @@ def test_the_asyncio_methods_take_the_blocking_methods_parameters():
     from kinplan.mobile import Mobile
 
     not_yet = {"local", "limits_key"}  # the in-process backend; a cache key
-    # aio's ik takes the blocking ik's keyword options as **options
-    differ = {"ik"}
     checked = []
     for sync_cls, aio_cls in ((kinplan.Client, kinplan.aio.Client), (kinplan.Robot, kinplan.aio.AsyncRobot),
                               (Mobile, AsyncMobile)):
@@ -364,12 +362,10 @@ def test_the_asyncio_methods_take_the_blocking_methods_parameters():
             other = getattr(aio_cls, name)
             assert inspect.iscoroutinefunction(other) or inspect.isasyncgenfunction(other) or name in (
                 "robot", "stream_ik"), name
-            if name in differ:
-                continue
             params = [(p.name, p.kind, p.default) for p in inspect.signature(method).parameters.values()]
             assert params == [(p.name, p.kind, p.default) for p in inspect.signature(other).parameters.values()], name
             checked.append(name)
-    assert {"track", "solve_linear", "compare", "plan_stream", "explore", "navigate", "step", "urdf",
+    assert {"ik", "track", "solve_linear", "compare", "plan_stream", "explore", "navigate", "step", "urdf",
             "wait_for_ready"} <= set(checked)
 
     async def mobile_of_a_client():
@@ -405,4 +401,26 @@ def test_urdf_wait_for_ready_and_robot_arguments_as_the_blocking_client(server_a
         sync.robot(urdf="arm.urdf")
     with pytest.raises(kinplan.Unavailable, match="within 0.3 s"):
         kinplan.Client(nobody, timeout=10).wait_for_ready(0.3)
+    sync.close()
+
+
+def test_ik_keywords_give_the_blocking_answers(server_address):
+    sync = kinplan.Client(server_address, timeout=10)
+    robot_sync = sync.robot(KR210)
+    T = robot_sync.fk(Q0)
+    kw = dict(num_solutions=3, max_restarts=50, rng_seed=4, position_tolerance=1e-7, history=True)
+
+    async def main():
+        async with kinplan.aio.Client(server_address, timeout=10) as c:
+            robot = c.robot(KR210)
+            return await robot.ik(T, seed=np.zeros(6), **kw), await robot.ik(T[:3, 3], seed=Q0)
+
+    full, position = run(main())
+    expect = robot_sync.ik(T, seed=np.zeros(6), **kw)
+    assert full.success and len(full.solutions) == len(expect.solutions) >= 1
+    for a, b in zip(full.solutions, expect.solutions):
+        assert np.array_equal(a.q, b.q) and np.array_equal(a.history, b.history)
+        assert np.linalg.norm(robot_sync.fk(a.q)[:3, 3] - T[:3, 3]) <= 1e-7
+    # a bare 3-vector is a position-only target in both clients
+    assert position.success and np.array_equal(position.q, robot_sync.ik(T[:3, 3], seed=Q0).q)
     sync.close()
