@@ -6,33 +6,94 @@
         sols = await asyncio.gather(*(robot.ik(T_k) for T_k in targets))  # concurrent calls
         async with robot.stream_ik(seed=q) as s:
             answer = await s.solve(T)
+        async for frame in c.plan_stream(ur5, start=q0, goal=q1):     # server streams: async iterators
+            ...
 
 Same names, arguments, results and errors as the blocking client
 (:class:`kinplan.Client`, :class:`kinplan.Robot`) for: ``ping``,
-``list_robots``, ``robot``, ``plan``, ``check_states``, ``score``; and on a
-robot ``describe``, ``fk``, ``fk_batch``, ``jacobian``, ``ik``, ``ik_batch``,
-``stream_ik``. Each method awaits its call; many calls can be in flight on
-one channel. Requests and replies are built and read by the same functions
-as the blocking client's, so both give the same answers.
+``wait_for_ready``, ``list_robots``, ``robot``, ``solve_linear``, ``plan``,
+``plan_stream``, ``check_states``, ``score``, ``compare``, ``mobile``
+(``wheels``, ``step``, ``follow``, ``navigate``), ``next_best_view``,
+``insert_scan``, ``octree_info``, ``reference_scene``, ``explore``; and on a
+robot ``describe``, ``urdf``, ``fk``, ``fk_batch``, ``jacobian``, ``ik``,
+``ik_batch``, ``track``, ``stream_ik``. Each method awaits its call; many
+calls can be in flight on one channel. ``plan_stream`` and ``explore`` are
+async iterators (``async for``). Requests and replies are built and read by
+the same functions as the blocking client's, so both give the same answers.
 """
 from __future__ import annotations
 
 import asyncio
-from typing import Any, Callable, Dict, List, Optional, Sequence, Union
+from typing import Any, AsyncIterator, Callable, Dict, Iterable, List, Literal, Mapping, Optional, Sequence, Tuple, Union
 
 import grpc
 import grpc.aio
 import numpy as np
 import numpy.typing as npt
 
+from ._aio_mobile import AsyncMobile
 from ._convert import joints, matrix_from_proto, matrix_to_proto, pose_to_matrix
-from .client import DEFAULT_TIMEOUT, JointLimits, Robot, RobotDescription, RobotRefs, _channel_options, _pem, normalize_target
+from .client import (
+    DEFAULT_TIMEOUT,
+    JointLimits,
+    Robot,
+    RobotDescription,
+    RobotRefs,
+    _channel_options,
+    _check_robot_args,
+    _no_server,
+    _pem,
+    _urdf_request,
+    normalize_target,
+)
 from .errors import KinplanError, error_for, invalid_argument
-from .kinematics import IkBatchResult, IkResult, _is_position, _targets, ik_options, target_to_pose
-from .planning import Obstacle, Plan, PlanningMixin, StateChecks, scene_to_proto
-from .scoring import Scores, _check_trajectory_limits, score_options, trajectory_to_proto
+from .exploration import (
+    Octree,
+    Views,
+    _insert_scan_request,
+    _nbv_request,
+    _octree_info,
+    _octree_info_request,
+    _views,
+    _with_robot,
+)
+from .explore import (
+    ExploreStep,
+    ExploreSummary,
+    ReferenceScene,
+    _explore_message,
+    _explore_request,
+    _reference_scene,
+    _reference_scene_request,
+)
+from .kinematics import (
+    IkBatchResult,
+    IkMethodName,
+    IkResult,
+    LinearSolverName,
+    LinearSolution,
+    TrackResult,
+    _is_position,
+    _linear_solution,
+    _solve_linear_request,
+    _targets,
+    _track_request,
+    ik_options,
+    target_to_pose,
+)
+from .planning import (
+    Obstacle,
+    Plan,
+    StateChecks,
+    _plan_request,
+    _plan_stream_message,
+    _plan_stream_request,
+    scene_to_proto,
+)
+from .scoring import Comparison, Scores, Trajectory, _check_trajectory_limits, _compare_request, score_options, trajectory_to_proto
 from .v1 import (
     common_pb2,
+    exploration_pb2_grpc,
     kinematics_pb2,
     kinematics_pb2_grpc,
     planning_pb2,
@@ -43,7 +104,7 @@ from .v1 import (
     scoring_pb2_grpc,
 )
 
-__all__ = ["AsyncIkStream", "AsyncRobot", "Client"]
+__all__ = ["AsyncIkStream", "AsyncMobile", "AsyncRobot", "Client"]
 
 
 class Client:
@@ -81,6 +142,9 @@ class Client:
         self._kinematics = kinematics_pb2_grpc.KinematicsServiceStub(self._channel)
         self._planning = planning_pb2_grpc.PlanningServiceStub(self._channel)
         self._scoring = scoring_pb2_grpc.ScoringServiceStub(self._channel)
+        self._exploration = exploration_pb2_grpc.ExplorationServiceStub(self._channel)
+        self.mobile = AsyncMobile(self)
+        """The MobileService calls (as :attr:`kinplan.Client.mobile`)."""
 
     async def __aenter__(self) -> "Client":
         return self
@@ -100,6 +164,27 @@ class Client:
         except grpc.aio.AioRpcError as err:
             raise KinplanError.from_rpc_error(err) from None
 
+    async def _stream(self, method: Callable[..., Any], request: Any, timeout: Optional[float]) -> AsyncIterator[Any]:
+        """The messages of a server-streaming call; its errors as :class:`KinplanError`.
+        Leaving the loop early cancels the call."""
+        call = method(request, timeout=self.timeout if timeout is None else timeout, metadata=self._metadata)
+        try:
+            async for message in call:
+                yield message
+        except grpc.aio.AioRpcError as err:
+            raise KinplanError.from_rpc_error(err) from None
+        finally:
+            call.cancel()
+
+    async def wait_for_ready(self, timeout: Optional[float] = None) -> None:
+        """As :meth:`kinplan.Client.wait_for_ready`: waits until the channel
+        connects (at most `timeout` s, default the client's)."""
+        t = self.timeout if timeout is None else timeout
+        try:
+            await asyncio.wait_for(self._channel.channel_ready(), t)
+        except asyncio.TimeoutError:
+            raise _no_server(self.target, t) from None
+
     async def ping(self, *, timeout: Optional[float] = None) -> float:
         """Round-trip time (s) of the cheapest call."""
         t0 = asyncio.get_running_loop().time()
@@ -116,8 +201,7 @@ class Client:
     def robot(self, name: Optional[str] = None, *, urdf: Optional[str] = None, base_link: str = "",
               tip_link: str = "", strict: bool = False) -> "AsyncRobot":
         """As :meth:`kinplan.Client.robot`."""
-        if (name is None) == (urdf is None):
-            raise invalid_argument("name", "give exactly one of name or urdf=")
+        _check_robot_args(name, urdf)
         return AsyncRobot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link, strict=strict)
 
     def _robot_of(self, robot: Any) -> "AsyncRobot":
@@ -131,12 +215,21 @@ class Client:
                    padded_motion: bool = False, return_cost_history: bool = True, stomp: Any = None, cartesian: Any = None,
                    rrt_connect: Any = None, timing: Any = None, timeout: Optional[float] = None) -> Plan:
         """As :meth:`kinplan.Client.plan`."""
-        build = PlanningMixin._plan_request(
-            self,  # type: ignore[arg-type]  # it reads no attribute of self
-            robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution, padded_motion,
+        build = _plan_request(
+            start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution, padded_motion,
             return_cost_history, stomp, cartesian, rrt_connect, timing,
         )
         return Plan.from_proto(await self._robot_of(robot)._call(self._planning.Plan, build, timeout))
+
+    async def plan_stream(self, robot: Any, *, start: Any, goal: Any = None, pose: Any = None,
+                          algorithm: str = "stomp", scene: Optional[Sequence[Obstacle]] = None, seed: int = 0,
+                          timeout: Optional[float] = None, **options: Any) -> AsyncIterator[Union[np.ndarray, Plan]]:
+        """As :meth:`kinplan.Client.plan_stream`, an async iterator: the
+        trajectory after every STOMP / CCSTOMP iteration, then the :class:`Plan`."""
+        build = _plan_stream_request(start, goal, pose, algorithm, scene, seed, options)
+        request = build(self._robot_of(robot)._ref())
+        async for message in self._stream(self._planning.PlanStream, request, timeout):
+            yield _plan_stream_message(message)
 
     async def check_states(self, robot: Any, qs: Any, scene: Optional[Sequence[Obstacle]] = None, *,
                            max_distance: float = 1.0, timeout: Optional[float] = None) -> StateChecks:
@@ -170,6 +263,91 @@ class Client:
             timeout,
         )
         return Scores.from_proto(reply)
+
+    async def compare(self, sets: Mapping[str, Sequence[Trajectory]], robot: Any = None, *,
+                      weights: Optional[Iterable[float]] = None, robot_points: Optional[str] = None,
+                      max_velocity: Optional[Iterable[float]] = None, max_acceleration: Optional[Iterable[float]] = None,
+                      jerk_peaks: Optional[Mapping[str, Any]] = None, potential_tolerance: Optional[float] = None,
+                      timeout: Optional[float] = None) -> Comparison:
+        """As :meth:`kinplan.Client.compare`."""
+        r = self._robot_of(robot)
+        build = _compare_request(sets, weights, robot_points, max_velocity, max_acceleration, jerk_peaks,
+                                 potential_tolerance)
+        return Comparison(await r._call(self._scoring.CompareTrajectories, build, timeout))
+
+    async def solve_linear(self, A: Any, b: Any, method: Optional[str] = "svd", *,
+                           max_iterations: Optional[int] = None, tolerance: Optional[float] = None,
+                           relative_tolerance: Optional[float] = None, rng_seed: int = 0, history: bool = False,
+                           singular_value_tolerance: Optional[float] = None,
+                           timeout: Optional[float] = None) -> LinearSolution:
+        """As :meth:`kinplan.Client.solve_linear`."""
+        request = _solve_linear_request(A, b, method, max_iterations, tolerance, relative_tolerance, rng_seed,
+                                        history, singular_value_tolerance)
+        return _linear_solution(await self._call(self._kinematics.SolveLinearSystem, request, timeout))
+
+    async def next_best_view(self, octree: Any, *, camera_pose: Any = None, robot: Any = None,
+                             camera_mount: Any = None, candidate_poses: Sequence[Any] = (),
+                             weights: Optional[Sequence[float]] = None, gain: str = "intersection",
+                             ray_fraction: Optional[float] = None, max_results: int = 10,
+                             camera: Optional[Dict[str, Any]] = None, timeout: Optional[float] = None,
+                             **options: Any) -> Views:
+        """As :meth:`kinplan.Client.next_best_view`."""
+        req = _nbv_request(octree, camera_pose, camera_mount, candidate_poses, weights, gain, ray_fraction,
+                           max_results, camera, options)
+        if robot is not None:
+            reply = await self._robot_of(robot)._call(self._exploration.NextBestView, _with_robot(req), timeout)
+        else:
+            reply = await self._call(self._exploration.NextBestView, req, timeout)
+        return _views(reply)
+
+    async def insert_scan(self, octree: Optional[Octree], points: Any, origin: Any = None, *,
+                          resolution: float = 0.05, max_range: Optional[float] = None, discretize: bool = False,
+                          timeout: Optional[float] = None) -> Octree:
+        """As :meth:`kinplan.Client.insert_scan`."""
+        req = _insert_scan_request(octree, points, origin, resolution, max_range, discretize)
+        return Octree.from_proto((await self._call(self._exploration.InsertScan, req, timeout)).octree)
+
+    async def octree_info(self, octree: Any, *, box: Any = None, timeout: Optional[float] = None) -> Dict[str, Any]:
+        """As :meth:`kinplan.Client.octree_info`."""
+        req = _octree_info_request(octree, box)
+        return _octree_info(await self._call(self._exploration.OctreeInfo, req, timeout))
+
+    async def reference_scene(self, name: str = "s0_open_cell", *, seed: int = 1,
+                              timeout: Optional[float] = None) -> ReferenceScene:
+        """As :meth:`kinplan.Client.reference_scene`."""
+        req = _reference_scene_request(name, seed)
+        return _reference_scene(name, await self._call(self._exploration.ReferenceScene, req, timeout))
+
+    async def explore(
+        self,
+        robot: Any = None,
+        *,
+        scene: Union[ReferenceScene, Sequence[Obstacle]],
+        start: Any = None,
+        region: Optional[Tuple[npt.ArrayLike, npt.ArrayLike]] = None,
+        planner: str = "rrt_connect",
+        weights: Optional[Sequence[float]] = None,
+        seed: int = 0,
+        resolution: Optional[float] = None,
+        pixel_stride: Optional[int] = None,
+        known_ratio: Optional[float] = None,
+        max_iterations: Optional[int] = None,
+        max_consecutive_failures: Optional[int] = None,
+        camera: Optional[Mapping[str, Any]] = None,
+        camera_mount: Any = None,
+        nbv: Optional[Mapping[str, Any]] = None,
+        plan_options: Optional[Mapping[str, Any]] = None,
+        timeout: Optional[float] = None,
+        **options: Any,
+    ) -> AsyncIterator[Union[ExploreStep, ExploreSummary]]:
+        """As :meth:`kinplan.Client.explore`, an async iterator: an
+        :class:`ExploreStep` per iteration, then the :class:`ExploreSummary`."""
+        req = _explore_request(
+            self.robot, robot, scene, start, region, planner, weights, seed, resolution, pixel_stride, known_ratio,
+            max_iterations, max_consecutive_failures, camera, camera_mount, nbv, plan_options, options,
+        )
+        async for message in self._stream(self._exploration.Explore, req, timeout):
+            yield _explore_message(message)
 
 
 class AsyncRobot(RobotRefs):
@@ -217,6 +395,12 @@ class AsyncRobot(RobotRefs):
                              lambda ref: robot_pb2.DescribeRobotRequest(robot=ref), timeout)
         return RobotDescription.from_proto(r)
 
+    async def urdf(self, *, keep_capsules: bool = False, timeout: Optional[float] = None) -> str:
+        """As :meth:`kinplan.Robot.urdf`."""
+        if self.urdf_text is not None:
+            return self.urdf_text
+        return str((await self._call(self.client._robots.DescribeRobot, _urdf_request(keep_capsules), timeout)).urdf)
+
     async def fk(self, q: npt.ArrayLike, *, links: bool = False, timeout: Optional[float] = None) -> Any:
         positions = joints(q)
         await self.check_limits(positions)
@@ -256,13 +440,41 @@ class AsyncRobot(RobotRefs):
         )
         return matrix_from_proto(r.jacobian)
 
-    async def ik(self, T: Any, seed: Optional[npt.ArrayLike] = None, method: Optional[str] = "lm",
-                 linear_solver: Optional[str] = "svd", *, timeout: Optional[float] = None, **options: Any) -> IkResult:
+    async def ik(
+        self,
+        T: Any,
+        seed: Optional[npt.ArrayLike] = None,
+        method: Optional[IkMethodName] = "lm",
+        linear_solver: Optional[LinearSolverName] = "svd",
+        *,
+        max_restarts: Optional[int] = None,
+        num_solutions: Optional[int] = None,
+        position_tolerance: Optional[float] = None,
+        orientation_tolerance: Optional[float] = None,
+        position_only: bool = False,
+        max_iterations: Optional[int] = None,
+        damping: Optional[float] = None,
+        rng_seed: int = 0,
+        joint_limits: Optional[Literal["clamp", "ignore"]] = None,
+        time_budget: Optional[float] = None,
+        adaptive_damping: Optional[bool] = None,
+        max_step: Optional[float] = None,
+        distinct_tolerance: Optional[float] = None,
+        rlxa_max_iterations: Optional[int] = None,
+        history: bool = False,
+        timeout: Optional[float] = None,
+    ) -> IkResult:
         """As :meth:`kinplan.Robot.ik`."""
         if _is_position(T):
             T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
-            options["position_only"] = True
-        o = ik_options(method, linear_solver, **options)
+            position_only = True
+        o = ik_options(
+            method, linear_solver, position_tolerance=position_tolerance, orientation_tolerance=orientation_tolerance,
+            position_only=position_only, max_iterations=max_iterations, damping=damping, max_restarts=max_restarts,
+            num_solutions=num_solutions, rng_seed=rng_seed, joint_limits=joint_limits, time_budget=time_budget,
+            adaptive_damping=adaptive_damping, max_step=max_step, distinct_tolerance=distinct_tolerance,
+            rlxa_max_iterations=rlxa_max_iterations, history=history,
+        )
         target = target_to_pose(T)
         seed_list = [] if seed is None else joints(seed, "seed")
         reply = await self._call(
@@ -289,6 +501,14 @@ class AsyncRobot(RobotRefs):
         )
         return IkBatchResult(results=[IkResult.from_proto(r) for r in reply.results], succeeded=reply.succeeded,
                              elapsed_us=reply.elapsed_us)
+
+    async def track(self, poses: Any = None, seed: Optional[npt.ArrayLike] = None, *,
+                    line: Optional[Mapping[str, Any]] = None, circle: Optional[Mapping[str, Any]] = None,
+                    method: Optional[str] = "lm", linear_solver: Optional[str] = "svd", stop_on_failure: bool = False,
+                    timeout: Optional[float] = None, **options: Any) -> TrackResult:
+        """As :meth:`kinplan.Robot.track`."""
+        build = _track_request(poses, seed, line, circle, method, linear_solver, stop_on_failure, options)
+        return TrackResult.from_proto(await self._call(self.client._kinematics.TrackPath, build, timeout))
 
     def stream_ik(self, seed: Optional[npt.ArrayLike] = None, method: Optional[str] = "lm",
                   linear_solver: Optional[str] = "svd", *, timeout: Optional[float] = None,

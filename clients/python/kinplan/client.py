@@ -232,9 +232,7 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         try:
             grpc.channel_ready_future(self._channel).result(timeout=t)
         except grpc.FutureTimeoutError:
-            raise error_for(
-                grpc.StatusCode.UNAVAILABLE, f"no server at {self.target} within {t} s", []
-            ) from None
+            raise _no_server(self.target, t) from None
 
     def ping(self, *, timeout: Optional[float] = None) -> float:
         """Round-trip time (s) of the cheapest call (ListRobots); raises
@@ -301,13 +299,7 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         radians are meant) raise a :class:`kinplan.JointLimitWarning` in
         ``fk``, ``fk_batch``, ``jacobian`` and ``Client.score``; with
         `strict=True` they raise :class:`kinplan.InvalidArgument` instead."""
-        if (name is None) == (urdf is None):
-            raise invalid_argument("name", "give exactly one of name or urdf=")
-        if urdf is not None and "<" not in urdf and urdf.strip().lower().endswith((".urdf", ".xml")):
-            raise invalid_argument(
-                "urdf",
-                f"{urdf!r} looks like a file path; urdf= takes the document's text: urdf=open(path).read()",
-            )
+        _check_robot_args(name, urdf)
         return Robot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link, strict=strict)
 
 
@@ -381,6 +373,32 @@ class JointLimits:
         if strict:
             raise invalid_argument(field_name, message)
         warnings.warn(f"{field_name}: {message}", JointLimitWarning, stacklevel=4)
+
+
+def _check_robot_args(name: Optional[str], urdf: Optional[str]) -> None:
+    """`Client.robot`'s checks (blocking and asyncio): one of a name or a URDF
+    text, and a URDF that is not a file's path."""
+    if (name is None) == (urdf is None):
+        raise invalid_argument("name", "give exactly one of name or urdf=")
+    if urdf is not None and "<" not in urdf and urdf.strip().lower().endswith((".urdf", ".xml")):
+        raise invalid_argument(
+            "urdf",
+            f"{urdf!r} looks like a file path; urdf= takes the document's text: urdf=open(path).read()",
+        )
+
+
+def _urdf_request(keep_capsules: bool) -> Callable[[common_pb2.RobotRef], robot_pb2.DescribeRobotRequest]:
+    """The DescribeRobotRequest of :meth:`Robot.urdf` for a robot reference
+    (shared by the blocking and asyncio clients)."""
+    def build(ref: common_pb2.RobotRef) -> robot_pb2.DescribeRobotRequest:
+        return robot_pb2.DescribeRobotRequest(robot=ref, include_urdf=True, keep_capsules=keep_capsules)
+
+    return build
+
+
+def _no_server(target: str, timeout: Optional[float]) -> KinplanError:
+    """The :class:`kinplan.errors.Unavailable` of a ``wait_for_ready`` that timed out."""
+    return error_for(grpc.StatusCode.UNAVAILABLE, f"no server at {target} within {timeout} s", [])
 
 
 class RobotRefs:
@@ -489,12 +507,7 @@ class Robot(RobotRefs, RobotKinematicsMixin):
         an inline model's own text as given."""
         if self.urdf_text is not None:
             return self.urdf_text
-        r = self._call(
-            self.client._robots.DescribeRobot,
-            lambda ref: robot_pb2.DescribeRobotRequest(robot=ref, include_urdf=True, keep_capsules=keep_capsules),
-            timeout,
-        )
-        return str(r.urdf)
+        return str(self._call(self.client._robots.DescribeRobot, _urdf_request(keep_capsules), timeout).urdf)
 
     @overload
     def fk(self, q: npt.ArrayLike, *, links: Literal[False] = False,

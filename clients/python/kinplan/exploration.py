@@ -9,7 +9,7 @@ bytes; the server never opens a file.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 
@@ -157,6 +157,121 @@ class Views:
 _REACH = {0: None, 1: True, 2: False}
 
 
+def _nbv_request(octree: Any, camera_pose: Any, camera_mount: Any, candidate_poses: Sequence[Any],
+                 weights: Optional[Sequence[float]], gain: str, ray_fraction: Optional[float], max_results: int,
+                 camera: Optional[Dict[str, Any]], options: Dict[str, Any]) -> exploration_pb2.NextBestViewRequest:
+    """The NextBestViewRequest of :meth:`ExplorationMixin.next_best_view`'s
+    arguments, without a robot (shared by the blocking and asyncio clients)."""
+    tree = octree if isinstance(octree, Octree) else Octree.from_bt(bytes(octree))
+    if gain not in GAINS:
+        raise ValueError(f"gain must be one of {sorted(GAINS)}, got {gain!r}")
+    opts = exploration_pb2.NbvOptions(gain=GAINS[gain], max_results=int(max_results), **options)
+    if ray_fraction is not None:
+        opts.ray_fraction = float(ray_fraction)
+    if weights is not None:
+        w_i, w_d, w_r = (float(v) for v in weights)
+        opts.weights.CopyFrom(exploration_pb2.UtilityWeights(information_gain=w_i, distance=w_d, rotation=w_r))
+    req = exploration_pb2.NextBestViewRequest(
+        octree=tree.to_proto(),
+        camera=exploration_pb2.CameraModel(**(camera or {})),
+        camera_pose=_pose(camera_pose),
+        candidate_poses=[_pose(p) for p in candidate_poses],
+        options=opts,
+    )
+    if camera_mount is not None:
+        req.camera_mount.CopyFrom(_pose(camera_mount))
+    return req
+
+
+def _with_robot(req: exploration_pb2.NextBestViewRequest,
+                ) -> Callable[[common_pb2.RobotRef], exploration_pb2.NextBestViewRequest]:
+    """`req` with a robot reference (for a robot's ``_call``)."""
+    def build(ref: common_pb2.RobotRef) -> exploration_pb2.NextBestViewRequest:
+        r = exploration_pb2.NextBestViewRequest()
+        r.CopyFrom(req)
+        r.robot.CopyFrom(ref)
+        return r
+
+    return build
+
+
+def _views(reply: exploration_pb2.NextBestViewResponse) -> Views:
+    """The :class:`Views` of a NextBestView reply."""
+    c = reply.candidates
+    s = reply.stages
+    return Views(
+        poses=np.array([pose_to_matrix(v.pose) for v in c]).reshape(-1, 4, 4),
+        utility=np.array([v.utility for v in c]),
+        gain=np.array([v.information_gain for v in c]),
+        distance=np.array([v.distance_score for v in c]),
+        rotation=np.array([v.rotation_score for v in c]),
+        unknown_cells=np.array([v.unknown_cells for v in c]),
+        frontier=np.array(
+            [[v.frontier.x, v.frontier.y, v.frontier.z] if v.HasField("frontier") else [np.nan] * 3 for v in c]
+        ).reshape(-1, 3),
+        reachable=[_REACH[v.reachability] for v in c],
+        joints=[np.array(v.joints) if len(v.joints) else None for v in c],
+        stages={f.name: getattr(s, f.name) for f in s.DESCRIPTOR.fields},
+        status=exploration_pb2.NbvStatus.Name(reply.status).removeprefix("NBV_STATUS_"),
+        weights={
+            "information_gain": reply.weights.information_gain,
+            "distance": reply.weights.distance,
+            "rotation": reply.weights.rotation,
+        },
+        raw=reply,
+    )
+
+
+def _insert_scan_request(octree: Optional[Octree], points: Any, origin: Any, resolution: float,
+                         max_range: Optional[float], discretize: bool) -> exploration_pb2.InsertScanRequest:
+    """The InsertScanRequest of :meth:`ExplorationMixin.insert_scan`'s arguments
+    (the reply's tree reads as :meth:`Octree.from_proto`)."""
+    pts = np.asarray(points, dtype=np.float32)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise ValueError(f"points must be n x 3, got shape {pts.shape}")
+    req = exploration_pb2.InsertScanRequest(
+        resolution=float(resolution),
+        sensor_pose=_pose(origin),
+        points=exploration_pb2.PointCloud(xyz=pts.ravel().tolist()),
+        discretize=discretize,
+    )
+    if octree is not None:
+        req.octree.CopyFrom(octree.to_proto())
+    if max_range is not None:
+        req.max_range = float(max_range)
+    return req
+
+
+def _octree_info_request(octree: Any, box: Any) -> exploration_pb2.OctreeInfoRequest:
+    """The OctreeInfoRequest of :meth:`ExplorationMixin.octree_info`'s arguments."""
+    tree = octree if isinstance(octree, Octree) else Octree.from_bt(bytes(octree))
+    req = exploration_pb2.OctreeInfoRequest(octree=tree.to_proto())
+    if box is not None:
+        lo, hi = (np.asarray(b, dtype=float) for b in box)
+        req.box.min.CopyFrom(common_pb2.Vec3(x=lo[0], y=lo[1], z=lo[2]))
+        req.box.max.CopyFrom(common_pb2.Vec3(x=hi[0], y=hi[1], z=hi[2]))
+    return req
+
+
+def _octree_info(r: exploration_pb2.OctreeInfoResponse) -> Dict[str, Any]:
+    """The dict of an OctreeInfo reply."""
+    s = r.stats
+    return {
+        "resolution": s.resolution,
+        "nodes": s.nodes,
+        "leaves": s.leaves,
+        "occupied_leaves": s.occupied_leaves,
+        "free_leaves": s.free_leaves,
+        "bounds": (
+            np.array([s.bounds.min.x, s.bounds.min.y, s.bounds.min.z]),
+            np.array([s.bounds.max.x, s.bounds.max.y, s.bounds.max.z]),
+        ),
+        "occupied_volume": r.occupied_volume,
+        "free_volume": r.free_volume,
+        "unknown_volume": r.unknown_volume,
+    }
+
+
 class ExplorationMixin:
     """``Client.next_best_view``, ``Client.insert_scan``, ``Client.octree_info``."""
 
@@ -189,57 +304,13 @@ class ExplorationMixin:
         "unobserved_voxels"; ``robot`` (optional) adds the reach filter and IK
         checks of the best candidates; further ``options`` are the fields of
         ``NbvOptions`` (e.g. ``frontier_unknown_ratio=0.3``)."""
-        tree = octree if isinstance(octree, Octree) else Octree.from_bt(bytes(octree))
-        if gain not in GAINS:
-            raise ValueError(f"gain must be one of {sorted(GAINS)}, got {gain!r}")
-        opts = exploration_pb2.NbvOptions(gain=GAINS[gain], max_results=int(max_results), **options)
-        if ray_fraction is not None:
-            opts.ray_fraction = float(ray_fraction)
-        if weights is not None:
-            w_i, w_d, w_r = (float(v) for v in weights)
-            opts.weights.CopyFrom(exploration_pb2.UtilityWeights(information_gain=w_i, distance=w_d, rotation=w_r))
-        req = exploration_pb2.NextBestViewRequest(
-            octree=tree.to_proto(),
-            camera=exploration_pb2.CameraModel(**(camera or {})),
-            camera_pose=_pose(camera_pose),
-            candidate_poses=[_pose(p) for p in candidate_poses],
-            options=opts,
-        )
-        if camera_mount is not None:
-            req.camera_mount.CopyFrom(_pose(camera_mount))
+        req = _nbv_request(octree, camera_pose, camera_mount, candidate_poses, weights, gain, ray_fraction,
+                           max_results, camera, options)
         if robot is not None:
-            def build(ref: common_pb2.RobotRef) -> exploration_pb2.NextBestViewRequest:
-                r = exploration_pb2.NextBestViewRequest()
-                r.CopyFrom(req)
-                r.robot.CopyFrom(ref)
-                return r
-
-            reply = robot._call(self._exploration().NextBestView, build, timeout)
+            reply = robot._call(self._exploration().NextBestView, _with_robot(req), timeout)
         else:
             reply = self._call(self._exploration().NextBestView, req, timeout)  # type: ignore[attr-defined]
-        c = reply.candidates
-        s = reply.stages
-        return Views(
-            poses=np.array([pose_to_matrix(v.pose) for v in c]).reshape(-1, 4, 4),
-            utility=np.array([v.utility for v in c]),
-            gain=np.array([v.information_gain for v in c]),
-            distance=np.array([v.distance_score for v in c]),
-            rotation=np.array([v.rotation_score for v in c]),
-            unknown_cells=np.array([v.unknown_cells for v in c]),
-            frontier=np.array(
-                [[v.frontier.x, v.frontier.y, v.frontier.z] if v.HasField("frontier") else [np.nan] * 3 for v in c]
-            ).reshape(-1, 3),
-            reachable=[_REACH[v.reachability] for v in c],
-            joints=[np.array(v.joints) if len(v.joints) else None for v in c],
-            stages={f.name: getattr(s, f.name) for f in s.DESCRIPTOR.fields},
-            status=exploration_pb2.NbvStatus.Name(reply.status).removeprefix("NBV_STATUS_"),
-            weights={
-                "information_gain": reply.weights.information_gain,
-                "distance": reply.weights.distance,
-                "rotation": reply.weights.rotation,
-            },
-            raw=reply,
-        )
+        return _views(reply)
 
     def insert_scan(
         self,
@@ -255,44 +326,12 @@ class ExplorationMixin:
         """Inserts ``points`` (n x 3, world frame, metres) seen from ``origin``
         (3-vector or 4x4 sensor pose) with OctoMap's sensor model; a new tree at
         ``resolution`` when ``octree`` is None. Returns the updated tree."""
-        pts = np.asarray(points, dtype=np.float32)
-        if pts.ndim != 2 or pts.shape[1] != 3:
-            raise ValueError(f"points must be n x 3, got shape {pts.shape}")
-        req = exploration_pb2.InsertScanRequest(
-            resolution=float(resolution),
-            sensor_pose=_pose(origin),
-            points=exploration_pb2.PointCloud(xyz=pts.ravel().tolist()),
-            discretize=discretize,
-        )
-        if octree is not None:
-            req.octree.CopyFrom(octree.to_proto())
-        if max_range is not None:
-            req.max_range = float(max_range)
+        req = _insert_scan_request(octree, points, origin, resolution, max_range, discretize)
         reply = self._call(self._exploration().InsertScan, req, timeout)  # type: ignore[attr-defined]
         return Octree.from_proto(reply.octree)
 
     def octree_info(self, octree: Any, *, box: Any = None, timeout: Optional[float] = None) -> Dict[str, Any]:
         """Resolution, node and leaf counts, bounds, and free / occupied /
         unknown volume (m^3) inside ``box`` = (min xyz, max xyz) or the bounds."""
-        tree = octree if isinstance(octree, Octree) else Octree.from_bt(bytes(octree))
-        req = exploration_pb2.OctreeInfoRequest(octree=tree.to_proto())
-        if box is not None:
-            lo, hi = (np.asarray(b, dtype=float) for b in box)
-            req.box.min.CopyFrom(common_pb2.Vec3(x=lo[0], y=lo[1], z=lo[2]))
-            req.box.max.CopyFrom(common_pb2.Vec3(x=hi[0], y=hi[1], z=hi[2]))
-        r = self._call(self._exploration().OctreeInfo, req, timeout)  # type: ignore[attr-defined]
-        s = r.stats
-        return {
-            "resolution": s.resolution,
-            "nodes": s.nodes,
-            "leaves": s.leaves,
-            "occupied_leaves": s.occupied_leaves,
-            "free_leaves": s.free_leaves,
-            "bounds": (
-                np.array([s.bounds.min.x, s.bounds.min.y, s.bounds.min.z]),
-                np.array([s.bounds.max.x, s.bounds.max.y, s.bounds.max.z]),
-            ),
-            "occupied_volume": r.occupied_volume,
-            "free_volume": r.free_volume,
-            "unknown_volume": r.unknown_volume,
-        }
+        req = _octree_info_request(octree, box)
+        return _octree_info(self._call(self._exploration().OctreeInfo, req, timeout))  # type: ignore[attr-defined]

@@ -5,7 +5,7 @@ holding the totals and the final octree."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -147,6 +147,104 @@ def _summary(s: exploration_pb2.ExploreSummary) -> ExploreSummary:
     )
 
 
+def _explore_message(m: exploration_pb2.ExploreResponse) -> Union[ExploreStep, ExploreSummary]:
+    """The step or summary an Explore stream message carries."""
+    if m.HasField("summary"):
+        return _summary(m.summary)
+    return _step(m.iteration)
+
+
+def _reference_scene_request(name: str, seed: int) -> exploration_pb2.ReferenceSceneRequest:
+    """The ReferenceSceneRequest of :meth:`ExploreMixin.reference_scene`'s
+    arguments (shared by the blocking and asyncio clients)."""
+    if name not in SCENES:
+        raise ValueError(f"name must be one of {sorted(SCENES)}, got {name!r}")
+    return exploration_pb2.ReferenceSceneRequest(name=SCENES[name], seed=int(seed))
+
+
+def _reference_scene(name: str, r: exploration_pb2.ReferenceSceneResponse) -> ReferenceScene:
+    """The :class:`ReferenceScene` `name` of a ReferenceScene reply."""
+    def v(p: Any) -> np.ndarray:
+        return np.array([p.x, p.y, p.z], dtype=float)
+
+    return ReferenceScene(
+        name=name,
+        robot=r.robot,
+        obstacles=list(r.scene.objects),
+        region=(v(r.region.min), v(r.region.max)),
+        start=np.array(r.start, dtype=float),
+    )
+
+
+def _explore_request(
+    make_robot: Callable[[str], Any],
+    robot: Any,
+    scene: Union[ReferenceScene, Sequence[Obstacle]],
+    start: Any,
+    region: Optional[Tuple[npt.ArrayLike, npt.ArrayLike]],
+    planner: str,
+    weights: Optional[Sequence[float]],
+    seed: int,
+    resolution: Optional[float],
+    pixel_stride: Optional[int],
+    known_ratio: Optional[float],
+    max_iterations: Optional[int],
+    max_consecutive_failures: Optional[int],
+    camera: Optional[Mapping[str, Any]],
+    camera_mount: Any,
+    nbv: Optional[Mapping[str, Any]],
+    plan_options: Optional[Mapping[str, Any]],
+    options: Dict[str, Any],
+) -> exploration_pb2.ExploreRequest:
+    """The ExploreRequest of :meth:`ExploreMixin.explore`'s arguments; a
+    robot given by name (or a :class:`ReferenceScene`'s) is made by
+    `make_robot` (the client's ``robot``)."""
+    if isinstance(scene, ReferenceScene):
+        start = scene.start if start is None else start
+        region = scene.region if region is None else region
+        if robot is None:
+            robot = make_robot(scene.robot)
+        scene = scene.obstacles
+    if isinstance(robot, str):
+        robot = make_robot(robot)
+    if robot is None or start is None or region is None:
+        raise ValueError("robot, start and region are required unless scene is a ReferenceScene")
+    if planner not in ALGORITHMS:
+        raise ValueError(f"planner must be one of {sorted(ALGORITHMS)}, got {planner!r}")
+    lo, hi = (np.asarray(b, dtype=float).reshape(3) for b in region)
+    nbv_opts = exploration_pb2.NbvOptions(**dict(nbv or {}))
+    if weights is not None:
+        w_i, w_d, w_r = (float(v) for v in weights)
+        nbv_opts.weights.CopyFrom(exploration_pb2.UtilityWeights(information_gain=w_i, distance=w_d, rotation=w_r))
+    req = exploration_pb2.ExploreRequest(
+        start=[float(v) for v in np.asarray(start, dtype=float).ravel()],
+        scene=scene_to_proto(scene),
+        region=exploration_pb2.BoundingBox(
+            min=common_pb2.Vec3(x=lo[0], y=lo[1], z=lo[2]), max=common_pb2.Vec3(x=hi[0], y=hi[1], z=hi[2])
+        ),
+        camera=exploration_pb2.CameraModel(**dict(camera or {})),
+        nbv=nbv_opts,
+        algorithm=ALGORITHMS[planner],
+        plan_options=planning_pb2.PlanOptions(**dict(plan_options or {})),
+        seed=int(seed),
+        **options,
+    )
+    if camera_mount is not None:
+        req.camera_mount.CopyFrom(_pose(camera_mount))
+    for name, value in (("resolution", resolution), ("pixel_stride", pixel_stride)):
+        if value is not None:
+            setattr(req, name, value)
+    for name, value in (
+        ("known_ratio", known_ratio),
+        ("max_iterations", max_iterations),
+        ("max_consecutive_failures", max_consecutive_failures),
+    ):
+        if value is not None:
+            setattr(req.stop, name, value)
+    req.robot.CopyFrom(robot._ref())
+    return req
+
+
 class ExploreMixin:
     """``Client.explore``, ``Client.reference_scene``."""
 
@@ -154,20 +252,9 @@ class ExploreMixin:
                         timeout: Optional[float] = None) -> ReferenceScene:
         """The reference cell ``name`` ("s0_open_cell" or "s0_walled_cell")
         built with ``seed``."""
-        if name not in SCENES:
-            raise ValueError(f"name must be one of {sorted(SCENES)}, got {name!r}")
-        req = exploration_pb2.ReferenceSceneRequest(name=SCENES[name], seed=int(seed))
+        req = _reference_scene_request(name, seed)
         r = self._call(self._exploration().ReferenceScene, req, timeout)  # type: ignore[attr-defined]
-        def v(p: Any) -> np.ndarray:
-            return np.array([p.x, p.y, p.z], dtype=float)
-
-        return ReferenceScene(
-            name=name,
-            robot=r.robot,
-            obstacles=list(r.scene.objects),
-            region=(v(r.region.min), v(r.region.max)),
-            start=np.array(r.start, dtype=float),
-        )
+        return _reference_scene(name, r)
 
     def explore(
         self,
@@ -203,49 +290,11 @@ class ExploreMixin:
         further ``options`` the remaining ``ExploreRequest`` fields
         (``noise_stddev``, ``candidates_per_iteration``, ``plan_time_budget``,
         ``time_budget``)."""
-        if isinstance(scene, ReferenceScene):
-            start = scene.start if start is None else start
-            region = scene.region if region is None else region
-            if robot is None:
-                robot = self.robot(scene.robot)  # type: ignore[attr-defined]
-            scene = scene.obstacles
-        if isinstance(robot, str):
-            robot = self.robot(robot)  # type: ignore[attr-defined]
-        if robot is None or start is None or region is None:
-            raise ValueError("robot, start and region are required unless scene is a ReferenceScene")
-        if planner not in ALGORITHMS:
-            raise ValueError(f"planner must be one of {sorted(ALGORITHMS)}, got {planner!r}")
-        lo, hi = (np.asarray(b, dtype=float).reshape(3) for b in region)
-        nbv_opts = exploration_pb2.NbvOptions(**dict(nbv or {}))
-        if weights is not None:
-            w_i, w_d, w_r = (float(v) for v in weights)
-            nbv_opts.weights.CopyFrom(exploration_pb2.UtilityWeights(information_gain=w_i, distance=w_d, rotation=w_r))
-        req = exploration_pb2.ExploreRequest(
-            start=[float(v) for v in np.asarray(start, dtype=float).ravel()],
-            scene=scene_to_proto(scene),
-            region=exploration_pb2.BoundingBox(
-                min=common_pb2.Vec3(x=lo[0], y=lo[1], z=lo[2]), max=common_pb2.Vec3(x=hi[0], y=hi[1], z=hi[2])
-            ),
-            camera=exploration_pb2.CameraModel(**dict(camera or {})),
-            nbv=nbv_opts,
-            algorithm=ALGORITHMS[planner],
-            plan_options=planning_pb2.PlanOptions(**dict(plan_options or {})),
-            seed=int(seed),
-            **options,
+        req = _explore_request(
+            self.robot, robot, scene, start, region, planner, weights, seed,  # type: ignore[attr-defined]
+            resolution, pixel_stride, known_ratio, max_iterations, max_consecutive_failures, camera, camera_mount,
+            nbv, plan_options, options,
         )
-        if camera_mount is not None:
-            req.camera_mount.CopyFrom(_pose(camera_mount))
-        for name, value in (("resolution", resolution), ("pixel_stride", pixel_stride)):
-            if value is not None:
-                setattr(req, name, value)
-        for name, value in (
-            ("known_ratio", known_ratio),
-            ("max_iterations", max_iterations),
-            ("max_consecutive_failures", max_consecutive_failures),
-        ):
-            if value is not None:
-                setattr(req.stop, name, value)
-        req.robot.CopyFrom(robot._ref())
         from .errors import KinplanError
         import grpc
 
@@ -253,9 +302,6 @@ class ExploreMixin:
         t = self.timeout if timeout is None else timeout  # type: ignore[attr-defined]
         try:
             for m in stub.Explore(req, timeout=t):
-                if m.HasField("summary"):
-                    yield _summary(m.summary)
-                else:
-                    yield _step(m.iteration)
+                yield _explore_message(m)
         except grpc.RpcError as err:
             raise KinplanError.from_rpc_error(err) from None

@@ -18,7 +18,7 @@ from __future__ import annotations
 import queue
 import threading
 from dataclasses import dataclass, field
-from typing import Any, Dict, Iterable, Iterator, List, Literal, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Literal, Mapping, Optional, Sequence, Union
 
 import grpc
 import numpy as np
@@ -435,6 +435,90 @@ class LinearSolution:
         return self.status == "converged"
 
 
+def _track_request(poses: Any, seed: Optional[npt.ArrayLike], line: Optional[Mapping[str, Any]],
+                   circle: Optional[Mapping[str, Any]], method: Optional[str], linear_solver: Optional[str],
+                   stop_on_failure: bool, options: Dict[str, Any],
+                   ) -> Callable[[common_pb2.RobotRef], kinematics_pb2.TrackPathRequest]:
+    """The TrackPathRequest of :meth:`RobotKinematicsMixin.track`'s arguments
+    for a robot reference (shared by the blocking and asyncio clients)."""
+    o = ik_options(method, linear_solver, **options)
+    seed_list = [] if seed is None else joints(seed, "seed")
+    kwargs: Dict[str, Any] = {}
+    if poses is not None:
+        kwargs["poses"] = _targets(poses)
+    if line is not None:
+        spec = dict(line)
+        lp = kinematics_pb2.LinePath(steps=int(spec.pop("steps", 0)))
+        if spec.get("start") is not None:
+            lp.start.CopyFrom(target_to_pose(spec["start"]))
+        spec.pop("start", None)
+        if spec.get("end") is not None:
+            lp.end.CopyFrom(target_to_pose(spec["end"]))
+        spec.pop("end", None)
+        if spec:
+            raise ValueError(f"unknown line keys {sorted(spec)}")
+        kwargs["line"] = lp
+    if circle is not None:
+        spec = dict(circle)
+        cp = kinematics_pb2.CirclePath(angle_step=float(spec.pop("angle_step", 0.0)), steps=int(spec.pop("steps", 0)))
+        if spec.get("start") is not None:
+            cp.start.CopyFrom(target_to_pose(spec["start"]))
+        spec.pop("start", None)
+        for key in ("centre", "normal"):
+            value = spec.pop(key, spec.pop("center", None) if key == "centre" else None)
+            if value is not None:
+                v = np.asarray(value, dtype=float).ravel()
+                getattr(cp, key).CopyFrom(common_pb2.Vec3(x=v[0], y=v[1], z=v[2]))
+        if spec:
+            raise ValueError(f"unknown circle keys {sorted(spec)}")
+        kwargs["circle"] = cp
+
+    def build(ref: common_pb2.RobotRef) -> kinematics_pb2.TrackPathRequest:
+        return kinematics_pb2.TrackPathRequest(
+            robot=ref, seed=seed_list, options=o, stop_on_failure=stop_on_failure, **kwargs
+        )
+
+    return build
+
+
+def _solve_linear_request(A: Any, b: Any, method: Optional[str], max_iterations: Optional[int],
+                          tolerance: Optional[float], relative_tolerance: Optional[float], rng_seed: int,
+                          history: bool, singular_value_tolerance: Optional[float],
+                          ) -> kinematics_pb2.SolveLinearSystemRequest:
+    """The SolveLinearSystemRequest of :meth:`KinematicsMixin.solve_linear`'s arguments."""
+    a = np.asarray(A, dtype=float)
+    if a.ndim != 2:
+        raise ValueError(f"A must be two-dimensional, got shape {a.shape}")
+    rhs = np.asarray(b, dtype=float).ravel()
+    request = kinematics_pb2.SolveLinearSystemRequest(
+        a=matrix_to_proto(a),
+        b=rhs.tolist(),
+        method=_choice(LINEAR_SOLVERS, method, "method"),
+        max_iterations=int(max_iterations or 0),
+        rng_seed=int(rng_seed),
+        record_history=bool(history),
+    )
+    if tolerance is not None:
+        request.tolerance = float(tolerance)
+    if relative_tolerance is not None:
+        request.relative_tolerance = float(relative_tolerance)
+    if singular_value_tolerance is not None:
+        request.singular_value_tolerance = float(singular_value_tolerance)
+    return request
+
+
+def _linear_solution(reply: kinematics_pb2.SolveLinearSystemResponse) -> LinearSolution:
+    """The :class:`LinearSolution` of a SolveLinearSystem reply."""
+    return LinearSolution(
+        x=np.asarray(reply.x, dtype=float),
+        residual_norm=reply.residual_norm,
+        iterations=reply.iterations,
+        status=kinematics_pb2.LinearSolveStatus.Name(reply.status).removeprefix("LINEAR_SOLVE_STATUS_").lower(),
+        history=np.asarray(reply.residual_history, dtype=float),
+        elapsed_us=reply.elapsed_us,
+    )
+
+
 class IkStream:
     """A ``StreamIk`` call: send targets, read answers in order, each
     warm-started from the previous answer. Use as a context manager::
@@ -666,44 +750,8 @@ class RobotKinematicsMixin:
         "start": T0}`` (``start`` defaults to the tool pose at ``seed``).
         ``seed`` defaults to the middle of the joint limits. Options as
         :meth:`ik`; ``time_budget`` bounds the whole path."""
-        o = ik_options(method, linear_solver, **options)
-        seed_list = [] if seed is None else joints(seed, "seed")
-        kwargs: Dict[str, Any] = {}
-        if poses is not None:
-            kwargs["poses"] = _targets(poses)
-        if line is not None:
-            spec = dict(line)
-            lp = kinematics_pb2.LinePath(steps=int(spec.pop("steps", 0)))
-            if spec.get("start") is not None:
-                lp.start.CopyFrom(target_to_pose(spec["start"]))
-            spec.pop("start", None)
-            if spec.get("end") is not None:
-                lp.end.CopyFrom(target_to_pose(spec["end"]))
-            spec.pop("end", None)
-            if spec:
-                raise ValueError(f"unknown line keys {sorted(spec)}")
-            kwargs["line"] = lp
-        if circle is not None:
-            spec = dict(circle)
-            cp = kinematics_pb2.CirclePath(angle_step=float(spec.pop("angle_step", 0.0)), steps=int(spec.pop("steps", 0)))
-            if spec.get("start") is not None:
-                cp.start.CopyFrom(target_to_pose(spec["start"]))
-            spec.pop("start", None)
-            for key in ("centre", "normal"):
-                value = spec.pop(key, spec.pop("center", None) if key == "centre" else None)
-                if value is not None:
-                    v = np.asarray(value, dtype=float).ravel()
-                    getattr(cp, key).CopyFrom(common_pb2.Vec3(x=v[0], y=v[1], z=v[2]))
-            if spec:
-                raise ValueError(f"unknown circle keys {sorted(spec)}")
-            kwargs["circle"] = cp
-        reply = self._call(  # type: ignore[attr-defined]
-            self.client._kinematics.TrackPath,  # type: ignore[attr-defined]
-            lambda ref: kinematics_pb2.TrackPathRequest(
-                robot=ref, seed=seed_list, options=o, stop_on_failure=stop_on_failure, **kwargs
-            ),
-            timeout,
-        )
+        build = _track_request(poses, seed, line, circle, method, linear_solver, stop_on_failure, options)
+        reply = self._call(self.client._kinematics.TrackPath, build, timeout)  # type: ignore[attr-defined]
         return TrackResult.from_proto(reply)
 
     def stream_ik(
@@ -756,33 +804,10 @@ class KinematicsMixin:
         ``"angle_relaxation_safeguarded"`` (RLXA: ``max_iterations``, default
         20,000; ``tolerance`` on |b - A x|, default 0.01; ``rng_seed``;
         ``history=True`` returns the residual after every iteration)."""
-        a = np.asarray(A, dtype=float)
-        if a.ndim != 2:
-            raise ValueError(f"A must be two-dimensional, got shape {a.shape}")
-        rhs = np.asarray(b, dtype=float).ravel()
-        request = kinematics_pb2.SolveLinearSystemRequest(
-            a=matrix_to_proto(a),
-            b=rhs.tolist(),
-            method=_choice(LINEAR_SOLVERS, method, "method"),
-            max_iterations=int(max_iterations or 0),
-            rng_seed=int(rng_seed),
-            record_history=bool(history),
-        )
-        if tolerance is not None:
-            request.tolerance = float(tolerance)
-        if relative_tolerance is not None:
-            request.relative_tolerance = float(relative_tolerance)
-        if singular_value_tolerance is not None:
-            request.singular_value_tolerance = float(singular_value_tolerance)
+        request = _solve_linear_request(A, b, method, max_iterations, tolerance, relative_tolerance, rng_seed,
+                                        history, singular_value_tolerance)
         reply = self._call(self._kinematics.SolveLinearSystem, request, timeout)  # type: ignore[attr-defined]
-        return LinearSolution(
-            x=np.asarray(reply.x, dtype=float),
-            residual_norm=reply.residual_norm,
-            iterations=reply.iterations,
-            status=kinematics_pb2.LinearSolveStatus.Name(reply.status).removeprefix("LINEAR_SOLVE_STATUS_").lower(),
-            history=np.asarray(reply.residual_history, dtype=float),
-            elapsed_us=reply.elapsed_us,
-        )
+        return _linear_solution(reply)
 
 
 __all__ = [

@@ -286,6 +286,163 @@ def _wheels_in(kind: str, wheels: Mapping[str, Any]) -> mobile_pb2.WheelState:
     return msg
 
 
+def _wheels_request(chassis: str, twist: Optional[Sequence[float]], wheels: Optional[Mapping[str, Any]],
+                    chassis_params: Optional[Mapping[str, float]]) -> mobile_pb2.WheelKinematicsRequest:
+    """The WheelKinematicsRequest of :meth:`Mobile.wheels`'s arguments
+    (shared by the blocking and asyncio clients)."""
+    if (twist is None) == (wheels is None):
+        raise ValueError("give exactly one of twist or wheels=")
+    c = chassis_to_proto(chassis, chassis_params)
+    req = mobile_pb2.WheelKinematicsRequest(chassis=c)
+    if twist is not None:
+        req.twist.CopyFrom(mobile_pb2.Twist2D(vx=float(twist[0]), vy=float(twist[1]), omega=float(twist[2])))
+    else:
+        req.wheels.CopyFrom(_wheels_in(c.WhichOneof("kind"), wheels or {}))
+    return req
+
+
+def _wheels_reply(r: mobile_pb2.WheelKinematicsResponse) -> WheelKinematics:
+    """The :class:`WheelKinematics` of a WheelKinematics reply."""
+    return WheelKinematics(_twist(r.twist), _wheels_out(r.wheels), _saturation(r.saturation), raw=r)
+
+
+def _step_request(
+    state: Sequence[float],
+    chassis: str,
+    controller: str,
+    path: Optional[Iterable[Sequence[float]]],
+    goal: Optional[Sequence[float]],
+    gains: Optional[Mapping[str, Any]],
+    params: Optional[Mapping[str, Any]],
+    sensors: Optional[Mapping[str, Any]],
+    readings: Optional[Iterable[float]],
+    world: Optional[Iterable[Obstacle]],
+    robot_radius: Optional[float],
+    seed: int,
+    dt: Optional[float],
+    token: Union[bytes, StepResult, None],
+    chassis_params: Optional[Mapping[str, float]],
+) -> mobile_pb2.ControlStepRequest:
+    """The ControlStepRequest of :meth:`Mobile.step`'s arguments."""
+    if isinstance(token, StepResult):
+        token = token.token
+    req = mobile_pb2.ControlStepRequest(
+        chassis=chassis_to_proto(chassis, chassis_params),
+        state=_pose(state),
+        controller=_controller(controller),
+        path=path_to_proto(path or []),
+        follow=follow_options(controller, gains) if controller != "vector_distance" else None,
+        vdf=_fill(mobile_pb2.VectorDistanceParams(), params),
+        sensors=_fill(mobile_pb2.RangeSensorParams(), sensors),
+        readings=[float(r) for r in (readings if readings is not None else [])],
+        world=world_to_proto(world),
+        seed=seed,
+        state_token=token or b"",
+    )
+    if goal is not None:
+        req.goal.CopyFrom(_xy(goal))
+    if robot_radius is not None:
+        req.robot_radius = float(robot_radius)
+    if dt is not None:
+        req.dt = float(dt)
+    return req
+
+
+def _step_reply(req: mobile_pb2.ControlStepRequest, r: mobile_pb2.ControlStepResponse) -> StepResult:
+    """The :class:`StepResult` of the ControlStep reply `r` to `req`."""
+    vd = req.controller == mobile_pb2.CONTROLLER_VECTOR_DISTANCE
+    return StepResult(
+        command=_twist(r.command),
+        applied=_twist(r.applied),
+        saturation=_saturation(r.saturation),
+        reached=r.reached,
+        token=r.state_token,
+        target_node=r.target_node,
+        mode=_MODE_LETTERS.get(r.mode) if vd else None,
+        readings=np.array(r.readings, dtype=float),
+        force=np.array([r.force.x, r.force.y]) if vd else None,
+        hit_point=np.array([r.hit_point.x, r.hit_point.y]) if r.HasField("hit_point") else None,
+        leave_point=np.array([r.leave_point.x, r.leave_point.y]) if r.HasField("leave_point") else None,
+        no_path=r.no_path,
+        raw=r,
+    )
+
+
+def _sim(robot_radius: Optional[float], dt: Optional[float], max_time: Optional[float]) -> mobile_pb2.SimOptions:
+    sim = mobile_pb2.SimOptions()
+    if robot_radius is not None:
+        sim.robot_radius = float(robot_radius)
+    if dt is not None:
+        sim.dt = float(dt)
+    if max_time is not None:
+        sim.max_time = float(max_time)
+    return sim
+
+
+def _follow_request(
+    chassis: str,
+    start: Sequence[float],
+    path: Iterable[Sequence[float]],
+    controller: str,
+    gains: Optional[Mapping[str, Any]],
+    world: Optional[Iterable[Obstacle]],
+    robot_radius: Optional[float],
+    dt: Optional[float],
+    max_time: Optional[float],
+    chassis_params: Optional[Mapping[str, float]],
+) -> mobile_pb2.FollowPathRequest:
+    """The FollowPathRequest of :meth:`Mobile.follow`'s arguments (the reply
+    reads as :meth:`MobileRun.from_proto`)."""
+    return mobile_pb2.FollowPathRequest(
+        chassis=chassis_to_proto(chassis, chassis_params),
+        start=_pose(start),
+        path=path_to_proto(path),
+        controller=_controller(controller),
+        follow=follow_options(controller, gains),
+        world=world_to_proto(world),
+        sim=_sim(robot_radius, dt, max_time),
+    )
+
+
+def _navigate_request(
+    chassis: str,
+    start: Sequence[float],
+    goal: Sequence[float],
+    world: Optional[Iterable[Obstacle]],
+    robot_radius: Optional[float],
+    navigator: str,
+    params: Optional[Mapping[str, Any]],
+    sensors: Optional[Mapping[str, Any]],
+    seed: int,
+    controller: str,
+    gains: Optional[Mapping[str, Any]],
+    astar: Optional[Mapping[str, Any]],
+    dt: Optional[float],
+    max_time: Optional[float],
+    chassis_params: Optional[Mapping[str, float]],
+) -> mobile_pb2.NavigateRequest:
+    """The NavigateRequest of :meth:`Mobile.navigate`'s arguments (the reply
+    reads as :meth:`MobileRun.from_proto`)."""
+    try:
+        nav = NAVIGATORS[navigator]
+    except KeyError:
+        raise ValueError(f"unknown navigator {navigator!r}; one of {sorted(NAVIGATORS)}") from None
+    return mobile_pb2.NavigateRequest(
+        chassis=chassis_to_proto(chassis, chassis_params),
+        start=_pose(start),
+        goal=_xy(goal),
+        world=world_to_proto(world),
+        sim=_sim(robot_radius, dt, max_time),
+        navigator=nav,
+        sensors=_fill(mobile_pb2.RangeSensorParams(), sensors),
+        vdf=_fill(mobile_pb2.VectorDistanceParams(), params),
+        seed=seed,
+        astar=_fill(mobile_pb2.GridAstarOptions(), astar),
+        follow=follow_options(controller, gains),
+        controller=_controller(controller),
+    )
+
+
 class Mobile:
     """The MobileService calls; reach it as ``client.mobile``."""
 
@@ -304,16 +461,8 @@ class Mobile:
     ) -> WheelKinematics:
         """Inverse kinematics of ``twist`` = (vx, vy, ω), or forward kinematics
         of ``wheels`` (a dict as in :class:`WheelKinematics`)."""
-        if (twist is None) == (wheels is None):
-            raise ValueError("give exactly one of twist or wheels=")
-        c = chassis_to_proto(chassis, chassis_params)
-        req = mobile_pb2.WheelKinematicsRequest(chassis=c)
-        if twist is not None:
-            req.twist.CopyFrom(mobile_pb2.Twist2D(vx=float(twist[0]), vy=float(twist[1]), omega=float(twist[2])))
-        else:
-            req.wheels.CopyFrom(_wheels_in(c.WhichOneof("kind"), wheels or {}))
-        r = self._client._call(self._stub.WheelKinematics, req, timeout)
-        return WheelKinematics(_twist(r.twist), _wheels_out(r.wheels), _saturation(r.saturation), raw=r)
+        req = _wheels_request(chassis, twist, wheels, chassis_params)
+        return _wheels_reply(self._client._call(self._stub.WheelKinematics, req, timeout))
 
     def step(
         self,
@@ -340,55 +489,9 @@ class Mobile:
         ``sensors`` and either ``readings`` (gaps from the rim, m) or a
         ``world`` to sense. Pass the previous result (or its ``token``) as
         ``token=`` to continue; empty starts a fresh controller."""
-        if isinstance(token, StepResult):
-            token = token.token
-        req = mobile_pb2.ControlStepRequest(
-            chassis=chassis_to_proto(chassis, chassis_params),
-            state=_pose(state),
-            controller=_controller(controller),
-            path=path_to_proto(path or []),
-            follow=follow_options(controller, gains) if controller != "vector_distance" else None,
-            vdf=_fill(mobile_pb2.VectorDistanceParams(), params),
-            sensors=_fill(mobile_pb2.RangeSensorParams(), sensors),
-            readings=[float(r) for r in (readings if readings is not None else [])],
-            world=world_to_proto(world),
-            seed=seed,
-            state_token=token or b"",
-        )
-        if goal is not None:
-            req.goal.CopyFrom(_xy(goal))
-        if robot_radius is not None:
-            req.robot_radius = float(robot_radius)
-        if dt is not None:
-            req.dt = float(dt)
-        r = self._client._call(self._stub.ControlStep, req, timeout)
-        vd = req.controller == mobile_pb2.CONTROLLER_VECTOR_DISTANCE
-        return StepResult(
-            command=_twist(r.command),
-            applied=_twist(r.applied),
-            saturation=_saturation(r.saturation),
-            reached=r.reached,
-            token=r.state_token,
-            target_node=r.target_node,
-            mode=_MODE_LETTERS.get(r.mode) if vd else None,
-            readings=np.array(r.readings, dtype=float),
-            force=np.array([r.force.x, r.force.y]) if vd else None,
-            hit_point=np.array([r.hit_point.x, r.hit_point.y]) if r.HasField("hit_point") else None,
-            leave_point=np.array([r.leave_point.x, r.leave_point.y]) if r.HasField("leave_point") else None,
-            no_path=r.no_path,
-            raw=r,
-        )
-
-    @staticmethod
-    def _sim(robot_radius: Optional[float], dt: Optional[float], max_time: Optional[float]) -> mobile_pb2.SimOptions:
-        sim = mobile_pb2.SimOptions()
-        if robot_radius is not None:
-            sim.robot_radius = float(robot_radius)
-        if dt is not None:
-            sim.dt = float(dt)
-        if max_time is not None:
-            sim.max_time = float(max_time)
-        return sim
+        req = _step_request(state, chassis, controller, path, goal, gains, params, sensors, readings, world,
+                            robot_radius, seed, dt, token, chassis_params)
+        return _step_reply(req, self._client._call(self._stub.ControlStep, req, timeout))
 
     def follow(
         self,
@@ -408,15 +511,8 @@ class Mobile:
         """Simulates ``controller`` along ``path`` ([(x, y[, θ]), ...]; a
         heading is honoured on the last node) from ``start`` = (x, y, θ),
         optionally among obstacles (collisions end the run)."""
-        req = mobile_pb2.FollowPathRequest(
-            chassis=chassis_to_proto(chassis, chassis_params),
-            start=_pose(start),
-            path=path_to_proto(path),
-            controller=_controller(controller),
-            follow=follow_options(controller, gains),
-            world=world_to_proto(world),
-            sim=self._sim(robot_radius, dt, max_time),
-        )
+        req = _follow_request(chassis, start, path, controller, gains, world, robot_radius, dt, max_time,
+                              chassis_params)
         return MobileRun.from_proto(self._client._call(self._stub.FollowPath, req, timeout))
 
     def navigate(
@@ -443,24 +539,8 @@ class Mobile:
         ``world``: the vector-distance navigator (``params``, ``sensors``,
         noise ``seed``) or ``navigator="grid_astar"`` (``astar`` options, then
         ``controller`` with ``gains`` follows the grid path)."""
-        try:
-            nav = NAVIGATORS[navigator]
-        except KeyError:
-            raise ValueError(f"unknown navigator {navigator!r}; one of {sorted(NAVIGATORS)}") from None
-        req = mobile_pb2.NavigateRequest(
-            chassis=chassis_to_proto(chassis, chassis_params),
-            start=_pose(start),
-            goal=_xy(goal),
-            world=world_to_proto(world),
-            sim=self._sim(robot_radius, dt, max_time),
-            navigator=nav,
-            sensors=_fill(mobile_pb2.RangeSensorParams(), sensors),
-            vdf=_fill(mobile_pb2.VectorDistanceParams(), params),
-            seed=seed,
-            astar=_fill(mobile_pb2.GridAstarOptions(), astar),
-            follow=follow_options(controller, gains),
-            controller=_controller(controller),
-        )
+        req = _navigate_request(chassis, start, goal, world, robot_radius, navigator, params, sensors, seed,
+                                controller, gains, astar, dt, max_time, chassis_params)
         return MobileRun.from_proto(self._client._call(self._stub.Navigate, req, timeout))
 
 

@@ -9,7 +9,7 @@ robot's base frame; units are metres and radians (proto/kinplan/v1/planning.prot
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -301,6 +301,84 @@ def _vec(v: Any, present: bool) -> List[float]:
     return [v.x, v.y, v.z] if present else [np.nan] * 3
 
 
+def _plan_request(
+    start: Any,
+    goal: Any,
+    pose: Any,
+    algorithm: str,
+    scene: Optional[Sequence[Obstacle]],
+    seed: int,
+    time_budget: Optional[float],
+    motion_resolution: Optional[float],
+    padded_motion: bool,
+    return_cost_history: bool,
+    stomp: Optional[Mapping[str, Any]],
+    cartesian: Optional[Mapping[str, Any]],
+    rrt_connect: Optional[Mapping[str, Any]],
+    timing: Optional[Mapping[str, Any]],
+) -> Callable[[common_pb2.RobotRef], planning_pb2.PlanRequest]:
+    """The PlanRequest of :meth:`PlanningMixin.plan`'s arguments for a robot
+    reference (shared by the blocking and asyncio clients)."""
+    if (goal is None) == (pose is None):
+        raise ValueError("give exactly one of goal= (joints) or pose= (4x4 tool pose)")
+    if algorithm not in ALGORITHMS:
+        raise ValueError(f"algorithm must be one of {sorted(ALGORITHMS)}, got {algorithm!r}")
+    options = planning_pb2.PlanOptions(
+        stomp=planning_pb2.StompOptions(**dict(stomp or {})),
+        cartesian=planning_pb2.CartesianOptions(**dict(cartesian or {})),
+        rrt_connect=planning_pb2.RrtConnectOptions(**dict(rrt_connect or {})),
+        timing=planning_pb2.TimingOptions(**dict(timing or {})),
+        return_cost_history=return_cost_history,
+    )
+    if time_budget is not None:
+        options.time_budget = float(time_budget)
+    if motion_resolution is not None:
+        options.motion_resolution = float(motion_resolution)
+    options.padded_motion = bool(padded_motion)
+    proto_scene = scene_to_proto(scene)
+
+    def build(ref: common_pb2.RobotRef) -> planning_pb2.PlanRequest:
+        req = planning_pb2.PlanRequest(
+            robot=ref,
+            start=joints(start, "start"),
+            scene=proto_scene,
+            algorithm=ALGORITHMS[algorithm],
+            options=options,
+            seed=int(seed),
+        )
+        if goal is not None:
+            req.goal_joints.positions.extend(joints(goal, "goal"))
+        else:
+            req.goal_pose.CopyFrom(_pose(pose))
+        return req
+
+    return build
+
+
+def _plan_stream_request(start: Any, goal: Any, pose: Any, algorithm: str, scene: Optional[Sequence[Obstacle]],
+                         seed: int, options: Dict[str, Any]) -> Callable[[common_pb2.RobotRef], planning_pb2.PlanRequest]:
+    """The PlanRequest of :meth:`PlanningMixin.plan_stream`'s arguments
+    (`options` those of :meth:`PlanningMixin.plan`; TypeError on others)."""
+    options = dict(options)
+    build = _plan_request(
+        start, goal, pose, algorithm, scene, seed, options.pop("time_budget", None),
+        options.pop("motion_resolution", None), options.pop("padded_motion", False),
+        options.pop("return_cost_history", True),
+        options.pop("stomp", None), options.pop("cartesian", None), options.pop("rrt_connect", None),
+        options.pop("timing", None),
+    )
+    if options:
+        raise TypeError(f"unknown options: {sorted(options)}")
+    return build
+
+
+def _plan_stream_message(m: planning_pb2.PlanStreamResponse) -> Union[np.ndarray, Plan]:
+    """The trajectory (waypoints x dof) or final :class:`Plan` a PlanStream message carries."""
+    if m.HasField("result"):
+        return Plan.from_proto(m.result)
+    return np.array([list(p.positions) for p in m.trajectory.points], dtype=float)
+
+
 class PlanningMixin:
     """``Client.plan``, ``Client.plan_stream`` and ``Client.check_states``."""
 
@@ -310,59 +388,6 @@ class PlanningMixin:
             stub = planning_pb2_grpc.PlanningServiceStub(self._channel)  # type: ignore[attr-defined]
             self._planning_stub = stub
         return stub
-
-    def _plan_request(
-        self,
-        robot: Any,
-        start: Any,
-        goal: Any,
-        pose: Any,
-        algorithm: str,
-        scene: Optional[Sequence[Obstacle]],
-        seed: int,
-        time_budget: Optional[float],
-        motion_resolution: Optional[float],
-        padded_motion: bool,
-        return_cost_history: bool,
-        stomp: Optional[Mapping[str, Any]],
-        cartesian: Optional[Mapping[str, Any]],
-        rrt_connect: Optional[Mapping[str, Any]],
-        timing: Optional[Mapping[str, Any]],
-    ) -> Any:
-        if (goal is None) == (pose is None):
-            raise ValueError("give exactly one of goal= (joints) or pose= (4x4 tool pose)")
-        if algorithm not in ALGORITHMS:
-            raise ValueError(f"algorithm must be one of {sorted(ALGORITHMS)}, got {algorithm!r}")
-        options = planning_pb2.PlanOptions(
-            stomp=planning_pb2.StompOptions(**dict(stomp or {})),
-            cartesian=planning_pb2.CartesianOptions(**dict(cartesian or {})),
-            rrt_connect=planning_pb2.RrtConnectOptions(**dict(rrt_connect or {})),
-            timing=planning_pb2.TimingOptions(**dict(timing or {})),
-            return_cost_history=return_cost_history,
-        )
-        if time_budget is not None:
-            options.time_budget = float(time_budget)
-        if motion_resolution is not None:
-            options.motion_resolution = float(motion_resolution)
-        options.padded_motion = bool(padded_motion)
-        proto_scene = scene_to_proto(scene)
-
-        def build(ref: common_pb2.RobotRef) -> planning_pb2.PlanRequest:
-            req = planning_pb2.PlanRequest(
-                robot=ref,
-                start=joints(start, "start"),
-                scene=proto_scene,
-                algorithm=ALGORITHMS[algorithm],
-                options=options,
-                seed=int(seed),
-            )
-            if goal is not None:
-                req.goal_joints.positions.extend(joints(goal, "goal"))
-            else:
-                req.goal_pose.CopyFrom(_pose(pose))
-            return req
-
-        return build
 
     def plan(
         self,
@@ -394,8 +419,8 @@ class PlanningMixin:
         collides; slower); by default states ``motion_resolution`` apart are
         checked (an obstacle thinner than one step can be grazed). The same ``seed`` gives the
         same answer."""
-        build = self._plan_request(
-            robot, start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution, padded_motion,
+        build = _plan_request(
+            start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution, padded_motion,
             return_cost_history, stomp, cartesian, rrt_connect, timing,
         )
         reply = robot._call(self._planning().Plan, build, timeout)
@@ -407,25 +432,14 @@ class PlanningMixin:
         """Yields the trajectory (waypoints x dof) after every STOMP / CCSTOMP
         iteration, then the final :class:`Plan` (for animations). ``options``
         are those of :meth:`plan`."""
-        build = self._plan_request(
-            robot, start, goal, pose, algorithm, scene, seed, options.pop("time_budget", None),
-            options.pop("motion_resolution", None), options.pop("padded_motion", False),
-            options.pop("return_cost_history", True),
-            options.pop("stomp", None), options.pop("cartesian", None), options.pop("rrt_connect", None),
-            options.pop("timing", None),
-        )
-        if options:
-            raise TypeError(f"unknown options: {sorted(options)}")
+        build = _plan_stream_request(start, goal, pose, algorithm, scene, seed, options)
         from .errors import KinplanError
         import grpc
 
         t = self.timeout if timeout is None else timeout  # type: ignore[attr-defined]
         try:
             for m in self._planning().PlanStream(build(robot._ref()), timeout=t):
-                if m.HasField("result"):
-                    yield Plan.from_proto(m.result)
-                else:
-                    yield np.array([list(p.positions) for p in m.trajectory.points], dtype=float)
+                yield _plan_stream_message(m)
         except grpc.RpcError as err:
             raise KinplanError.from_rpc_error(err) from None
 

@@ -10,7 +10,7 @@ installed. Units: metres, radians, seconds (see proto/kinplan/v1/scoring.proto).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -338,6 +338,29 @@ def score_options(
     return o
 
 
+def _compare_request(
+    sets: Mapping[str, Sequence[Trajectory]],
+    weights: Optional[Iterable[float]],
+    robot_points: Optional[str],
+    max_velocity: Optional[Iterable[float]],
+    max_acceleration: Optional[Iterable[float]],
+    jerk_peaks: Optional[Mapping[str, Any]],
+    potential_tolerance: Optional[float],
+) -> Callable[[common_pb2.RobotRef], scoring_pb2.CompareTrajectoriesRequest]:
+    """The CompareTrajectoriesRequest of :meth:`ScoringMixin.compare`'s
+    arguments for a robot reference (shared by the blocking and asyncio clients)."""
+    request_sets = [
+        scoring_pb2.TrajectorySet(label=label, trajectories=[trajectory_to_proto(q) for q in trajectories])
+        for label, trajectories in sets.items()
+    ]
+    options = score_options(weights, False, robot_points, max_velocity, max_acceleration, jerk_peaks, potential_tolerance)
+
+    def build(ref: common_pb2.RobotRef) -> scoring_pb2.CompareTrajectoriesRequest:
+        return scoring_pb2.CompareTrajectoriesRequest(robot=ref, sets=request_sets, options=options)
+
+    return build
+
+
 class ScoringMixin:
     """Adds :meth:`score` and :meth:`compare` to :class:`kinplan.Client`."""
 
@@ -409,17 +432,9 @@ class ScoringMixin:
         "ccstomp": [q3]}``, and returns per set and criterion the mean,
         variance and sum (S0 Tab. 5.3-5.5) as a :class:`Comparison`."""
         r = self._robot_of(robot)
-        request_sets = [
-            scoring_pb2.TrajectorySet(label=label, trajectories=[trajectory_to_proto(q) for q in trajectories])
-            for label, trajectories in sets.items()
-        ]
-        options = score_options(weights, False, robot_points, max_velocity, max_acceleration, jerk_peaks, potential_tolerance)
-        reply = r._call(
-            self._scoring.CompareTrajectories,
-            lambda ref: scoring_pb2.CompareTrajectoriesRequest(robot=ref, sets=request_sets, options=options),
-            timeout,
-        )
-        return Comparison(reply)
+        build = _compare_request(sets, weights, robot_points, max_velocity, max_acceleration, jerk_peaks,
+                                 potential_tolerance)
+        return Comparison(r._call(self._scoring.CompareTrajectories, build, timeout))
 
 
 __all__ = [
