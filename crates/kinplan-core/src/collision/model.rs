@@ -199,6 +199,27 @@ impl RobotModel {
     /// `T_link = Π_{joints before it} (O_i · M_i(q_i)) · offset_link`; a body's
     /// pose is `T_link · offset_body`.
     pub(crate) fn body_poses(&self, q: &[f64], out: &mut [Isometry3<f64>; MAX_BODIES]) {
+        self.pose_bodies(q, out, None);
+    }
+
+    /// [`RobotModel::body_poses`], plus every joint's axis (a point on it
+    /// and its unit direction, base frame) into `axes[..dof]`: the axis of
+    /// joint `i` is `axis_i` in the frame `Π_{k<i} (O_k · M_k(q_k)) · O_i`.
+    pub(crate) fn body_poses_and_axes(
+        &self,
+        q: &[f64],
+        out: &mut [Isometry3<f64>; MAX_BODIES],
+        axes: &mut [JointAxis],
+    ) {
+        self.pose_bodies(q, out, Some(axes));
+    }
+
+    fn pose_bodies(
+        &self,
+        q: &[f64],
+        out: &mut [Isometry3<f64>; MAX_BODIES],
+        mut axes: Option<&mut [JointAxis]>,
+    ) {
         let joints = self.chain.joints();
         let links = self.chain.links();
         let mut t = Isometry3::identity();
@@ -207,13 +228,20 @@ impl RobotModel {
         // chain poses them all without storing every link frame.
         let mut next = 0;
         for (li, link) in links.iter().enumerate() {
-            if next == self.by_link.len() {
+            if next == self.by_link.len() && axes.is_none() {
                 break;
             }
             if let Some(j) = link.after_joint {
                 while applied <= j && applied < joints.len() {
                     let joint = &joints[applied];
-                    t = t * joint.origin * joint.motion(q.get(applied).copied().unwrap_or(0.0));
+                    let frame = t * joint.origin;
+                    if let Some(slot) = axes.as_deref_mut().and_then(|a| a.get_mut(applied)) {
+                        *slot = JointAxis {
+                            point: frame.translation.vector,
+                            direction: frame.rotation * joint.axis.into_inner(),
+                        };
+                    }
+                    t = frame * joint.motion(q.get(applied).copied().unwrap_or(0.0));
                     applied += 1;
                 }
             }
@@ -222,6 +250,22 @@ impl RobotModel {
                 out[b] = t * link.offset * self.bodies[b].offset;
                 next += 1;
             }
+        }
+    }
+}
+
+/// A joint's axis in the base frame: a point on it and its unit direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct JointAxis {
+    pub point: Vector3<f64>,
+    pub direction: Vector3<f64>,
+}
+
+impl Default for JointAxis {
+    fn default() -> Self {
+        JointAxis {
+            point: Vector3::zeros(),
+            direction: Vector3::z(),
         }
     }
 }

@@ -15,7 +15,7 @@ use nalgebra::{Isometry3, Point3};
 
 use super::acm::AllowedCollisions;
 use super::bvh::Aabb;
-use super::model::{MAX_BODIES, RobotModel};
+use super::model::{JointAxis, MAX_BODIES, MAX_LINKS, RobotModel};
 use super::narrow::{
     Witness, body_body_contact, body_body_intersect, body_body_within, body_leaf_contact,
     body_leaf_intersect, body_leaf_within, sphere_center,
@@ -238,6 +238,11 @@ impl SceneChecker {
     pub fn in_collision_padded(&self, q: &[f64], pads: &[f64; MAX_BODIES]) -> bool {
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
+        self.hits_padded(&poses, pads)
+    }
+
+    /// [`SceneChecker::in_collision_padded`] on bodies already posed.
+    fn hits_padded(&self, poses: &[Isometry3<f64>; MAX_BODIES], pads: &[f64; MAX_BODIES]) -> bool {
         let bodies = &self.model.bodies;
         // A zero pad still counts touching: growing by a hair keeps `≤ 0` a hit.
         let margin = |pad: f64| pad.max(f64::MIN_POSITIVE);
@@ -422,9 +427,13 @@ impl StateChecker for SceneChecker {
         if !self.within_limits(q) || half_step.len() != q.len() {
             return Some(false);
         }
+        let mut poses = [Isometry3::identity(); MAX_BODIES];
+        let mut axes = [JointAxis::default(); MAX_LINKS];
+        let axes = axes.get_mut(..q.len())?;
+        self.model.body_poses_and_axes(q, &mut poses, axes);
         let mut pads = [0.0; MAX_BODIES];
-        sweep.pads(half_step, &mut pads);
-        Some(!self.in_collision_padded(q, &pads))
+        sweep.pads_at(&self.model, &poses, axes, half_step, &mut pads);
+        Some(!self.hits_padded(&poses, &pads))
     }
 
     fn motion_check(&self) -> MotionCheck {

@@ -18,10 +18,23 @@
 //! travel `max(|lower|, |upper|)` (0 for a revolute one), `c_b` the bounding
 //! sphere's centre in the frame of the last joint moving `b` and `r_b` its
 //! radius. Rotations keep lengths, so the bound holds for every `q`.
+//!
+//! Around a known state `m` the bound tightens ([`SweepBound::pads_at`]):
+//! for `|q_j − m_j| ≤ h_j`, a point's distance from revolute joint `j`'s axis
+//! changes only through the joints after `j` (the joints before move point
+//! and axis together; `j` turns about its own axis), so it stays below
+//! `ρ_{j,b}(m) + Σ_{i>j} h_i L_{i,b}`, with `ρ_{j,b}(m)` the distance of the
+//! body's bounding sphere from the axis at `m` plus its radius. Hence
+//!
+//! ```text
+//! δ_b ≤ Σ_{j moves b} h_j · min(L_{j,b}, ρ_{j,b}(m) + Σ_{i>j} h_i L_{i,b})
+//! ```
+//!
+//! (a prismatic `j` contributes `h_j`).
 
-use nalgebra::Point3;
+use nalgebra::{Isometry3, Point3};
 
-use super::model::{MAX_BODIES, RobotModel};
+use super::model::{JointAxis, MAX_BODIES, RobotModel};
 use crate::robot::JointKind;
 
 /// The lever arms `L_{j,b}` of a robot model (see the module doc).
@@ -30,6 +43,8 @@ pub struct SweepBound {
     dof: usize,
     /// `levers[b * dof + j] = L_{j,b}`, 0 where joint `j` does not move body `b`.
     levers: Vec<f64>,
+    /// Joints that translate instead of turning.
+    prismatic: Vec<bool>,
 }
 
 impl SweepBound {
@@ -62,10 +77,12 @@ impl SweepBound {
                 reach += travel + joint.origin.translation.vector.norm();
             }
         }
-        levers
-            .iter()
-            .all(|v| v.is_finite())
-            .then_some(SweepBound { dof, levers })
+        let prismatic = joints.iter().map(|j| j.kind == JointKind::Prismatic).collect();
+        levers.iter().all(|v| v.is_finite()).then_some(SweepBound {
+            dof,
+            levers,
+            prismatic,
+        })
     }
 
     /// `δ_b(Δq)` for every body into `pads[..bodies]`, with `Δq = step`
@@ -77,6 +94,52 @@ impl SweepBound {
         }
         for (pad, levers) in pads.iter_mut().zip(self.levers.chunks_exact(self.dof)) {
             *pad = levers.iter().zip(step).map(|(l, d)| l * d.abs()).sum();
+        }
+    }
+
+    /// The tightened bound around state `m` (see the module doc) for every
+    /// body into `pads[..bodies]`: `poses` and `axes` are the bodies' poses
+    /// and the joints' axes at `m` ([`RobotModel::body_poses_and_axes`]),
+    /// `half` the largest joint offsets `h_j ≥ 0` from `m`.
+    pub(crate) fn pads_at(
+        &self,
+        model: &RobotModel,
+        poses: &[Isometry3<f64>; MAX_BODIES],
+        axes: &[JointAxis],
+        half: &[f64],
+        pads: &mut [f64; MAX_BODIES],
+    ) {
+        if self.dof == 0 {
+            pads.fill(0.0);
+            return;
+        }
+        for (b, (pad, levers)) in pads
+            .iter_mut()
+            .zip(self.levers.chunks_exact(self.dof))
+            .enumerate()
+        {
+            let body = &model.bodies[b];
+            let centre = poses[b] * Point3::from(body.center);
+            // Σ_{i>j} h_i L_{i,b}, built from the last joint back
+            let mut tail = 0.0;
+            let mut sum = 0.0;
+            for j in (0..self.dof).rev() {
+                let lever = levers[j];
+                if lever == 0.0 {
+                    continue;
+                }
+                let h = half[j].abs();
+                sum += h * if self.prismatic[j] {
+                    1.0
+                } else {
+                    let axis = &axes[j];
+                    let r = centre.coords - axis.point;
+                    let from_axis = (r - axis.direction * r.dot(&axis.direction)).norm() + body.radius;
+                    lever.min(from_axis + tail)
+                };
+                tail += h * lever;
+            }
+            *pad = sum;
         }
     }
 

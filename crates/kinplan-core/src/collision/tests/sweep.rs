@@ -8,6 +8,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use super::super::model::JointAxis;
 use super::super::*;
 use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
@@ -368,4 +369,104 @@ fn a_grown_shape_hits_whatever_is_within_the_margin_and_little_beyond() {
             }
         }
     }
+}
+
+#[test]
+fn the_bound_around_a_state_holds_for_the_true_motion_and_is_tighter() {
+    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let sweep = SweepBound::new(&model).unwrap();
+    let joints = model.chain().joints().to_vec();
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let (mut at_m, mut at_s) = (
+        [Isometry3::identity(); MAX_BODIES],
+        [Isometry3::identity(); MAX_BODIES],
+    );
+    let mut axes = [JointAxis::default(); 7];
+    let (mut ratio_sum, mut ratio_count) = (0.0, 0);
+    for _ in 0..300 {
+        let m: Vec<f64> = joints
+            .iter()
+            .map(|j| rng.random_range(j.lower..j.upper))
+            .collect();
+        let half: Vec<f64> = (0..7).map(|_| rng.random_range(0.0..0.05)).collect();
+        model.body_poses_and_axes(&m, &mut at_m, &mut axes);
+        let (mut near, mut far) = ([0.0; MAX_BODIES], [0.0; MAX_BODIES]);
+        sweep.pads_at(&model, &at_m, &axes, &half, &mut near);
+        sweep.pads(&half, &mut far);
+        for k in 0..40 {
+            // a state within `half` of m on every joint
+            let s: Vec<f64> = m
+                .iter()
+                .zip(&half)
+                .map(|(x, h)| x + h * if k == 0 { 1.0 } else { rng.random_range(-1.0..1.0) })
+                .collect();
+            model.body_poses(&s, &mut at_s);
+            for (b, body) in model.bodies.iter().enumerate() {
+                let mut points = vec![Point3::from(body.center)];
+                for axis in 0..3 {
+                    for sign in [-1.0, 1.0] {
+                        let mut p = body.center;
+                        p[axis] += sign * body.radius;
+                        points.push(Point3::from(p));
+                    }
+                }
+                for p in points {
+                    let moved = (at_s[b] * p - at_m[b] * p).norm();
+                    assert!(
+                        moved <= near[b] + 1e-12,
+                        "body {b}: moved {moved} > pad {}",
+                        near[b]
+                    );
+                }
+            }
+        }
+        for b in 0..model.body_count() {
+            assert!(near[b] <= far[b] + 1e-15, "body {b}: {} > {}", near[b], far[b]);
+            if far[b] > 0.0 {
+                ratio_sum += near[b] / far[b];
+                ratio_count += 1;
+            }
+        }
+    }
+    let mean = ratio_sum / f64::from(ratio_count);
+    assert!(
+        mean < 0.9,
+        "the bound around a state is no tighter: mean ratio {mean}"
+    );
+    eprintln!("pads around a state / global pads: mean {mean:.3}");
+}
+
+#[test]
+fn the_bound_around_a_bent_elbow_covers_every_state_of_the_piece() {
+    // The two-link arm with point-like spheres, elbow bent: within the piece
+    // the elbow opens, so the tip's distance from joint 1's axis grows and
+    // joint 1 moves it farther than the distance at the midpoint says.
+    let urdf = TWO_LINK
+        .replace(r#"radius="0.1""#, r#"radius="0.000001""#)
+        .replace(r#"radius="0.05""#, r#"radius="0.000001""#);
+    let model = model_of(&urdf);
+    let sweep = SweepBound::new(&model).unwrap();
+    let (mut at_m, mut at_s) = (
+        [Isometry3::identity(); MAX_BODIES],
+        [Isometry3::identity(); MAX_BODIES],
+    );
+    let mut axes = [JointAxis::default(); 2];
+    let m = [0.0, 2.0];
+    let half = [0.4, 0.6];
+    model.body_poses_and_axes(&m, &mut at_m, &mut axes);
+    let mut pads = [0.0; MAX_BODIES];
+    sweep.pads_at(&model, &at_m, &axes, &half, &mut pads);
+    let tip = Point3::from(model.bodies[1].center);
+    let mut worst: f64 = 0.0;
+    for i in 0..=40 {
+        for k in 0..=40 {
+            let s = [
+                m[0] - half[0] + 2.0 * half[0] * f64::from(i) / 40.0,
+                m[1] - half[1] + 2.0 * half[1] * f64::from(k) / 40.0,
+            ];
+            model.body_poses(&s, &mut at_s);
+            worst = worst.max((at_s[1] * tip - at_m[1] * tip).norm());
+        }
+    }
+    assert!(worst <= pads[1], "the tip moved {worst} > pad {}", pads[1]);
 }
