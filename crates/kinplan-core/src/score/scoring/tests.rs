@@ -1,7 +1,7 @@
 //! Hand-computed cases, bad inputs and invariances of `score`.
 
 use super::*;
-use crate::score::{Criterion, JointLimits, Rows, TrajectoryData};
+use crate::score::{Criterion, JointLimits, Rows, ScoreField, ScoreParam, TrajectoryData};
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use proptest::prelude::*;
 
@@ -138,9 +138,10 @@ fn jerk_spike_by_hand() {
     // one peak: the flat top 5–6, reported at its middle rounded down
     assert_eq!(
         se.joint_peaks,
-        vec![Peak {
+        vec![CountedPeak {
             index: 5,
-            height: 2.25
+            height: 2.25,
+            slowdown: 3.0 * 2.25f64.log10() + 4.0
         }]
     );
     assert_eq!(s.joint_peak_count, 1);
@@ -148,14 +149,15 @@ fn jerk_spike_by_hand() {
     // Cartesian: d = 0.5 m in y → CJ = 4, CMJ = 1.5
     assert_eq!(s.cj, 4.0);
     assert_eq!(s.cmj, 1.5);
+    let p = JerkPeakParams::default();
     assert_eq!(
         se.cartesian_peaks,
-        vec![Peak {
+        vec![CountedPeak {
             index: 5,
-            height: 1.5
+            height: 1.5,
+            slowdown: p.cartesian_sqrt_gain * 1.5f64.sqrt() + p.cartesian_offset
         }]
     );
-    let p = JerkPeakParams::default();
     assert!((s.cjp - (p.cartesian_sqrt_gain * 1.5f64.sqrt() + p.cartesian_offset)).abs() < 1e-9);
     // configurable coefficients
     let params = ScoreParams {
@@ -196,12 +198,10 @@ fn spike_near_the_start_is_an_edge_peak() {
         ..Default::default()
     };
     let r = score(&ScoreInput::new(t), &params).unwrap();
+    let peaks = r.series.unwrap().joint_peaks;
     assert_eq!(
-        r.series.unwrap().joint_peaks,
-        vec![Peak {
-            index: 3,
-            height: 2.25
-        }]
+        peaks.iter().map(|p| (p.index, p.height)).collect::<Vec<_>>(),
+        vec![(3, 2.25)]
     );
 }
 
@@ -319,7 +319,12 @@ fn series_sum_to_the_totals() {
     let jjp: f64 = se
         .joint_peaks
         .iter()
-        .map(|p| joint_slowdown(p.height, &JerkPeakParams::default()))
+        .map(|p| {
+            let defaults = JerkPeakParams::default();
+            let own = defaults.joint_log_gain * p.height.log10() + defaults.joint_offset;
+            assert_eq!(p.slowdown, own.max(defaults.slowdown_floor));
+            p.slowdown
+        })
         .sum();
     assert!((jjp - s.jjp).abs() < 1e-9);
     assert_eq!(se.joint_peaks.len(), s.joint_peak_count);
@@ -382,7 +387,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert_eq!(
         err(&ScoreInput::new(tr(&ragged))),
         ScoreError::RaggedRow {
-            field: "joints",
+            field: ScoreField::Joints,
             index: 1,
             expected: 2,
             found: 1
@@ -392,7 +397,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert!(matches!(
         err(&ScoreInput::new(tr(&nan))),
         ScoreError::NonFinite {
-            field: "joints",
+            field: ScoreField::Joints,
             index: 2,
             component: 1,
             ..
@@ -433,7 +438,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert_eq!(
         err(&ScoreInput::new(t)),
         ScoreError::FlatShape {
-            field: "joints",
+            field: ScoreField::Joints,
             len: 5,
             width: 2
         }
@@ -483,7 +488,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert!(matches!(
         err(&ScoreInput::new(t)),
         ScoreError::NonFinite {
-            field: "timestamps",
+            field: ScoreField::Timestamps,
             index: 1,
             ..
         }
@@ -496,7 +501,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert_eq!(
         err(&ScoreInput::new(t)),
         ScoreError::LengthMismatch {
-            field: "timestamps",
+            field: ScoreField::Timestamps,
             expected: 3,
             found: 2
         }
@@ -507,7 +512,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert_eq!(
         err(&ScoreInput::new(t)),
         ScoreError::LengthMismatch {
-            field: "poses",
+            field: ScoreField::Poses,
             expected: 3,
             found: 2
         }
@@ -518,7 +523,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert!(matches!(
         err(&ScoreInput::new(t)),
         ScoreError::NonFinite {
-            field: "poses",
+            field: ScoreField::Poses,
             index: 1,
             component: 2,
             ..
@@ -537,7 +542,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert!(matches!(
         err(&ScoreInput::new(t)),
         ScoreError::NonFinite {
-            field: "poses",
+            field: ScoreField::Poses,
             index: 0,
             component: 3,
             ..
@@ -554,7 +559,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert_eq!(
         err(&ScoreInput::new(t)),
         ScoreError::RaggedRow {
-            field: "robot_points",
+            field: ScoreField::RobotPoints,
             index: 1,
             expected: 2,
             found: 1
@@ -568,7 +573,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert!(matches!(
         err(&ScoreInput::new(t)),
         ScoreError::LengthMismatch {
-            field: "robot_points",
+            field: ScoreField::RobotPoints,
             ..
         }
     ));
@@ -580,7 +585,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert!(matches!(
         err(&ScoreInput::new(t)),
         ScoreError::NonFinite {
-            field: "robot_points",
+            field: ScoreField::RobotPoints,
             index: 1,
             component: 1,
             ..
@@ -595,7 +600,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert_eq!(
         err(&input),
         ScoreError::LengthMismatch {
-            field: "joint_weights",
+            field: ScoreField::JointWeights,
             expected: 2,
             found: 1
         }
@@ -607,7 +612,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert!(matches!(
         err(&input),
         ScoreError::InvalidValue {
-            field: "joint_weights",
+            field: ScoreField::JointWeights,
             index: 1,
             ..
         }
@@ -622,7 +627,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert!(matches!(
         err(&input),
         ScoreError::InvalidValue {
-            field: "v_max",
+            field: ScoreField::VMax,
             index: 1,
             ..
         }
@@ -636,7 +641,10 @@ fn bad_inputs_are_rejected_with_their_variant() {
     };
     assert!(matches!(
         err(&input),
-        ScoreError::LengthMismatch { field: "a_max", .. }
+        ScoreError::LengthMismatch {
+            field: ScoreField::AMax,
+            ..
+        }
     ));
 
     // parameters
@@ -650,7 +658,7 @@ fn bad_inputs_are_rejected_with_their_variant() {
     assert!(matches!(
         score(&ScoreInput::new(tr(&good)), &params),
         Err(ScoreError::InvalidParam {
-            name: "joint_offset",
+            name: ScoreParam::JointOffset,
             ..
         })
     ));
@@ -668,7 +676,7 @@ fn errors_print_the_field_and_index() {
         "timestamps[4] = 1 s does not exceed timestamps[3] = 1.5 s"
     );
     let e = ScoreError::RaggedRow {
-        field: "joints",
+        field: ScoreField::Joints,
         index: 7,
         expected: 6,
         found: 5,

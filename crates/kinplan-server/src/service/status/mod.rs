@@ -8,6 +8,8 @@ use tonic_types::{ErrorDetails, StatusExt};
 
 use kinplan_core::robot::RobotError;
 
+pub mod score;
+
 /// INVALID_ARGUMENT naming `field`, with a BadRequest field violation.
 pub fn invalid(field: impl Into<String>, description: impl Into<String>) -> Status {
     field_status(Code::InvalidArgument, field, description)
