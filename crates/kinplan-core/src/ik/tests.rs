@@ -471,7 +471,7 @@ fn bad_inputs_are_errors() {
         ),
     ] {
         match solve_ik(&chain, &good, None, &bad, 0, &never) {
-            Err(IkError::InvalidParam { field: f, .. }) => assert_eq!(f, field),
+            Err(IkError::InvalidParam { field: f, .. }) => assert_eq!(f.name(), field),
             other => panic!("{field}: expected InvalidParam, got {other:?}"),
         }
     }
@@ -621,9 +621,30 @@ fn bad_paths_are_errors() {
         Err(IkError::EmptyPath)
     ));
     let s = Isometry3::identity();
-    assert!(line_path(&s, &s, 0).is_err());
-    assert!(circle_path(&s, &Point3::origin(), &Vector3::zeros(), 0.1, 10).is_err());
-    assert!(circle_path(&s, &Point3::origin(), &Vector3::z(), f64::NAN, 10).is_err());
+    let path_field = |r: Result<Vec<Isometry3<f64>>, IkError>| match r {
+        Err(IkError::InvalidPath { field, .. }) => field,
+        other => panic!("expected InvalidPath, got {other:?}"),
+    };
+    assert_eq!(path_field(line_path(&s, &s, 0)), PathParam::Steps);
+    let o = Point3::origin();
+    assert_eq!(
+        path_field(circle_path(&s, &o, &Vector3::zeros(), 0.1, 10)),
+        PathParam::Normal
+    );
+    assert_eq!(
+        path_field(circle_path(&s, &o, &Vector3::z(), f64::NAN, 10)),
+        PathParam::AngleStep
+    );
+    let far = Point3::new(0.0, f64::INFINITY, 0.0);
+    assert_eq!(
+        path_field(circle_path(&s, &far, &Vector3::z(), 0.1, 10)),
+        PathParam::Centre
+    );
+    let nan_axis = Vector3::new(0.0, 0.0, f64::NAN);
+    assert_eq!(
+        path_field(circle_path(&s, &o, &nan_axis, 0.1, 10)),
+        PathParam::Normal
+    );
 }
 
 /// Regression: the Jacobi SVD must terminate quickly on rank-deficient 6×7 Jacobians

@@ -292,7 +292,9 @@ fn bad_inputs_are_errors() {
     let p = PseudoinverseParams::default();
     assert!(matches!(
         solve_pseudoinverse(&a, &b, &p),
-        Err(LinalgError::NonFinite { what: "A" })
+        Err(LinalgError::NonFinite {
+            what: crate::linalg::Operand::A
+        })
     ));
     let a = DMatrix::identity(2, 2);
     let b3 = DVector::from_vec(vec![1.0, 2.0, 3.0]);

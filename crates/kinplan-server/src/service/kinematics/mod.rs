@@ -21,14 +21,16 @@ use tonic::{Request, Response, Status, Streaming};
 use super::convert::{finite_slice, matrix_in, pose_in, pose_out, vec3_in};
 use super::pb::{self, kinematics_service_server::KinematicsService};
 use super::server::Shared;
+use super::status::ik::{IkAt, PathAt, ik_error};
+use super::status::linalg::{SolveAt, linalg_error};
 use super::status::{invalid, robot_error, too_large};
 use super::{Budget, Compute, ModelStore};
 use kinplan_core::ik::{
-    BatchSeeds, IkError, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
+    BatchSeeds, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
     JointLimitMode, TrackParams, TrackResult, circle_path, line_path, solve_ik, solve_ik_batch, track_path,
 };
 use kinplan_core::linalg::{
-    LinalgError, LinearSolution, LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus,
+    LinearSolution, LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus,
     solve_angle_relaxation_until, solve_pseudoinverse,
 };
 use kinplan_core::robot::Chain;
@@ -117,7 +119,7 @@ impl KinematicsService for KinematicsApi {
                 )
             })
             .await?
-            .map_err(|e| ik_error(e, "target", ""))?;
+            .map_err(|e| ik_error(e, IkAt::Target))?;
         let mut reply = result_out(result);
         reply.model_id = robot.model_id;
         Ok(Response::new(reply))
@@ -214,7 +216,7 @@ impl KinematicsService for KinematicsApi {
                     .into_iter()
                     .enumerate()
                     .map(|(i, r)| {
-                        let mut r = r.map_err(|e| ik_error(e, &format!("targets[{i}]"), ""))?;
+                        let mut r = r.map_err(|e| ik_error(e, IkAt::Batch(i)))?;
                         if late {
                             relabel_cancelled(&mut r);
                         }
@@ -273,7 +275,7 @@ impl KinematicsService for KinematicsApi {
                 })
             })
             .await?
-            .map_err(|e| ik_error(e, path_field, path_field))?;
+            .map_err(|e| ik_error(e, IkAt::Path(path_field)))?;
         Ok(Response::new(track_out(result, &poses, robot.model_id)))
     }
 
@@ -347,7 +349,7 @@ impl KinematicsService for KinematicsApi {
                 };
                 params
                     .validate()
-                    .map_err(|e| invalid("singular_value_tolerance", e.to_string()))?;
+                    .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
                 LinearSolve::Svd(params)
             }
             Some(variant) => {
@@ -364,7 +366,9 @@ impl KinematicsService for KinematicsApi {
                     record_history: req.record_history,
                     ..d
                 };
-                params.validate().map_err(|e| linalg_error(e, ""))?;
+                params
+                    .validate()
+                    .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
                 if params.record_history && params.max_iterations > MAX_LINEAR_HISTORY {
                     return Err(too_large(
                         "max_iterations",
@@ -404,7 +408,7 @@ impl KinematicsService for KinematicsApi {
                 s.map(|s| (s, start.elapsed()))
             })
             .await?
-            .map_err(|e| linalg_error(e, ""))?;
+            .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
         Ok(Response::new(linear_out(solution, elapsed)))
     }
 }

@@ -98,7 +98,7 @@ impl Options {
             record_history: o.return_history,
             ..d
         };
-        params.validate().map_err(|e| ik_error(e, "target", ""))?;
+        params.validate().map_err(|e| ik_error(e, IkAt::Target))?;
         Ok(Self {
             params,
             position_only: o.position_only,

@@ -1,49 +1,6 @@
 use super::*;
 
 #[test]
-fn errors_name_request_fields() {
-    let cases = [
-        (IkError::WrongSeedLength { expected: 6, got: 5 }, "seed"),
-        (IkError::NonFiniteSeed { index: 2 }, "seed[2]"),
-        (
-            IkError::InvalidParam {
-                field: "position_tolerance",
-                value: 0.0,
-                reason: "",
-            },
-            "options.position_tolerance",
-        ),
-        (
-            IkError::MethodCannotServe {
-                method: IkMethod::Fabrik,
-                reason: String::new(),
-            },
-            "options.method",
-        ),
-        (
-            IkError::InvalidPath {
-                field: "normal",
-                reason: "",
-            },
-            "circle.normal",
-        ),
-        (
-            IkError::Linalg(LinalgError::InvalidParam {
-                field: "max_iterations",
-                value: 0.0,
-                reason: "",
-            }),
-            "options.rlxa_max_iterations",
-        ),
-    ];
-    for (err, field) in cases {
-        let status = ik_error(err, "targets[1]", "circle");
-        assert_eq!(status.code(), tonic::Code::InvalidArgument);
-        assert!(status.message().starts_with(field), "{}", status.message());
-    }
-}
-
-#[test]
 fn the_deadline_leaves_a_reply_reserve() {
     let now = Instant::now();
     let soft = soft_deadline(Some(now + Duration::from_millis(12))).unwrap();

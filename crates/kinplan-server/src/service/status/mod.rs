@@ -8,6 +8,8 @@ use tonic_types::{ErrorDetails, StatusExt};
 
 use kinplan_core::robot::RobotError;
 
+pub mod ik;
+pub mod linalg;
 pub mod score;
 
 /// INVALID_ARGUMENT naming `field`, with a BadRequest field violation.
