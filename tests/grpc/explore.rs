@@ -175,6 +175,16 @@ async fn bad_exploration_requests_are_named_by_field() {
             r.resolution = Some(f64::NAN);
             r
         }),
+        ("pixel_stride", {
+            let mut r = request();
+            r.pixel_stride = Some(0);
+            r
+        }),
+        ("noise_stddev", {
+            let mut r = request();
+            r.noise_stddev = Some(-1.0);
+            r
+        }),
         ("stop.known_ratio", {
             let mut r = request();
             r.stop.as_mut().unwrap().known_ratio = Some(1.5);

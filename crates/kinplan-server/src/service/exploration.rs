@@ -12,8 +12,9 @@ use super::kinematics::soft_deadline;
 use super::pb::{self, exploration_service_server::ExplorationService};
 use super::server::Shared;
 use super::status::invalid;
+use super::status::octree::octree_error;
 use kinplan_core::nbv::next_best_view;
-use kinplan_core::octree::{Octree, OctreeError, OctreeLimits, PinholeIntrinsics, ScanParams, ScanStatus};
+use kinplan_core::octree::{Octree, OctreeLimits, PinholeIntrinsics, ScanParams, ScanStatus};
 
 /// Largest tree a request may carry or grow, in nodes (about 8 bytes per
 /// node plus 68 per inner node: a few hundred MB at worst).
@@ -32,15 +33,6 @@ fn octree_in(field: &str, tree: Option<&pb::Octree>) -> Result<Octree, Status> {
     };
     Octree::from_message_data(t.binary, &t.id, t.resolution, &t.data, &limits())
         .map_err(|e| octree_error(field, e))
-}
-
-fn octree_error(field: &str, e: OctreeError) -> Status {
-    match e {
-        OctreeError::TooManyNodes { .. } | OctreeError::ScanTooLarge { .. } => {
-            super::status::too_large(field, e.to_string())
-        }
-        _ => invalid(field, e.to_string()),
-    }
 }
 
 pub struct ExplorationApi {

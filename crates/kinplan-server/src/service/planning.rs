@@ -17,11 +17,12 @@ use super::convert::vec3_out;
 use super::kinematics::soft_deadline;
 use super::pb::{self, planning_service_server::PlanningService};
 use super::planning_convert::{
-    PlanInput, colliding_out, pair_name, plan_error, plan_input, plan_response, trajectory_out,
+    PlanInput, colliding_out, pair_name, plan_input, plan_response, trajectory_out,
 };
 use super::scene::scene_in;
 use super::server::Shared;
 use super::status::invalid;
+use super::status::plan::plan_error;
 use super::{Budget, models::Resolved};
 use kinplan_core::collision::{CheckerParams, SceneChecker, SceneGeometry, SceneLimits};
 use kinplan_core::plan::{Goal, IterationReport, PlanControl, PlanStatus, plan};

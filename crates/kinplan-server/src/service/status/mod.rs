@@ -8,8 +8,11 @@ use tonic_types::{ErrorDetails, StatusExt};
 
 use kinplan_core::robot::RobotError;
 
+pub mod explore;
 pub mod ik;
 pub mod linalg;
+pub mod octree;
+pub mod plan;
 pub mod score;
 
 /// INVALID_ARGUMENT naming `field`, with a BadRequest field violation.
