@@ -124,10 +124,15 @@ pub(super) fn linear_solver_in(field: &str, value: i32) -> Result<Option<RlxaVar
 pub(crate) fn soft_deadline(deadline: Option<Instant>) -> Option<Instant> {
     let deadline = deadline?;
     let remaining = deadline.saturating_duration_since(Instant::now());
-    let reserve = (remaining / 10)
+    Some(deadline - reply_reserve(remaining))
+}
+
+/// The reply reserve taken from `remaining`: `min(clamp(remaining / 10,
+/// 200 µs, 100 ms), remaining / 2)`.
+pub(super) fn reply_reserve(remaining: Duration) -> Duration {
+    (remaining / 10)
         .clamp(Duration::from_micros(200), Duration::from_millis(100))
-        .min(remaining / 2);
-    Some(deadline - reserve)
+        .min(remaining / 2)
 }
 
 /// The earlier of the explicit budget and the time left until `soft`.

@@ -23,6 +23,24 @@ fn the_deadline_leaves_a_reply_reserve() {
     assert_eq!(time_budget(None, None), None);
 }
 
+/// The reserve on exact durations (no clock involved): a tenth of the time
+/// left, at least 200 µs, at most 100 ms, and never more than half of it.
+#[test]
+fn the_reply_reserve_is_a_clamped_tenth_and_at_most_half() {
+    let us = Duration::from_micros;
+    // the long branch: a tenth, then the 100 ms ceiling
+    assert_eq!(reply_reserve(us(12_000)), us(1_200));
+    assert_eq!(reply_reserve(Duration::from_secs(60)), Duration::from_millis(100));
+    // the 200 µs floor while it is below half the time left
+    assert_eq!(reply_reserve(us(1_000)), us(200));
+    assert_eq!(reply_reserve(us(401)), us(200));
+    // the short-deadline branch: half the time left, below the floor
+    assert_eq!(reply_reserve(us(400)), us(200));
+    assert_eq!(reply_reserve(us(300)), us(150));
+    assert_eq!(reply_reserve(us(2)), us(1));
+    assert_eq!(reply_reserve(Duration::ZERO), Duration::ZERO);
+}
+
 /// Short deadlines: the reserve is at most half the time left (the
 /// 200 µs floor would otherwise eat a 300 µs deadline's whole budget).
 #[test]
