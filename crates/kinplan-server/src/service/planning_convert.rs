@@ -188,10 +188,11 @@ pub fn plan_input(req: &pb::PlanRequest) -> Result<PlanInput, Status> {
 
     let mut checker = CheckerParams::default();
     if let Some(res) = options.motion_resolution {
-        if !(res.is_finite() && res > 0.0 && res <= 0.05) {
+        let max = CheckerParams::MAX_MOTION_RESOLUTION;
+        if !(res.is_finite() && res > 0.0 && res <= max) {
             return Err(invalid(
                 "options.motion_resolution",
-                format!("must be in (0, 0.05] rad, got {res}"),
+                format!("must be in (0, {max}] rad, got {res}"),
             ));
         }
         checker.motion_resolution = res;

@@ -72,10 +72,12 @@ pub const MAX_LINEAR_ENTRY: f64 = 1e100;
 /// Most RLXA iterations inside one IK iteration (`options.rlxa_max_iterations`):
 /// the IK loop checks its deadline between iterations.
 pub const MAX_IK_RLXA_ITERATIONS: u32 = 100_000;
-/// Default random restarts of `SolveIk` and `SolveIkBatch` (the domain default).
-const RESTARTS_SOLVE: usize = 200;
-/// Default random restarts of `TrackPath` and `StreamIk`: stay on the seed's branch.
-const RESTARTS_WARM: usize = 0;
+/// Default random restarts of `SolveIk` and `SolveIkBatch`: the domain's
+/// (`IkParams::default().max_restarts`).
+const RESTARTS_SOLVE: Option<usize> = None;
+/// Default random restarts of `TrackPath` and `StreamIk`: none, to stay on the
+/// seed's branch.
+const RESTARTS_WARM: Option<usize> = Some(0);
 
 pub struct KinematicsApi {
     shared: Shared,

@@ -21,7 +21,11 @@ pub(super) struct Options {
 impl Options {
     /// Unset fields take the documented defaults; ranges are checked by
     /// [`IkParams::validate`], whose field names are the proto's.
-    pub(super) fn from_proto(o: Option<&pb::IkOptions>, default_restarts: usize) -> Result<Self, Status> {
+    /// `default_restarts` replaces the domain's default restart count when set.
+    pub(super) fn from_proto(
+        o: Option<&pb::IkOptions>,
+        default_restarts: Option<usize>,
+    ) -> Result<Self, Status> {
         let o = o.cloned().unwrap_or_default();
         let d = IkParams::default();
         let method = match pb::IkMethod::try_from(o.method) {
@@ -91,7 +95,9 @@ impl Options {
             max_step: o.max_step.unwrap_or(d.max_step),
             rlxa,
             joint_limits,
-            max_restarts: o.max_restarts.map_or(default_restarts, |n| n as usize),
+            max_restarts: o
+                .max_restarts
+                .map_or(default_restarts.unwrap_or(d.max_restarts), |n| n as usize),
             num_solutions: (o.num_solutions as usize).max(1),
             distinct_tolerance: o.distinct_tolerance.unwrap_or(d.distinct_tolerance),
             time_budget,
