@@ -68,6 +68,8 @@ fn unset_options_take_the_domain_defaults() {
         max_restarts: Some(7),
         ..Default::default()
     };
-    let p = Options::from_proto(Some(&explicit), RESTARTS_WARM).unwrap().params;
+    let p = Options::from_proto(Some(&explicit), RESTARTS_WARM)
+        .unwrap()
+        .params;
     assert_eq!(p.max_restarts, 7);
 }
