@@ -12,6 +12,7 @@ use super::kinematics::soft_deadline;
 use super::pb::{self, exploration_service_server::ExplorationService};
 use super::server::Shared;
 use super::status::invalid;
+use super::status::nbv::nbv_error;
 use super::status::octree::octree_error;
 use kinplan_core::nbv::next_best_view;
 use kinplan_core::octree::{Octree, OctreeLimits, PinholeIntrinsics, ScanParams, ScanStatus};
@@ -102,7 +103,7 @@ impl ExplorationService for ExplorationApi {
                 let result = next_best_view(&tree, &params, &camera, &camera_pose, chain.as_deref(), &|| {
                     b.should_stop()
                 })
-                .map_err(|e| invalid("options", e.to_string()))?;
+                .map_err(|e| nbv_error("options", e))?;
                 Ok(nbv_response(result))
             })
             .await??;
@@ -160,7 +161,7 @@ impl ExplorationService for ExplorationApi {
             .run(&budget, move |b| -> Result<pb::InsertScanResponse, Status> {
                 let mut tree = match &existing {
                     Some(t) => octree_in("octree", Some(t))?,
-                    None => Octree::new(resolution).map_err(|e| invalid("resolution", e.to_string()))?,
+                    None => Octree::new(resolution).map_err(|e| octree_error("resolution", e))?,
                 };
                 let stop = || b.should_stop();
                 let stats = match &scan {
@@ -229,7 +230,7 @@ impl ExplorationService for ExplorationApi {
                 let volumes = match bounds.or_else(|| tree.known_bounds()) {
                     Some((min, max)) => Some(
                         tree.volumes_in_box(&min, &max)
-                            .map_err(|e| invalid("box", e.to_string()))?,
+                            .map_err(|e| octree_error("box", e))?,
                     ),
                     None => None,
                 };

@@ -19,6 +19,7 @@ use super::kinematics::soft_deadline;
 use super::pb;
 use super::scene::scene_in;
 use super::server::Shared;
+use super::status::collision::collision_error;
 use super::status::explore::explore_error;
 use super::status::invalid;
 use kinplan_core::collision::{SceneGeometry, SceneLimits};
@@ -55,8 +56,7 @@ pub async fn explore_stream(
         let run_budget = budget.clone();
         let outcome = compute
             .run(&run_budget, move |b| -> Result<pb::ExploreResponse, Status> {
-                let truth =
-                    Arc::new(SceneGeometry::build(&scene).map_err(|e| invalid("scene", e.to_string()))?);
+                let truth = Arc::new(SceneGeometry::build(&scene).map_err(|e| collision_error("scene", e))?);
                 let chain = robot.chain.clone();
                 let world = ExploreWorld {
                     chain: &chain,

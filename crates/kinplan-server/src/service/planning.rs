@@ -21,6 +21,7 @@ use super::planning_convert::{
 };
 use super::scene::scene_in;
 use super::server::Shared;
+use super::status::collision::{collision_error, collision_internal};
 use super::status::invalid;
 use super::status::plan::plan_error;
 use super::{Budget, models::Resolved};
@@ -88,7 +89,7 @@ fn run_plan<'a>(
     progress: Option<&'a mut dyn FnMut(&IterationReport<'_>)>,
     started: Instant,
 ) -> Result<pb::PlanResponse, Status> {
-    let world = Arc::new(SceneGeometry::build(&p.scene).map_err(|e| invalid("scene", e.to_string()))?);
+    let world = Arc::new(SceneGeometry::build(&p.scene).map_err(|e| collision_error("scene", e))?);
     let checker = checker_for(&p.setup, world, p.input.checker)?;
     let chain = &p.robot.chain;
     let result = plan(
@@ -239,8 +240,7 @@ impl PlanningService for PlanningApi {
             .shared
             .compute
             .run(&budget, move |b| -> Result<Vec<pb::StateCheck>, Status> {
-                let world =
-                    Arc::new(SceneGeometry::build(&scene).map_err(|e| invalid("scene", e.to_string()))?);
+                let world = Arc::new(SceneGeometry::build(&scene).map_err(|e| collision_error("scene", e))?);
                 let checker = checker_for(&setup, world, CheckerParams::default())?;
                 let mut out = Vec::with_capacity(req.states.len());
                 for (i, s) in req.states.iter().enumerate() {
@@ -260,9 +260,8 @@ impl PlanningService for PlanningApi {
 
 /// Validity, clearance and witness points of one state.
 fn check_one(checker: &SceneChecker, q: &[f64], max_distance: f64) -> Result<pb::StateCheck, Status> {
-    let internal = |e: kinplan_core::collision::CollisionError| Status::internal(e.to_string());
-    let report = checker.report(q).map_err(internal)?;
-    let nearest = checker.proximity(q, max_distance).map_err(internal)?;
+    let report = checker.report(q).map_err(collision_internal)?;
+    let nearest = checker.proximity(q, max_distance).map_err(collision_internal)?;
     let (clearance, robot_point, obstacle_point, closest_pair) = match &nearest {
         Some(p) => (
             p.distance,

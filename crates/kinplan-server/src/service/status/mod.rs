@@ -8,9 +8,11 @@ use tonic_types::{ErrorDetails, StatusExt};
 
 use kinplan_core::robot::RobotError;
 
+pub mod collision;
 pub mod explore;
 pub mod ik;
 pub mod linalg;
+pub mod nbv;
 pub mod octree;
 pub mod plan;
 pub mod score;
