@@ -10,6 +10,7 @@ use kinplan_server::service::pb::{
     explore_response::Event,
 };
 use tonic::Code;
+use tonic_types::StatusExt;
 
 use crate::start;
 
@@ -208,6 +209,20 @@ async fn bad_exploration_requests_are_named_by_field() {
         };
         assert_eq!(err.code(), Code::InvalidArgument, "{field}: {}", err.message());
         assert!(err.message().contains(field), "{field}: {}", err.message());
+    }
+    // Parameters the explore room names (ExploreField) are reported by their
+    // request field, exactly.
+    let mut stride = request();
+    stride.pixel_stride = Some(0);
+    let mut noise = request();
+    noise.noise_stddev = Some(-1.0);
+    for (field, req) in [("pixel_stride", stride), ("noise_stddev", noise)] {
+        let Err(err) = client.explore(req).await else {
+            panic!("{field}: accepted");
+        };
+        assert_eq!(err.code(), Code::InvalidArgument, "{field}: {}", err.message());
+        let details = err.get_details_bad_request().expect("BadRequest details");
+        assert_eq!(details.field_violations[0].field, field);
     }
     // a start in collision with the scene is refused before the loop runs
     let mut r = request();

@@ -1160,6 +1160,14 @@ async fn bad_inputs_name_their_field_and_the_server_keeps_serving() {
             "tolerance",
         ),
         (
+            "negative relative tolerance",
+            pb::SolveLinearSystemRequest {
+                relative_tolerance: Some(-1.0),
+                ..linear((1, 1, vec![1.0]), vec![1.0], L::AngleRelaxationSafeguarded)
+            },
+            "relative_tolerance",
+        ),
+        (
             "negative singular-value tolerance",
             pb::SolveLinearSystemRequest {
                 singular_value_tolerance: Some(-1.0),

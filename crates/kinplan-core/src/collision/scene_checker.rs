@@ -28,32 +28,37 @@ use super::{CollisionError, MotionCheck, StateChecker};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CheckerParams {
     /// Largest joint step (rad or m) between states checked along a motion
-    /// (default 0.05, the coarsest allowed resolution).
+    /// (default and largest allowed: [`Self::MAX_MOTION_RESOLUTION`]).
     pub motion_resolution: f64,
-    /// Check each state of a motion with every body padded by how far it can
-    /// move in half a step ([`MotionCheck::Padded`], conservative); `false`
-    /// checks the states as they are ([`MotionCheck::Interpolated`]).
+    /// Prove each motion free piece by piece, every body padded by how far it
+    /// can move within the piece ([`MotionCheck::Padded`], conservative);
+    /// `false` checks interpolated states as they are
+    /// ([`MotionCheck::Interpolated`]).
     pub padded_motion: bool,
 }
 
 impl Default for CheckerParams {
     fn default() -> Self {
         CheckerParams {
-            motion_resolution: 0.05,
+            motion_resolution: Self::MAX_MOTION_RESOLUTION,
             padded_motion: false,
         }
     }
 }
 
 impl CheckerParams {
+    /// The coarsest allowed motion resolution, 0.05 rad (or m).
+    pub const MAX_MOTION_RESOLUTION: f64 = 0.05;
+
     pub fn validate(&self) -> Result<(), CollisionError> {
         let r = self.motion_resolution;
-        if !(r.is_finite() && r > 0.0 && r <= 0.05) {
+        let upper = Self::MAX_MOTION_RESOLUTION;
+        if !(r.is_finite() && r > 0.0 && r <= upper) {
             return Err(CollisionError::OutOfRange {
                 field: "motion_resolution".into(),
                 value: r,
                 lower: 0.0,
-                upper: 0.05,
+                upper,
             });
         }
         Ok(())

@@ -2,7 +2,7 @@
 
 use nalgebra::Vector3;
 
-use super::IkError;
+use super::{IkError, IkParam, TargetPart};
 
 /// Outcome of a point-chain solve (FABRIK or length relaxation).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,7 +25,7 @@ pub(crate) fn check_point_chain(
 ) -> Result<(), IkError> {
     if points.len() < 2 || lengths.len() + 1 != points.len() {
         return Err(IkError::InvalidParam {
-            field: "lengths",
+            field: IkParam::Lengths,
             value: lengths.len() as f64,
             reason: "need at least 2 points and exactly one length per consecutive pair",
         });
@@ -40,17 +40,19 @@ pub(crate) fn check_point_chain(
     }
     if lengths.iter().any(|l| !(l.is_finite() && *l >= 0.0)) {
         return Err(IkError::InvalidParam {
-            field: "lengths",
+            field: IkParam::Lengths,
             value: f64::NAN,
             reason: "must be finite and >= 0",
         });
     }
     if target.iter().any(|v| !v.is_finite()) {
-        return Err(IkError::NonFiniteTarget { field: "position" });
+        return Err(IkError::NonFiniteTarget {
+            field: TargetPart::Position,
+        });
     }
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(IkError::InvalidParam {
-            field: "position_tolerance",
+            field: IkParam::PositionTolerance,
             value: tolerance,
             reason: "must be finite and > 0",
         });

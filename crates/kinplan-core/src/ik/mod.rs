@@ -17,7 +17,7 @@ mod workspace;
 #[cfg(test)]
 mod tests;
 
-pub use error::IkError;
+pub use error::{IkError, IkParam, PathParam, TargetPart};
 pub use fabrik::{PointChainReport, fabrik_points};
 pub use length_relaxation::{RelaxationGraph, length_relaxation_points, relax_length};
 pub use params::{IkMethod, IkParams, JointLimitMode};

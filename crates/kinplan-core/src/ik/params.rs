@@ -2,7 +2,7 @@
 
 use std::time::Duration;
 
-use super::IkError;
+use super::{IkError, IkParam};
 use crate::linalg::{LinearSolverKind, RlxaParams};
 
 /// IK algorithm (ALGORITHMS.md §2).
@@ -137,7 +137,7 @@ impl Default for IkParams {
     }
 }
 
-fn positive(field: &'static str, value: f64) -> Result<(), IkError> {
+fn positive(field: IkParam, value: f64) -> Result<(), IkError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
@@ -149,7 +149,7 @@ fn positive(field: &'static str, value: f64) -> Result<(), IkError> {
     }
 }
 
-fn non_negative(field: &'static str, value: f64) -> Result<(), IkError> {
+fn non_negative(field: IkParam, value: f64) -> Result<(), IkError> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
@@ -164,31 +164,31 @@ fn non_negative(field: &'static str, value: f64) -> Result<(), IkError> {
 impl IkParams {
     /// Rejects zero tolerances, NaN, zero caps, …, naming the field.
     pub fn validate(&self) -> Result<(), IkError> {
-        positive("position_tolerance", self.position_tolerance)?;
-        positive("orientation_tolerance", self.orientation_tolerance)?;
+        positive(IkParam::PositionTolerance, self.position_tolerance)?;
+        positive(IkParam::OrientationTolerance, self.orientation_tolerance)?;
         if self.max_iterations == 0 {
             return Err(IkError::InvalidParam {
-                field: "max_iterations",
+                field: IkParam::MaxIterations,
                 value: 0.0,
                 reason: "must be >= 1",
             });
         }
-        non_negative("damping", self.damping)?;
-        positive("max_step", self.max_step)?;
-        non_negative("singular_value_tolerance", self.singular_value_tolerance)?;
+        non_negative(IkParam::Damping, self.damping)?;
+        positive(IkParam::MaxStep, self.max_step)?;
+        non_negative(IkParam::SingularValueTolerance, self.singular_value_tolerance)?;
         if self.num_solutions == 0 {
             return Err(IkError::InvalidParam {
-                field: "num_solutions",
+                field: IkParam::NumSolutions,
                 value: 0.0,
                 reason: "must be >= 1",
             });
         }
-        positive("distinct_tolerance", self.distinct_tolerance)?;
+        positive(IkParam::DistinctTolerance, self.distinct_tolerance)?;
         if let Some(b) = self.time_budget
             && b.is_zero()
         {
             return Err(IkError::InvalidParam {
-                field: "time_budget",
+                field: IkParam::TimeBudget,
                 value: 0.0,
                 reason: "must be > 0 when set",
             });

@@ -2,7 +2,7 @@
 
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3, Vector6};
 
-use super::IkError;
+use super::{IkError, TargetPart};
 
 /// What the tool should reach, in the chain's base frame (metres).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -19,10 +19,14 @@ impl IkTarget {
     /// than `1e-6`.
     pub fn from_position_quaternion(p: [f64; 3], wxyz: [f64; 4]) -> Result<Self, IkError> {
         if p.iter().any(|v| !v.is_finite()) {
-            return Err(IkError::NonFiniteTarget { field: "position" });
+            return Err(IkError::NonFiniteTarget {
+                field: TargetPart::Position,
+            });
         }
         if wxyz.iter().any(|v| !v.is_finite()) {
-            return Err(IkError::NonFiniteTarget { field: "orientation" });
+            return Err(IkError::NonFiniteTarget {
+                field: TargetPart::Orientation,
+            });
         }
         let q = Quaternion::new(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
         let norm = q.norm();
@@ -59,16 +63,22 @@ impl IkTarget {
         match self {
             IkTarget::Position(p) => {
                 if p.coords.iter().any(|v| !v.is_finite()) {
-                    return Err(IkError::NonFiniteTarget { field: "position" });
+                    return Err(IkError::NonFiniteTarget {
+                        field: TargetPart::Position,
+                    });
                 }
             }
             IkTarget::Pose(t) => {
                 if t.translation.vector.iter().any(|v| !v.is_finite()) {
-                    return Err(IkError::NonFiniteTarget { field: "position" });
+                    return Err(IkError::NonFiniteTarget {
+                        field: TargetPart::Position,
+                    });
                 }
                 let q = t.rotation.quaternion();
                 if q.coords.iter().any(|v| !v.is_finite()) {
-                    return Err(IkError::NonFiniteTarget { field: "orientation" });
+                    return Err(IkError::NonFiniteTarget {
+                        field: TargetPart::Orientation,
+                    });
                 }
                 let norm = q.norm();
                 if (norm - 1.0).abs() > 1e-6 {

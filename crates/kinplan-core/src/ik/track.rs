@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use super::attempt::Clock;
 use super::solve::validate_request;
-use super::{IkError, IkParams, IkResult, IkSolver, IkStatus, IkTarget};
+use super::{IkError, IkParams, IkResult, IkSolver, IkStatus, IkTarget, PathParam};
 use crate::robot::Chain;
 
 /// Per-target RNG seed of a batch: a SplitMix64 step of `rng_seed + index`.
@@ -256,7 +256,7 @@ pub fn track_path(
 fn check_steps(steps: usize) -> Result<(), IkError> {
     if steps == 0 {
         return Err(IkError::InvalidPath {
-            field: "steps",
+            field: PathParam::Steps,
             reason: "must be >= 1",
         });
     }
@@ -300,19 +300,21 @@ pub fn circle_path(
     check_steps(steps)?;
     if !angle_step.is_finite() {
         return Err(IkError::InvalidPath {
-            field: "angle_step",
+            field: PathParam::AngleStep,
             reason: "must be finite",
         });
     }
     IkTarget::Pose(*start).validate()?;
-    if centre.coords.iter().chain(normal.iter()).any(|v| !v.is_finite()) {
-        return Err(IkError::InvalidPath {
-            field: "centre/normal",
-            reason: "must be finite",
-        });
+    for (field, v) in [(PathParam::Centre, &centre.coords), (PathParam::Normal, normal)] {
+        if v.iter().any(|v| !v.is_finite()) {
+            return Err(IkError::InvalidPath {
+                field,
+                reason: "must be finite",
+            });
+        }
     }
     let axis = Unit::try_new(*normal, 1e-12).ok_or(IkError::InvalidPath {
-        field: "normal",
+        field: PathParam::Normal,
         reason: "must be non-zero",
     })?;
     let r0 = start.translation.vector - centre.coords;

@@ -4,7 +4,7 @@ use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 
 use super::pseudoinverse::check_system;
-use super::{LinalgError, LinearSolution, SolveStatus};
+use super::{LinalgError, LinalgParam, LinearSolution, SolveStatus};
 
 /// Faithful RLXA, or the safeguarded variant (reported separately).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
@@ -53,28 +53,28 @@ impl RlxaParams {
     pub fn validate(&self) -> Result<(), LinalgError> {
         if self.max_iterations == 0 {
             return Err(LinalgError::InvalidParam {
-                field: "max_iterations",
+                field: LinalgParam::MaxIterations,
                 value: 0.0,
                 reason: "must be >= 1",
             });
         }
         if !(self.tolerance.is_finite() && self.tolerance > 0.0) {
             return Err(LinalgError::InvalidParam {
-                field: "tolerance",
+                field: LinalgParam::Tolerance,
                 value: self.tolerance,
                 reason: "must be finite and > 0",
             });
         }
         if !(self.relative_tolerance.is_finite() && self.relative_tolerance >= 0.0) {
             return Err(LinalgError::InvalidParam {
-                field: "relative_tolerance",
+                field: LinalgParam::RelativeTolerance,
                 value: self.relative_tolerance,
                 reason: "must be finite and >= 0",
             });
         }
         if !(self.zero_column_tolerance.is_finite() && self.zero_column_tolerance >= 0.0) {
             return Err(LinalgError::InvalidParam {
-                field: "zero_column_tolerance",
+                field: LinalgParam::ZeroColumnTolerance,
                 value: self.zero_column_tolerance,
                 reason: "must be finite and >= 0",
             });

@@ -12,6 +12,6 @@ pub use angle_relaxation::{
     RlxaParams, RlxaReport, RlxaVariant, RlxaWorkspace, STOP_CHECK_WORK, solve_angle_relaxation,
     solve_angle_relaxation_until,
 };
-pub use error::LinalgError;
+pub use error::{LinalgError, LinalgParam, Operand};
 pub use pseudoinverse::{PseudoinverseParams, SvdWorkspace, solve_pseudoinverse};
 pub use solution::{LinearSolution, LinearSolverKind, SolveStatus};

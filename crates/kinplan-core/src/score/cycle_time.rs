@@ -1,7 +1,7 @@
 //! Synchronized point-to-point (PTP) cycle time and the "time potential" of
 //! intermediate waypoints (S2 §3.3).
 
-use super::error::ScoreError;
+use super::error::{ScoreError, ScoreParam};
 use super::input::{JointLimits, Rows, validate_joint_rows};
 
 /// Options of the time-potential search.
@@ -28,7 +28,7 @@ impl CycleTimeParams {
         let value = self.potential_tolerance;
         if !(value.is_finite() && value >= 0.0) {
             return Err(ScoreError::InvalidParam {
-                name: "potential_tolerance",
+                name: ScoreParam::PotentialTolerance,
                 value,
                 reason: "must be finite and >= 0",
             });
@@ -214,6 +214,7 @@ pub(crate) fn cycle_time_unchecked(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::score::ScoreField;
 
     fn flat(q: &[f64], m: usize) -> Rows<'_, f64> {
         Rows::Flat { values: q, width: m }
@@ -370,7 +371,7 @@ mod tests {
         assert!(matches!(
             cycle_time(flat(&q, 2), &lim, &p),
             Err(ScoreError::LengthMismatch {
-                field: "v_max",
+                field: ScoreField::VMax,
                 expected: 2,
                 found: 1
             })
@@ -382,7 +383,7 @@ mod tests {
         assert!(matches!(
             cycle_time(flat(&q, 2), &lim, &p),
             Err(ScoreError::InvalidValue {
-                field: "v_max",
+                field: ScoreField::VMax,
                 index: 1,
                 ..
             })
@@ -394,7 +395,7 @@ mod tests {
         assert!(matches!(
             cycle_time(flat(&q, 2), &lim, &p),
             Err(ScoreError::InvalidValue {
-                field: "a_max",
+                field: ScoreField::AMax,
                 index: 0,
                 ..
             })
@@ -414,7 +415,7 @@ mod tests {
         assert!(matches!(
             cycle_time(flat(&q, 2), &lim, &p),
             Err(ScoreError::NonFinite {
-                field: "joints",
+                field: ScoreField::Joints,
                 index: 0,
                 component: 1,
                 ..

@@ -1,4 +1,85 @@
-//! The one error type of the `score` room: bad input and bad parameters.
+//! The one error type of the `score` room: bad input and bad parameters,
+//! naming the offending input field or parameter by a typed identifier
+//! ([`ScoreField`], [`ScoreParam`]) the service layer turns into its own names.
+
+use std::fmt;
+
+/// An input field of [`ScoreInput`](super::ScoreInput) /
+/// [`TrajectoryData`](super::TrajectoryData) an error is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ScoreField {
+    /// `TrajectoryData::joints`.
+    Joints,
+    /// `TrajectoryData::poses`.
+    Poses,
+    /// `TrajectoryData::robot_points`.
+    RobotPoints,
+    /// `TrajectoryData::timestamps`.
+    Timestamps,
+    /// `ScoreInput::joint_weights`.
+    JointWeights,
+    /// `JointLimits::v_max`.
+    VMax,
+    /// `JointLimits::a_max`.
+    AMax,
+}
+
+impl ScoreField {
+    /// The field's name as the input structs spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ScoreField::Joints => "joints",
+            ScoreField::Poses => "poses",
+            ScoreField::RobotPoints => "robot_points",
+            ScoreField::Timestamps => "timestamps",
+            ScoreField::JointWeights => "joint_weights",
+            ScoreField::VMax => "v_max",
+            ScoreField::AMax => "a_max",
+        }
+    }
+}
+
+impl fmt::Display for ScoreField {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A parameter of [`JerkPeakParams`](super::JerkPeakParams) or
+/// [`CycleTimeParams`](super::CycleTimeParams) an error is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ScoreParam {
+    JointLogGain,
+    JointOffset,
+    CartesianSqrtGain,
+    CartesianOffset,
+    JointMinHeight,
+    CartesianMinHeight,
+    SlowdownFloor,
+    PotentialTolerance,
+}
+
+impl ScoreParam {
+    /// The parameter's name as the parameter structs spell it.
+    pub fn name(self) -> &'static str {
+        match self {
+            ScoreParam::JointLogGain => "joint_log_gain",
+            ScoreParam::JointOffset => "joint_offset",
+            ScoreParam::CartesianSqrtGain => "cartesian_sqrt_gain",
+            ScoreParam::CartesianOffset => "cartesian_offset",
+            ScoreParam::JointMinHeight => "joint_min_height",
+            ScoreParam::CartesianMinHeight => "cartesian_min_height",
+            ScoreParam::SlowdownFloor => "slowdown_floor",
+            ScoreParam::PotentialTolerance => "potential_tolerance",
+        }
+    }
+}
+
+impl fmt::Display for ScoreParam {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
 
 /// Everything that makes a scoring request unanswerable.
 ///
@@ -10,8 +91,8 @@ pub enum ScoreError {
     /// A row has a different length from the first row of the same field.
     #[error("{field}[{index}] has {found} entries, expected {expected} like row 0")]
     RaggedRow {
-        /// Input field, e.g. `"joints"` or `"robot_points"`.
-        field: &'static str,
+        /// Input field, e.g. joints or robot points.
+        field: ScoreField,
         /// Waypoint index of the bad row.
         index: usize,
         /// Length of row 0.
@@ -37,7 +118,7 @@ pub enum ScoreError {
     #[error("{field}: flat buffer of {len} values does not split into rows of {width}")]
     FlatShape {
         /// Input field.
-        field: &'static str,
+        field: ScoreField,
         /// Number of values in the buffer.
         len: usize,
         /// Declared row width.
@@ -46,8 +127,8 @@ pub enum ScoreError {
     /// A per-waypoint or per-joint field has the wrong number of entries.
     #[error("{field} has {found} entries, expected {expected}")]
     LengthMismatch {
-        /// Input field, e.g. `"poses"`, `"timestamps"`, `"joint_weights"`, `"v_max"`.
-        field: &'static str,
+        /// Input field, e.g. poses, timestamps, joint weights, `v_max`.
+        field: ScoreField,
         /// Required count (waypoints or joints).
         expected: usize,
         /// Given count.
@@ -57,7 +138,7 @@ pub enum ScoreError {
     #[error("{field}[{index}][{component}] is not finite ({value})")]
     NonFinite {
         /// Input field.
-        field: &'static str,
+        field: ScoreField,
         /// Waypoint (or joint) index.
         index: usize,
         /// Component inside the row: joint index, point index × 3 + axis, or for
@@ -89,7 +170,7 @@ pub enum ScoreError {
     #[error("{field}[{index}] = {value}: {reason}")]
     InvalidValue {
         /// Input field.
-        field: &'static str,
+        field: ScoreField,
         /// Joint index.
         index: usize,
         /// The offending value.
@@ -100,8 +181,8 @@ pub enum ScoreError {
     /// A parameter outside its allowed range.
     #[error("parameter {name} = {value}: {reason}")]
     InvalidParam {
-        /// Parameter field name.
-        name: &'static str,
+        /// The parameter.
+        name: ScoreParam,
         /// The offending value.
         value: f64,
         /// What is required.

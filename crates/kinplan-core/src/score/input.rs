@@ -3,7 +3,7 @@
 
 use nalgebra::{Isometry3, Point3};
 
-use super::error::ScoreError;
+use super::error::{ScoreError, ScoreField};
 
 /// Tolerance on `|‖quaternion‖ − 1|` accepted by validation.
 pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-6;
@@ -64,7 +64,7 @@ impl<'a, T> Rows<'a, T> {
 
     /// Checks the shape: flat buffers split into whole rows, nested rows all
     /// as long as row 0. Returns the row width (`None` without rows).
-    fn check_shape(&self, field: &'static str) -> Result<Option<usize>, ScoreError> {
+    fn check_shape(&self, field: ScoreField) -> Result<Option<usize>, ScoreError> {
         match self {
             Rows::Flat { values, width } => {
                 if *width == 0 {
@@ -166,7 +166,7 @@ impl<'a> TrajectoryData<'a> {
 
         if self.poses.len() != n {
             return Err(ScoreError::LengthMismatch {
-                field: "poses",
+                field: ScoreField::Poses,
                 expected: n,
                 found: self.poses.len(),
             });
@@ -185,7 +185,7 @@ impl<'a> TrajectoryData<'a> {
             for (i, pose) in self.poses.iter().enumerate() {
                 let t = pose.translation.vector;
                 let c = pose.rotation.coords; // i, j, k, w
-                check_finite("poses", i, t.iter().chain(c.iter()).copied())?;
+                check_finite(ScoreField::Poses, i, t.iter().chain(c.iter()).copied())?;
                 let norm = c.norm();
                 if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
                     return Err(ScoreError::NonUnitQuaternion { index: i, norm });
@@ -197,12 +197,12 @@ impl<'a> TrajectoryData<'a> {
         if let Some(rp) = &self.robot_points {
             if rp.len() != n {
                 return Err(ScoreError::LengthMismatch {
-                    field: "robot_points",
+                    field: ScoreField::RobotPoints,
                     expected: n,
                     found: rp.len(),
                 });
             }
-            points = rp.check_shape("robot_points")?;
+            points = rp.check_shape(ScoreField::RobotPoints)?;
             let points_ok = match rp {
                 Rows::Flat { values, .. } => all_points_finite(values),
                 Rows::Nested(rows) => rows.iter().fold(true, |ok, r| ok & all_points_finite(r)),
@@ -211,7 +211,7 @@ impl<'a> TrajectoryData<'a> {
                 for i in 0..n {
                     let row = rp.row(i);
                     check_finite(
-                        "robot_points",
+                        ScoreField::RobotPoints,
                         i,
                         row.iter().flat_map(|p| p.coords.iter().copied()),
                     )?;
@@ -222,7 +222,7 @@ impl<'a> TrajectoryData<'a> {
         if let Some(ts) = self.timestamps {
             if ts.len() != n {
                 return Err(ScoreError::LengthMismatch {
-                    field: "timestamps",
+                    field: ScoreField::Timestamps,
                     expected: n,
                     found: ts.len(),
                 });
@@ -230,7 +230,7 @@ impl<'a> TrajectoryData<'a> {
             for (index, &value) in ts.iter().enumerate() {
                 if !value.is_finite() {
                     return Err(ScoreError::NonFinite {
-                        field: "timestamps",
+                        field: ScoreField::Timestamps,
                         index,
                         component: 0,
                         value,
@@ -281,14 +281,20 @@ impl JointLimits<'_> {
     /// Checks the lengths (`joints`) and ranges of both limit vectors.
     pub fn validate(&self, joints: usize) -> Result<(), ScoreError> {
         check_per_joint(
-            "v_max",
+            ScoreField::VMax,
             self.v_max,
             joints,
             |v| v.is_finite() && v > 0.0,
             "must be finite and > 0",
         )?;
         if let Some(a) = self.a_max {
-            check_per_joint("a_max", a, joints, |v| v > 0.0, "must be > 0 (+inf allowed)")?;
+            check_per_joint(
+                ScoreField::AMax,
+                a,
+                joints,
+                |v| v > 0.0,
+                "must be > 0 (+inf allowed)",
+            )?;
         }
         Ok(())
     }
@@ -326,7 +332,7 @@ impl<'a> ScoreInput<'a> {
         if shape.waypoints > 0 || self.dof.is_some() {
             if let Some(w) = self.joint_weights {
                 check_per_joint(
-                    "joint_weights",
+                    ScoreField::JointWeights,
                     w,
                     shape.joints,
                     |v| v.is_finite() && v >= 0.0,
@@ -360,7 +366,7 @@ pub(crate) fn validate_joint_rows(
             }
         }
     }
-    let width = joints.check_shape("joints")?;
+    let width = joints.check_shape(ScoreField::Joints)?;
     let m = match (dof, width) {
         (Some(d), Some(w)) if d != w => {
             return Err(ScoreError::WrongJointCount {
@@ -381,7 +387,7 @@ pub(crate) fn validate_joint_rows(
     };
     if !ok {
         for i in 0..n {
-            check_finite("joints", i, joints.row(i).iter().copied())?;
+            check_finite(ScoreField::Joints, i, joints.row(i).iter().copied())?;
         }
     }
     Ok(m)
@@ -401,7 +407,7 @@ fn all_points_finite(points: &[Point3<f64>]) -> bool {
 }
 
 fn check_finite(
-    field: &'static str,
+    field: ScoreField,
     index: usize,
     values: impl Iterator<Item = f64>,
 ) -> Result<(), ScoreError> {
@@ -419,7 +425,7 @@ fn check_finite(
 }
 
 fn check_per_joint(
-    field: &'static str,
+    field: ScoreField,
     values: &[f64],
     joints: usize,
     ok: impl Fn(f64) -> bool,
@@ -515,7 +521,10 @@ mod tests {
         assert!(l.validate(2).is_ok());
         assert!(matches!(
             l.validate(3),
-            Err(ScoreError::LengthMismatch { field: "v_max", .. })
+            Err(ScoreError::LengthMismatch {
+                field: ScoreField::VMax,
+                ..
+            })
         ));
         let l = JointLimits {
             v_max: &[1.0, 2.0],
@@ -524,7 +533,7 @@ mod tests {
         assert!(matches!(
             l.validate(2),
             Err(ScoreError::InvalidValue {
-                field: "a_max",
+                field: ScoreField::AMax,
                 index: 0,
                 ..
             })

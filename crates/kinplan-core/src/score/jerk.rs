@@ -1,7 +1,7 @@
 //! Pseudo-jerk (third finite differences), its local peaks and the S0
 //! "slowdown" regressions behind JJP and CJP (S0 eq. 2.6–2.14).
 
-use super::error::ScoreError;
+use super::error::{ScoreError, ScoreParam};
 
 /// Third backward difference of four consecutive samples
 /// `[x_{i−3}, x_{i−2}, x_{i−1}, x_i]`:
@@ -122,10 +122,10 @@ impl JerkPeakParams {
     /// Coefficients finite, minimum heights finite and ≥ 0.
     pub fn validate(&self) -> Result<(), ScoreError> {
         for (name, value) in [
-            ("joint_log_gain", self.joint_log_gain),
-            ("joint_offset", self.joint_offset),
-            ("cartesian_sqrt_gain", self.cartesian_sqrt_gain),
-            ("cartesian_offset", self.cartesian_offset),
+            (ScoreParam::JointLogGain, self.joint_log_gain),
+            (ScoreParam::JointOffset, self.joint_offset),
+            (ScoreParam::CartesianSqrtGain, self.cartesian_sqrt_gain),
+            (ScoreParam::CartesianOffset, self.cartesian_offset),
         ] {
             if !value.is_finite() {
                 return Err(ScoreError::InvalidParam {
@@ -136,8 +136,8 @@ impl JerkPeakParams {
             }
         }
         for (name, value) in [
-            ("joint_min_height", self.joint_min_height),
-            ("cartesian_min_height", self.cartesian_min_height),
+            (ScoreParam::JointMinHeight, self.joint_min_height),
+            (ScoreParam::CartesianMinHeight, self.cartesian_min_height),
         ] {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(ScoreError::InvalidParam {
@@ -149,7 +149,7 @@ impl JerkPeakParams {
         }
         if self.slowdown_floor.is_nan() || self.slowdown_floor == f64::INFINITY {
             return Err(ScoreError::InvalidParam {
-                name: "slowdown_floor",
+                name: ScoreParam::SlowdownFloor,
                 value: self.slowdown_floor,
                 reason: "must be finite or -inf",
             });
@@ -332,7 +332,7 @@ mod tests {
         assert!(matches!(
             p.validate(),
             Err(ScoreError::InvalidParam {
-                name: "joint_log_gain",
+                name: ScoreParam::JointLogGain,
                 ..
             })
         ));
@@ -343,7 +343,7 @@ mod tests {
         assert!(matches!(
             p.validate(),
             Err(ScoreError::InvalidParam {
-                name: "cartesian_min_height",
+                name: ScoreParam::CartesianMinHeight,
                 ..
             })
         ));

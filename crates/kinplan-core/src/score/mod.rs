@@ -11,6 +11,7 @@ mod cycle_time;
 mod error;
 mod input;
 mod jerk;
+mod limits;
 mod robot_points;
 mod scoring;
 
@@ -22,11 +23,12 @@ pub use criteria::{
 pub use cycle_time::{
     CycleTime, CycleTimeParams, SegmentTime, TimePotential, cycle_time, ptp_joint_time, ptp_segment_time,
 };
-pub use error::ScoreError;
+pub use error::{ScoreError, ScoreField, ScoreParam};
 pub use input::{JointLimits, QUATERNION_NORM_TOLERANCE, Rows, ScoreInput, Shape, TrajectoryData};
 pub use jerk::{
     JerkPeakParams, Peak, cartesian_slowdown, find_peaks, joint_slowdown, third_derivative,
     third_derivative_weights, third_difference,
 };
+pub use limits::{MissingSpeedLimit, OwnedLimits, limits_for};
 pub use robot_points::{ChainSamples, PointSet, robot_link_points, sample_chain, shape_extreme_points};
-pub use scoring::{ScoreParams, ScoreReport, Series, score};
+pub use scoring::{CountedPeak, ScoreParams, ScoreReport, Series, score};

@@ -206,6 +206,7 @@ pub fn sample_chain(
 mod tests {
     use super::*;
     use crate::robot::builtin_chain;
+    use crate::score::ScoreField;
 
     #[test]
     fn box_corners_and_sphere_poles() {
@@ -261,7 +262,7 @@ mod tests {
         assert!(matches!(
             sample_chain(&chain, Rows::Nested(&q), None),
             Err(ScoreError::NonFinite {
-                field: "joints",
+                field: ScoreField::Joints,
                 index: 1,
                 component: 1,
                 ..

@@ -47,14 +47,27 @@ pub struct Series {
     pub joint_jerk: Vec<f64>,
     /// Cartesian pseudo-jerk `‖Δ³p_i‖`, m (CJ's terms).
     pub cartesian_jerk: Vec<f64>,
-    /// Peaks of `joint_jerk` counted in JJP.
-    pub joint_peaks: Vec<Peak>,
-    /// Peaks of `cartesian_jerk` counted in CJP.
-    pub cartesian_peaks: Vec<Peak>,
+    /// Peaks of `joint_jerk` counted in JJP, with their slowdowns (S0 eq. 2.11).
+    pub joint_peaks: Vec<CountedPeak>,
+    /// Peaks of `cartesian_jerk` counted in CJP, with their slowdowns (S0 eq. 2.12).
+    pub cartesian_peaks: Vec<CountedPeak>,
     /// Time-scaled `Σ_j |q⃛_{i,j}|`, rad/s³; `None` without timestamps.
     pub joint_jerk_rate: Option<Vec<f64>>,
     /// Time-scaled `‖p⃛_i‖`, m/s³; `None` without timestamps.
     pub cartesian_jerk_rate: Option<Vec<f64>>,
+}
+
+/// A jerk peak above its minimum height, counted in JJP or CJP, with the
+/// slowdown it predicts ([`joint_slowdown`] or [`cartesian_slowdown`] of its
+/// height); JJP / CJP are the sums of these slowdowns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CountedPeak {
+    /// Waypoint index of the peak.
+    pub index: usize,
+    /// Peak height `P` (rad summed over joints, or m).
+    pub height: f64,
+    /// Predicted slowdown at the peak.
+    pub slowdown: f64,
 }
 
 impl Series {
@@ -265,20 +278,30 @@ pub fn score(input: &ScoreInput<'_>, params: &ScoreParams) -> Result<ScoreReport
 
 fn count_joint_peak(s: &mut Scores, series: Option<&mut Series>, p: Peak, pk: &JerkPeakParams) {
     if p.height > pk.joint_min_height {
-        s.jjp += joint_slowdown(p.height, pk);
+        let slowdown = joint_slowdown(p.height, pk);
+        s.jjp += slowdown;
         s.joint_peak_count += 1;
         if let Some(se) = series {
-            se.joint_peaks.push(p);
+            se.joint_peaks.push(CountedPeak {
+                index: p.index,
+                height: p.height,
+                slowdown,
+            });
         }
     }
 }
 
 fn count_cartesian_peak(s: &mut Scores, series: Option<&mut Series>, p: Peak, pk: &JerkPeakParams) {
     if p.height > pk.cartesian_min_height {
-        s.cjp += cartesian_slowdown(p.height, pk);
+        let slowdown = cartesian_slowdown(p.height, pk);
+        s.cjp += slowdown;
         s.cartesian_peak_count += 1;
         if let Some(se) = series {
-            se.cartesian_peaks.push(p);
+            se.cartesian_peaks.push(CountedPeak {
+                index: p.index,
+                height: p.height,
+                slowdown,
+            });
         }
     }
 }

@@ -109,7 +109,7 @@ pub async fn collision_setup(
             Ok(setup)
         })
         .await?
-        .map_err(|e: CollisionError| super::status::invalid("robot", e.to_string()))
+        .map_err(|e: CollisionError| super::status::collision::collision_error("robot", e))
 }
 
 #[cfg(test)]

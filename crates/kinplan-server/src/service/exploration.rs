@@ -12,8 +12,10 @@ use super::kinematics::soft_deadline;
 use super::pb::{self, exploration_service_server::ExplorationService};
 use super::server::Shared;
 use super::status::invalid;
+use super::status::nbv::nbv_error;
+use super::status::octree::octree_error;
 use kinplan_core::nbv::next_best_view;
-use kinplan_core::octree::{Octree, OctreeError, OctreeLimits, PinholeIntrinsics, ScanParams, ScanStatus};
+use kinplan_core::octree::{Octree, OctreeLimits, PinholeIntrinsics, ScanParams, ScanStatus};
 
 /// Largest tree a request may carry or grow, in nodes (about 8 bytes per
 /// node plus 68 per inner node: a few hundred MB at worst).
@@ -32,15 +34,6 @@ fn octree_in(field: &str, tree: Option<&pb::Octree>) -> Result<Octree, Status> {
     };
     Octree::from_message_data(t.binary, &t.id, t.resolution, &t.data, &limits())
         .map_err(|e| octree_error(field, e))
-}
-
-fn octree_error(field: &str, e: OctreeError) -> Status {
-    match e {
-        OctreeError::TooManyNodes { .. } | OctreeError::ScanTooLarge { .. } => {
-            super::status::too_large(field, e.to_string())
-        }
-        _ => invalid(field, e.to_string()),
-    }
 }
 
 pub struct ExplorationApi {
@@ -110,7 +103,7 @@ impl ExplorationService for ExplorationApi {
                 let result = next_best_view(&tree, &params, &camera, &camera_pose, chain.as_deref(), &|| {
                     b.should_stop()
                 })
-                .map_err(|e| invalid("options", e.to_string()))?;
+                .map_err(|e| nbv_error("options", e))?;
                 Ok(nbv_response(result))
             })
             .await??;
@@ -168,7 +161,7 @@ impl ExplorationService for ExplorationApi {
             .run(&budget, move |b| -> Result<pb::InsertScanResponse, Status> {
                 let mut tree = match &existing {
                     Some(t) => octree_in("octree", Some(t))?,
-                    None => Octree::new(resolution).map_err(|e| invalid("resolution", e.to_string()))?,
+                    None => Octree::new(resolution).map_err(|e| octree_error("resolution", e))?,
                 };
                 let stop = || b.should_stop();
                 let stats = match &scan {
@@ -237,7 +230,7 @@ impl ExplorationService for ExplorationApi {
                 let volumes = match bounds.or_else(|| tree.known_bounds()) {
                     Some((min, max)) => Some(
                         tree.volumes_in_box(&min, &max)
-                            .map_err(|e| invalid("box", e.to_string()))?,
+                            .map_err(|e| octree_error("box", e))?,
                     ),
                     None => None,
                 };

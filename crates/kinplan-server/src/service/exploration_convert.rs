@@ -8,6 +8,7 @@ use super::convert::{finite, optional_seconds, pose_in, vec3_in, vec3_out};
 use super::exploration::box_in;
 use super::pb;
 use super::status::invalid;
+use super::status::nbv::nbv_error;
 use kinplan_core::nbv::{CameraModel, GainMethod, NbvParams, NbvResult, NbvStatus, Weights};
 use kinplan_core::octree::Octree;
 
@@ -27,7 +28,7 @@ pub fn camera_in(c: Option<&pb::CameraModel>) -> Result<CameraModel, Status> {
         width: c.width.map_or(d.width, |v| v as usize),
         height: c.height.map_or(d.height, |v| v as usize),
     };
-    camera.validate().map_err(|e| invalid("camera", e.to_string()))?;
+    camera.validate().map_err(|e| nbv_error("camera", e))?;
     Ok(camera)
 }
 
@@ -123,7 +124,7 @@ pub fn nbv_params_in(req: &pb::NextBestViewRequest) -> Result<NbvParams, Status>
         time_budget,
         seed: o.seed,
     };
-    params.validate().map_err(|e| invalid("options", e.to_string()))?;
+    params.validate().map_err(|e| nbv_error("options", e))?;
     Ok(params)
 }
 

@@ -19,21 +19,13 @@ use super::kinematics::soft_deadline;
 use super::pb;
 use super::scene::scene_in;
 use super::server::Shared;
+use super::status::collision::collision_error;
+use super::status::explore::explore_error;
 use super::status::invalid;
 use kinplan_core::collision::{SceneGeometry, SceneLimits};
-use kinplan_core::explore::{ExploreControl, ExploreError, ExploreStep, ExploreWorld, explore};
+use kinplan_core::explore::{ExploreControl, ExploreStep, ExploreWorld, explore};
 
 pub type ExploreStream = ReceiverStream<Result<pb::ExploreResponse, Status>>;
-
-fn explore_error(e: ExploreError) -> Status {
-    match e {
-        ExploreError::InvalidParam { field, reason } => invalid(field.name(), reason),
-        ExploreError::Nbv(e) => invalid("nbv", e.to_string()),
-        ExploreError::Plan(e) => invalid("plan_options", e.to_string()),
-        ExploreError::Collision(e) => invalid("scene", e.to_string()),
-        ExploreError::Octree(e) => invalid("resolution", e.to_string()),
-    }
-}
 
 /// Starts the loop and returns the stream of its messages.
 pub async fn explore_stream(
@@ -64,8 +56,7 @@ pub async fn explore_stream(
         let run_budget = budget.clone();
         let outcome = compute
             .run(&run_budget, move |b| -> Result<pb::ExploreResponse, Status> {
-                let truth =
-                    Arc::new(SceneGeometry::build(&scene).map_err(|e| invalid("scene", e.to_string()))?);
+                let truth = Arc::new(SceneGeometry::build(&scene).map_err(|e| collision_error("scene", e))?);
                 let chain = robot.chain.clone();
                 let world = ExploreWorld {
                     chain: &chain,

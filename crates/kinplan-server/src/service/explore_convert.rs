@@ -122,7 +122,9 @@ pub fn explore_params_in(
         ));
     }
     p.validate(dof).map_err(|e| match e {
-        kinplan_core::explore::ExploreError::InvalidParam { field, reason } => invalid(field.name(), reason),
+        e @ kinplan_core::explore::ExploreError::InvalidParam { .. } => {
+            super::status::explore::explore_error(e)
+        }
         e => invalid("nbv", e.to_string()),
     })?;
     Ok((p, optional_seconds("time_budget", req.time_budget)?))

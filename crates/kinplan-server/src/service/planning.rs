@@ -17,13 +17,15 @@ use super::convert::vec3_out;
 use super::kinematics::soft_deadline;
 use super::pb::{self, planning_service_server::PlanningService};
 use super::planning_convert::{
-    PlanInput, colliding_out, pair_name, plan_error, plan_input, plan_response, trajectory_out,
+    PlanInput, colliding_out, pair_name, plan_input, plan_response, trajectory_out,
 };
 use super::scene::scene_in;
 use super::server::Shared;
+use super::status::collision::{checker_error, collision_error, collision_internal};
 use super::status::invalid;
+use super::status::plan::plan_error;
 use super::{Budget, models::Resolved};
-use kinplan_core::collision::{CheckerParams, CollisionError, SceneChecker, SceneGeometry, SceneLimits};
+use kinplan_core::collision::{CheckerParams, SceneChecker, SceneGeometry, SceneLimits};
 use kinplan_core::plan::{Goal, IterationReport, PlanControl, PlanStatus, plan};
 
 /// Most states one CheckState request may ask about.
@@ -87,7 +89,7 @@ fn run_plan<'a>(
     progress: Option<&'a mut dyn FnMut(&IterationReport<'_>)>,
     started: Instant,
 ) -> Result<pb::PlanResponse, Status> {
-    let world = Arc::new(SceneGeometry::build(&p.scene).map_err(|e| invalid("scene", e.to_string()))?);
+    let world = Arc::new(SceneGeometry::build(&p.scene).map_err(|e| collision_error("scene", e))?);
     let checker = checker_for(&p.setup, world, p.input.checker)?;
     let chain = &p.robot.chain;
     let result = plan(
@@ -123,13 +125,7 @@ fn checker_for(
     world: Arc<SceneGeometry>,
     params: CheckerParams,
 ) -> Result<SceneChecker, Status> {
-    SceneChecker::new(setup.model.clone(), &setup.acm, world, params).map_err(|e| match e {
-        CollisionError::CannotPad => invalid("options.padded_motion", e.to_string()),
-        e => {
-            tracing::error!(error = %e, "collision checker rejected service-built input");
-            Status::internal(format!("collision checker: {e}"))
-        }
-    })
+    SceneChecker::new(setup.model.clone(), &setup.acm, world, params).map_err(checker_error)
 }
 
 #[tonic::async_trait]
@@ -241,8 +237,7 @@ impl PlanningService for PlanningApi {
             .shared
             .compute
             .run(&budget, move |b| -> Result<Vec<pb::StateCheck>, Status> {
-                let world =
-                    Arc::new(SceneGeometry::build(&scene).map_err(|e| invalid("scene", e.to_string()))?);
+                let world = Arc::new(SceneGeometry::build(&scene).map_err(|e| collision_error("scene", e))?);
                 let checker = checker_for(&setup, world, CheckerParams::default())?;
                 let mut out = Vec::with_capacity(req.states.len());
                 for (i, s) in req.states.iter().enumerate() {
@@ -262,9 +257,8 @@ impl PlanningService for PlanningApi {
 
 /// Validity, clearance and witness points of one state.
 fn check_one(checker: &SceneChecker, q: &[f64], max_distance: f64) -> Result<pb::StateCheck, Status> {
-    let internal = |e: kinplan_core::collision::CollisionError| Status::internal(e.to_string());
-    let report = checker.report(q).map_err(internal)?;
-    let nearest = checker.proximity(q, max_distance).map_err(internal)?;
+    let report = checker.report(q).map_err(collision_internal)?;
+    let nearest = checker.proximity(q, max_distance).map_err(collision_internal)?;
     let (clearance, robot_point, obstacle_point, closest_pair) = match &nearest {
         Some(p) => (
             p.distance,

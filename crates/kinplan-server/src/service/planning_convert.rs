@@ -9,9 +9,7 @@ use super::convert::{finite, optional_seconds, pose_in};
 use super::pb;
 use super::status::invalid;
 use kinplan_core::collision::{CheckerParams, Part, StateReport};
-use kinplan_core::plan::{
-    Algorithm, Goal, InitialTrajectory, PlanError, PlanField, PlanRequest, PlanResult, PlanStatus,
-};
+use kinplan_core::plan::{Algorithm, Goal, InitialTrajectory, PlanRequest, PlanResult, PlanStatus};
 use kinplan_core::robot::Chain;
 
 /// Largest RRT-Connect sample budget (each sample may add a tree node).
@@ -38,7 +36,7 @@ fn number(field: &str, v: Option<f64>, default: f64) -> Result<f64, Status> {
 
 /// Converts and checks what only the service knows (oneofs, enums, the time
 /// budget, the motion resolution); ranges of the planners' parameters are
-/// checked by the domain's `validate`, mapped by [`plan_error`].
+/// checked by the domain's `validate`, mapped by [`plan_error`](super::status::plan::plan_error).
 pub fn plan_input(req: &pb::PlanRequest) -> Result<PlanInput, Status> {
     let mut request = PlanRequest {
         start: req.start.clone(),
@@ -190,10 +188,11 @@ pub fn plan_input(req: &pb::PlanRequest) -> Result<PlanInput, Status> {
 
     let mut checker = CheckerParams::default();
     if let Some(res) = options.motion_resolution {
-        if !(res.is_finite() && res > 0.0 && res <= 0.05) {
+        let max = CheckerParams::MAX_MOTION_RESOLUTION;
+        if !(res.is_finite() && res > 0.0 && res <= max) {
             return Err(invalid(
                 "options.motion_resolution",
-                format!("must be in (0, 0.05] rad, got {res}"),
+                format!("must be in (0, {max}] rad, got {res}"),
             ));
         }
         checker.motion_resolution = res;
@@ -206,64 +205,6 @@ pub fn plan_input(req: &pb::PlanRequest) -> Result<PlanInput, Status> {
         time_budget,
         return_cost_history: options.return_cost_history,
     })
-}
-
-/// The request field a plan-room parameter comes from.
-fn plan_field(field: PlanField) -> &'static str {
-    match field {
-        PlanField::Start => "start",
-        PlanField::GoalJoints => "goal_joints.positions",
-        PlanField::GoalPose => "goal_pose",
-        PlanField::Timesteps => "options.stomp.timesteps",
-        PlanField::Rollouts => "options.stomp.rollouts",
-        PlanField::MaxRollouts => "options.stomp.max_rollouts",
-        PlanField::MaxIterations => "options.stomp.max_iterations",
-        PlanField::IterationsAfterValid => "options.stomp.iterations_after_valid",
-        PlanField::NoiseStddev => "options.stomp.noise_stddev",
-        PlanField::CostSensitivity => "options.stomp.cost_sensitivity",
-        PlanField::ControlCostWeight => "options.stomp.control_cost_weight",
-        PlanField::CollisionPenalty => "options.stomp.collision_penalty",
-        PlanField::KernelHalfWidth => "options.stomp.kernel_half_width",
-        PlanField::ClearanceDistance => "options.stomp.clearance_distance",
-        PlanField::ClearanceWeight => "options.stomp.clearance_weight",
-        PlanField::JointLimitWeight => "options.stomp.joint_limit_weight",
-        PlanField::TranslationTolerance => "options.cartesian.translation_tolerance",
-        PlanField::RotationTolerance => "options.cartesian.rotation_tolerance",
-        PlanField::TranslationWeight => "options.cartesian.translation_weight",
-        PlanField::RotationWeight => "options.cartesian.rotation_weight",
-        PlanField::TranslationStddev => "options.cartesian.translation_stddev",
-        PlanField::RotationStddev => "options.cartesian.rotation_stddev",
-        PlanField::ViolationPenalty => "options.cartesian.violation_penalty",
-        PlanField::IkIterations => "options.cartesian.ik_iterations",
-        PlanField::RrtRange => "options.rrt_connect.range",
-        PlanField::RrtMaxSamples => "options.rrt_connect.max_samples",
-        PlanField::ShortcutAttempts => "options.rrt_connect.shortcut_attempts",
-        // not exposed in the proto; named as the core names it
-        PlanField::ShortcutResolution => "rrt.shortcut_resolution",
-        PlanField::VelocityLimits => "options.timing.max_velocity",
-        PlanField::AccelerationLimits => "options.timing.max_acceleration",
-        PlanField::VelocityScale => "options.timing.velocity_scale",
-    }
-}
-
-/// INVALID_ARGUMENT naming the request field behind a refused plan; INTERNAL
-/// for what the service itself built wrong.
-pub fn plan_error(err: PlanError) -> Status {
-    let text = err.to_string();
-    match err {
-        PlanError::EmptyChain => invalid("robot", text),
-        PlanError::WrongLength { field, .. } | PlanError::InvalidParam { field, .. } => {
-            invalid(plan_field(field), text)
-        }
-        PlanError::NonFinite { field, index } => match field {
-            PlanField::GoalPose => invalid(plan_field(field), text),
-            _ => invalid(format!("{}[{index}]", plan_field(field)), text),
-        },
-        PlanError::CheckerDof { .. } | PlanError::GoalIk(_) => {
-            tracing::error!(error = %text, "planning rejected service-built input");
-            Status::internal(format!("planning failed on service-built input: {text}"))
-        }
-    }
 }
 
 fn status_out(s: PlanStatus) -> pb::PlanStatus {

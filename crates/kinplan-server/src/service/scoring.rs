@@ -13,11 +13,12 @@ use tonic::{Request, Response, Status};
 use super::Budget;
 use super::pb::{self, scoring_service_server::ScoringService};
 use super::server::Shared;
+use super::status::score::{TrajectoryAt, score_error};
 use super::status::{invalid, too_large};
 use kinplan_core::robot::Chain;
 use kinplan_core::score::{
-    self, CycleTime, CycleTimeParams, JerkPeakParams, JointLimits, LabelledSet, PointSet, Rows, ScoreError,
-    ScoreInput, ScoreParams, ScoreReport, Scores, Series, TrajectoryData, cartesian_slowdown, joint_slowdown,
+    self, CountedPeak, CycleTime, CycleTimeParams, JerkPeakParams, LabelledSet, OwnedLimits, PointSet, Rows,
+    ScoreError, ScoreInput, ScoreParams, ScoreReport, Scores, Series, TrajectoryData,
 };
 
 /// Requests whose estimated cost (waypoints × (1 + robot points per
@@ -108,9 +109,10 @@ impl ScoringService for ScoringApi {
         let mut reply = self
             .run(&budget, cost, move |_| {
                 let options = Options::from_proto(req.options.as_ref(), &chain)?;
-                let trajectory = Trajectory::from_proto(req.trajectory, &chain, "trajectory")?;
+                let at = TrajectoryAt::Single;
+                let trajectory = Trajectory::from_proto(req.trajectory, &chain, at)?;
                 let report = score_one(&chain, &trajectory, &options, options.series)
-                    .map_err(|e| score_error(e, "trajectory"))?;
+                    .map_err(|e| score_error(e, at))?;
                 Ok(score_reply(report, &options))
             })
             .await?;
@@ -168,8 +170,8 @@ struct Options {
     weights: Option<Vec<f64>>,
     series: bool,
     points: Option<PointSet>,
-    /// `(v_max, a_max)`, or why the cycle time is unavailable.
-    limits: Result<(Vec<f64>, Option<Vec<f64>>), String>,
+    /// The cycle time's joint limits, or why the cycle time is unavailable.
+    limits: Result<OwnedLimits, String>,
     params: ScoreParams,
 }
 
@@ -206,22 +208,8 @@ impl Options {
                 ));
             }
         }
-        let limits = if !o.max_velocity.is_empty() {
-            Ok(o.max_velocity)
-        } else {
-            chain
-                .joints()
-                .iter()
-                .map(|j| match j.max_velocity {
-                    Some(v) if v.is_finite() && v > 0.0 => Ok(v),
-                    _ => Err(format!(
-                        "joint {:?} has no speed limit in the model; pass options.max_velocity",
-                        j.name
-                    )),
-                })
-                .collect()
-        }
-        .map(|v| (v, (!o.max_acceleration.is_empty()).then_some(o.max_acceleration)));
+        let limits = score::limits_for(chain, o.max_velocity, o.max_acceleration)
+            .map_err(|missing| format!("{missing}; pass options.max_velocity"));
         let d = JerkPeakParams::default();
         let jp = o.jerk_peaks.unwrap_or_default();
         let peaks = JerkPeakParams {
@@ -265,7 +253,8 @@ struct Trajectory {
 }
 
 impl Trajectory {
-    fn from_proto(t: Option<pb::JointTrajectory>, chain: &Chain, field: &str) -> Result<Self, Status> {
+    fn from_proto(t: Option<pb::JointTrajectory>, chain: &Chain, at: TrajectoryAt) -> Result<Self, Status> {
+        let field = at.to_string();
         let Some(t) = t else {
             return Err(invalid(field, "is required"));
         };
@@ -326,10 +315,7 @@ fn score_one(
         },
         dof: Some(chain.dof()),
         joint_weights: options.weights.as_deref(),
-        limits: options.limits.as_ref().ok().map(|(v, a)| JointLimits {
-            v_max: v,
-            a_max: a.as_deref(),
-        }),
+        limits: options.limits.as_ref().ok().map(OwnedLimits::as_limits),
     };
     let params = ScoreParams {
         series,
@@ -358,7 +344,7 @@ fn score_reply(report: ScoreReport, options: &Options) -> pb::ScoreTrajectoryRes
             jmj: t.jmj,
             cmj: t.cmj,
         }),
-        series: report.series.map(|se| series_out(se, &options.params.peaks)),
+        series: report.series.map(series_out),
         model_id: Vec::new(),
     }
 }
@@ -388,7 +374,15 @@ fn cycle_time_out(c: &CycleTime) -> pb::CycleTime {
     }
 }
 
-fn series_out(s: Series, peaks: &JerkPeakParams) -> pb::ScoreSeries {
+fn peak_out(p: &CountedPeak) -> pb::JerkPeak {
+    pb::JerkPeak {
+        index: p.index as u32,
+        height: p.height,
+        slowdown: p.slowdown,
+    }
+}
+
+fn series_out(s: Series) -> pb::ScoreSeries {
     pb::ScoreSeries {
         cd: s.cd,
         jd: s.jd,
@@ -397,24 +391,8 @@ fn series_out(s: Series, peaks: &JerkPeakParams) -> pb::ScoreSeries {
         rdm: s.rdm.unwrap_or_default(),
         joint_jerk: s.joint_jerk,
         cartesian_jerk: s.cartesian_jerk,
-        joint_peaks: s
-            .joint_peaks
-            .iter()
-            .map(|p| pb::JerkPeak {
-                index: p.index as u32,
-                height: p.height,
-                slowdown: joint_slowdown(p.height, peaks),
-            })
-            .collect(),
-        cartesian_peaks: s
-            .cartesian_peaks
-            .iter()
-            .map(|p| pb::JerkPeak {
-                index: p.index as u32,
-                height: p.height,
-                slowdown: cartesian_slowdown(p.height, peaks),
-            })
-            .collect(),
+        joint_peaks: s.joint_peaks.iter().map(peak_out).collect(),
+        cartesian_peaks: s.cartesian_peaks.iter().map(peak_out).collect(),
         joint_jerk_rate: s.joint_jerk_rate.unwrap_or_default(),
         cartesian_jerk_rate: s.cartesian_jerk_rate.unwrap_or_default(),
     }
@@ -437,9 +415,9 @@ fn compare_sets(
                     "the request's deadline passed before the work finished",
                 ));
             }
-            let field = format!("sets[{k}].trajectories[{i}]");
-            let t = Trajectory::from_proto(Some(t), chain, &field)?;
-            let report = score_one(chain, &t, &options, false).map_err(|e| score_error(e, &field))?;
+            let at = TrajectoryAt::InSet { set: k, index: i };
+            let t = Trajectory::from_proto(Some(t), chain, at)?;
+            let report = score_one(chain, &t, &options, false).map_err(|e| score_error(e, at))?;
             set_scores.push(report.scores);
         }
         labels.push(set.label);
@@ -451,7 +429,7 @@ fn compare_sets(
         .map(|(label, scores)| LabelledSet { label, scores })
         .collect();
     // Empty sets and repeated labels were rejected before scoring.
-    let comparison = score::compare(&sets).map_err(|e| score_error(e, "sets"))?;
+    let comparison = score::compare(&sets).map_err(|e| score_error(e, TrajectoryAt::Single))?;
     let criteria = score::Criterion::ALL
         .into_iter()
         .filter(|c| comparison.sets.iter().any(|s| s.get(*c).is_some()))
@@ -496,116 +474,4 @@ fn compare_sets(
         cycle_time_unavailable: options.unavailable(),
         model_id: Vec::new(),
     })
-}
-
-/// INVALID_ARGUMENT naming the request field behind a [`ScoreError`];
-/// `trajectory` is the path of the trajectory being scored
-/// (`trajectory`, `sets[1].trajectories[4]`).
-fn score_error(err: ScoreError, trajectory: &str) -> Status {
-    let text = err.to_string();
-    let option = |field: &str| match field {
-        "joint_weights" => "options.joint_weights",
-        "v_max" => "options.max_velocity",
-        "a_max" => "options.max_acceleration",
-        _ => "",
-    };
-    let field = match &err {
-        ScoreError::RaggedRow { index, .. } | ScoreError::WrongJointCount { index, .. } => {
-            format!("{trajectory}.points[{index}].positions")
-        }
-        ScoreError::NoJoints => format!("{trajectory}.points"),
-        ScoreError::NonFinite {
-            field: "joints",
-            index,
-            component,
-            ..
-        } => format!("{trajectory}.points[{index}].positions[{component}]"),
-        ScoreError::NonFinite {
-            field: "timestamps",
-            index,
-            ..
-        }
-        | ScoreError::NonIncreasingTimestamp { index, .. } => {
-            format!("{trajectory}.points[{index}].time_from_start")
-        }
-        ScoreError::LengthMismatch { field, .. } if !option(field).is_empty() => option(field).to_string(),
-        ScoreError::InvalidValue { field, index, .. } if !option(field).is_empty() => {
-            format!("{}[{index}]", option(field))
-        }
-        ScoreError::InvalidParam {
-            name: "potential_tolerance",
-            ..
-        } => "options.potential_tolerance".to_string(),
-        ScoreError::InvalidParam { name, .. } => format!("options.jerk_peaks.{name}"),
-        ScoreError::EmptySet { .. } | ScoreError::DuplicateLabel { .. } => "sets".to_string(),
-        // Poses and robot points come from FK of validated joints.
-        _ => {
-            tracing::error!(error = %text, "scoring rejected derived data");
-            return Status::internal(format!("scoring failed on derived data: {text}"));
-        }
-    };
-    invalid(field, text)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn errors_name_request_fields() {
-        let cases = [
-            (
-                ScoreError::WrongJointCount {
-                    index: 12,
-                    expected: 6,
-                    found: 5,
-                },
-                "trajectory.points[12].positions",
-            ),
-            (
-                ScoreError::NonFinite {
-                    field: "joints",
-                    index: 3,
-                    component: 1,
-                    value: f64::NAN,
-                },
-                "trajectory.points[3].positions[1]",
-            ),
-            (
-                ScoreError::NonIncreasingTimestamp {
-                    index: 2,
-                    previous: 1.0,
-                    value: 1.0,
-                },
-                "trajectory.points[2].time_from_start",
-            ),
-            (
-                ScoreError::InvalidValue {
-                    field: "joint_weights",
-                    index: 1,
-                    value: -1.0,
-                    reason: "",
-                },
-                "options.joint_weights[1]",
-            ),
-            (
-                ScoreError::InvalidParam {
-                    name: "joint_log_gain",
-                    value: f64::NAN,
-                    reason: "",
-                },
-                "options.jerk_peaks.joint_log_gain",
-            ),
-        ];
-        for (err, field) in cases {
-            let status = score_error(err, "trajectory");
-            assert_eq!(status.code(), tonic::Code::InvalidArgument);
-            assert!(status.message().starts_with(field), "{}", status.message());
-        }
-        let derived = score_error(
-            ScoreError::NonUnitQuaternion { index: 0, norm: 2.0 },
-            "trajectory",
-        );
-        assert_eq!(derived.code(), tonic::Code::Internal);
-    }
 }

@@ -3,7 +3,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{LinalgError, LinearSolution, SolveStatus};
+use super::{LinalgError, LinalgParam, LinearSolution, Operand, SolveStatus};
 
 mod fixed;
 mod svd;
@@ -33,7 +33,7 @@ impl PseudoinverseParams {
     pub fn validate(&self) -> Result<(), LinalgError> {
         if !self.relative_tolerance.is_finite() || self.relative_tolerance < 0.0 {
             return Err(LinalgError::InvalidParam {
-                field: "relative_tolerance",
+                field: LinalgParam::SingularValueTolerance,
                 value: self.relative_tolerance,
                 reason: "must be finite and >= 0",
             });
@@ -55,10 +55,10 @@ pub(crate) fn check_system(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<(), Lin
         });
     }
     if a.iter().any(|v| !v.is_finite()) {
-        return Err(LinalgError::NonFinite { what: "A" });
+        return Err(LinalgError::NonFinite { what: Operand::A });
     }
     if b.iter().any(|v| !v.is_finite()) {
-        return Err(LinalgError::NonFinite { what: "b" });
+        return Err(LinalgError::NonFinite { what: Operand::B });
     }
     Ok(())
 }

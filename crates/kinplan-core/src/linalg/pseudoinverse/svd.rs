@@ -4,7 +4,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::super::LinalgError;
+use super::super::{LinalgError, LinalgParam};
 use super::{PseudoinverseParams, check_system};
 
 /// Reusable buffers for a one-sided (Hestenes) Jacobi SVD of an m×n matrix, so a
@@ -304,7 +304,7 @@ impl SvdWorkspace {
         check_system(a, b)?;
         if !damping.is_finite() || damping < 0.0 {
             return Err(LinalgError::InvalidParam {
-                field: "damping",
+                field: LinalgParam::Damping,
                 value: damping,
                 reason: "must be finite and >= 0",
             });

@@ -29,6 +29,66 @@ fn sweep_counts_are_pinned() {
     assert_eq!(got, PINNED_SWEEPS);
 }
 
+/// Reference sweep count of the fixed-size path, derived without its norm cache:
+/// the same cyclic one-sided Jacobi method (cold start, `W = Â`, round-robin pair
+/// order, stop after a sweep without rotation) with every `‖wᵢ‖²`, `‖wⱼ‖²`, `wᵢᵀwⱼ`
+/// recomputed from the columns before each pair and the rotation in the textbook
+/// `ζ` form ([`jacobi_rotation`](super::svd::jacobi_rotation)).
+fn reference_fixed_sweeps(a: &DMatrix<f64>) -> usize {
+    let (m, n) = a.shape();
+    let at = if m < n { a.transpose() } else { a.clone() };
+    let k = at.ncols();
+    let mut w: Vec<Vec<f64>> = (0..k).map(|j| at.column(j).iter().copied().collect()).collect();
+    let negligible = f64::EPSILON * f64::EPSILON * a.norm_squared();
+    let tol2 = SvdWorkspace::DEFAULT_ORTHOGONALITY * SvdWorkspace::DEFAULT_ORTHOGONALITY;
+    let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(p, q)| p * q).sum::<f64>();
+    for sweep in 1..=super::svd::MAX_SWEEPS {
+        let mut rotated = false;
+        for &(i, j) in &ROUND_ROBIN[k][..k * k.saturating_sub(1) / 2] {
+            let (i, j) = (i as usize, j as usize);
+            let (alpha, beta, gamma) = (dot(&w[i], &w[i]), dot(&w[j], &w[j]), dot(&w[i], &w[j]));
+            if alpha <= negligible || beta <= negligible || gamma * gamma <= tol2 * alpha * beta {
+                continue;
+            }
+            let Some((c, s)) = super::svd::jacobi_rotation(alpha, beta, gamma, negligible, 0.0) else {
+                continue;
+            };
+            rotated = true;
+            for r in 0..w[i].len() {
+                let (x, y) = (w[i][r], w[j][r]);
+                w[i][r] = c * x - s * y;
+                w[j][r] = s * x + c * y;
+            }
+        }
+        if !rotated {
+            return sweep;
+        }
+    }
+    super::svd::MAX_SWEEPS
+}
+
+/// The fixed-size kernel caches squared column norms across a sweep; a wrong
+/// update (stale, or with the sign of `tγ` flipped) still converges, only in more
+/// sweeps, so the answers alone would not show it. Its sweep counts must equal
+/// those of the cache-free reference on every small shape.
+#[test]
+fn fixed_path_sweeps_match_a_cache_free_reference() {
+    let mut compared = 0;
+    for m in 1..=MAX_FIXED {
+        for n in 1..=MAX_FIXED {
+            for seed in 0..4u64 {
+                let a = lcg_matrix(m, n, seed * 1000 + (m * 10 + n) as u64);
+                let mut ws = SvdWorkspace::new(m, n);
+                let got = ws.decompose(&a);
+                let want = reference_fixed_sweeps(&a);
+                assert_eq!(got, want, "{m}x{n} seed {seed}");
+                compared += usize::from(m.min(n) >= 3);
+            }
+        }
+    }
+    assert!(compared > 100);
+}
+
 #[test]
 fn jacobi_matches_nalgebra_singular_values() {
     for (m, n) in [(6, 6), (6, 7), (3, 6), (13, 7), (2, 9), (9, 2)] {
@@ -292,7 +352,9 @@ fn bad_inputs_are_errors() {
     let p = PseudoinverseParams::default();
     assert!(matches!(
         solve_pseudoinverse(&a, &b, &p),
-        Err(LinalgError::NonFinite { what: "A" })
+        Err(LinalgError::NonFinite {
+            what: crate::linalg::Operand::A
+        })
     ));
     let a = DMatrix::identity(2, 2);
     let b3 = DVector::from_vec(vec![1.0, 2.0, 3.0]);

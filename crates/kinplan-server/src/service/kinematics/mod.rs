@@ -21,14 +21,16 @@ use tonic::{Request, Response, Status, Streaming};
 use super::convert::{finite_slice, matrix_in, pose_in, pose_out, vec3_in};
 use super::pb::{self, kinematics_service_server::KinematicsService};
 use super::server::Shared;
+use super::status::ik::{IkAt, PathAt, ik_error};
+use super::status::linalg::{SolveAt, linalg_error};
 use super::status::{invalid, robot_error, too_large};
 use super::{Budget, Compute, ModelStore};
 use kinplan_core::ik::{
-    BatchSeeds, IkError, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
+    BatchSeeds, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
     JointLimitMode, TrackParams, TrackResult, circle_path, line_path, solve_ik, solve_ik_batch, track_path,
 };
 use kinplan_core::linalg::{
-    LinalgError, LinearSolution, LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus,
+    LinearSolution, LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus,
     solve_angle_relaxation_until, solve_pseudoinverse,
 };
 use kinplan_core::robot::Chain;
@@ -70,10 +72,12 @@ pub const MAX_LINEAR_ENTRY: f64 = 1e100;
 /// Most RLXA iterations inside one IK iteration (`options.rlxa_max_iterations`):
 /// the IK loop checks its deadline between iterations.
 pub const MAX_IK_RLXA_ITERATIONS: u32 = 100_000;
-/// Default random restarts of `SolveIk` and `SolveIkBatch` (the domain default).
-const RESTARTS_SOLVE: usize = 200;
-/// Default random restarts of `TrackPath` and `StreamIk`: stay on the seed's branch.
-const RESTARTS_WARM: usize = 0;
+/// Default random restarts of `SolveIk` and `SolveIkBatch`: the domain's
+/// (`IkParams::default().max_restarts`).
+const RESTARTS_SOLVE: Option<usize> = None;
+/// Default random restarts of `TrackPath` and `StreamIk`: none, to stay on the
+/// seed's branch.
+const RESTARTS_WARM: Option<usize> = Some(0);
 
 pub struct KinematicsApi {
     shared: Shared,
@@ -117,7 +121,7 @@ impl KinematicsService for KinematicsApi {
                 )
             })
             .await?
-            .map_err(|e| ik_error(e, "target", ""))?;
+            .map_err(|e| ik_error(e, IkAt::Target))?;
         let mut reply = result_out(result);
         reply.model_id = robot.model_id;
         Ok(Response::new(reply))
@@ -214,7 +218,7 @@ impl KinematicsService for KinematicsApi {
                     .into_iter()
                     .enumerate()
                     .map(|(i, r)| {
-                        let mut r = r.map_err(|e| ik_error(e, &format!("targets[{i}]"), ""))?;
+                        let mut r = r.map_err(|e| ik_error(e, IkAt::Batch(i)))?;
                         if late {
                             relabel_cancelled(&mut r);
                         }
@@ -273,7 +277,7 @@ impl KinematicsService for KinematicsApi {
                 })
             })
             .await?
-            .map_err(|e| ik_error(e, path_field, path_field))?;
+            .map_err(|e| ik_error(e, IkAt::Path(path_field)))?;
         Ok(Response::new(track_out(result, &poses, robot.model_id)))
     }
 
@@ -347,7 +351,7 @@ impl KinematicsService for KinematicsApi {
                 };
                 params
                     .validate()
-                    .map_err(|e| invalid("singular_value_tolerance", e.to_string()))?;
+                    .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
                 LinearSolve::Svd(params)
             }
             Some(variant) => {
@@ -364,7 +368,9 @@ impl KinematicsService for KinematicsApi {
                     record_history: req.record_history,
                     ..d
                 };
-                params.validate().map_err(|e| linalg_error(e, ""))?;
+                params
+                    .validate()
+                    .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
                 if params.record_history && params.max_iterations > MAX_LINEAR_HISTORY {
                     return Err(too_large(
                         "max_iterations",
@@ -404,7 +410,7 @@ impl KinematicsService for KinematicsApi {
                 s.map(|s| (s, start.elapsed()))
             })
             .await?
-            .map_err(|e| linalg_error(e, ""))?;
+            .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
         Ok(Response::new(linear_out(solution, elapsed)))
     }
 }

@@ -21,7 +21,11 @@ pub(super) struct Options {
 impl Options {
     /// Unset fields take the documented defaults; ranges are checked by
     /// [`IkParams::validate`], whose field names are the proto's.
-    pub(super) fn from_proto(o: Option<&pb::IkOptions>, default_restarts: usize) -> Result<Self, Status> {
+    /// `default_restarts` replaces the domain's default restart count when set.
+    pub(super) fn from_proto(
+        o: Option<&pb::IkOptions>,
+        default_restarts: Option<usize>,
+    ) -> Result<Self, Status> {
         let o = o.cloned().unwrap_or_default();
         let d = IkParams::default();
         let method = match pb::IkMethod::try_from(o.method) {
@@ -91,14 +95,16 @@ impl Options {
             max_step: o.max_step.unwrap_or(d.max_step),
             rlxa,
             joint_limits,
-            max_restarts: o.max_restarts.map_or(default_restarts, |n| n as usize),
+            max_restarts: o
+                .max_restarts
+                .map_or(default_restarts.unwrap_or(d.max_restarts), |n| n as usize),
             num_solutions: (o.num_solutions as usize).max(1),
             distinct_tolerance: o.distinct_tolerance.unwrap_or(d.distinct_tolerance),
             time_budget,
             record_history: o.return_history,
             ..d
         };
-        params.validate().map_err(|e| ik_error(e, "target", ""))?;
+        params.validate().map_err(|e| ik_error(e, IkAt::Target))?;
         Ok(Self {
             params,
             position_only: o.position_only,
@@ -124,10 +130,15 @@ pub(super) fn linear_solver_in(field: &str, value: i32) -> Result<Option<RlxaVar
 pub(crate) fn soft_deadline(deadline: Option<Instant>) -> Option<Instant> {
     let deadline = deadline?;
     let remaining = deadline.saturating_duration_since(Instant::now());
-    let reserve = (remaining / 10)
+    Some(deadline - reply_reserve(remaining))
+}
+
+/// The reply reserve taken from `remaining`: `min(clamp(remaining / 10,
+/// 200 µs, 100 ms), remaining / 2)`.
+pub(super) fn reply_reserve(remaining: Duration) -> Duration {
+    (remaining / 10)
         .clamp(Duration::from_micros(200), Duration::from_millis(100))
-        .min(remaining / 2);
-    Some(deadline - reserve)
+        .min(remaining / 2)
 }
 
 /// The earlier of the explicit budget and the time left until `soft`.

@@ -9,7 +9,7 @@ pub(super) fn path_in(
     circle: Option<&pb::CirclePath>,
     chain: &Chain,
     seed: &[f64],
-) -> Result<(Vec<Isometry3<f64>>, &'static str), Status> {
+) -> Result<(Vec<Isometry3<f64>>, PathAt), Status> {
     let given = usize::from(!poses.is_empty()) + usize::from(line.is_some()) + usize::from(circle.is_some());
     if given != 1 {
         return Err(invalid(
@@ -35,8 +35,8 @@ pub(super) fn path_in(
         let s = start("line.start", line.start.as_ref())?;
         let e = pose_in("line.end", line.end.as_ref())?;
         let n = steps("line.steps", line.steps)?;
-        let path = line_path(&s, &e, n).map_err(|e| ik_error(e, "line", "line"))?;
-        return Ok((path, "line"));
+        let path = line_path(&s, &e, n).map_err(|e| ik_error(e, IkAt::Path(PathAt::Line)))?;
+        return Ok((path, PathAt::Line));
     }
     if let Some(c) = circle {
         let s = start("circle.start", c.start.as_ref())?;
@@ -47,8 +47,8 @@ pub(super) fn path_in(
         let normal = vec3_in("circle.normal", c.normal.as_ref())?;
         let n = steps("circle.steps", c.steps)?;
         let path = circle_path(&s, &centre, &normal, c.angle_step, n)
-            .map_err(|e| ik_error(e, "circle", "circle"))?;
-        return Ok((path, "circle"));
+            .map_err(|e| ik_error(e, IkAt::Path(PathAt::Circle)))?;
+        return Ok((path, PathAt::Circle));
     }
     if poses.len() > MAX_PATH_POSES {
         return Err(invalid(
@@ -61,5 +61,5 @@ pub(super) fn path_in(
         .enumerate()
         .map(|(i, p)| pose_in(&format!("poses[{i}]"), Some(p)))
         .collect::<Result<_, _>>()?;
-    Ok((path, "poses"))
+    Ok((path, PathAt::Poses))
 }

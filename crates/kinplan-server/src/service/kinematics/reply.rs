@@ -85,38 +85,3 @@ pub(super) fn linear_out(s: LinearSolution, elapsed: Duration) -> pb::SolveLinea
         elapsed_us: micros(elapsed),
     }
 }
-
-/// INVALID_ARGUMENT naming the request field behind an [`IkError`]; `target`
-/// is the path of the target (`target`, `targets[3]`), `path` that of a
-/// TrackPath's line or circle.
-pub(super) fn ik_error(err: IkError, target: &str, path: &str) -> Status {
-    let text = err.to_string();
-    match err {
-        IkError::EmptyChain => invalid("robot", text),
-        IkError::WrongSeedLength { .. } => invalid("seed", text),
-        IkError::NonFiniteSeed { index } => invalid(format!("seed[{index}]"), text),
-        IkError::NonFiniteTarget { field } => invalid(format!("{target}.{field}"), text),
-        IkError::NonUnitQuaternion { .. } => invalid(format!("{target}.orientation"), text),
-        IkError::InvalidParam { field, .. } => invalid(format!("options.{field}"), text),
-        IkError::MethodCannotServe { .. } => invalid("options.method", text),
-        IkError::EmptyPath => invalid("poses", text),
-        IkError::InvalidPath { field, .. } => {
-            let field = if field == "centre/normal" { "normal" } else { field };
-            invalid(format!("{path}.{field}"), text)
-        }
-        IkError::Linalg(e) => linalg_error(e, "options.rlxa_"),
-    }
-}
-
-/// INVALID_ARGUMENT for a refused linear solve; `prefix` turns the solver's
-/// parameter names into request fields.
-pub(super) fn linalg_error(err: LinalgError, prefix: &str) -> Status {
-    let text = err.to_string();
-    match err {
-        LinalgError::InvalidParam { field, .. } => invalid(format!("{prefix}{field}"), text),
-        LinalgError::ShapeMismatch { .. } => invalid("b", text),
-        LinalgError::Empty { .. } => invalid("a", text),
-        LinalgError::NonFinite { what: "b" } => invalid("b", text),
-        LinalgError::NonFinite { .. } => invalid("a.data", text),
-    }
-}

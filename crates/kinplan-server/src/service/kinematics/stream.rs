@@ -83,7 +83,7 @@ pub(super) async fn stream_loop(
             })
             .await?;
         st.workspace = Some(workspace);
-        let result = result.map_err(|e| at(ik_error(e, "target", "")))?;
+        let result = result.map_err(|e| at(ik_error(e, IkAt::Target)))?;
         if let Some(best) = result.best() {
             st.previous.copy_from_slice(&best.joints);
         }

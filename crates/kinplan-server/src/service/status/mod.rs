@@ -6,9 +6,18 @@
 use tonic::{Code, Status};
 use tonic_types::{ErrorDetails, StatusExt};
 
-use kinplan_core::robot::RobotError;
-
+pub mod collision;
+pub mod explore;
+pub mod ik;
+pub mod linalg;
 pub mod mobile;
+pub mod nbv;
+pub mod octree;
+pub mod plan;
+mod robot;
+pub mod score;
+
+pub use robot::robot_error;
 
 /// INVALID_ARGUMENT naming `field`, with a BadRequest field violation.
 pub fn invalid(field: impl Into<String>, description: impl Into<String>) -> Status {
@@ -47,32 +56,6 @@ fn field_status(code: Code, field: impl Into<String>, description: impl Into<Str
         message,
         ErrorDetails::with_bad_request_violation(field, description),
     )
-}
-
-/// Maps a robot-model error; `joints_field` names the joint vector in the
-/// request, for errors about joint values.
-pub fn robot_error(err: RobotError, joints_field: &str) -> Status {
-    let text = err.to_string();
-    match err {
-        RobotError::UnknownRobot { .. } => not_found("robot.name", text),
-        RobotError::UnknownLink { .. } => not_found("robot.base_link/tip_link", text),
-        RobotError::AmbiguousTip { .. } | RobotError::NotSerialChain { .. } => {
-            invalid("robot.tip_link", text)
-        }
-        RobotError::WrongJointCount { .. } => invalid(joints_field, text),
-        RobotError::NonFiniteJoint { index } | RobotError::JointOutOfRange { index, .. } => {
-            invalid(format!("{joints_field}[{index}]"), text)
-        }
-        RobotError::MalformedUrdf(_)
-        | RobotError::UrdfTooLarge { .. }
-        | RobotError::TooManyElements { .. }
-        | RobotError::NonFiniteValue { .. }
-        | RobotError::ValueOutOfRange { .. }
-        | RobotError::NoSingleRoot { .. }
-        | RobotError::UnsupportedJoint { .. }
-        | RobotError::ZeroAxis { .. }
-        | RobotError::InvertedLimits { .. } => invalid("robot.urdf", text),
-    }
 }
 
 /// The canonical upper-case name of a gRPC status code, as metrics label it.
