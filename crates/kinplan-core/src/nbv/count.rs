@@ -241,8 +241,8 @@ impl RowCounter<'_> {
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
         let (alo, ahi) = r[a];
         let res = self.res;
-        // per cutting plane: crossing coefficients and tolerance (None: per-cell tests)
-        let mut lin = [None::<(usize, f64, f64, f64, f64, bool)>; 6];
+        // per cutting plane: crossing coefficients and tolerance (or in `exact`: per-cell tests)
+        let mut lin = [(0usize, 0.0f64, 0.0f64, 0.0f64, 0.0f64, false); 6];
         let mut exact = [usize::MAX; 6];
         let (mut nl, mut ne) = (0, 0);
         for j in 0..6 {
@@ -263,24 +263,34 @@ impl RowCounter<'_> {
             let kb = -n[b] / n[a];
             let kc = -n[c] / n[a];
             let k0 = -d / (n[a] * res) - (kb + kc) * 32767.5 + 32767.5;
-            lin[nl] = Some((j, k0, kb, kc, tol, n[a] > 0.0));
+            lin[nl] = (j, k0, kb, kc, tol, n[a] > 0.0);
             nl += 1;
         }
         let mut total = 0u64;
         let mut k = [0i64; 3];
-        if nl == 1
-            && ne == 0
-            && let Some((j, k0, cb, cc, tol, up)) = lin[0]
-        {
-            // the common case, one cutting plane: the same rule in a tight loop
-            let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
+        let (j, k0, cb, cc, tol, up) = lin[0];
+        if nl == 1 && ne == 0 && cb.abs() <= 2.0 && r[b].1 - r[b].0 < 32 {
+            // the common case, one cutting plane: the same rule in 32.32 fixed point,
+            // relative to `alo`. Per c-row the crossing is evaluated once in f64 at the
+            // first b and then stepped by `cb` in fixed point (at most 31 steps: the
+            // stepping adds under 2^−27 keys of error, covered by the `2^−20` added to
+            // `tol`). Starting crossings are clamped to [−64, len + 64]: 31 steps of
+            // |cb| ≤ 2 cannot bring a clamped one back into [−1, len + 1], so its rows
+            // count the same (all or none of the row).
+            const ONE: i64 = 1 << 32;
+            let len = ahi - alo + 1;
+            let tol_fp = ((tol + 1.0 / 1_048_576.0) * ONE as f64) as i64;
+            let step = (cb * ONE as f64) as i64;
+            let (b0, b1) = r[b];
+            let (lo_fp, hi_fp) = (-ONE, len * ONE);
             for kc in r[c].0..=r[c].1 {
                 k[c] = kc;
-                for kb in r[b].0..=r[b].1 {
-                    let kr = k0 + cb * kb as f64 + cc * kc as f64;
-                    let fl = floor_i64(kr.clamp(lo_f, hi_f));
-                    let frac = kr - fl as f64;
-                    let n = if kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol) {
+                let rel = (k0 + cb * b0 as f64 + cc * kc as f64 - alo as f64).clamp(-64.0, len as f64 + 64.0);
+                let mut v = (rel * ONE as f64) as i64;
+                for kb in b0..=b1 {
+                    let fl = v >> 32;
+                    let frac = v & (ONE - 1);
+                    let n = if v > lo_fp && v < hi_fp && (frac <= tol_fp || frac >= ONE - tol_fp) {
                         k[b] = kb;
                         if up {
                             ahi - self.first_inside(j, k, a, alo, alo, ahi) + 1
@@ -288,38 +298,76 @@ impl RowCounter<'_> {
                             self.last_inside(j, k, a, ahi, alo, ahi) - alo + 1
                         }
                     } else if up {
-                        ahi - (fl + 1).max(alo) + 1
+                        len - (fl + 1).max(0)
                     } else {
-                        fl.min(ahi) - alo + 1
+                        (fl + 1).min(len)
                     };
                     total += n.max(0) as u64;
+                    v += step;
                 }
             }
             return total;
         }
+        // the crossings in the 32.32 fixed point of the one-plane loop above when every
+        // plane's |cb| ≤ 2^20 (same error argument; the clamp margin grows to
+        // 4 + 32·max|cb| so that 31 steps cannot bring a clamped crossing back into the
+        // row), else in f64 per row
+        const ONE: i64 = 1 << 32;
+        let max_cb = lin[..nl].iter().fold(0.0f64, |m, p| m.max(p.2.abs()));
+        let fixed = max_cb <= 1_048_576.0 && r[b].1 - r[b].0 < 32;
+        let margin = 4.0 + 32.0 * max_cb.ceil();
+        let (mut vs, mut steps, mut tols) = ([0i64; 6], [0i64; 6], [0i64; 6]);
+        for (p, &(_, _, cb, _, tol, _)) in lin[..nl].iter().enumerate() {
+            steps[p] = (cb * ONE as f64) as i64;
+            tols[p] = ((tol + 1.0 / 1_048_576.0) * ONE as f64) as i64;
+        }
+        let len = ahi - alo + 1;
+        let (lo_fp, hi_fp) = (-ONE, len * ONE);
         for kc in r[c].0..=r[c].1 {
             k[c] = kc;
+            if fixed {
+                for (p, &(_, k0, cb, cc, _, _)) in lin[..nl].iter().enumerate() {
+                    let rel = (k0 + cb * r[b].0 as f64 + cc * kc as f64 - alo as f64)
+                        .clamp(-margin, len as f64 + margin);
+                    vs[p] = (rel * ONE as f64) as i64;
+                }
+            }
             for kb in r[b].0..=r[b].1 {
                 k[b] = kb;
                 // fast path: the floors of the crossings; a crossing within `tol` of an
                 // integer (rare) sends the row to the per-cell tests instead
                 let (mut first_in, mut last_in) = (alo, ahi);
                 let mut near = false;
-                let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
-                for &(_, k0, cb, cc, tol, up) in lin[..nl].iter().flatten() {
-                    let kr = k0 + cb * kb as f64 + cc * kc as f64;
-                    let fl = floor_i64(kr.clamp(lo_f, hi_f));
-                    let frac = kr - fl as f64;
-                    near |= kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol);
-                    if up {
-                        first_in = first_in.max(fl + 1);
-                    } else {
-                        last_in = last_in.min(fl);
+                if fixed {
+                    for (p, &(_, _, _, _, _, up)) in lin[..nl].iter().enumerate() {
+                        let v = vs[p];
+                        vs[p] += steps[p];
+                        let fl = (v >> 32) + alo;
+                        let frac = v & (ONE - 1);
+                        near |= v > lo_fp && v < hi_fp && (frac <= tols[p] || frac >= ONE - tols[p]);
+                        if up {
+                            first_in = first_in.max(fl + 1);
+                        } else {
+                            last_in = last_in.min(fl);
+                        }
+                    }
+                } else {
+                    let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
+                    for &(_, k0, cb, cc, tol, up) in lin[..nl].iter() {
+                        let kr = k0 + cb * kb as f64 + cc * kc as f64;
+                        let fl = floor_i64(kr.clamp(lo_f, hi_f));
+                        let frac = kr - fl as f64;
+                        near |= kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol);
+                        if up {
+                            first_in = first_in.max(fl + 1);
+                        } else {
+                            last_in = last_in.min(fl);
+                        }
                     }
                 }
                 if near {
                     (first_in, last_in) = (alo, ahi);
-                    for &(j, _, _, _, _, up) in lin[..nl].iter().flatten() {
+                    for &(j, _, _, _, _, up) in lin[..nl].iter() {
                         if first_in > last_in {
                             break;
                         }
