@@ -21,6 +21,21 @@ mod room_scene;
 
 const VIEWS: usize = 8;
 
+/// CPU time on a core and time waiting in the run queue (ns), summed over the threads
+/// of this process (Linux `/proc/self/task/*/schedstat`); `None` elsewhere. The wait
+/// shows how much of a wall time the machine's other load took.
+fn sched_ns() -> Option<(u64, u64)> {
+    let mut on = 0u64;
+    let mut wait = 0u64;
+    for t in std::fs::read_dir("/proc/self/task").ok()? {
+        let s = std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok()?;
+        let mut f = s.split_whitespace().map(|v| v.parse::<u64>().unwrap_or(0));
+        on += f.next()?;
+        wait += f.next()?;
+    }
+    Some((on, wait))
+}
+
 fn room_tree(res: f64) -> Octree {
     let mut t = Octree::new(res).unwrap();
     for (o, yaw, pitch) in room_scene::scan_poses() {
@@ -149,9 +164,9 @@ fn main() {
     println!("NBV end to end, room @ 0.05 m, robot abb_irb4600_60_205 at the origin, Kinect v2 model:");
     println!();
     println!(
-        "| config | frontier cells | candidates | after ORF | after PTF | after IGF | IK checked / failed | frontier ms | field ms | ORF ms | PTF ms | IGF ms | IK ms | total ms |"
+        "| config | frontier cells | candidates | after ORF | after PTF | after IGF | IK checked / failed | frontier ms | field ms | ORF ms | PTF ms | IGF ms | IK ms | total ms | CPU ms, all threads (run-queue wait ms) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let cfgs: [(&str, NbvParams); 3] = [
         (
             "S0 filters (PTF 0.2 m / 20°), intersection gain",
@@ -179,11 +194,20 @@ fn main() {
             continue;
         }
         let s = Instant::now();
+        let c0 = sched_ns();
         let r = next_best_view(&t, &p, &cam, &current, Some(&chain), &|| false).unwrap();
         let total = s.elapsed().as_secs_f64() * 1e3;
+        let cpu = match (c0, sched_ns()) {
+            (Some(a), Some(b)) => format!(
+                "{:.1} ({:.1})",
+                (b.0 - a.0) as f64 / 1e6,
+                (b.1 - a.1) as f64 / 1e6
+            ),
+            _ => "n/a".into(),
+        };
         let st = r.stages;
         println!(
-            "| {name} | {} | {} | {} | {} | {} | {} / {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
+            "| {name} | {} | {} | {} | {} | {} | {} / {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {cpu} |",
             st.frontier_cells,
             st.frontier_candidates + st.caller_candidates,
             st.after_orf,
