@@ -191,6 +191,10 @@ impl<'a> FrustumCounter<'a> {
     }
 }
 
+/// One cutting plane's crossing along a row: plane index, `κ0`, `κ_b`, `κ_c` (the
+/// crossing `κ = κ0 + κ_b·k_b + κ_c·k_c`), its tolerance, and whether `n_a > 0`.
+type Lin = (usize, f64, f64, f64, f64, bool);
+
 /// Row-by-row count of the cells of an unknown cube inside the key box and the planes.
 struct RowCounter<'f> {
     planes: &'f [(Vector3<f64>, f64); 6],
@@ -242,7 +246,7 @@ impl RowCounter<'_> {
         let (alo, ahi) = r[a];
         let res = self.res;
         // per cutting plane: crossing coefficients and tolerance (or in `exact`: per-cell tests)
-        let mut lin = [(0usize, 0.0f64, 0.0f64, 0.0f64, 0.0f64, false); 6];
+        let mut lin: [Lin; 6] = [(0, 0.0, 0.0, 0.0, 0.0, false); 6];
         let mut exact = [usize::MAX; 6];
         let (mut nl, mut ne) = (0, 0);
         for j in 0..6 {
@@ -266,103 +270,37 @@ impl RowCounter<'_> {
             lin[nl] = (j, k0, kb, kc, tol, n[a] > 0.0);
             nl += 1;
         }
+        // the crossings of up to three planes in 32.32 fixed point when every plane's
+        // |cb| ≤ 2^20 and rows are at most 32 long (always below `ROW_LOG` 5)
+        let max_cb = lin[..nl].iter().fold(0.0f64, |m, p| m.max(p.2.abs()));
+        if ne == 0 && max_cb <= 1_048_576.0 && r[b].1 - r[b].0 < 32 {
+            match nl {
+                1 => return self.fixed_rows::<1>(&lin, &r, [a, b, c], max_cb),
+                2 => return self.fixed_rows::<2>(&lin, &r, [a, b, c], max_cb),
+                3 => return self.fixed_rows::<3>(&lin, &r, [a, b, c], max_cb),
+                _ => {}
+            }
+        }
         let mut total = 0u64;
         let mut k = [0i64; 3];
-        let (j, k0, cb, cc, tol, up) = lin[0];
-        if nl == 1 && ne == 0 && cb.abs() <= 2.0 && r[b].1 - r[b].0 < 32 {
-            // the common case, one cutting plane: the same rule in 32.32 fixed point,
-            // relative to `alo`. Per c-row the crossing is evaluated once in f64 at the
-            // first b and then stepped by `cb` in fixed point (at most 31 steps: the
-            // stepping adds under 2^−27 keys of error, covered by the `2^−20` added to
-            // `tol`). Starting crossings are clamped to [−64, len + 64]: 31 steps of
-            // |cb| ≤ 2 cannot bring a clamped one back into [−1, len + 1], so its rows
-            // count the same (all or none of the row).
-            const ONE: i64 = 1 << 32;
-            let len = ahi - alo + 1;
-            let tol_fp = ((tol + 1.0 / 1_048_576.0) * ONE as f64) as i64;
-            let step = (cb * ONE as f64) as i64;
-            let (b0, b1) = r[b];
-            let (lo_fp, hi_fp) = (-ONE, len * ONE);
-            for kc in r[c].0..=r[c].1 {
-                k[c] = kc;
-                let rel = (k0 + cb * b0 as f64 + cc * kc as f64 - alo as f64).clamp(-64.0, len as f64 + 64.0);
-                let mut v = (rel * ONE as f64) as i64;
-                for kb in b0..=b1 {
-                    let fl = v >> 32;
-                    let frac = v & (ONE - 1);
-                    let n = if v > lo_fp && v < hi_fp && (frac <= tol_fp || frac >= ONE - tol_fp) {
-                        k[b] = kb;
-                        if up {
-                            ahi - self.first_inside(j, k, a, alo, alo, ahi) + 1
-                        } else {
-                            self.last_inside(j, k, a, ahi, alo, ahi) - alo + 1
-                        }
-                    } else if up {
-                        len - (fl + 1).max(0)
-                    } else {
-                        (fl + 1).min(len)
-                    };
-                    total += n.max(0) as u64;
-                    v += step;
-                }
-            }
-            return total;
-        }
-        // the crossings in the 32.32 fixed point of the one-plane loop above when every
-        // plane's |cb| ≤ 2^20 (same error argument; the clamp margin grows to
-        // 4 + 32·max|cb| so that 31 steps cannot bring a clamped crossing back into the
-        // row), else in f64 per row
-        const ONE: i64 = 1 << 32;
-        let max_cb = lin[..nl].iter().fold(0.0f64, |m, p| m.max(p.2.abs()));
-        let fixed = max_cb <= 1_048_576.0 && r[b].1 - r[b].0 < 32;
-        let margin = 4.0 + 32.0 * max_cb.ceil();
-        let (mut vs, mut steps, mut tols) = ([0i64; 6], [0i64; 6], [0i64; 6]);
-        for (p, &(_, _, cb, _, tol, _)) in lin[..nl].iter().enumerate() {
-            steps[p] = (cb * ONE as f64) as i64;
-            tols[p] = ((tol + 1.0 / 1_048_576.0) * ONE as f64) as i64;
-        }
-        let len = ahi - alo + 1;
-        let (lo_fp, hi_fp) = (-ONE, len * ONE);
         for kc in r[c].0..=r[c].1 {
             k[c] = kc;
-            if fixed {
-                for (p, &(_, k0, cb, cc, _, _)) in lin[..nl].iter().enumerate() {
-                    let rel = (k0 + cb * r[b].0 as f64 + cc * kc as f64 - alo as f64)
-                        .clamp(-margin, len as f64 + margin);
-                    vs[p] = (rel * ONE as f64) as i64;
-                }
-            }
             for kb in r[b].0..=r[b].1 {
                 k[b] = kb;
                 // fast path: the floors of the crossings; a crossing within `tol` of an
                 // integer (rare) sends the row to the per-cell tests instead
                 let (mut first_in, mut last_in) = (alo, ahi);
                 let mut near = false;
-                if fixed {
-                    for (p, &(_, _, _, _, _, up)) in lin[..nl].iter().enumerate() {
-                        let v = vs[p];
-                        vs[p] += steps[p];
-                        let fl = (v >> 32) + alo;
-                        let frac = v & (ONE - 1);
-                        near |= v > lo_fp && v < hi_fp && (frac <= tols[p] || frac >= ONE - tols[p]);
-                        if up {
-                            first_in = first_in.max(fl + 1);
-                        } else {
-                            last_in = last_in.min(fl);
-                        }
-                    }
-                } else {
-                    let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
-                    for &(_, k0, cb, cc, tol, up) in lin[..nl].iter() {
-                        let kr = k0 + cb * kb as f64 + cc * kc as f64;
-                        let fl = floor_i64(kr.clamp(lo_f, hi_f));
-                        let frac = kr - fl as f64;
-                        near |= kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol);
-                        if up {
-                            first_in = first_in.max(fl + 1);
-                        } else {
-                            last_in = last_in.min(fl);
-                        }
+                let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
+                for &(_, k0, cb, cc, tol, up) in lin[..nl].iter() {
+                    let kr = k0 + cb * kb as f64 + cc * kc as f64;
+                    let fl = floor_i64(kr.clamp(lo_f, hi_f));
+                    let frac = kr - fl as f64;
+                    near |= kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol);
+                    if up {
+                        first_in = first_in.max(fl + 1);
+                    } else {
+                        last_in = last_in.min(fl);
                     }
                 }
                 if near {
@@ -396,6 +334,80 @@ impl RowCounter<'_> {
                 }
                 if last_in >= first_in {
                     total += (last_in - first_in + 1) as u64;
+                }
+            }
+        }
+        total
+    }
+
+    /// The rows of [`count`](Self::count) for `N` (1–3) cutting planes, all with a
+    /// crossing (`lin`), in 32.32 fixed point relative to `alo`: per c-row each
+    /// crossing is evaluated once in f64 at the first b, then stepped by `cb` as an
+    /// integer (at most 31 steps; truncating `cb` and the start to 2^−32 adds under
+    /// 2^−26 keys of error, covered by the 2^−20 added to each `tol`). Starting
+    /// crossings are clamped to `[−m, len + m]` with `m = 4 + 32·⌈max|cb|⌉`: 31 steps
+    /// cannot bring a clamped one back into `[−1, len + 1]`, so its rows count the same
+    /// (all or none of the row). A row with a crossing within `tol` of an integer is
+    /// decided by the per-cell tests, as in the f64 path.
+    #[inline(always)]
+    fn fixed_rows<const N: usize>(
+        &self,
+        lin: &[Lin; 6],
+        r: &[(i64, i64); 3],
+        [a, b, c]: [usize; 3],
+        max_cb: f64,
+    ) -> u64 {
+        const ONE: i64 = 1 << 32;
+        let (alo, ahi) = r[a];
+        let len = ahi - alo + 1;
+        let margin = 4.0 + 32.0 * max_cb.ceil();
+        let (mut steps, mut tols, mut ups) = ([0i64; N], [0i64; N], [false; N]);
+        for p in 0..N {
+            steps[p] = (lin[p].2 * ONE as f64) as i64;
+            tols[p] = ((lin[p].4 + 1.0 / 1_048_576.0) * ONE as f64) as i64;
+            ups[p] = lin[p].5;
+        }
+        let (lo_fp, hi_fp) = (-ONE, len * ONE);
+        let mut total = 0u64;
+        let mut k = [0i64; 3];
+        for kc in r[c].0..=r[c].1 {
+            k[c] = kc;
+            let mut vs = [0i64; N];
+            for p in 0..N {
+                let (_, k0, cb, cc, _, _) = lin[p];
+                let rel = (k0 + cb * r[b].0 as f64 + cc * kc as f64 - alo as f64)
+                    .clamp(-margin, len as f64 + margin);
+                vs[p] = (rel * ONE as f64) as i64;
+            }
+            for kb in r[b].0..=r[b].1 {
+                // relative first and last keys inside every plane
+                let (mut first, mut last) = (0i64, len - 1);
+                let mut near = false;
+                for p in 0..N {
+                    let v = vs[p];
+                    vs[p] += steps[p];
+                    let fl = v >> 32;
+                    let frac = v & (ONE - 1);
+                    near |= v > lo_fp && v < hi_fp && (frac <= tols[p] || frac >= ONE - tols[p]);
+                    first = first.max(if ups[p] { fl + 1 } else { i64::MIN });
+                    last = last.min(if ups[p] { i64::MAX } else { fl });
+                }
+                if near {
+                    k[b] = kb;
+                    let (mut f, mut l) = (alo, ahi);
+                    for p in 0..N {
+                        if f > l {
+                            break;
+                        }
+                        if ups[p] {
+                            f = f.max(self.first_inside(lin[p].0, k, a, alo, alo, ahi));
+                        } else {
+                            l = l.min(self.last_inside(lin[p].0, k, a, ahi, alo, ahi));
+                        }
+                    }
+                    total += (l - f + 1).max(0) as u64;
+                } else {
+                    total += (last - first + 1).max(0) as u64;
                 }
             }
         }

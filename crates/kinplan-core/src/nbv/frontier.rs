@@ -32,7 +32,7 @@ pub(crate) fn unknown_needed(min_unknown_ratio: f64) -> usize {
 /// surface cells of pruned free cubes) whose 26 neighbours are unknown in a share of at
 /// least `min_unknown_ratio`. Sorted by key (x fastest) so the result is deterministic.
 ///
-/// When the box's keys with one cell of margin hold at most `grid::MAX_CELLS` (2^25) cells, the
+/// When the box's keys with one cell of margin hold at most `grid::MAX_CELLS` (2^24) cells, the
 /// states are copied into a dense grid once and counted by 3×3×3 block sums
 /// (`StateGrid::frontier`, z planes in parallel, `should_stop` polled per plane);
 /// otherwise free cubes are scanned in parallel chunks with neighbour lookups in the

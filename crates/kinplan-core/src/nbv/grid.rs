@@ -18,9 +18,10 @@ pub(crate) const OCCUPIED: u8 = 2;
 /// The cell lies outside the tree's key space `[0, 65536)³` (no cell there).
 pub(crate) const OUTSIDE: u8 = 3;
 
-/// Largest grid built (cells, one byte each, plus one byte each for the frontier's
-/// row sums): 2^25, 32 MiB. Larger boxes take the per-cell tree paths instead.
-pub(crate) const MAX_CELLS: usize = 1 << 25;
+/// Largest grid built for a region (cells, one byte each, plus one byte each for the
+/// frontier's row sums): 2^24, at most 32 MiB per request together (a 20 × 20 × 5 m
+/// region at 5 cm fits). Larger boxes take the tree-lookup paths instead.
+pub(crate) const MAX_CELLS: usize = 1 << 24;
 
 /// Cell states of the inclusive key box `[lo, hi]` (keys as i64, so the box may reach
 /// one cell or more past the key space: those cells are [`OUTSIDE`]). x fastest.
