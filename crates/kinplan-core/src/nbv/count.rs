@@ -101,7 +101,7 @@ impl<'a> FrustumCounter<'a> {
                 }
             }
         }
-        let rows = RowCounter { planes, res, lo, hi };
+        let rows = RowCounter::new(planes, res, lo, hi);
         let mut stack = [Entry {
             key: [0; 3],
             depth: 0,
@@ -201,9 +201,50 @@ struct RowCounter<'f> {
     res: f64,
     lo: [u16; 3],
     hi: [u16; 3],
+    /// Per plane j: the row axis when j is a cube's first cutting plane (the axis
+    /// its normal is steepest in).
+    axis: [usize; 6],
+    /// Per plane j and row axis a: the crossing coefficients and tolerance, `None` when
+    /// the plane needs the per-cell tests along that axis. They depend on the plane and
+    /// the axis only, so they are computed once per view instead of once per cube.
+    coef: [[Option<Lin>; 3]; 6],
 }
 
-impl RowCounter<'_> {
+impl<'f> RowCounter<'f> {
+    fn new(planes: &'f [(Vector3<f64>, f64); 6], res: f64, lo: [u16; 3], hi: [u16; 3]) -> Self {
+        let axis = planes.map(|(n, _)| {
+            (0..3)
+                .max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs()))
+                .unwrap_or(0)
+        });
+        let mut coef = [[None; 3]; 6];
+        for (j, (n, d)) in planes.iter().enumerate() {
+            for a in 0..3 {
+                let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+                let scale = (n[0].abs() + n[1].abs() + n[2].abs()) / n[a].abs();
+                // key-unit error bound of κ and of the per-cell test near the crossing,
+                // with a safety factor of about 10^6 over f64 rounding
+                let tol = 1e-9 * scale * (32768.0 + (32768.0 * res + d.abs()) / res);
+                if n[a] == 0.0 || tol.is_nan() || tol >= 0.25 {
+                    continue;
+                }
+                // κ = −(n_b·c_b + n_c·c_c + d)/(n_a·res) + 32767.5, c_i = (k_i − 32767.5)·res
+                let kb = -n[b] / n[a];
+                let kc = -n[c] / n[a];
+                let k0 = -d / (n[a] * res) - (kb + kc) * 32767.5 + 32767.5;
+                coef[j][a] = Some((j, k0, kb, kc, tol, n[a] > 0.0));
+            }
+        }
+        Self {
+            planes,
+            res,
+            lo,
+            hi,
+            axis,
+            coef,
+        }
+    }
+
     /// The per-cell test, written exactly as [`Frustum::contains`] evaluates it at the
     /// cell centre `key_center(k, 16)`.
     #[inline]
@@ -237,14 +278,9 @@ impl RowCounter<'_> {
             return r.iter().map(|(a, b)| (b - a + 1) as u64).product();
         }
         // rows along the axis the first cutting plane is steepest in
-        let first = mask.trailing_zeros() as usize;
-        let n0 = self.planes[first].0;
-        let a = (0..3)
-            .max_by(|&i, &j| n0[i].abs().total_cmp(&n0[j].abs()))
-            .unwrap_or(0);
+        let a = self.axis[mask.trailing_zeros() as usize];
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
         let (alo, ahi) = r[a];
-        let res = self.res;
         // per cutting plane: crossing coefficients and tolerance (or in `exact`: per-cell tests)
         let mut lin: [Lin; 6] = [(0, 0.0, 0.0, 0.0, 0.0, false); 6];
         let mut exact = [usize::MAX; 6];
@@ -253,22 +289,16 @@ impl RowCounter<'_> {
             if mask & (1 << j) == 0 {
                 continue;
             }
-            let (n, d) = &self.planes[j];
-            let scale = (n[0].abs() + n[1].abs() + n[2].abs()) / n[a].abs();
-            // key-unit error bound of κ and of the per-cell test near the crossing,
-            // with a safety factor of about 10^6 over f64 rounding
-            let tol = 1e-9 * scale * (32768.0 + (32768.0 * res + d.abs()) / res);
-            if n[a] == 0.0 || tol.is_nan() || tol >= 0.25 {
-                exact[ne] = j;
-                ne += 1;
-                continue;
+            match self.coef[j][a] {
+                Some(l) => {
+                    lin[nl] = l;
+                    nl += 1;
+                }
+                None => {
+                    exact[ne] = j;
+                    ne += 1;
+                }
             }
-            // κ = −(n_b·c_b + n_c·c_c + d)/(n_a·res) + 32767.5, c_i = (k_i − 32767.5)·res
-            let kb = -n[b] / n[a];
-            let kc = -n[c] / n[a];
-            let k0 = -d / (n[a] * res) - (kb + kc) * 32767.5 + 32767.5;
-            lin[nl] = (j, k0, kb, kc, tol, n[a] > 0.0);
-            nl += 1;
         }
         // the crossings of up to three planes in 32.32 fixed point when every plane's
         // |cb| ≤ 2^20 and rows are at most 32 long (always below `ROW_LOG` 5)
