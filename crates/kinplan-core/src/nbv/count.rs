@@ -397,7 +397,8 @@ impl<'f> RowCounter<'f> {
             tols[p] = ((lin[p].4 + 1.0 / 1_048_576.0) * ONE as f64) as i64;
             ups[p] = lin[p].5;
         }
-        let (lo_fp, hi_fp) = (-ONE, len * ONE);
+        // `v ∈ (−1, len)` (keys, fixed point) as one unsigned compare
+        let span = ((len + 1) * ONE - 1) as u64;
         let mut total = 0u64;
         let mut k = [0i64; 3];
         for kc in r[c].0..=r[c].1 {
@@ -418,7 +419,10 @@ impl<'f> RowCounter<'f> {
                     vs[p] += steps[p];
                     let fl = v >> 32;
                     let frac = v & (ONE - 1);
-                    near |= v > lo_fp && v < hi_fp && (frac <= tols[p] || frac >= ONE - tols[p]);
+                    // within tol of an integer: `frac ≤ tol` or `frac ≥ 1 − tol`, i.e.
+                    // `(frac + tol) mod 1 ≤ 2·tol` (tol < ¼); no branches
+                    let inside = ((v + ONE - 1) as u64) < span;
+                    near |= inside & (((frac + tols[p]) & (ONE - 1)) <= 2 * tols[p]);
                     first = first.max(if ups[p] { fl + 1 } else { i64::MIN });
                     last = last.min(if ups[p] { i64::MAX } else { fl });
                 }
