@@ -21,6 +21,21 @@ mod room_scene;
 
 const VIEWS: usize = 8;
 
+/// CPU time on a core and time waiting in the run queue (ns), summed over the threads
+/// of this process (Linux `/proc/self/task/*/schedstat`); `None` elsewhere. The wait
+/// shows how much of a wall time the machine's other load took.
+fn sched_ns() -> Option<(u64, u64)> {
+    let mut on = 0u64;
+    let mut wait = 0u64;
+    for t in std::fs::read_dir("/proc/self/task").ok()? {
+        let s = std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok()?;
+        let mut f = s.split_whitespace().map(|v| v.parse::<u64>().unwrap_or(0));
+        on += f.next()?;
+        wait += f.next()?;
+    }
+    Some((on, wait))
+}
+
 fn room_tree(res: f64) -> Octree {
     let mut t = Octree::new(res).unwrap();
     for (o, yaw, pitch) in room_scene::scan_poses() {
@@ -80,9 +95,14 @@ fn row(name: &str, t: &Octree, vs: &[Isometry3<f64>], cam: &CameraModel, no_rays
     }
     let n = vs.len() as f64;
     let pct = |i: usize| 100.0 * sums[i] / sums[1];
+    // without rays: the mean intersection count itself (cells), to compare builds
+    let first = if no_rays {
+        format!("{:.1} cells", sums[0] / n)
+    } else {
+        format!("{:.1} %", pct(0))
+    };
     println!(
-        "| {name} | {:.1} % | {:.2} % | {:.2} % | {:.2} % | {:.0} | {:.3} ({build_ms:.2} build) | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
-        pct(0),
+        "| {name} | {first} | {:.2} % | {:.2} % | {:.2} % | {:.0} | {:.3} ({build_ms:.2} build) | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
         pct(2),
         pct(3),
         pct(4),
@@ -97,7 +117,8 @@ fn row(name: &str, t: &Octree, vs: &[Isometry3<f64>], cam: &CameraModel, no_rays
 }
 
 fn main() {
-    // --no-rays: intersection column only (ray columns print NaN); --nbv-only: skip Tab. 5.1
+    // --no-rays: intersection column only, as the mean count (ray columns print NaN);
+    // --nbv-only: skip Tab. 5.1
     let args: Vec<String> = std::env::args().collect();
     let no_rays = args.iter().any(|a| a == "--no-rays");
     let nbv_only = args.iter().any(|a| a == "--nbv-only");
@@ -149,9 +170,9 @@ fn main() {
     println!("NBV end to end, room @ 0.05 m, robot abb_irb4600_60_205 at the origin, Kinect v2 model:");
     println!();
     println!(
-        "| config | frontier cells | candidates | after ORF | after PTF | after IGF | IK checked / failed | frontier ms | field ms | ORF ms | PTF ms | IGF ms | IK ms | total ms |"
+        "| config | frontier cells | candidates | after ORF | after PTF | after IGF | IK checked / failed | frontier ms | field ms | ORF ms | PTF ms | IGF ms | IK ms | total ms | CPU ms, all threads (run-queue wait ms) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let cfgs: [(&str, NbvParams); 3] = [
         (
             "S0 filters (PTF 0.2 m / 20°), intersection gain",
@@ -179,11 +200,20 @@ fn main() {
             continue;
         }
         let s = Instant::now();
+        let c0 = sched_ns();
         let r = next_best_view(&t, &p, &cam, &current, Some(&chain), &|| false).unwrap();
         let total = s.elapsed().as_secs_f64() * 1e3;
+        let cpu = match (c0, sched_ns()) {
+            (Some(a), Some(b)) => format!(
+                "{:.1} ({:.1})",
+                (b.0 - a.0) as f64 / 1e6,
+                (b.1 - a.1) as f64 / 1e6
+            ),
+            _ => "n/a".into(),
+        };
         let st = r.stages;
         println!(
-            "| {name} | {} | {} | {} | {} | {} | {} / {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} |",
+            "| {name} | {} | {} | {} | {} | {} | {} / {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {cpu} |",
             st.frontier_cells,
             st.frontier_candidates + st.caller_candidates,
             st.after_orf,

@@ -101,7 +101,7 @@ impl<'a> FrustumCounter<'a> {
                 }
             }
         }
-        let rows = RowCounter { planes, res, lo, hi };
+        let rows = RowCounter::new(planes, res, lo, hi);
         let mut stack = [Entry {
             key: [0; 3],
             depth: 0,
@@ -191,15 +191,60 @@ impl<'a> FrustumCounter<'a> {
     }
 }
 
+/// One cutting plane's crossing along a row: plane index, `κ0`, `κ_b`, `κ_c` (the
+/// crossing `κ = κ0 + κ_b·k_b + κ_c·k_c`), its tolerance, and whether `n_a > 0`.
+type Lin = (usize, f64, f64, f64, f64, bool);
+
 /// Row-by-row count of the cells of an unknown cube inside the key box and the planes.
 struct RowCounter<'f> {
     planes: &'f [(Vector3<f64>, f64); 6],
     res: f64,
     lo: [u16; 3],
     hi: [u16; 3],
+    /// Per plane j: the row axis when j is a cube's first cutting plane (the axis
+    /// its normal is steepest in).
+    axis: [usize; 6],
+    /// Per plane j and row axis a: the crossing coefficients and tolerance, `None` when
+    /// the plane needs the per-cell tests along that axis. They depend on the plane and
+    /// the axis only, so they are computed once per view instead of once per cube.
+    coef: [[Option<Lin>; 3]; 6],
 }
 
-impl RowCounter<'_> {
+impl<'f> RowCounter<'f> {
+    fn new(planes: &'f [(Vector3<f64>, f64); 6], res: f64, lo: [u16; 3], hi: [u16; 3]) -> Self {
+        let axis = planes.map(|(n, _)| {
+            (0..3)
+                .max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs()))
+                .unwrap_or(0)
+        });
+        let mut coef = [[None; 3]; 6];
+        for (j, (n, d)) in planes.iter().enumerate() {
+            for a in 0..3 {
+                let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+                let scale = (n[0].abs() + n[1].abs() + n[2].abs()) / n[a].abs();
+                // key-unit error bound of κ and of the per-cell test near the crossing,
+                // with a safety factor of about 10^6 over f64 rounding
+                let tol = 1e-9 * scale * (32768.0 + (32768.0 * res + d.abs()) / res);
+                if n[a] == 0.0 || tol.is_nan() || tol >= 0.25 {
+                    continue;
+                }
+                // κ = −(n_b·c_b + n_c·c_c + d)/(n_a·res) + 32767.5, c_i = (k_i − 32767.5)·res
+                let kb = -n[b] / n[a];
+                let kc = -n[c] / n[a];
+                let k0 = -d / (n[a] * res) - (kb + kc) * 32767.5 + 32767.5;
+                coef[j][a] = Some((j, k0, kb, kc, tol, n[a] > 0.0));
+            }
+        }
+        Self {
+            planes,
+            res,
+            lo,
+            hi,
+            axis,
+            coef,
+        }
+    }
+
     /// The per-cell test, written exactly as [`Frustum::contains`] evaluates it at the
     /// cell centre `key_center(k, 16)`.
     #[inline]
@@ -233,70 +278,41 @@ impl RowCounter<'_> {
             return r.iter().map(|(a, b)| (b - a + 1) as u64).product();
         }
         // rows along the axis the first cutting plane is steepest in
-        let first = mask.trailing_zeros() as usize;
-        let n0 = self.planes[first].0;
-        let a = (0..3)
-            .max_by(|&i, &j| n0[i].abs().total_cmp(&n0[j].abs()))
-            .unwrap_or(0);
+        let a = self.axis[mask.trailing_zeros() as usize];
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
         let (alo, ahi) = r[a];
-        let res = self.res;
-        // per cutting plane: crossing coefficients and tolerance (None: per-cell tests)
-        let mut lin = [None::<(usize, f64, f64, f64, f64, bool)>; 6];
+        // per cutting plane: crossing coefficients and tolerance (or in `exact`: per-cell tests)
+        let mut lin: [Lin; 6] = [(0, 0.0, 0.0, 0.0, 0.0, false); 6];
         let mut exact = [usize::MAX; 6];
         let (mut nl, mut ne) = (0, 0);
         for j in 0..6 {
             if mask & (1 << j) == 0 {
                 continue;
             }
-            let (n, d) = &self.planes[j];
-            let scale = (n[0].abs() + n[1].abs() + n[2].abs()) / n[a].abs();
-            // key-unit error bound of κ and of the per-cell test near the crossing,
-            // with a safety factor of about 10^6 over f64 rounding
-            let tol = 1e-9 * scale * (32768.0 + (32768.0 * res + d.abs()) / res);
-            if n[a] == 0.0 || tol.is_nan() || tol >= 0.25 {
-                exact[ne] = j;
-                ne += 1;
-                continue;
+            match self.coef[j][a] {
+                Some(l) => {
+                    lin[nl] = l;
+                    nl += 1;
+                }
+                None => {
+                    exact[ne] = j;
+                    ne += 1;
+                }
             }
-            // κ = −(n_b·c_b + n_c·c_c + d)/(n_a·res) + 32767.5, c_i = (k_i − 32767.5)·res
-            let kb = -n[b] / n[a];
-            let kc = -n[c] / n[a];
-            let k0 = -d / (n[a] * res) - (kb + kc) * 32767.5 + 32767.5;
-            lin[nl] = Some((j, k0, kb, kc, tol, n[a] > 0.0));
-            nl += 1;
+        }
+        // the crossings of up to three planes in 32.32 fixed point when every plane's
+        // |cb| ≤ 2^20 and rows are at most 32 long (always below `ROW_LOG` 5)
+        let max_cb = lin[..nl].iter().fold(0.0f64, |m, p| m.max(p.2.abs()));
+        if ne == 0 && max_cb <= 1_048_576.0 && r[b].1 - r[b].0 < 32 {
+            match nl {
+                1 => return self.fixed_rows::<1>(&lin, &r, [a, b, c], max_cb),
+                2 => return self.fixed_rows::<2>(&lin, &r, [a, b, c], max_cb),
+                3 => return self.fixed_rows::<3>(&lin, &r, [a, b, c], max_cb),
+                _ => {}
+            }
         }
         let mut total = 0u64;
         let mut k = [0i64; 3];
-        if nl == 1
-            && ne == 0
-            && let Some((j, k0, cb, cc, tol, up)) = lin[0]
-        {
-            // the common case, one cutting plane: the same rule in a tight loop
-            let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
-            for kc in r[c].0..=r[c].1 {
-                k[c] = kc;
-                for kb in r[b].0..=r[b].1 {
-                    let kr = k0 + cb * kb as f64 + cc * kc as f64;
-                    let fl = floor_i64(kr.clamp(lo_f, hi_f));
-                    let frac = kr - fl as f64;
-                    let n = if kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol) {
-                        k[b] = kb;
-                        if up {
-                            ahi - self.first_inside(j, k, a, alo, alo, ahi) + 1
-                        } else {
-                            self.last_inside(j, k, a, ahi, alo, ahi) - alo + 1
-                        }
-                    } else if up {
-                        ahi - (fl + 1).max(alo) + 1
-                    } else {
-                        fl.min(ahi) - alo + 1
-                    };
-                    total += n.max(0) as u64;
-                }
-            }
-            return total;
-        }
         for kc in r[c].0..=r[c].1 {
             k[c] = kc;
             for kb in r[b].0..=r[b].1 {
@@ -306,7 +322,7 @@ impl RowCounter<'_> {
                 let (mut first_in, mut last_in) = (alo, ahi);
                 let mut near = false;
                 let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
-                for &(_, k0, cb, cc, tol, up) in lin[..nl].iter().flatten() {
+                for &(_, k0, cb, cc, tol, up) in lin[..nl].iter() {
                     let kr = k0 + cb * kb as f64 + cc * kc as f64;
                     let fl = floor_i64(kr.clamp(lo_f, hi_f));
                     let frac = kr - fl as f64;
@@ -319,7 +335,7 @@ impl RowCounter<'_> {
                 }
                 if near {
                     (first_in, last_in) = (alo, ahi);
-                    for &(j, _, _, _, _, up) in lin[..nl].iter().flatten() {
+                    for &(j, _, _, _, _, up) in lin[..nl].iter() {
                         if first_in > last_in {
                             break;
                         }
@@ -348,6 +364,84 @@ impl RowCounter<'_> {
                 }
                 if last_in >= first_in {
                     total += (last_in - first_in + 1) as u64;
+                }
+            }
+        }
+        total
+    }
+
+    /// The rows of [`count`](Self::count) for `N` (1–3) cutting planes, all with a
+    /// crossing (`lin`), in 32.32 fixed point relative to `alo`: per c-row each
+    /// crossing is evaluated once in f64 at the first b, then stepped by `cb` as an
+    /// integer (at most 31 steps; truncating `cb` and the start to 2^−32 adds under
+    /// 2^−26 keys of error, covered by the 2^−20 added to each `tol`). Starting
+    /// crossings are clamped to `[−m, len + m]` with `m = 4 + 32·⌈max|cb|⌉`: 31 steps
+    /// cannot bring a clamped one back into `[−1, len + 1]`, so its rows count the same
+    /// (all or none of the row). A row with a crossing within `tol` of an integer is
+    /// decided by the per-cell tests, as in the f64 path.
+    #[inline(always)]
+    fn fixed_rows<const N: usize>(
+        &self,
+        lin: &[Lin; 6],
+        r: &[(i64, i64); 3],
+        [a, b, c]: [usize; 3],
+        max_cb: f64,
+    ) -> u64 {
+        const ONE: i64 = 1 << 32;
+        let (alo, ahi) = r[a];
+        let len = ahi - alo + 1;
+        let margin = 4.0 + 32.0 * max_cb.ceil();
+        let (mut steps, mut tols, mut ups) = ([0i64; N], [0i64; N], [false; N]);
+        for p in 0..N {
+            steps[p] = (lin[p].2 * ONE as f64) as i64;
+            tols[p] = ((lin[p].4 + 1.0 / 1_048_576.0) * ONE as f64) as i64;
+            ups[p] = lin[p].5;
+        }
+        // `v ∈ (−1, len)` (keys, fixed point) as one unsigned compare
+        let span = ((len + 1) * ONE - 1) as u64;
+        let mut total = 0u64;
+        let mut k = [0i64; 3];
+        for kc in r[c].0..=r[c].1 {
+            k[c] = kc;
+            let mut vs = [0i64; N];
+            for p in 0..N {
+                let (_, k0, cb, cc, _, _) = lin[p];
+                let rel = (k0 + cb * r[b].0 as f64 + cc * kc as f64 - alo as f64)
+                    .clamp(-margin, len as f64 + margin);
+                vs[p] = (rel * ONE as f64) as i64;
+            }
+            for kb in r[b].0..=r[b].1 {
+                // relative first and last keys inside every plane
+                let (mut first, mut last) = (0i64, len - 1);
+                let mut near = false;
+                for p in 0..N {
+                    let v = vs[p];
+                    vs[p] += steps[p];
+                    let fl = v >> 32;
+                    let frac = v & (ONE - 1);
+                    // within tol of an integer: `frac ≤ tol` or `frac ≥ 1 − tol`, i.e.
+                    // `(frac + tol) mod 1 ≤ 2·tol` (tol < ¼); no branches
+                    let inside = ((v + ONE - 1) as u64) < span;
+                    near |= inside & (((frac + tols[p]) & (ONE - 1)) <= 2 * tols[p]);
+                    first = first.max(if ups[p] { fl + 1 } else { i64::MIN });
+                    last = last.min(if ups[p] { i64::MAX } else { fl });
+                }
+                if near {
+                    k[b] = kb;
+                    let (mut f, mut l) = (alo, ahi);
+                    for p in 0..N {
+                        if f > l {
+                            break;
+                        }
+                        if ups[p] {
+                            f = f.max(self.first_inside(lin[p].0, k, a, alo, alo, ahi));
+                        } else {
+                            l = l.min(self.last_inside(lin[p].0, k, a, ahi, alo, ahi));
+                        }
+                    }
+                    total += (l - f + 1).max(0) as u64;
+                } else {
+                    total += (last - first + 1).max(0) as u64;
                 }
             }
         }

@@ -113,6 +113,40 @@ proptest! {
         }
     }
 
+    /// Frusta whose planes run through cell centres: the camera at a cell centre,
+    /// looking along a small integer direction, tan(fov/2) of ½, 1 or 3/2, near and far a
+    /// whole number of cells. Many rows then cross a plane exactly at (or within
+    /// rounding of) a cell centre, which the fixed-point row loops must hand to the
+    /// per-cell tests; the count still equals the count of every cell.
+    #[test]
+    fn lattice_aligned_frusta_count_like_every_cell(
+        seed in 0u64..1_000_000,
+        cell in prop::array::uniform3(-12i32..12),
+        dir in prop::array::uniform3(-2i32..=2),
+        th in 1u32..=3,
+        tv in 1u32..=3,
+        near in 1u32..4,
+        depth in 3u32..14,
+    ) {
+        let t = random_tree(seed);
+        let key: OcKey = cell.map(|v| (32768 + v) as u16);
+        let d = Vector3::new(dir[0] as f64, dir[1] as f64, dir[2] as f64);
+        let Some(pose) = look_along(&t.key_center(&key, TREE_DEPTH), &d) else {
+            return Ok(());
+        };
+        let cam = CameraModel {
+            hfov: 2.0 * (th as f64 / 2.0).atan(),
+            vfov: 2.0 * (tv as f64 / 2.0).atan(),
+            near: near as f64 * 0.1,
+            far: (near + depth) as f64 * 0.1,
+            width: 8,
+            height: 6,
+        };
+        let f = Frustum::new(&cam, &pose);
+        let (lo, hi) = corner_box(&t, &f);
+        prop_assert_eq!(FrustumCounter::new(&t).count(&f), brute(&t, &f, lo, hi));
+    }
+
     #[test]
     fn known_counts_sum_the_leaves(seed in 0u64..1_000_000) {
         let t = random_tree(seed);
@@ -185,6 +219,73 @@ proptest! {
             }
         }
         let got: Vec<(OcKey, f64)> = got.iter().map(|f| (f.key, f.unknown_ratio)).collect();
-        prop_assert_eq!(got, want);
+        prop_assert_eq!(&got, &want);
+        // the lookup path (taken when the region's grid would be too large) agrees
+        let by_lookups = super::frontier::frontier_by_lookups(&t, &min, &max, ratio, &|| false).unwrap();
+        let by_lookups: Vec<(OcKey, f64)> = by_lookups.iter().map(|f| (f.key, f.unknown_ratio)).collect();
+        prop_assert_eq!(by_lookups, want);
+    }
+
+    /// The grid's potential field against the per-cell sum written out with one tree
+    /// lookup per cell of the radius' key box, at free and unknown cells and radii of
+    /// 0.5–7 cells; the region's shared grid and the per-call grid agree exactly.
+    #[test]
+    fn potential_field_equals_a_sum_over_every_cell(
+        seed in 0u64..1_000_000,
+        radius in 0.05f64..0.7,
+        o in proptest::array::uniform3(-22i32..22),
+    ) {
+        let t = random_tree(seed);
+        let res = t.resolution();
+        let key: OcKey = o.map(|v| (32768 + v) as u16);
+        let reach = (radius / res).ceil() as i32 + 1;
+        let mut want = Vector3::zeros();
+        let mut scale = 0.0;
+        for dz in -reach..=reach {
+            for dy in -reach..=reach {
+                for dx in -reach..=reach {
+                    let d = Vector3::new(dx as f64 * res, dy as f64 * res, dz as f64 * res);
+                    let dist = d.norm();
+                    if (dx, dy, dz) == (0, 0, 0) || dist > radius {
+                        continue;
+                    }
+                    let k = [0, 1, 2].map(|i| (key[i] as i32 + [dx, dy, dz][i]) as u16);
+                    let s = if t.state_of_key(&k) == CellState::Unknown { 1.0 } else { -1.0 };
+                    want += d / (dist * dist) * s;
+                    scale += 1.0 / dist;
+                }
+            }
+        }
+        let got = potential_field(&t, &key, radius).unwrap();
+        prop_assert!((got - want).norm() <= 1e-12 * scale, "{} vs {}", got, want);
+        let ball = super::grid::Ball::new(res, radius).unwrap();
+        let g = super::grid::StateGrid::new(&t, [32700; 3], [32830; 3], usize::MAX).unwrap();
+        prop_assert_eq!(g.field(&key, &ball), got);
+    }
+}
+
+/// At the corner of the key space a cell has 7 neighbours in the tree's cube; the
+/// other 19 are neither unknown nor known (the grid marks them outside), so a free
+/// cell there has 7/26 unknown neighbours, and its field sums the 7 cells only.
+#[test]
+fn frontier_and_field_at_the_edge_of_the_key_space() {
+    let mut t = Octree::new(0.1).unwrap();
+    let miss = t.sensor_model().log_odds().miss;
+    t.update_key(&[0, 0, 0], miss);
+    let (min, max) = (t.key_center(&[0; 3], 16), t.key_center(&[3; 3], 16));
+    for f in [
+        frontier_cells(&t, &min, &max, 0.25, &|| false).unwrap(),
+        super::frontier::frontier_by_lookups(&t, &min, &max, 0.25, &|| false).unwrap(),
+    ] {
+        assert_eq!(f.len(), 1);
+        assert_eq!((f[0].key, f[0].unknown_ratio), ([0; 3], 7.0 / 26.0));
+    }
+    assert!(frontier_cells(&t, &min, &max, 0.3, &|| false).unwrap().is_empty());
+    // seven unknown cells at +x, +y, +z, the face diagonals and the body diagonal:
+    // F = (1/0.1)·(1 + 2·½ + ⅓)·(1,1,1) per axis = 23.33…·(1, 1, 1)
+    let f = potential_field(&t, &[0; 3], 0.18).unwrap();
+    let want = (1.0 + 2.0 * 0.5 + 1.0 / 3.0) / 0.1;
+    for i in 0..3 {
+        assert!((f[i] - want).abs() < 1e-9, "{f}");
     }
 }

@@ -7,6 +7,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use rayon::prelude::*;
 
 use super::camera::look_along;
+use super::grid::{Ball, MAX_CELLS, StateGrid};
 use crate::octree::{CellState, OcKey, Octree, SearchCache, StateFilter, TREE_DEPTH};
 
 /// One frontier cell: a known-free depth-16 cell with enough unknown neighbours.
@@ -19,12 +20,46 @@ pub struct Frontier {
     pub unknown_ratio: f64,
 }
 
+/// Unknown neighbours (of 26) a frontier cell needs: the least `u` with
+/// `u/26 ≥ min_unknown_ratio` (at least 1; 27, none, for a NaN or a ratio above 1).
+pub(crate) fn unknown_needed(min_unknown_ratio: f64) -> usize {
+    (1..=26usize)
+        .find(|&u| u as f64 / 26.0 >= min_unknown_ratio)
+        .unwrap_or(27)
+}
+
 /// Frontier cells inside the box `[min, max]` (m): free depth-16 cells (including the
 /// surface cells of pruned free cubes) whose 26 neighbours are unknown in a share of at
 /// least `min_unknown_ratio`. Sorted by key (x fastest) so the result is deterministic.
-/// Cubes are scanned in parallel chunks (rayon); `should_stop` is polled every 256
-/// cells of a chunk; the cells found so far are returned.
+///
+/// When the box's keys with one cell of margin hold at most `grid::MAX_CELLS` (2^24) cells, the
+/// states are copied into a dense grid once and counted by 3×3×3 block sums
+/// (`StateGrid::frontier`, z planes in parallel, `should_stop` polled per plane);
+/// otherwise free cubes are scanned in parallel chunks with neighbour lookups in the
+/// tree (`should_stop` polled every 256 cells of a chunk). Either way the cells found
+/// so far are returned when stopped.
 pub fn frontier_cells(
+    tree: &Octree,
+    min: &Point3<f64>,
+    max: &Point3<f64>,
+    min_unknown_ratio: f64,
+    should_stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Vec<Frontier>, crate::octree::OctreeError> {
+    let (kmin, kmax) = (tree.key_of(min)?, tree.key_of(max)?);
+    if (0..3).all(|i| kmin[i] <= kmax[i]) {
+        let lo = kmin.map(|k| k as i64 - 1);
+        let hi = kmax.map(|k| k as i64 + 1);
+        if let Some(g) = StateGrid::new(tree, lo, hi, MAX_CELLS) {
+            return Ok(g.frontier(tree, &kmin, &kmax, unknown_needed(min_unknown_ratio), should_stop));
+        }
+    }
+    frontier_by_lookups(tree, min, max, min_unknown_ratio, should_stop)
+}
+
+/// [`frontier_cells`] by neighbour lookups in the tree: the surface cells of every free
+/// cube in the box, skipping cubes whose 26 same-size neighbour cubes are single
+/// leaves (no grid, so no memory beyond the result for any box size).
+pub(crate) fn frontier_by_lookups(
     tree: &Octree,
     min: &Point3<f64>,
     max: &Point3<f64>,
@@ -40,9 +75,7 @@ pub fn frontier_cells(
     tree.for_each_in_box(min, max, TREE_DEPTH, free, |c| cubes.push((c.key, c.depth)))?;
     let (kmin, kmax) = (tree.key_of(min)?, tree.key_of(max)?);
     // unknown neighbours needed: the least u with u/26 ≥ the ratio (same test as below)
-    let need = (1..=26usize)
-        .find(|&u| u as f64 / 26.0 >= min_unknown_ratio)
-        .unwrap_or(27);
+    let need = unknown_needed(min_unknown_ratio);
     let stopped = AtomicBool::new(false);
     // one cell of the free cube [base, base + n): neighbours inside the cube are known
     // (free) without a lookup; the lookups stop once too many are known to qualify
@@ -209,12 +242,38 @@ fn one_leaf(tree: &Octree, key: &OcKey, depth: u8) -> bool {
     !tree.has_children(n)
 }
 
-/// Potential field at `p` (S0 eq. 4.1): `F = Σ F_p − Σ F_o` over the space within
-/// `radius` (m): every unknown cell attracts and every known (free or occupied) cell
-/// repels with `(c − p)/‖c − p‖²` (unit direction over distance, so closer cells weigh
-/// more). Octree cubes are taken whole (their centre, clipped to the radius' box,
-/// weighted by the cells they hold), so the cost follows the tree, not the radius³.
+/// Potential field of the frontier cell `key` (S0 eq. 4.1, ALGORITHMS.md §5 step 1):
+/// `F = Σ F_p − Σ F_o` over every depth-16 cell `k + o` within `radius` (m) of the
+/// cell's centre — `0 < ‖o·res‖ ≤ radius` — where an unknown cell attracts and a known
+/// (free or occupied) cell repels with `o·res/‖o·res‖²` (unit direction over distance,
+/// so closer cells weigh more); cells outside the key space add nothing. Exact per
+/// cell: the cells of the radius' key box are read from a dense grid filled from the
+/// tree (`grid::StateGrid`).
+///
+/// Approximation above `grid::MAX_BALL_REACH` (32) cells of radius only: octree cubes are
+/// then taken whole — each cube's part inside the radius' box counts as
+/// its cell count at its centre (see [`potential_field_cubes`]).
 pub fn potential_field(
+    tree: &Octree,
+    key: &OcKey,
+    radius: f64,
+) -> Result<Vector3<f64>, crate::octree::OctreeError> {
+    let Some(ball) = Ball::new(tree.resolution(), radius) else {
+        return potential_field_cubes(tree, &tree.key_center(key, TREE_DEPTH), radius);
+    };
+    let lo = key.map(|k| k as i64 - ball.reach);
+    let hi = key.map(|k| k as i64 + ball.reach);
+    let g = StateGrid::new(tree, lo, hi, usize::MAX).expect("a ball's box is never empty");
+    Ok(g.field(key, &ball))
+}
+
+/// The field of wide radii (over `grid::MAX_BALL_REACH` cells), approximated by cubes:
+/// every octree cube overlapping the radius' box around `p` is clipped to the box and
+/// contributes its clipped cell count (rounded, at least one) times `(c − p)/‖c − p‖²`
+/// at the clipped part's centre `c`, when `0 < ‖c − p‖ ≤ radius`. The cost follows the
+/// tree, not the radius³; the direction differs from the per-cell sum by the spread of
+/// each cube's cells around its centre.
+pub fn potential_field_cubes(
     tree: &Octree,
     p: &Point3<f64>,
     radius: f64,

@@ -7,6 +7,7 @@ mod count;
 mod error;
 mod frontier;
 mod gain;
+mod grid;
 mod params;
 mod select;
 
@@ -18,7 +19,7 @@ mod tests;
 pub use camera::{CameraModel, Frustum, look_along};
 pub use count::FrustumCounter;
 pub use error::NbvError;
-pub use frontier::{Frontier, candidate_pose, frontier_cells, potential_field};
+pub use frontier::{Frontier, candidate_pose, frontier_cells, potential_field, potential_field_cubes};
 pub use gain::{
     GainMethod, GainWorkspace, ViewGain, frustum_unknown_count, frustum_unknown_count_in, ray_gain, walk,
 };

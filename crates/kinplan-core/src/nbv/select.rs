@@ -11,8 +11,9 @@ use rayon::prelude::*;
 
 use super::camera::{CameraModel, Frustum};
 use super::count::FrustumCounter;
-use super::frontier::{candidate_pose, frontier_cells, potential_field};
+use super::frontier::{candidate_pose, frontier_cells, potential_field, unknown_needed};
 use super::gain::{GainMethod, GainWorkspace, ray_gain};
+use super::grid::{Ball, MAX_CELLS, StateGrid};
 use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
 use crate::octree::{CellState, Octree};
@@ -183,11 +184,33 @@ pub fn next_best_view(
     // deadline or cancellation, for the loops that take a closure
     let stop = || clock.interrupted().is_some();
 
-    // 1. candidates
+    // 1. candidates: one dense state grid of the region plus the field's radius serves
+    // the frontier test and every potential field when it fits (else tree lookups)
     let t = Instant::now();
+    let ball = Ball::new(tree.resolution(), params.field_radius);
+    let mut grid = None;
     let mut frontier = match &region {
         Some((a, b)) if params.max_frontier_candidates > 0 => {
-            frontier_cells(tree, a, b, params.frontier_unknown_ratio, &stop)?
+            let (ka, kb) = (tree.key_of(a)?, tree.key_of(b)?);
+            let pad = ball.as_ref().map_or(1, |b| b.reach.max(1));
+            if (0..3).all(|i| ka[i] <= kb[i]) {
+                grid = StateGrid::new(
+                    tree,
+                    ka.map(|k| k as i64 - pad),
+                    kb.map(|k| k as i64 + pad),
+                    MAX_CELLS,
+                );
+            }
+            match &grid {
+                Some(g) => g.frontier(
+                    tree,
+                    &ka,
+                    &kb,
+                    unknown_needed(params.frontier_unknown_ratio),
+                    &stop,
+                ),
+                None => frontier_cells(tree, a, b, params.frontier_unknown_ratio, &stop)?,
+            }
         }
         _ => Vec::new(),
     };
@@ -209,7 +232,10 @@ pub fn next_best_view(
             if clock.interrupted().is_some() {
                 return Ok(None);
             }
-            let field = potential_field(tree, &f.center, params.field_radius)?;
+            let field = match (&grid, &ball) {
+                (Some(g), Some(b)) => g.field(&f.key, b),
+                _ => potential_field(tree, &f.key, params.field_radius)?,
+            };
             Ok(Some(candidate_pose(
                 &f.center,
                 &field,

@@ -178,15 +178,17 @@ fn frontier_of_a_free_cube_is_its_surface() {
 #[test]
 fn potential_field_points_into_the_unknown() {
     let mut t = Octree::new(0.1).unwrap();
-    // known free slab x < 0, unknown x ≥ 0, symmetric in y and z about the probe
-    free_box(&mut t, [32758, 32758, 32758], [32767, 32777, 32777]);
-    let p = Point3::new(-0.05, 0.0, 0.0);
-    let f = potential_field(&t, &p, 0.5).unwrap();
+    // known free slab x < 0, unknown x ≥ 0, symmetric in y and z about the probe cell
+    free_box(&mut t, [32758, 32757, 32757], [32767, 32777, 32777]);
+    let k = [32767; 3];
+    let p = t.key_center(&k, 16);
+    assert_eq!(p, Point3::new(-0.05, -0.05, -0.05));
+    let f = potential_field(&t, &k, 0.5).unwrap();
     assert!(f.x > 0.0, "{f}");
     assert!(f.y.abs() < 1e-9 * f.x.abs().max(1.0) + 1e-9 && f.z.abs() < 1e-9 + 1e-9 * f.x.abs());
     let pose = candidate_pose(&p, &f, 0.3, 0.5).unwrap();
     // stand-off raised to the near range, camera behind the frontier looking at it
-    assert!((pose.translation.vector - Vector3::new(-0.55, 0.0, 0.0)).norm() < 1e-9);
+    assert!((pose.translation.vector - Vector3::new(-0.55, -0.05, -0.05)).norm() < 1e-9);
     assert!((pose.rotation * Vector3::z() - Vector3::x()).norm() < 1e-9);
 }
 
