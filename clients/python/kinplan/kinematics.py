@@ -112,30 +112,21 @@ def _target_wire(T: Any) -> bytes:
         return pose_bytes(T)
     out: bytes = target_to_pose(T).SerializeToString()
     return out
-_IK_OPTIONS_WIRE: Dict[Any, bytes] = {}
+_IK_OPTIONS_FIELD: Dict[Any, bytes] = {}
 
 
-def _ik_options_field(method: Any, linear_solver: Any, max_restarts: Any, num_solutions: Any,
-                     position_tolerance: Any, orientation_tolerance: Any, position_only: Any,
-                     options: Dict[str, Any]) -> bytes:
-    """The encoded IkOptions of :meth:`RobotKinematicsMixin.ik`'s arguments as
-    field 4 of a SolveIkRequest, cached per distinct set (the same message as
-    :func:`ik_options` builds)."""
+def _ik_options_field(*args: Any) -> bytes:
+    """The IkOptions of ``ik_options(*args)`` (all its parameters, in order)
+    encoded as field 4 of a SolveIkRequest: the same message, cached per
+    distinct set of arguments."""
     try:
-        key: Any = (method, linear_solver, max_restarts, num_solutions, position_tolerance,
-                    orientation_tolerance, position_only, tuple(sorted(options.items())))
-        cached = _IK_OPTIONS_WIRE.get(key)
+        cached = _IK_OPTIONS_FIELD.get(args)
     except TypeError:  # an unhashable argument: no cache
-        key, cached = None, None
+        return length_delimited(4, _build_ik_options(*args).SerializeToString())
     if cached is None:
-        cached = ik_options(
-            method, linear_solver, max_restarts=max_restarts, num_solutions=num_solutions,
-            position_tolerance=position_tolerance, orientation_tolerance=orientation_tolerance,
-            position_only=position_only, **options,
-        ).SerializeToString()
-        cached = length_delimited(4, cached)
-        if key is not None and len(_IK_OPTIONS_WIRE) < 256:
-            _IK_OPTIONS_WIRE[key] = cached
+        cached = length_delimited(4, _build_ik_options(*args).SerializeToString())
+        if len(_IK_OPTIONS_FIELD) < 256:
+            _IK_OPTIONS_FIELD[args] = cached
     return cached
 
 
@@ -241,15 +232,16 @@ class IkSolution:
 
     @classmethod
     def from_proto(cls, s: kinematics_pb2.IkSolution) -> "IkSolution":
+        # positional, in field order: the hot path of every IK answer
         return cls(
-            q=np.array(s.joints[:], dtype=float),  # a list first: ~3x faster than asarray for a few values
-            position_error=s.position_error,
-            orientation_error=s.orientation_error,
-            iterations=s.iterations,
-            elapsed_us=s.elapsed_us,
-            status=_ik_status(s.status),
-            attempt=s.attempt,
-            history=(
+            np.array(s.joints[:], dtype=float),  # a list first: ~3x faster than asarray for a few values
+            s.position_error,
+            s.orientation_error,
+            s.iterations,
+            s.elapsed_us,
+            _IK_STATUS.get(s.status) or _ik_status(s.status),
+            s.attempt,
+            (
                 np.column_stack([s.position_error_history, s.orientation_error_history])
                 if len(s.position_error_history)
                 else None
@@ -301,20 +293,13 @@ class IkResult:
         solutions = [IkSolution.from_proto(s) for s in r.solutions]
         best = IkSolution.from_proto(r.best_attempt) if r.HasField("best_attempt") else None
         head = solutions[0] if solutions else best
-        return cls(
-            success=r.success,
-            q=None if head is None else head.q,
-            position_error=float("nan") if head is None else head.position_error,
-            orientation_error=float("nan") if head is None else head.orientation_error,
-            iterations=0 if head is None else head.iterations,
-            status=_ik_status(r.status),
-            solutions=solutions,
-            best_attempt=best,
-            attempts=r.attempts,
-            total_iterations=r.total_iterations,
-            elapsed_us=r.elapsed_us,
-            raw=r,
-        )
+        status = _IK_STATUS.get(r.status) or _ik_status(r.status)
+        # positional, in field order: the hot path of every IK answer
+        if head is None:
+            return cls(r.success, None, float("nan"), float("nan"), 0, status, solutions, best, r.attempts,
+                       r.total_iterations, r.elapsed_us, None, r)
+        return cls(r.success, head.q, head.position_error, head.orientation_error, head.iterations, status,
+                   solutions, best, r.attempts, r.total_iterations, r.elapsed_us, None, r)
 
     def __bool__(self) -> bool:
         return self.success
@@ -667,17 +652,10 @@ class RobotKinematicsMixin:
         if _is_position(T):
             T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
             position_only = True
-        options = {
-            k: v for k, v in (
-                ("max_iterations", max_iterations), ("damping", damping), ("rng_seed", rng_seed),
-                ("joint_limits", joint_limits), ("time_budget", time_budget), ("adaptive_damping", adaptive_damping),
-                ("max_step", max_step), ("distinct_tolerance", distinct_tolerance),
-                ("rlxa_max_iterations", rlxa_max_iterations), ("history", history),
-            ) if v is not None
-        }
         options_field = _ik_options_field(
-            method, linear_solver, max_restarts, num_solutions, position_tolerance, orientation_tolerance,
-            position_only, options,
+            method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
+            damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
+            max_step, distinct_tolerance, rlxa_max_iterations, history,
         )
         # the request goes out as bytes built field by field: no message objects
         body = (

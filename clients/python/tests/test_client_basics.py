@@ -244,7 +244,8 @@ def test_the_ik_request_encoded_by_hand_parses_as_the_message_built_one():
         wire = (length_delimited(1, ref.SerializeToString())
                 + length_delimited(2, _target_wire(T if k % 5 else (T[:3, 3], [0.0, 0.0, 0.0, 1.0])))
                 + packed_doubles(3, seed)
-                + _ik_options_field("lm", "svd", 10, None, 1e-6, None, False, extra))
+                + _ik_options_field("lm", "svd", 1e-6, None, False, extra.get("max_iterations"), None, 10, None,
+                                    extra.get("rng_seed", 0), None, None, None, None, None, None, False))
         expected = kinematics_pb2.SolveIkRequest(
             robot=ref, target=target_to_pose(T if k % 5 else (T[:3, 3], [0.0, 0.0, 0.0, 1.0])), seed=seed,
             options=ik_options("lm", "svd", max_restarts=10, position_tolerance=1e-6, **extra),
