@@ -3,7 +3,7 @@
 //! 0.05–0.15 m and on geb079.bt; then NBV end to end with 1,000 frontier candidates at
 //! 5 cm. Seeded; prints Markdown.
 //!
-//! cargo run --release -p kinplan-core --example nbv_table
+//! cargo run --release -p kinplan-core --example nbv_table [-- --no-rays | --nbv-only] [--write-bt PATH]
 
 use std::time::Instant;
 
@@ -164,6 +164,10 @@ fn main() {
 
     // NBV end to end at 5 cm
     let t = room_tree(0.05);
+    // `--write-bt PATH`: the tree as OctoMap .bt, to time the same call over gRPC
+    if let Some(path) = args.iter().position(|a| a == "--write-bt").and_then(|i| args.get(i + 1)) {
+        std::fs::write(path, t.write_bt()).expect("writing the .bt file");
+    }
     let chain = kinplan_core::robot::builtin_chain("abb_irb4600_60_205").unwrap();
     let current = look_along(&Point3::new(0.1, 0.2, 1.3), &Vector3::new(1.0, 0.3, 0.0)).unwrap();
     println!();

@@ -301,11 +301,13 @@ class ExplorationMixin:
         """Ranked next views of the unknown space in ``octree`` (an
         :class:`Octree` or a ``.bt`` file's bytes). ``weights`` = (w_i, w_d,
         w_r); ``gain`` one of "intersection", "rays", "occlusion_aware",
-        "unobserved_voxels"; ``robot`` (optional) adds the reach filter and IK
+        "unobserved_voxels"; ``robot`` (optional, a robot or a built-in's name) adds the reach filter and IK
         checks of the best candidates; further ``options`` are the fields of
         ``NbvOptions`` (e.g. ``frontier_unknown_ratio=0.3``)."""
         req = _nbv_request(octree, camera_pose, camera_mount, candidate_poses, weights, gain, ray_fraction,
                            max_results, camera, options)
+        if isinstance(robot, str):
+            robot = self.robot(robot)  # type: ignore[attr-defined]
         if robot is not None:
             reply = robot._call(self._exploration().NextBestView, _with_robot(req), timeout)
         else:

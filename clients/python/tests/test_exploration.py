@@ -40,6 +40,16 @@ def test_views_follow_the_utility_formula(client):
     assert all(r is None for r in views.reachable)
 
 
+def test_a_robot_named_by_its_built_in_name_checks_reach_as_the_robot_object(client):
+    tree = client.insert_scan(None, wall(), origin=np.eye(4), resolution=0.1)
+    by_name = client.next_best_view(tree, camera_pose=np.eye(4), robot="abb_irb4600_60_205", max_results=3)
+    by_robot = client.next_best_view(tree, camera_pose=np.eye(4), robot=client.robot("abb_irb4600_60_205"),
+                                     max_results=3)
+    assert list(by_name.reachable) == list(by_robot.reachable)
+    assert all(r is not None for r in by_name.reachable)
+    np.testing.assert_array_equal(by_name.poses, by_robot.poses)
+
+
 def test_bad_scans_are_refused(client):
     with pytest.raises(ValueError):
         client.insert_scan(None, np.zeros((4, 2)))
