@@ -70,6 +70,19 @@ fn fine_motion_valid(c: &SceneChecker, a: &[f64], b: &[f64], resolution: f64) ->
     }) && c.is_valid(b) // the end exactly: a + 1·(b − a) may round past a limit
 }
 
+/// A body's bounding-sphere centre and its six poles (body frame).
+fn sphere_points(body: &super::super::model::Body) -> Vec<Point3<f64>> {
+    let mut points = vec![Point3::from(body.center)];
+    for axis in 0..3 {
+        for sign in [-1.0, 1.0] {
+            let mut p = body.center;
+            p[axis] += sign * body.radius;
+            points.push(Point3::from(p));
+        }
+    }
+    points
+}
+
 /// Twelve thin posts and plates 0.35–0.8 m from the Panda's base axis.
 fn posts(rng: &mut ChaCha8Rng) -> Vec<Obstacle> {
     (0..12)
@@ -134,15 +147,7 @@ fn no_point_of_a_panda_body_moves_farther_than_its_pad() {
             model.body_poses(&qt, &mut at_t);
             for (b, body) in model.bodies.iter().enumerate() {
                 // the bounding sphere's centre and its six poles
-                let mut points = vec![Point3::from(body.center)];
-                for axis in 0..3 {
-                    for sign in [-1.0, 1.0] {
-                        let mut p = body.center;
-                        p[axis] += sign * body.radius;
-                        points.push(Point3::from(p));
-                    }
-                }
-                for p in points {
+                for p in sphere_points(body) {
                     let moved = (at_t[b] * p - at_a[b] * p).norm();
                     assert!(
                         moved <= pads[b] + 1e-12,
@@ -402,15 +407,7 @@ fn the_bound_around_a_state_holds_for_the_true_motion_and_is_tighter() {
                 .collect();
             model.body_poses(&s, &mut at_s);
             for (b, body) in model.bodies.iter().enumerate() {
-                let mut points = vec![Point3::from(body.center)];
-                for axis in 0..3 {
-                    for sign in [-1.0, 1.0] {
-                        let mut p = body.center;
-                        p[axis] += sign * body.radius;
-                        points.push(Point3::from(p));
-                    }
-                }
-                for p in points {
+                for p in sphere_points(body) {
                     let moved = (at_s[b] * p - at_m[b] * p).norm();
                     assert!(
                         moved <= near[b] + 1e-12,
