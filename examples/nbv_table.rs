@@ -165,7 +165,11 @@ fn main() {
     // NBV end to end at 5 cm
     let t = room_tree(0.05);
     // `--write-bt PATH`: the tree as OctoMap .bt, to time the same call over gRPC
-    if let Some(path) = args.iter().position(|a| a == "--write-bt").and_then(|i| args.get(i + 1)) {
+    if let Some(path) = args
+        .iter()
+        .position(|a| a == "--write-bt")
+        .and_then(|i| args.get(i + 1))
+    {
         std::fs::write(path, t.write_bt()).expect("writing the .bt file");
     }
     let chain = kinplan_core::robot::builtin_chain("abb_irb4600_60_205").unwrap();
