@@ -12,7 +12,8 @@ pub const MIN_PIECE: f64 = 1e-5;
 /// refused: bounds the cost of a motion that runs along an obstacle.
 pub const MAX_CHECKS_PER_PIECE: usize = 64;
 
-/// True when no state of the straight motion `a → b` collides, proved piece
+/// True when no state of the straight motion `a → b` collides (the motion
+/// check of ALGORITHMS.md §4 and issue 10, made conservative), proved piece
 /// by piece (conservative advancement over joint space, Schwarzer, Saha and
 /// Latombe's idea with the distance test replaced by a padded overlap test):
 ///
