@@ -58,13 +58,16 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
     let (mut q, mut half) = ([0.0; MAX_DOF], [0.0; MAX_DOF]);
     let mut checks = 0usize;
     // Pieces in bisection order (the middle one first), each proved by
-    // halving where needed; a stack of parameter intervals.
-    let mut stack: Vec<(f64, f64)> = Vec::new();
+    // halving where needed; a stack of parameter intervals on the stack (each
+    // check pushes at most two and the budget bounds the checks).
+    let mut stack = [(0.0, 0.0); MAX_CHECKS_PER_PIECE + 1];
     for index in bisection_order(pieces) {
         let mut budget = MAX_CHECKS_PER_PIECE;
-        stack.clear();
-        stack.push((index as f64 / pieces as f64, (index + 1) as f64 / pieces as f64));
-        while let Some((s, t)) = stack.pop() {
+        stack[0] = (index as f64 / pieces as f64, (index + 1) as f64 / pieces as f64);
+        let mut len = 1;
+        while len > 0 {
+            len -= 1;
+            let (s, t) = stack[len];
             checks += 1;
             if checks.is_multiple_of(32) && interrupted() {
                 return None;
@@ -86,8 +89,9 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
             if (t - s) * span < MIN_PIECE || !checker.is_valid(&q[..n]) {
                 return Some(false);
             }
-            stack.push((m, t));
-            stack.push((s, m));
+            stack[len] = (m, t);
+            stack[len + 1] = (s, m);
+            len += 2;
         }
     }
     Some(true)
