@@ -138,6 +138,23 @@ class Client:
             raise invalid_argument("tls_ca", "a client certificate needs TLS: give tls_ca too")
         else:
             self._channel = grpc.aio.insecure_channel(self.target, options=options)
+        self._attach_stubs()
+
+    @classmethod
+    def local(cls, *, timeout: Optional[float] = DEFAULT_TIMEOUT, cpu_threads: int = 0,
+              acm_samples: int = 10_000) -> "Client":
+        """As :meth:`kinplan.Client.local`: the services inside this process
+        (``pip install kinplan-native``), each call run on a worker thread so
+        the event loop keeps running."""
+        from .inprocess import AioLocalChannel
+
+        client = cls.__new__(cls)
+        client.target, client.timeout, client._metadata = "in-process", timeout, None
+        client._channel = AioLocalChannel(cpu_threads, acm_samples)
+        client._attach_stubs()
+        return client
+
+    def _attach_stubs(self) -> None:
         self._robots = robot_pb2_grpc.RobotServiceStub(self._channel)
         self._kinematics = kinematics_pb2_grpc.KinematicsServiceStub(self._channel)
         self._planning = planning_pb2_grpc.PlanningServiceStub(self._channel)

@@ -9,12 +9,13 @@ latency-critical loops; use a server for sharing and scale-out.
 """
 from __future__ import annotations
 
+import asyncio
 import importlib.machinery
 import importlib.util
 import os
 import threading
 from types import ModuleType
-from typing import Any, Callable, Iterable, Iterator, List, Optional, Tuple
+from typing import Any, AsyncIterator, Callable, Iterable, Iterator, List, Optional, Tuple
 
 import grpc
 
@@ -181,3 +182,110 @@ class LocalChannel:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
+
+
+def _aio_error(err: Exception) -> grpc.aio.AioRpcError:
+    """A native call error as grpc.aio's error (code, details, rich status)."""
+    code, message, details = err.args
+    trailing = grpc.aio.Metadata(("grpc-status-details-bin", details)) if details else grpc.aio.Metadata()
+    return grpc.aio.AioRpcError(_CODES.get(code, grpc.StatusCode.UNKNOWN), grpc.aio.Metadata(), trailing, details=message)
+
+
+class _AioUnary:
+    """An awaitable unary call: the native call runs on a worker thread (it
+    releases the GIL), so the event loop keeps running."""
+
+    def __init__(self, backend: Any, path: str, serialize: Callable[..., Any], deserialize: Callable[..., Any]):
+        self._backend, self._path = backend, path
+        self._serialize, self._deserialize = serialize, deserialize
+        self._error = native().CallError
+
+    async def __call__(self, request: Any, timeout: Optional[float] = None, **_: Any) -> Any:
+        wire = request if self._serialize is None else self._serialize(request)
+        try:
+            answer = await asyncio.to_thread(self._backend.unary, self._path, wire, timeout)
+        except self._error as err:
+            raise _aio_error(err) from None
+        return self._deserialize(answer)
+
+
+class _AioCall:
+    """A streaming call as grpc.aio's: ``async for`` over the answers,
+    ``read()`` (``grpc.aio.EOF`` at the end), ``write()``, ``done_writing()``
+    and ``cancel()``."""
+
+    def __init__(self, stream: Any, serialize: Callable[..., Any], deserialize: Callable[..., Any]):
+        self._stream, self._serialize, self._deserialize = stream, serialize, deserialize
+        self._error = native().CallError
+
+    async def read(self) -> Any:
+        try:
+            answer = await asyncio.to_thread(self._stream.recv)
+        except self._error as err:
+            raise _aio_error(err) from None
+        return grpc.aio.EOF if answer is None else self._deserialize(answer)
+
+    def __aiter__(self) -> AsyncIterator[Any]:
+        return self._answers()
+
+    async def _answers(self) -> AsyncIterator[Any]:
+        while True:
+            answer = await self.read()
+            if answer is grpc.aio.EOF:
+                return
+            yield answer
+
+    async def write(self, request: Any) -> None:
+        if not await asyncio.to_thread(self._stream.send, self._serialize(request)):
+            raise _aio_error(native().CallError(1, "the call has ended", b""))
+
+    async def done_writing(self) -> None:
+        self._stream.close()
+
+    def cancel(self) -> bool:
+        self._stream.close()
+        return True
+
+
+class _AioStreaming:
+    def __init__(self, backend: Any, path: str, serialize: Callable[..., Any], deserialize: Callable[..., Any], client_streams: bool):
+        self._backend, self._path = backend, path
+        self._serialize, self._deserialize = serialize, deserialize
+        self._client_streams = client_streams
+        self._error = native().CallError
+
+    def __call__(self, request: Any = None, timeout: Optional[float] = None, **_: Any) -> _AioCall:
+        try:
+            if self._client_streams:
+                stream = self._backend.stream(self._path, timeout)
+            else:
+                stream = self._backend.server_stream(self._path, self._serialize(request), timeout)
+        except self._error as err:
+            raise _aio_error(err) from None
+        return _AioCall(stream, self._serialize, self._deserialize)
+
+
+class AioLocalChannel:
+    """A stand-in for ``grpc.aio.Channel`` whose calls run in this process
+    (:meth:`kinplan.aio.Client.local`); the generated stubs work on it unchanged."""
+
+    def __init__(self, cpu_threads: int = 0, acm_samples: int = 10_000):
+        self._backend = native().Backend(cpu_threads, acm_samples)
+
+    def unary_unary(self, method: str, request_serializer: Callable[..., Any], response_deserializer: Callable[..., Any], **_: Any) -> _AioUnary:
+        return _AioUnary(self._backend, method, request_serializer, response_deserializer)
+
+    def unary_stream(self, method: str, request_serializer: Callable[..., Any], response_deserializer: Callable[..., Any], **_: Any) -> _AioStreaming:
+        return _AioStreaming(self._backend, method, request_serializer, response_deserializer, False)
+
+    def stream_stream(self, method: str, request_serializer: Callable[..., Any], response_deserializer: Callable[..., Any], **_: Any) -> _AioStreaming:
+        return _AioStreaming(self._backend, method, request_serializer, response_deserializer, True)
+
+    def stream_unary(self, method: str, request_serializer: Callable[..., Any], response_deserializer: Callable[..., Any], **_: Any) -> Any:
+        raise NotImplementedError("kinplan has no client-streaming calls")
+
+    async def channel_ready(self) -> None:
+        return None
+
+    async def close(self) -> None:
+        return None

@@ -352,7 +352,7 @@ def test_the_asyncio_methods_take_the_blocking_methods_parameters():
     from kinplan._aio_mobile import AsyncMobile
     from kinplan.mobile import Mobile
 
-    not_yet = {"local", "limits_key"}  # the in-process backend; a cache key
+    not_yet = {"limits_key"}  # a cache key
     checked = []
     for sync_cls, aio_cls in ((kinplan.Client, kinplan.aio.Client), (kinplan.Robot, kinplan.aio.AsyncRobot),
                               (Mobile, AsyncMobile)):
@@ -361,7 +361,7 @@ def test_the_asyncio_methods_take_the_blocking_methods_parameters():
                 continue
             other = getattr(aio_cls, name)
             assert inspect.iscoroutinefunction(other) or inspect.isasyncgenfunction(other) or name in (
-                "robot", "stream_ik"), name
+                "robot", "stream_ik", "local"), name
             params = [(p.name, p.kind, p.default) for p in inspect.signature(method).parameters.values()]
             assert params == [(p.name, p.kind, p.default) for p in inspect.signature(other).parameters.values()], name
             checked.append(name)
@@ -424,3 +424,44 @@ def test_ik_keywords_give_the_blocking_answers(server_address):
     # a bare 3-vector is a position-only target in both clients
     assert position.success and np.array_equal(position.q, robot_sync.ik(T[:3, 3], seed=Q0).q)
     sync.close()
+
+
+@pytest.mark.skipif("local" not in __import__("conftest").BACKENDS, reason="the native extension is not built")
+def test_the_in_process_asyncio_client_answers_as_the_blocking_one(local_client):
+    """kinplan.aio.Client.local(): unary calls, a server stream, a StreamIk
+    session and typed errors, against the blocking in-process client."""
+    robot_sync = local_client.robot("ur5")
+    start = np.array([-1.2, -1.3, 1.4, -1.6, -1.57, 0.0])
+    goal = np.array([1.2, -1.3, 1.4, -1.6, -1.57, 0.0])
+
+    async def main():
+        async with kinplan.aio.Client.local(timeout=10, acm_samples=1000) as c:
+            await c.wait_for_ready()
+            robot = c.robot("ur5")
+            T = await robot.fk(start)
+            # several calls at once on one in-process channel
+            Ts = await asyncio.gather(*(robot.fk(start + 0.01 * k) for k in range(4)))
+            ik = await robot.ik(T, seed=start + 0.05)
+            frames = [f async for f in c.plan_stream(robot, start=start, goal=goal, algorithm="stomp", seed=2,
+                                                      stomp={"timesteps": 10, "max_iterations": 5})]
+            async with robot.stream_ik(seed=start) as s:
+                tracked = [await s.solve(T), await s.solve(T)]
+            errors = []
+            for bad in (lambda: c.robot("no_such_robot").fk(start), lambda: robot.fk([math.nan] * 6)):
+                try:
+                    await bad()
+                except kinplan.KinplanError as e:
+                    errors.append(e)
+            return T, Ts, ik, frames, tracked, errors
+
+    T, Ts, ik, frames, tracked, errors = run(main())
+    np.testing.assert_array_equal(T, robot_sync.fk(start))
+    for k, Tk in enumerate(Ts):
+        np.testing.assert_array_equal(Tk, robot_sync.fk(start + 0.01 * k))
+    assert ik.success and np.allclose(robot_sync.fk(ik.q), T, atol=1e-5)
+    assert isinstance(frames[-1], kinplan.Plan) and len(frames) >= 2
+    assert all(isinstance(f, np.ndarray) for f in frames[:-1])
+    np.testing.assert_array_equal(frames[-1].q[0], start)
+    assert all(r.success for r in tracked)
+    assert isinstance(errors[0], kinplan.NotFound) and isinstance(errors[1], kinplan.InvalidArgument)
+    assert errors[1].field_violations and "joint_positions" in errors[1].field_violations[0][0]
