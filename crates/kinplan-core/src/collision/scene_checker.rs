@@ -24,6 +24,9 @@ use super::sweep::SweepBound;
 use super::world::SceneGeometry;
 use super::{CollisionError, MotionCheck, StateChecker};
 
+/// Joints of the chains whose padded checks keep their axes in a small buffer.
+const SMALL_CHAIN: usize = 16;
+
 /// Options of a [`SceneChecker`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CheckerParams {
@@ -433,8 +436,16 @@ impl StateChecker for SceneChecker {
             return Some(false);
         }
         let mut poses = [Isometry3::identity(); MAX_BODIES];
-        let mut axes = [JointAxis::default(); MAX_LINKS];
-        let axes = axes.get_mut(..q.len())?;
+        // Axes on the stack, sized for the usual arm: a 96-joint buffer would
+        // be zeroed on every check for chains that are almost always ≤ 16.
+        let (mut small, mut large);
+        let axes: &mut [JointAxis] = if q.len() <= SMALL_CHAIN {
+            small = [JointAxis::default(); SMALL_CHAIN];
+            &mut small[..q.len()]
+        } else {
+            large = [JointAxis::default(); MAX_LINKS];
+            large.get_mut(..q.len())?
+        };
         self.model.body_poses_and_axes(q, &mut poses, axes);
         let mut pads = [0.0; MAX_BODIES];
         sweep.pads_at(&self.model, &poses, axes, half_step, &mut pads);
