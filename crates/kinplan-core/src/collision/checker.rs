@@ -2,7 +2,7 @@
 //! is checked: the robot-and-scene checker implements them with parry3d, and
 //! tests implement them with closed-form toy worlds.
 
-use super::padded::padded_motion_valid;
+use super::padded::{bisection_order, padded_motion_valid};
 
 /// Validity queries on joint states of one robot in one scene.
 ///
@@ -114,24 +114,14 @@ pub fn interpolate_motion_valid<C: StateChecker + ?Sized>(
     }
     let segments = (segments as usize).next_power_of_two();
     let mut q = [0.0; MAX_DOF];
-    // Bisection order: the odd multiples of segments/2, then of segments/4, …
-    let mut stride = segments;
-    while stride > 1 {
-        let half = stride / 2;
-        let mut i = half;
-        while i < segments {
-            let t = i as f64 / segments as f64;
-            for (j, qj) in q[..n].iter_mut().enumerate() {
-                *qj = a[j] + t * (b[j] - a[j]);
-            }
-            if !checker.is_valid(&q[..n]) {
-                return false;
-            }
-            i += stride;
+    // the interior states: every index but 0, in bisection order
+    bisection_order(segments).skip(1).all(|i| {
+        let t = i as f64 / segments as f64;
+        for (j, qj) in q[..n].iter_mut().enumerate() {
+            *qj = a[j] + t * (b[j] - a[j]);
         }
-        stride = half;
-    }
-    true
+        checker.is_valid(&q[..n])
+    })
 }
 
 #[cfg(test)]

@@ -99,7 +99,7 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
 
 /// `0..count` (a power of two) in bisection order: 0, then the odd
 /// multiples of count/2, of count/4, … (8: 0, 4, 2, 6, 1, 3, 5, 7).
-fn bisection_order(count: usize) -> impl Iterator<Item = usize> {
+pub(crate) fn bisection_order(count: usize) -> impl Iterator<Item = usize> {
     let strides = std::iter::successors(Some(count), |s| (*s > 1).then_some(s / 2)).take_while(|s| *s > 1);
     std::iter::once(0).chain(strides.flat_map(move |stride| (stride / 2..count).step_by(stride)))
 }

@@ -7,7 +7,7 @@ use super::cartesian::{CartesianLine, Deviation, cartesian_cost, deviation, viol
 use super::clock::Clock;
 use super::stomp_matrices::ACCELERATION_STENCIL;
 use super::{CartesianParams, StompParams};
-use crate::collision::{StateChecker, padded_motion_valid};
+use crate::collision::{StateChecker, bisection_order, padded_motion_valid};
 use crate::robot::Chain;
 
 /// Everything that stays fixed while one trajectory is optimised.
@@ -102,26 +102,18 @@ pub(crate) fn interior_valid<C: StateChecker + ?Sized>(
         return Some(false);
     }
     let steps = (steps.max(1.0) as usize).next_power_of_two();
-    let mut stride = steps;
-    let mut visited = 0usize;
-    while stride > 1 {
-        let half = stride / 2;
-        let mut i = half;
-        while i < steps {
-            visited += 1;
-            if visited.is_multiple_of(32) && clock.interrupted().is_some() {
-                return None;
-            }
-            let s = i as f64 / steps as f64;
-            for ((v, x), y) in buf.iter_mut().zip(a).zip(b) {
-                *v = x + s * (y - x);
-            }
-            if !checker.is_valid(buf) {
-                return Some(false);
-            }
-            i += stride;
+    // the interior states: every index but 0, in bisection order
+    for (visited, i) in bisection_order(steps).skip(1).enumerate() {
+        if (visited + 1).is_multiple_of(32) && clock.interrupted().is_some() {
+            return None;
         }
-        stride = half;
+        let s = i as f64 / steps as f64;
+        for ((v, x), y) in buf.iter_mut().zip(a).zip(b) {
+            *v = x + s * (y - x);
+        }
+        if !checker.is_valid(buf) {
+            return Some(false);
+        }
     }
     Some(true)
 }
