@@ -17,6 +17,8 @@
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
+use super::fast_box::{boxes_overlap, segment_box_closest, segment_box_distance_squared};
+
 /// Robot shape in its body frame, when closed forms apply.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum RobotFast {
@@ -25,6 +27,11 @@ pub(crate) enum RobotFast {
         a: Point3<f64>,
         b: Point3<f64>,
         r: f64,
+    },
+    /// Box `[−half, half]` in the frame `offset` (body frame).
+    Box {
+        offset: Isometry3<f64>,
+        half: Vector3<f64>,
     },
     None,
 }
@@ -110,6 +117,7 @@ pub(crate) fn segment_segment_closest(
 }
 
 #[inline]
+#[cfg(test)]
 fn point_box_distance_squared(p: &Vector3<f64>, half: &Vector3<f64>) -> f64 {
     let mut d2 = 0.0;
     for k in 0..3 {
@@ -137,36 +145,7 @@ pub(crate) fn segment_box_within(
             return false;
         }
     }
-    let d = lb - la;
-    let f = |t: f64| point_box_distance_squared(&(la + d * t), half);
-    if f(0.0) <= r2 || f(1.0) <= r2 {
-        return true;
-    }
-    // Golden-section search of the convex f on [0, 1].
-    const INV_PHI: f64 = 0.618_033_988_749_894_9;
-    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-    let mut x1 = hi - INV_PHI * (hi - lo);
-    let mut x2 = lo + INV_PHI * (hi - lo);
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    while hi - lo > 1e-10 {
-        if f1 <= r2 || f2 <= r2 {
-            return true;
-        }
-        if f1 < f2 {
-            hi = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = hi - INV_PHI * (hi - lo);
-            f1 = f(x1);
-        } else {
-            lo = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = lo + INV_PHI * (hi - lo);
-            f2 = f(x2);
-        }
-    }
-    f1.min(f2) <= r2
+    segment_box_distance_squared(&la, &(lb - la), half) <= r2
 }
 
 /// Signed distance and witness points (robot side, other side) of two
@@ -176,38 +155,6 @@ fn swept_witness(c1: Point3<f64>, r1: f64, c2: Point3<f64>, r2: f64) -> (f64, Po
     let len = d.norm();
     let n = if len > 1e-12 { d / len } else { Vector3::x() };
     (len - r1 - r2, c1 + n * r1, c2 - n * r2)
-}
-
-/// Parameter `t ∈ [0, 1]` minimising the distance from `la + t·d` to the
-/// box of half extents `half` (golden section on the convex distance).
-fn segment_box_argmin(la: &Vector3<f64>, d: &Vector3<f64>, half: &Vector3<f64>) -> f64 {
-    const INV_PHI: f64 = 0.618_033_988_749_894_9;
-    let f = |t: f64| point_box_distance_squared(&(la + d * t), half);
-    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-    let mut x1 = hi - INV_PHI * (hi - lo);
-    let mut x2 = lo + INV_PHI * (hi - lo);
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    while hi - lo > 1e-10 {
-        if f1 < f2 {
-            hi = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = hi - INV_PHI * (hi - lo);
-            f1 = f(x1);
-        } else {
-            lo = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = lo + INV_PHI * (hi - lo);
-            f2 = f(x2);
-        }
-    }
-    let mid = 0.5 * (lo + hi);
-    // The minimum may sit at an end, which the open search only approaches.
-    [0.0, mid, 1.0]
-        .into_iter()
-        .min_by(|a, b| f(*a).total_cmp(&f(*b)))
-        .unwrap_or(mid)
 }
 
 /// Closed-form signed distance between a robot shape posed by `pose` and a
@@ -232,7 +179,7 @@ pub(crate) fn distance(
             let la = bp.inverse_transform_point(&wa).coords;
             let lb = bp.inverse_transform_point(&wb).coords;
             let d = lb - la;
-            let t = segment_box_argmin(&la, &d, half);
+            let t = segment_box_closest(&la, &d, half).1;
             let p = la + d * t;
             let q = Vector3::new(
                 p.x.clamp(-half.x, half.x),
@@ -271,23 +218,48 @@ pub(crate) fn distance_robot(
 /// `None` when no closed form applies.
 #[inline]
 pub(crate) fn overlap(robot: &RobotFast, pose: &Isometry3<f64>, leaf: &LeafFast) -> Option<bool> {
-    let RobotFast::Swept { a, b, r } = robot else {
-        return None;
-    };
-    let (wa, wb) = (pose * a, pose * b);
+    match *robot {
+        RobotFast::Swept { a, b, r } => swept_overlap(&(pose * a), &(pose * b), r, leaf),
+        RobotFast::Box { offset, half } => box_overlap(&(pose * offset), &half, leaf),
+        RobotFast::None => None,
+    }
+}
+
+/// A swept sphere (base frame) against a leaf.
+#[inline]
+fn swept_overlap(wa: &Point3<f64>, wb: &Point3<f64>, r: f64, leaf: &LeafFast) -> Option<bool> {
     match leaf {
         LeafFast::Swept { a: oa, b: ob, r: or } => {
             let rr = r + or;
-            Some(segment_segment_distance_squared(&wa, &wb, oa, ob) <= rr * rr)
+            Some(segment_segment_distance_squared(wa, wb, oa, ob) <= rr * rr)
         }
-        LeafFast::Box { pose: bp, half } => Some(segment_box_within(&wa, &wb, *r, bp, half)),
+        LeafFast::Box { pose: bp, half } => Some(segment_box_within(wa, wb, r, bp, half)),
         LeafFast::Cylinder { outer, inner } => {
             let ro = r + outer.2;
-            if segment_segment_distance_squared(&wa, &wb, &outer.0, &outer.1) > ro * ro {
+            if segment_segment_distance_squared(wa, wb, &outer.0, &outer.1) > ro * ro {
                 return Some(false);
             }
             let ri = r + inner.2;
-            if segment_segment_distance_squared(&wa, &wb, &inner.0, &inner.1) <= ri * ri {
+            if segment_segment_distance_squared(wa, wb, &inner.0, &inner.1) <= ri * ri {
+                return Some(true);
+            }
+            None
+        }
+        LeafFast::None => None,
+    }
+}
+
+/// A box at `pose` (base frame) against a leaf.
+#[inline]
+fn box_overlap(pose: &Isometry3<f64>, half: &Vector3<f64>, leaf: &LeafFast) -> Option<bool> {
+    match leaf {
+        LeafFast::Swept { a, b, r } => Some(segment_box_within(a, b, *r, pose, half)),
+        LeafFast::Box { pose: bp, half: bh } => Some(boxes_overlap(pose, half, bp, bh)),
+        LeafFast::Cylinder { outer, inner } => {
+            if !segment_box_within(&outer.0, &outer.1, outer.2, pose, half) {
+                return Some(false);
+            }
+            if segment_box_within(&inner.0, &inner.1, inner.2, pose, half) {
                 return Some(true);
             }
             None
@@ -304,10 +276,21 @@ pub(crate) fn overlap_robot(
     y: &RobotFast,
     py: &Isometry3<f64>,
 ) -> Option<bool> {
-    match (x, y) {
+    match (*x, *y) {
         (RobotFast::Swept { a, b, r }, RobotFast::Swept { a: c, b: d, r: s }) => {
             let rr = r + s;
             Some(segment_segment_distance_squared(&(px * a), &(px * b), &(py * c), &(py * d)) <= rr * rr)
+        }
+        (RobotFast::Swept { a, b, r }, RobotFast::Box { offset, half })
+        | (RobotFast::Box { offset, half }, RobotFast::Swept { a, b, r }) => {
+            let (pa, pb) = match x {
+                RobotFast::Swept { .. } => (px, py),
+                _ => (py, px),
+            };
+            Some(segment_box_within(&(pa * a), &(pa * b), r, &(pb * offset), &half))
+        }
+        (RobotFast::Box { offset: oa, half: ha }, RobotFast::Box { offset: ob, half: hb }) => {
+            Some(boxes_overlap(&(px * oa), &ha, &(py * ob), &hb))
         }
         _ => None,
     }

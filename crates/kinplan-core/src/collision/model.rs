@@ -6,7 +6,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d_f64::shape::SharedShape;
 
 use super::convert::{pose_to_parry, vec_to_parry};
@@ -14,7 +14,7 @@ use super::fast::RobotFast;
 use super::scene::{SceneLimits, validate_mesh};
 use super::world::primitive_shape;
 use super::{CollisionError, Geometry};
-use crate::robot::{Chain, CollisionShape, Shape};
+use crate::robot::{Chain, CollisionShape, JointKind, Shape};
 
 /// Most collision bodies (links with geometry) a model may have.
 pub const MAX_BODIES: usize = 32;
@@ -77,6 +77,9 @@ pub struct RobotModel {
     pub(crate) bodies: Vec<Body>,
     /// Body indices ordered by carrying link (stable).
     by_link: Vec<usize>,
+    /// Each body's frame in the frame of the joint moving its link (the
+    /// link's offset then the body's), composed once.
+    in_joint: Vec<Isometry3<f64>>,
 }
 
 impl std::fmt::Debug for RobotModel {
@@ -165,10 +168,15 @@ impl RobotModel {
         }
         let mut by_link: Vec<usize> = (0..bodies.len()).collect();
         by_link.sort_by_key(|&b| bodies[b].link);
+        let in_joint = bodies
+            .iter()
+            .map(|b| chain.links()[b.link].offset * b.offset)
+            .collect();
         Ok(RobotModel {
             chain,
             bodies,
             by_link,
+            in_joint,
         })
     }
 
@@ -241,13 +249,27 @@ impl RobotModel {
                             direction: frame.rotation * joint.axis.into_inner(),
                         };
                     }
-                    t = frame * joint.motion(q.get(applied).copied().unwrap_or(0.0));
+                    let v = q.get(applied).copied().unwrap_or(0.0);
+                    // frame · motion(v), without composing the motion's
+                    // zero translation or identity rotation
+                    t = match joint.kind {
+                        JointKind::Revolute | JointKind::Continuous => Isometry3::from_parts(
+                            frame.translation,
+                            frame.rotation * UnitQuaternion::from_axis_angle(&joint.axis, v),
+                        ),
+                        JointKind::Prismatic => Isometry3::from_parts(
+                            Translation3::from(
+                                frame.translation.vector + frame.rotation * (joint.axis.into_inner() * v),
+                            ),
+                            frame.rotation,
+                        ),
+                    };
                     applied += 1;
                 }
             }
             while next < self.by_link.len() && self.bodies[self.by_link[next]].link == li {
                 let b = self.by_link[next];
-                out[b] = t * link.offset * self.bodies[b].offset;
+                out[b] = t * self.in_joint[b];
                 next += 1;
             }
         }
@@ -374,6 +396,10 @@ fn body_shapes(
                 a: cs.origin * Point3::new(0.0, 0.0, -0.5 * length),
                 b: cs.origin * Point3::new(0.0, 0.0, 0.5 * length),
                 r: radius,
+            },
+            Geometry::Box { half_extents } => RobotFast::Box {
+                offset: cs.origin,
+                half: half_extents,
             },
             _ => RobotFast::None,
         };

@@ -187,6 +187,10 @@ pub(crate) fn closer(a: Option<Witness>, b: Option<Witness>) -> Option<Witness> 
 fn grown(shape: &RobotFast, margin: f64) -> RobotFast {
     match *shape {
         RobotFast::Swept { a, b, r } => RobotFast::Swept { a, b, r: r + margin },
+        RobotFast::Box { offset, half } => RobotFast::Box {
+            offset,
+            half: half.add_scalar(margin),
+        },
         RobotFast::None => RobotFast::None,
     }
 }
