@@ -42,8 +42,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use kinplan_core::collision::{
-    CheckerParams, MotionCheck, SceneChecker, SceneGeometry, SceneLimits, StateChecker, parse_joint_request,
-    parse_planning_scene,
+    CheckerParams, MotionCheck, PadVerdict, SceneChecker, SceneGeometry, SceneLimits, StateChecker,
+    parse_joint_request, parse_planning_scene,
 };
 use kinplan_core::plan::{
     Algorithm, Goal, PlanControl, PlanRequest, PlanStatus, RrtOutcome, RrtParams, RrtStop, plan, rrt_connect,
@@ -227,6 +227,10 @@ impl StateChecker for Counting<'_> {
     fn padded_valid(&self, q: &[f64], half_step: &[f64]) -> Option<bool> {
         self.states.fetch_add(1, Ordering::Relaxed);
         self.inner.padded_valid(q, half_step)
+    }
+    fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
+        self.states.fetch_add(1, Ordering::Relaxed);
+        self.inner.padded_verdict(q, half_step)
     }
     fn motion_check(&self) -> MotionCheck {
         self.inner.motion_check()

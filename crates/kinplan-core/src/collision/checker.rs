@@ -39,11 +39,35 @@ pub trait StateChecker: Sync {
         None
     }
 
+    /// [`StateChecker::padded_valid`], and when the padded check fails,
+    /// whether `q` itself is invalid ([`PadVerdict::Collides`]) or only not
+    /// proved free with the pads ([`PadVerdict::Unproved`]); `None` as
+    /// `padded_valid`. Implementations may answer both from one pose of the
+    /// robot; the default asks [`StateChecker::is_valid`] after a failure.
+    fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
+        Some(match self.padded_valid(q, half_step)? {
+            true => PadVerdict::Free,
+            false if self.is_valid(q) => PadVerdict::Unproved,
+            false => PadVerdict::Collides,
+        })
+    }
+
     /// How [`StateChecker::motion_valid`] checks a motion. Default: states
     /// interpolated at most 0.05 rad (or m) apart on every joint.
     fn motion_check(&self) -> MotionCheck {
         MotionCheck::Interpolated { resolution: 0.05 }
     }
+}
+
+/// What a padded check found about a state and its neighbourhood.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PadVerdict {
+    /// Every state within the half step is free.
+    Free,
+    /// The state itself collides or lies outside the limits.
+    Collides,
+    /// The state is valid, but a padded body touches something.
+    Unproved,
 }
 
 /// How a motion between two states is checked.

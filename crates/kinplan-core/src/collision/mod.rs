@@ -34,6 +34,7 @@ mod checker;
 mod convert;
 mod error;
 mod fast;
+mod fast_box;
 mod model;
 mod moveit;
 mod narrow;
@@ -46,7 +47,7 @@ mod world;
 
 pub use acm::{AcmParams, AllowReason, AllowedCollisions};
 pub use attach::attached_bodies;
-pub use checker::{MotionCheck, StateChecker, interpolate_motion_valid};
+pub use checker::{MotionCheck, PadVerdict, StateChecker, interpolate_motion_valid};
 pub use error::CollisionError;
 pub use model::{AttachedBody, InlineMesh, MAX_BODIES, MAX_LINKS, RobotModel};
 pub use moveit::{JointRequest, MAX_YAML_BYTES, parse_joint_request, parse_planning_scene};

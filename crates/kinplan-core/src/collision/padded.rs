@@ -1,6 +1,8 @@
 //! The conservative motion check, [`super::MotionCheck::Padded`].
 
-use super::StateChecker;
+use std::collections::VecDeque;
+
+use super::{PadVerdict, StateChecker};
 
 /// Most joints the check handles (stack buffers): as many as a chain with a
 /// collision model can have.
@@ -11,6 +13,9 @@ pub const MIN_PIECE: f64 = 1e-5;
 /// Most padded states checked per initial piece before the motion is
 /// refused: bounds the cost of a motion that runs along an obstacle.
 pub const MAX_CHECKS_PER_PIECE: usize = 64;
+/// Pieces proved together, breadth first (bounds the queue at
+/// `WINDOW · (MAX_CHECKS_PER_PIECE + 1)` entries whatever the motion's length).
+const WINDOW: usize = 64;
 
 /// True when no state of the straight motion `a → b` collides (the motion
 /// check of ALGORITHMS.md §4 and issue 10, made conservative), proved piece
@@ -25,10 +30,12 @@ pub const MAX_CHECKS_PER_PIECE: usize = 64;
 /// from where it is at `q(m)`. A piece that fails is refused if `q(m)`
 /// itself collides, else halved. Pieces below [`MIN_PIECE`] or more than
 /// [`MAX_CHECKS_PER_PIECE`] checks per initial piece refuse the motion.
+/// Pieces are visited breadth first (all midpoints before any half), in
+/// windows of 64 pieces in bisection order.
 ///
 /// The ends are not checked here (a straight motion between two states
 /// within the limits stays within them). `None` when `interrupted()` says so
-/// (asked every 32 checks); `Some(false)` as well when the checker cannot
+/// (asked every 32 checks); `Some(false)` when the checker cannot
 /// pad or the chain has more than `MAX_LINKS` joints.
 pub fn padded_motion_valid<C: StateChecker + ?Sized>(
     checker: &C,
@@ -57,41 +64,43 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
     let pieces = (pieces as usize).next_power_of_two();
     let (mut q, mut half) = ([0.0; MAX_DOF], [0.0; MAX_DOF]);
     let mut checks = 0usize;
-    // Pieces in bisection order (the middle one first), each proved by
-    // halving where needed; a stack of parameter intervals on the stack (each
-    // check pushes at most two and the budget bounds the checks).
-    let mut stack = [(0.0, 0.0); MAX_CHECKS_PER_PIECE + 1];
-    for index in bisection_order(pieces) {
-        let mut budget = MAX_CHECKS_PER_PIECE;
-        stack[0] = (index as f64 / pieces as f64, (index + 1) as f64 / pieces as f64);
-        let mut len = 1;
-        while len > 0 {
-            len -= 1;
-            let (s, t) = stack[len];
+    // Pieces in bisection order (the middle one first), a window of them at
+    // a time, breadth first: every piece's midpoint is checked before any
+    // piece is halved, so a motion through an obstacle is refused at the
+    // first midpoint inside it rather than after halving a grazing piece to
+    // its limit. Entries: (s, t, piece in the window).
+    let mut order = bisection_order(pieces).peekable();
+    let mut queue = VecDeque::new();
+    let mut spent = [0usize; WINDOW];
+    while order.peek().is_some() {
+        spent.fill(0);
+        queue.extend(
+            order
+                .by_ref()
+                .take(WINDOW)
+                .enumerate()
+                .map(|(slot, i)| (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64, slot)),
+        );
+        while let Some((s, t, slot)) = queue.pop_front() {
             checks += 1;
             if checks.is_multiple_of(32) && interrupted() {
                 return None;
             }
-            if budget == 0 {
+            if spent[slot] == MAX_CHECKS_PER_PIECE {
                 return Some(false);
             }
-            budget -= 1;
+            spent[slot] += 1;
             let m = 0.5 * (s + t);
             for j in 0..n {
                 q[j] = a[j] + m * delta[j];
                 half[j] = 0.5 * (t - s) * delta[j].abs();
             }
-            match checker.padded_valid(&q[..n], &half[..n]) {
-                None => return Some(false),
-                Some(true) => continue,
-                Some(false) => {}
+            match checker.padded_verdict(&q[..n], &half[..n]) {
+                None | Some(PadVerdict::Collides) => return Some(false),
+                Some(PadVerdict::Free) => {}
+                Some(PadVerdict::Unproved) if (t - s) * span < MIN_PIECE => return Some(false),
+                Some(PadVerdict::Unproved) => queue.extend([(s, m, slot), (m, t, slot)]),
             }
-            if (t - s) * span < MIN_PIECE || !checker.is_valid(&q[..n]) {
-                return Some(false);
-            }
-            stack[len] = (m, t);
-            stack[len + 1] = (s, m);
-            len += 2;
         }
     }
     Some(true)

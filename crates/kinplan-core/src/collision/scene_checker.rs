@@ -22,7 +22,7 @@ use super::narrow::{
 };
 use super::sweep::SweepBound;
 use super::world::SceneGeometry;
-use super::{CollisionError, MotionCheck, StateChecker};
+use super::{CollisionError, MotionCheck, PadVerdict, StateChecker};
 
 /// Joints of the chains whose padded checks keep their axes in a small buffer.
 const SMALL_CHAIN: usize = 16;
@@ -221,6 +221,11 @@ impl SceneChecker {
     pub fn in_collision(&self, q: &[f64]) -> bool {
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
+        self.hits(&poses)
+    }
+
+    /// [`SceneChecker::in_collision`] on bodies already posed.
+    fn hits(&self, poses: &[Isometry3<f64>; MAX_BODIES]) -> bool {
         let bodies = &self.model.bodies;
         // Distal bodies first: they are the likeliest to hit something.
         for (b, body) in bodies.iter().enumerate().rev() {
@@ -246,33 +251,55 @@ impl SceneChecker {
     pub fn in_collision_padded(&self, q: &[f64], pads: &[f64; MAX_BODIES]) -> bool {
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
-        self.hits_padded(&poses, pads)
+        self.hits_padded(&poses, pads, |b| pads[b])
     }
 
-    /// [`SceneChecker::in_collision_padded`] on bodies already posed.
-    fn hits_padded(&self, poses: &[Isometry3<f64>; MAX_BODIES], pads: &[f64; MAX_BODIES]) -> bool {
+    /// [`SceneChecker::in_collision_padded`] on bodies already posed, with
+    /// the pads in two grades: `coarse[b]`, cheap and never below the pad,
+    /// finds what a body might touch; `fine(b)`, the pad itself, is asked
+    /// (at most once per body) only for bodies that have something within
+    /// their coarse pad — in a cell most bodies have nothing near.
+    fn hits_padded(
+        &self,
+        poses: &[Isometry3<f64>; MAX_BODIES],
+        coarse: &[f64; MAX_BODIES],
+        mut fine: impl FnMut(usize) -> f64,
+    ) -> bool {
         let bodies = &self.model.bodies;
         // A zero pad still counts touching: growing by a hair keeps `≤ 0` a hit.
         let margin = |pad: f64| pad.max(f64::MIN_POSITIVE);
+        let mut fine_pads = [f64::NAN; MAX_BODIES];
+        let mut fine_pad = |b: usize| {
+            if fine_pads[b].is_nan() {
+                fine_pads[b] = margin(fine(b));
+            }
+            fine_pads[b]
+        };
         for (b, body) in bodies.iter().enumerate().rev() {
             let c = sphere_center(body, &poses[b]);
-            let m = margin(pads[b]);
-            let free = self.world.bvh.for_each_near(&c, body.radius + m, |leaf| {
-                !body_leaf_within(body, &poses[b], &c, &self.world.leaves[leaf as usize], m)
-            });
+            let free = self
+                .world
+                .bvh
+                .for_each_near(&c, body.radius + margin(coarse[b]), |leaf| {
+                    let m = fine_pad(b);
+                    !body_leaf_within(body, &poses[b], &c, &self.world.leaves[leaf as usize], m)
+                });
             if !free {
                 return true;
             }
         }
         self.self_pairs.iter().any(|&(a, b)| {
             let (a, b) = (a as usize, b as usize);
-            body_body_within(
-                &bodies[a],
-                &poses[a],
-                &bodies[b],
-                &poses[b],
-                margin(pads[a] + pads[b]),
-            )
+            let reach = bodies[a].radius + bodies[b].radius + margin(coarse[a] + coarse[b]);
+            let gap = sphere_center(&bodies[a], &poses[a]) - sphere_center(&bodies[b], &poses[b]);
+            gap.norm_squared() <= reach * reach
+                && body_body_within(
+                    &bodies[a],
+                    &poses[a],
+                    &bodies[b],
+                    &poses[b],
+                    margin(fine_pad(a) + fine_pad(b)),
+                )
         })
     }
 
@@ -431,9 +458,17 @@ impl StateChecker for SceneChecker {
     /// Within the limits and, every body padded by its [`SweepBound`] over
     /// `half_step`, free of collisions; `None` without a finite bound.
     fn padded_valid(&self, q: &[f64], half_step: &[f64]) -> Option<bool> {
+        Some(self.padded_verdict(q, half_step)? == PadVerdict::Free)
+    }
+
+    /// One pose of the robot answers both questions: the padded check with
+    /// the tight pads ([`SweepBound::pad_at`]) asked only for bodies that
+    /// have something within their global pads ([`SweepBound::pads`]), then,
+    /// when it fails, the plain check.
+    fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
         let sweep = self.sweep.as_ref()?;
         if !self.within_limits(q) || half_step.len() != q.len() {
-            return Some(false);
+            return Some(PadVerdict::Collides);
         }
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         // Axes on the stack, sized for the usual arm: a 96-joint buffer would
@@ -447,9 +482,16 @@ impl StateChecker for SceneChecker {
             large.get_mut(..q.len())?
         };
         self.model.body_poses_and_axes(q, &mut poses, axes);
-        let mut pads = [0.0; MAX_BODIES];
-        sweep.pads_at(&self.model, &poses, axes, half_step, &mut pads);
-        Some(!self.hits_padded(&poses, &pads))
+        let mut coarse = [0.0; MAX_BODIES];
+        sweep.pads(half_step, &mut coarse);
+        let tight = |b: usize| sweep.pad_at(&self.model, b, &poses[b], axes, half_step);
+        Some(if !self.hits_padded(&poses, &coarse, tight) {
+            PadVerdict::Free
+        } else if self.hits(&poses) {
+            PadVerdict::Collides
+        } else {
+            PadVerdict::Unproved
+        })
     }
 
     fn motion_check(&self) -> MotionCheck {

@@ -101,6 +101,7 @@ impl SweepBound {
     /// body into `pads[..bodies]`: `poses` and `axes` are the bodies' poses
     /// and the joints' axes at `m` ([`RobotModel::body_poses_and_axes`]),
     /// `half` the largest joint offsets `h_j ≥ 0` from `m`.
+    #[cfg(test)]
     pub(crate) fn pads_at(
         &self,
         model: &RobotModel,
@@ -109,38 +110,46 @@ impl SweepBound {
         half: &[f64],
         pads: &mut [f64; MAX_BODIES],
     ) {
+        for (b, pad) in pads.iter_mut().take(model.bodies.len()).enumerate() {
+            *pad = self.pad_at(model, b, &poses[b], axes, half);
+        }
+    }
+
+    /// [`SweepBound::pads_at`] for body `b` alone, posed at `pose`.
+    pub(crate) fn pad_at(
+        &self,
+        model: &RobotModel,
+        b: usize,
+        pose: &Isometry3<f64>,
+        axes: &[JointAxis],
+        half: &[f64],
+    ) -> f64 {
         if self.dof == 0 {
-            pads.fill(0.0);
-            return;
+            return 0.0;
         }
-        for (b, (pad, levers)) in pads
-            .iter_mut()
-            .zip(self.levers.chunks_exact(self.dof))
-            .enumerate()
-        {
-            let body = &model.bodies[b];
-            let centre = poses[b] * Point3::from(body.center);
-            // Σ_{i>j} h_i L_{i,b}, built from the last joint back
-            let mut tail = 0.0;
-            let mut sum = 0.0;
-            for j in (0..self.dof).rev() {
-                let lever = levers[j];
-                if lever == 0.0 {
-                    continue;
-                }
-                let h = half[j].abs();
-                sum += h * if self.prismatic[j] {
-                    1.0
-                } else {
-                    let axis = &axes[j];
-                    let r = centre.coords - axis.point;
-                    let from_axis = (r - axis.direction * r.dot(&axis.direction)).norm() + body.radius;
-                    lever.min(from_axis + tail)
-                };
-                tail += h * lever;
+        let levers = &self.levers[b * self.dof..(b + 1) * self.dof];
+        let body = &model.bodies[b];
+        let centre = pose * Point3::from(body.center);
+        // Σ_{i>j} h_i L_{i,b}, built from the last joint back
+        let mut tail = 0.0;
+        let mut sum = 0.0;
+        for j in (0..self.dof).rev() {
+            let lever = levers[j];
+            if lever == 0.0 {
+                continue;
             }
-            *pad = sum;
+            let h = half[j].abs();
+            sum += h * if self.prismatic[j] {
+                1.0
+            } else {
+                let axis = &axes[j];
+                let r = centre.coords - axis.point;
+                let from_axis = (r - axis.direction * r.dot(&axis.direction)).norm() + body.radius;
+                lever.min(from_axis + tail)
+            };
+            tail += h * lever;
         }
+        sum
     }
 
     /// `L_{j,b}` (m per rad, or 1 for a prismatic joint).
