@@ -86,7 +86,22 @@ pub(crate) fn interior_valid<C: StateChecker + ?Sized>(
     buf: &mut [f64],
     clock: &Clock<'_>,
 ) -> Option<bool> {
-    if checker.motion_check().is_padded() {
+    let padded = checker.motion_check().is_padded();
+    interior_valid_as(checker, a, b, resolution, padded, buf, clock)
+}
+
+/// [`interior_valid`] with the kind of check chosen by the caller: padded
+/// (conservative) or interpolated states, whatever the checker's own.
+pub(crate) fn interior_valid_as<C: StateChecker + ?Sized>(
+    checker: &C,
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+    padded: bool,
+    buf: &mut [f64],
+    clock: &Clock<'_>,
+) -> Option<bool> {
+    if padded {
         return padded_motion_valid(checker, a, b, resolution, || clock.interrupted().is_some());
     }
     let span = a

@@ -13,6 +13,7 @@ mod kd_index;
 pub(crate) mod noise;
 mod params;
 mod rrt_connect;
+mod rrt_tree;
 mod stomp;
 mod stomp_matrices;
 mod timing;

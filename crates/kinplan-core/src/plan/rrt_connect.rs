@@ -10,9 +10,9 @@ use super::RrtParams;
 use super::clock::{Clock, Interrupt};
 use super::costs::{interior_valid, resolution_of};
 use super::error::{PlanError, PlanField, check_vector};
-use super::kd_index::KdIndex;
 use super::noise::stream;
-use crate::collision::StateChecker;
+use super::rrt_tree::{Grown, grow};
+use crate::collision::{StateChecker, padded_motion_valid};
 use crate::robot::{Chain, JointKind};
 
 /// How RRT-Connect ended.
@@ -43,116 +43,6 @@ pub struct RrtOutcome {
     pub search_ns: u64,
     /// Wall time of the shortcutting after a connection, ns (0 otherwise).
     pub shortcut_ns: u64,
-}
-
-/// A tree of joint states: flat row-major storage and parent indices, so
-/// an extension appends to a few `Vec`s and allocates nothing else; nearest
-/// neighbours come from a [`KdIndex`] over the rows.
-struct Tree {
-    q: Vec<f64>,
-    parent: Vec<u32>,
-    dof: usize,
-    index: KdIndex,
-}
-
-enum Extend {
-    Reached(usize),
-    Advanced(usize),
-    Trapped,
-}
-
-impl Tree {
-    fn new(root: &[f64], capacity: usize) -> Self {
-        let mut q = Vec::with_capacity(capacity * root.len());
-        q.extend_from_slice(root);
-        let mut index = KdIndex::with_capacity(capacity);
-        index.insert(&q, root.len());
-        Self {
-            q,
-            parent: vec![u32::MAX],
-            dof: root.len(),
-            index,
-        }
-    }
-    fn len(&self) -> usize {
-        self.parent.len()
-    }
-    fn node(&self, i: usize) -> &[f64] {
-        &self.q[i * self.dof..(i + 1) * self.dof]
-    }
-    fn push(&mut self, q: &[f64], parent: usize) -> usize {
-        self.q.extend_from_slice(q);
-        self.parent.push(parent as u32);
-        self.index.insert(&self.q, self.dof);
-        self.len() - 1
-    }
-    /// Nearest node by Euclidean joint distance (the first of equals, as a
-    /// linear scan would answer).
-    fn nearest(&mut self, target: &[f64]) -> usize {
-        self.index.nearest(&self.q, self.dof, target).unwrap_or(0)
-    }
-}
-
-struct Search<'a, C: ?Sized> {
-    checker: &'a C,
-    range: f64,
-    resolution: f64,
-    q_new: Vec<f64>,
-    buf: Vec<f64>,
-}
-
-impl<C: StateChecker + ?Sized> Search<'_, C> {
-    /// One step of at most `range` from the nearest node towards `target`.
-    fn extend(&mut self, tree: &mut Tree, target: &[f64], clock: &Clock<'_>) -> Extend {
-        let near = tree.nearest(target);
-        let from = tree.node(near);
-        let dist = from
-            .iter()
-            .zip(target)
-            .map(|(a, b)| (b - a) * (b - a))
-            .sum::<f64>()
-            .sqrt();
-        let reached = dist <= self.range;
-        let s = if reached { 1.0 } else { self.range / dist };
-        for ((v, a), b) in self.q_new.iter_mut().zip(from).zip(target) {
-            *v = a + s * (b - a);
-        }
-        if reached {
-            self.q_new.copy_from_slice(target);
-        }
-        if !self.checker.is_valid(&self.q_new)
-            || interior_valid(
-                self.checker,
-                from,
-                &self.q_new,
-                self.resolution,
-                &mut self.buf,
-                clock,
-            ) != Some(true)
-        {
-            return Extend::Trapped;
-        }
-        let i = tree.push(&self.q_new, near);
-        if reached {
-            Extend::Reached(i)
-        } else {
-            Extend::Advanced(i)
-        }
-    }
-
-    /// Extends repeatedly towards `target` until reached or trapped.
-    fn connect(&mut self, tree: &mut Tree, target: &[f64], clock: &Clock<'_>) -> Extend {
-        loop {
-            match self.extend(tree, target, clock) {
-                Extend::Advanced(_) => {
-                    if clock.interrupted().is_some() {
-                        return Extend::Trapped;
-                    }
-                }
-                other => return other,
-            }
-        }
-    }
 }
 
 /// Sampling box per joint: the limits, or ±π (rotational) / ±1 m
@@ -211,15 +101,15 @@ pub fn rrt_connect<C: StateChecker + ?Sized>(
     ))
 }
 
-/// RRT-Connect between two valid states, then shortcut.
+/// RRT-Connect between two valid states ([`grow`]), then shortcut.
 ///
-/// Trees grow from start and goal; each sample `q_rand` (uniform in the
-/// limits, ChaCha8 stream from `seed`) extends one tree by at most `range`
-/// (Euclidean, rad or m) and the other tree connects greedily towards the
-/// new node; the trees swap roles each sample. Every edge is checked as the
-/// checker's interpolated motion (states ≤ its resolution apart). The
-/// joined path is shortcut by [`shortcut`]. Deadline and `should_stop` are
-/// checked every sample and every connect step. Parameters must be valid.
+/// Under a padded (conservative) motion check the trees grow with the
+/// cheaper interpolated check and the path they find is then proved edge by
+/// edge with the padded check ([`prove_lazily`]), so the returned path is as
+/// conservative as if every tree edge had been padded, while the many edges
+/// the search tries and drops are never padded. Shortcutting uses the
+/// checker's own check. Deadline and `should_stop` are checked every sample
+/// and every connect step. Parameters must be valid.
 pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
     chain: &Chain,
     checker: &C,
@@ -232,102 +122,116 @@ pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
     let dof = start.len();
     let bounds = sampling_bounds(chain);
     let mut rng = stream(seed, u64::MAX, 0);
-    let mut search = Search {
-        checker,
-        range: params.range,
-        resolution: resolution_of(checker),
-        q_new: vec![0.0; dof],
-        buf: vec![0.0; dof],
-    };
-    let cap = params.max_samples.min(4096);
-    let mut a = Tree::new(start, cap);
-    let mut b = Tree::new(goal, cap);
-    let mut a_is_start = true;
-    let mut q_rand = vec![0.0; dof];
-    let mut target = vec![0.0; dof];
-    let mut samples = 0;
     let t0 = Instant::now();
-    let outcome = |stop, path, a: &Tree, b: &Tree, samples, shortcut_ns| RrtOutcome {
+    let grown = if checker.motion_check().is_padded() {
+        prove_lazily(checker, &bounds, start, goal, params, &mut rng, clock)
+    } else {
+        let budget = params.max_samples;
+        grow(
+            checker, &bounds, start, goal, params, false, budget, &mut rng, clock,
+        )
+    };
+    let search_ns = t0.elapsed().as_nanos() as u64;
+    let outcome = |stop, path, shortcut_ns| RrtOutcome {
         path,
         stop,
-        samples,
-        nodes: a.len() + b.len(),
-        search_ns: (t0.elapsed().as_nanos() as u64).saturating_sub(shortcut_ns),
+        samples: grown.samples,
+        nodes: grown.nodes,
+        search_ns,
         shortcut_ns,
     };
-    // The straight motion first: free problems need no tree.
-    if interior_valid(checker, start, goal, search.resolution, &mut search.buf, clock) == Some(true) {
-        let mut path = start.to_vec();
-        path.extend_from_slice(goal);
-        return outcome(RrtStop::Connected, path, &a, &b, 0, 0);
+    let mut path = match grown.path {
+        Ok(path) => path,
+        Err(stop) => return outcome(stop, Vec::new(), 0),
+    };
+    if path.len() == 2 * dof {
+        return outcome(RrtStop::Connected, path, 0);
     }
-    while samples < params.max_samples {
-        if let Some(i) = clock.interrupted() {
-            let stop = match i {
-                Interrupt::Deadline => RrtStop::Deadline,
-                Interrupt::Cancelled => RrtStop::Cancelled,
-            };
-            return outcome(stop, Vec::new(), &a, &b, samples, 0);
+    let resolution = resolution_of(checker);
+    let res = params
+        .shortcut_resolution
+        .map_or(resolution, |r| r.min(resolution));
+    let t1 = Instant::now();
+    let attempts = params.shortcut_attempts;
+    shortcut(checker, &mut path, dof, res, attempts, &mut rng, clock);
+    outcome(RrtStop::Connected, path, t1.elapsed().as_nanos() as u64)
+}
+
+/// The padded search, lazily: trees grown with interpolated edge checks,
+/// then every edge of the path they find proved with the padded check
+/// ([`padded_motion_valid`]); an edge that cannot be proved is replaced by a
+/// path grown between its ends with padded edges, and if that fails too the
+/// whole problem is grown with padded edges. Samples count against one
+/// budget, `params.max_samples`.
+fn prove_lazily<C: StateChecker + ?Sized>(
+    checker: &C,
+    bounds: &[(f64, f64)],
+    start: &[f64],
+    goal: &[f64],
+    params: &RrtParams,
+    rng: &mut ChaCha8Rng,
+    clock: &Clock<'_>,
+) -> Grown {
+    let dof = start.len();
+    let resolution = resolution_of(checker);
+    let mut grown = grow(
+        checker,
+        bounds,
+        start,
+        goal,
+        params,
+        false,
+        params.max_samples,
+        rng,
+        clock,
+    );
+    let Ok(found) = grown.path else {
+        return grown;
+    };
+    let interrupted = || clock.interrupted().is_some();
+    let mut proved = start.to_vec();
+    for (x, y) in found.chunks_exact(dof).zip(found.chunks_exact(dof).skip(1)) {
+        match padded_motion_valid(checker, x, y, resolution, interrupted) {
+            Some(true) => {
+                proved.extend_from_slice(y);
+                continue;
+            }
+            None => {
+                grown.path = Err(clock.interrupted().map_or(RrtStop::Deadline, stop_of));
+                return grown;
+            }
+            Some(false) => {}
         }
-        samples += 1;
-        for (v, &(lo, hi)) in q_rand.iter_mut().zip(&bounds) {
-            *v = if hi > lo { rng.random_range(lo..=hi) } else { lo };
-        }
-        let new = match search.extend(&mut a, &q_rand, clock) {
-            Extend::Trapped => None,
-            Extend::Reached(i) | Extend::Advanced(i) => Some(i),
-        };
-        if let Some(ia) = new {
-            target.copy_from_slice(a.node(ia));
-            if let Extend::Reached(ib) = search.connect(&mut b, &target, clock) {
-                let (s_tree, s_end, g_tree, g_end) = if a_is_start {
-                    (&a, ia, &b, ib)
-                } else {
-                    (&b, ib, &a, ia)
-                };
-                let mut path = Vec::new();
-                let mut i = s_end;
-                let mut rows = Vec::new();
-                loop {
-                    rows.push(i);
-                    if s_tree.parent[i] == u32::MAX {
-                        break;
-                    }
-                    i = s_tree.parent[i] as usize;
-                }
-                for &r in rows.iter().rev() {
-                    path.extend_from_slice(s_tree.node(r));
-                }
-                // g_end duplicates s_end's state: start from its parent
-                let mut i = g_end;
-                while g_tree.parent[i] != u32::MAX {
-                    i = g_tree.parent[i] as usize;
-                    path.extend_from_slice(g_tree.node(i));
-                }
-                path[..dof].copy_from_slice(start);
-                let last = path.len() - dof;
-                path[last..].copy_from_slice(goal);
-                let res = params
-                    .shortcut_resolution
-                    .map_or(search.resolution, |r| r.min(search.resolution));
-                let t1 = Instant::now();
-                shortcut(
-                    checker,
-                    &mut path,
-                    dof,
-                    res,
-                    params.shortcut_attempts,
-                    &mut rng,
-                    clock,
-                );
-                let shortcut_ns = t1.elapsed().as_nanos() as u64;
-                return outcome(RrtStop::Connected, path, &a, &b, samples, shortcut_ns);
+        let budget = params.max_samples.saturating_sub(grown.samples);
+        let detour = grow(checker, bounds, x, y, params, true, budget, rng, clock);
+        grown.samples += detour.samples;
+        grown.nodes += detour.nodes;
+        match detour.path {
+            Ok(piece) => proved.extend_from_slice(&piece[dof..]),
+            Err(RrtStop::SampleBudget) => {
+                let budget = params.max_samples.saturating_sub(grown.samples);
+                let whole = grow(checker, bounds, start, goal, params, true, budget, rng, clock);
+                grown.samples += whole.samples;
+                grown.nodes += whole.nodes;
+                grown.path = whole.path;
+                return grown;
+            }
+            Err(stop) => {
+                grown.path = Err(stop);
+                return grown;
             }
         }
-        std::mem::swap(&mut a, &mut b);
-        a_is_start = !a_is_start;
     }
-    outcome(RrtStop::SampleBudget, Vec::new(), &a, &b, samples, 0)
+    grown.path = Ok(proved);
+    grown
+}
+
+/// The stop an interrupt means.
+pub(super) fn stop_of(interrupt: Interrupt) -> RrtStop {
+    match interrupt {
+        Interrupt::Deadline => RrtStop::Deadline,
+        Interrupt::Cancelled => RrtStop::Cancelled,
+    }
 }
 
 fn dist(a: &[f64], b: &[f64]) -> f64 {

@@ -467,3 +467,107 @@ fn the_bound_around_a_bent_elbow_covers_every_state_of_the_piece() {
     }
     assert!(worst <= pads[1], "the tip moved {worst} > pad {}", pads[1]);
 }
+
+/// A checker that counts its padded checks.
+struct CountingPads<'a> {
+    inner: &'a SceneChecker,
+    padded: std::sync::atomic::AtomicUsize,
+}
+
+impl StateChecker for CountingPads<'_> {
+    fn dof(&self) -> usize {
+        self.inner.dof()
+    }
+    fn is_valid(&self, q: &[f64]) -> bool {
+        self.inner.is_valid(q)
+    }
+    fn clearance(&self, q: &[f64], max_distance: f64) -> f64 {
+        self.inner.clearance(q, max_distance)
+    }
+    fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
+        self.padded.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.inner.padded_verdict(q, half_step)
+    }
+}
+
+#[test]
+fn a_motion_through_an_obstacle_is_refused_before_grazing_pieces_are_halved() {
+    // The swing (1 cm sphere at 1 m) turns 0 → 1.6 rad: 32 pieces of 0.05.
+    // A cube 0.1 mm off its circle at θ = 0.02 (piece 0, visited first)
+    // takes many halvings to prove clear; a wall across the circle
+    // at θ = 1.575 (the midpoint of piece 31, visited last) blocks the
+    // motion outright.
+    let graze = Obstacle::new(
+        "graze",
+        Isometry3::translation(0.02f64.cos() * 1.0111, 0.02f64.sin() * 1.0111, 0.0),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.001),
+        },
+    );
+    let wall = Obstacle::new(
+        "wall",
+        Isometry3::translation(1.575f64.cos(), 1.575f64.sin(), 0.0),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.005),
+        },
+    );
+    let checker = checker_with(model_of(SWING), vec![graze, wall], true);
+    let (a, b) = ([0.0], [1.6]);
+    assert!(checker.is_valid(&a) && checker.is_valid(&b));
+    let counting = CountingPads {
+        inner: &checker,
+        padded: 0.into(),
+    };
+    assert_eq!(
+        padded_motion_valid(&counting, &a, &b, 0.05, || false),
+        Some(false)
+    );
+    // breadth first: the 32 midpoints are checked before any piece is
+    // halved, and the wall's midpoint refuses the motion (depth first would
+    // halve piece 0 first, then check the 31 others)
+    let checks = counting.padded.into_inner();
+    assert!(checks <= 32, "{checks} padded checks");
+}
+
+#[test]
+fn rrt_connect_under_padded_motions_replaces_a_grazing_edge() {
+    use crate::plan::{RrtParams, RrtStop, rrt_connect};
+    // The xyz probe (a 2 cm sphere) moves 5 cm along x: the straight motion
+    // passes a 4 mm cube 1 mm closer than the sphere's radius at x = 0 but
+    // its ends are free, and at a 0.05 m resolution no state between them
+    // is checked — the interpolated search accepts it, the proof must not.
+    let cube = Obstacle::new(
+        "cube",
+        Isometry3::translation(0.0, 0.021, 0.0),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.002),
+        },
+    );
+    let probe = || model_of(&super::probe_urdf(r#"<sphere radius="0.02"/>"#));
+    let plain = checker_with(probe(), vec![cube.clone()], false);
+    let padded = checker_with(probe(), vec![cube], true);
+    let (a, b) = ([-0.025, 0.0, 0.0], [0.025, 0.0, 0.0]);
+    assert!(plain.motion_valid(&a, &b) && !fine_motion_valid(&plain, &a, &b, 1e-4));
+    let chain = padded.model().chain().clone();
+    for seed in 0..4 {
+        let out = rrt_connect(&chain, &plain, &a, &b, &RrtParams::default(), seed, None).unwrap();
+        assert_eq!(
+            out.path.len(),
+            6,
+            "the interpolated search takes the straight motion"
+        );
+        let out = rrt_connect(&chain, &padded, &a, &b, &RrtParams::default(), seed, None).unwrap();
+        assert_eq!(out.stop, RrtStop::Connected);
+        assert!(out.path.len() > 6, "seed {seed}: a detour");
+        assert_eq!(
+            (&out.path[..3], &out.path[out.path.len() - 3..]),
+            (&a[..], &b[..])
+        );
+        for w in out.path.chunks_exact(3).collect::<Vec<_>>().windows(2) {
+            assert!(
+                fine_motion_valid(&plain, w[0], w[1], 1e-4),
+                "seed {seed}: a segment collides"
+            );
+        }
+    }
+}
