@@ -11,7 +11,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Isometry3, Point3};
+use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::acm::AllowedCollisions;
 use super::bvh::Aabb;
@@ -227,9 +227,11 @@ impl SceneChecker {
     /// [`SceneChecker::in_collision`] on bodies already posed.
     fn hits(&self, poses: &[Isometry3<f64>; MAX_BODIES]) -> bool {
         let bodies = &self.model.bodies;
+        let mut centers = [Vector3::zeros(); MAX_BODIES];
         // Distal bodies first: they are the likeliest to hit something.
         for (b, body) in bodies.iter().enumerate().rev() {
             let c = sphere_center(body, &poses[b]);
+            centers[b] = c;
             let free = self.world.bvh.for_each_near(&c, body.radius, |leaf| {
                 !body_leaf_intersect(body, &poses[b], &c, &self.world.leaves[leaf as usize])
             });
@@ -239,7 +241,9 @@ impl SceneChecker {
         }
         self.self_pairs.iter().any(|&(a, b)| {
             let (a, b) = (a as usize, b as usize);
-            body_body_intersect(&bodies[a], &poses[a], &bodies[b], &poses[b])
+            let reach = bodies[a].radius + bodies[b].radius;
+            (centers[a] - centers[b]).norm_squared() <= reach * reach
+                && body_body_intersect(&bodies[a], &poses[a], &bodies[b], &poses[b])
         })
     }
 
@@ -275,8 +279,10 @@ impl SceneChecker {
             }
             fine_pads[b]
         };
+        let mut centers = [Vector3::zeros(); MAX_BODIES];
         for (b, body) in bodies.iter().enumerate().rev() {
             let c = sphere_center(body, &poses[b]);
+            centers[b] = c;
             let free = self
                 .world
                 .bvh
@@ -291,8 +297,7 @@ impl SceneChecker {
         self.self_pairs.iter().any(|&(a, b)| {
             let (a, b) = (a as usize, b as usize);
             let reach = bodies[a].radius + bodies[b].radius + margin(coarse[a] + coarse[b]);
-            let gap = sphere_center(&bodies[a], &poses[a]) - sphere_center(&bodies[b], &poses[b]);
-            gap.norm_squared() <= reach * reach
+            (centers[a] - centers[b]).norm_squared() <= reach * reach
                 && body_body_within(
                     &bodies[a],
                     &poses[a],

@@ -5,8 +5,9 @@
 //! rows with `x[a] < split` go left, the rest right (equal values go right,
 //! so repeated coordinates never need a rebalance or a bucket split and
 //! cannot fail). A query walks the near side first and visits a far side
-//! only when its lower bound `max(bound(parent), (t[a] − split)²)` does not
-//! exceed the best squared distance so far. Ties are broken by the smaller
+//! only when its lower bound (the squared distance from the target to the
+//! side's cell, kept incrementally) does not exceed the best squared
+//! distance so far. Ties are broken by the smaller
 //! row index, so the answer equals a linear scan's first minimum — the
 //! planner's output does not depend on which of the two is used.
 //!
@@ -20,8 +21,8 @@ pub(crate) struct KdIndex {
     left: Vec<u32>,
     right: Vec<u32>,
     axis: Vec<u8>,
-    /// Query stack of (node, lower bound), reused between queries.
-    stack: Vec<(u32, f64)>,
+    /// Query stack (see [`KdIndex::nearest`]), reused between queries.
+    stack: Vec<f64>,
 }
 
 impl KdIndex {
@@ -30,7 +31,7 @@ impl KdIndex {
             left: Vec::with_capacity(n),
             right: Vec::with_capacity(n),
             axis: Vec::with_capacity(n),
-            stack: Vec::with_capacity(64),
+            stack: Vec::with_capacity(64 * 9),
         }
     }
 
@@ -65,18 +66,34 @@ impl KdIndex {
 
     /// Row nearest to `target` by Euclidean distance (smallest index among
     /// equals); `None` when empty.
+    ///
+    /// Depth first, near side first; a far side is entered only when its
+    /// lower bound does not exceed the best squared distance so far. The
+    /// bound is incremental (Arya and Mount 1993): every stack entry keeps,
+    /// per axis, the offset `o_a` from the target to the nearest splitting
+    /// plane crossed on that axis, and its bound is `Σ_a o_a²` — crossing a
+    /// plane on axis `a` at offset `d` replaces `o_a²` by `d²`. (Each term
+    /// is a distance to a slab the subtree lies beyond, so the sum never
+    /// exceeds the distance to any row in it.)
     pub fn nearest(&mut self, rows: &[f64], dof: usize, target: &[f64]) -> Option<usize> {
         if self.left.is_empty() {
             return None;
         }
+        let stride = dof + 2;
         let (mut best, mut best_d) = (usize::MAX, f64::INFINITY);
-        self.stack.clear();
-        self.stack.push((0, 0.0));
-        while let Some((n, bound)) = self.stack.pop() {
+        // Entries of `stride` values: node, bound, then the dof offsets.
+        let stack = &mut self.stack;
+        stack.clear();
+        stack.push(0.0);
+        stack.push(0.0);
+        stack.extend(std::iter::repeat_n(0.0, dof));
+        while stack.len() >= stride {
+            let top = stack.len() - stride;
+            let (n, bound) = (stack[top] as usize, stack[top + 1]);
             if bound > best_d {
+                stack.truncate(top);
                 continue;
             }
-            let n = n as usize;
             let row = &rows[n * dof..(n + 1) * dof];
             let mut d = 0.0;
             for (a, b) in row.iter().zip(target) {
@@ -96,11 +113,24 @@ impl KdIndex {
             } else {
                 (self.right[n], self.left[n])
             };
-            if far != NONE {
-                self.stack.push((far, bound.max(diff * diff)));
-            }
-            if near != NONE {
-                self.stack.push((near, bound));
+            // The far side: this entry's offsets with axis `a` replaced.
+            let old = stack[top + 2 + a];
+            let far_bound = bound - old * old + diff * diff;
+            if far != NONE && far_bound <= best_d {
+                stack[top] = far as f64;
+                stack[top + 1] = far_bound;
+                stack[top + 2 + a] = diff;
+                if near != NONE {
+                    stack.extend_from_within(top..top + stride);
+                    let last = stack.len() - stride;
+                    stack[last] = near as f64;
+                    stack[last + 1] = bound;
+                    stack[last + 2 + a] = old;
+                }
+            } else if near != NONE {
+                stack[top] = near as f64;
+            } else {
+                stack.truncate(top);
             }
         }
         Some(best)

@@ -7,7 +7,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::RrtParams;
 use super::clock::Clock;
-use super::costs::{interior_valid_as, resolution_of};
+use super::costs::interior_valid_as;
 use super::kd_index::KdIndex;
 use super::rrt_connect::{RrtStop, stop_of};
 use crate::collision::StateChecker;
@@ -140,9 +140,9 @@ pub(super) struct Grown {
 /// most `budget` samples: each sample `q_rand` (uniform in `bounds`, from
 /// `rng`) extends one tree by at most `params.range` (Euclidean) and the
 /// other tree connects greedily towards the new node; the trees swap roles
-/// each sample. Tree edges are checked `padded` or as interpolated states at
-/// the checker's resolution. The straight motion is tried first. The clock
-/// is asked every sample and every connect step.
+/// each sample. Tree edges are checked `padded` or as interpolated states,
+/// with pieces or steps of at most `resolution`. The straight motion is
+/// tried first. The clock is asked every sample and every connect step.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn grow<C: StateChecker + ?Sized>(
     checker: &C,
@@ -151,6 +151,7 @@ pub(super) fn grow<C: StateChecker + ?Sized>(
     goal: &[f64],
     params: &RrtParams,
     padded: bool,
+    resolution: f64,
     budget: usize,
     rng: &mut ChaCha8Rng,
     clock: &Clock<'_>,
@@ -159,7 +160,7 @@ pub(super) fn grow<C: StateChecker + ?Sized>(
     let mut search = Search {
         checker,
         range: params.range,
-        resolution: resolution_of(checker),
+        resolution,
         padded,
         q_new: vec![0.0; dof],
         buf: vec![0.0; dof],
