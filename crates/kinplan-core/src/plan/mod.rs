@@ -5,6 +5,7 @@
 
 mod cartesian;
 mod clock;
+mod column_scan;
 mod costs;
 mod entry;
 mod error;

@@ -7,6 +7,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::RrtParams;
 use super::clock::Clock;
+use super::column_scan::ColumnScan;
 use super::costs::interior_valid_as;
 use super::kd_index::KdIndex;
 use super::rrt_connect::{RrtStop, stop_of};
@@ -14,11 +15,14 @@ use crate::collision::StateChecker;
 
 /// A tree of joint states: flat row-major storage and parent indices, so
 /// an extension appends to a few `Vec`s and allocates nothing else; nearest
-/// neighbours come from a [`KdIndex`] over the rows.
+/// neighbours come from a [`ColumnScan`] of the rows while the tree is
+/// small, from a [`KdIndex`] over them beyond [`ColumnScan::LARGEST`] rows
+/// (both answer the first nearest row, so the switch changes no answer).
 struct Tree {
     q: Vec<f64>,
     parent: Vec<u32>,
     dof: usize,
+    scan: ColumnScan,
     index: KdIndex,
 }
 
@@ -34,10 +38,13 @@ impl Tree {
         q.extend_from_slice(root);
         let mut index = KdIndex::with_capacity(capacity);
         index.insert(&q, root.len());
+        let mut scan = ColumnScan::new(root.len(), capacity.min(ColumnScan::LARGEST));
+        scan.push(root);
         Self {
             q,
             parent: vec![u32::MAX],
             dof: root.len(),
+            scan,
             index,
         }
     }
@@ -51,12 +58,20 @@ impl Tree {
         self.q.extend_from_slice(q);
         self.parent.push(parent as u32);
         self.index.insert(&self.q, self.dof);
+        if self.scan.len() < ColumnScan::LARGEST {
+            self.scan.push(q);
+        }
         self.len() - 1
     }
     /// Nearest node by Euclidean joint distance (the first of equals, as a
     /// linear scan would answer).
     fn nearest(&mut self, target: &[f64]) -> usize {
-        self.index.nearest(&self.q, self.dof, target).unwrap_or(0)
+        let found = if self.len() <= ColumnScan::LARGEST {
+            self.scan.nearest(target)
+        } else {
+            self.index.nearest(&self.q, self.dof, target)
+        };
+        found.unwrap_or(0)
     }
 }
 
