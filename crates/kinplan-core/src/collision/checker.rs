@@ -24,6 +24,13 @@ pub trait StateChecker: Sync {
     /// may be reported as `max_distance` (the search stops there).
     fn clearance(&self, q: &[f64], max_distance: f64) -> f64;
 
+    /// [`StateChecker::is_valid`] and [`StateChecker::clearance`] of one
+    /// state together; implementations may answer both from one pose of the
+    /// robot (the default asks each).
+    fn valid_and_clearance(&self, q: &[f64], max_distance: f64) -> (bool, f64) {
+        (self.is_valid(q), self.clearance(q, max_distance))
+    }
+
     /// True when the straight joint-space motion from `a` to `b` is valid,
     /// as [`MotionCheck`] describes how it was checked.
     fn motion_valid(&self, a: &[f64], b: &[f64]) -> bool {

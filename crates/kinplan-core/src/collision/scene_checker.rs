@@ -402,6 +402,15 @@ impl SceneChecker {
     fn nearest(&self, q: &[f64], margin: f64) -> Option<(Witness, usize, Other)> {
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
+        self.nearest_posed(&poses, margin)
+    }
+
+    /// [`SceneChecker::nearest`] on bodies already posed.
+    fn nearest_posed(
+        &self,
+        poses: &[Isometry3<f64>; MAX_BODIES],
+        margin: f64,
+    ) -> Option<(Witness, usize, Other)> {
         let bodies = &self.model.bodies;
         let mut best: Option<(Witness, usize, Other)> = None;
         let consider =
@@ -458,6 +467,20 @@ impl StateChecker for SceneChecker {
         }
         self.nearest(q, max_distance)
             .map_or(max_distance, |(w, _, _)| w.distance.min(max_distance))
+    }
+
+    /// One pose of the robot for both answers.
+    fn valid_and_clearance(&self, q: &[f64], max_distance: f64) -> (bool, f64) {
+        if self.check_q(q).is_err() || max_distance.is_nan() {
+            return (false, f64::NEG_INFINITY);
+        }
+        let mut poses = [Isometry3::identity(); MAX_BODIES];
+        self.model.body_poses(q, &mut poses);
+        let valid = self.within_limits(q) && !self.hits(&poses);
+        let clearance = self
+            .nearest_posed(&poses, max_distance)
+            .map_or(max_distance, |(w, _, _)| w.distance.min(max_distance));
+        (valid, clearance)
     }
 
     /// Within the limits and, every body padded by its [`SweepBound`] over

@@ -294,3 +294,32 @@ fn clearance_stops_at_max_distance_and_the_empty_scene_is_free() {
     assert!(!far.is_valid(&[11.0, 0.0, 0.0]));
     assert_eq!(far.report(&[11.0, 0.0, 0.0]).unwrap().out_of_limits.len(), 1);
 }
+
+#[test]
+fn validity_and_clearance_together_equal_the_two_queries() {
+    // Every probe shape beside every obstacle kind, at states from inside
+    // to 0.3 m away, within and outside the limits, and bad vectors.
+    for (name, shape, _, meshes) in probes() {
+        for (kind, geometry, _, _) in obstacles() {
+            let obstacle = Obstacle::new("o", Isometry3::identity(), geometry);
+            let c = checker(&probe_urdf(&shape), &meshes, vec![obstacle]);
+            for x in [0.0, 0.05, 0.12, 0.2, 0.3, 0.4, 0.6, 11.0] {
+                let q = [x, 0.03, -0.02];
+                let together = c.valid_and_clearance(&q, 0.25);
+                assert_eq!(
+                    together,
+                    (c.is_valid(&q), c.clearance(&q, 0.25)),
+                    "{name} vs {kind} at {x}"
+                );
+            }
+            assert_eq!(
+                c.valid_and_clearance(&[0.0, f64::NAN, 0.0], 0.25),
+                (false, f64::NEG_INFINITY)
+            );
+            assert_eq!(
+                c.valid_and_clearance(&[0.0, 0.0], 0.25),
+                (false, f64::NEG_INFINITY)
+            );
+        }
+    }
+}

@@ -32,6 +32,8 @@ pub(crate) struct Evaluation {
     /// Unsmoothed collision indicator per timestep.
     raw: Vec<f64>,
     state_ok: Vec<bool>,
+    /// Clearance per timestep (m), when the distance cost is on.
+    clearance: Vec<f64>,
     segment_ok: Vec<bool>,
     /// Per-waypoint Cartesian deviation (CCSTOMP only; empty otherwise).
     pub deviation: Vec<Deviation>,
@@ -51,6 +53,7 @@ impl Evaluation {
             control: vec![0.0; n],
             raw: vec![0.0; n],
             state_ok: vec![false; n],
+            clearance: vec![0.0; n],
             segment_ok: vec![false; n.saturating_sub(1)],
             deviation: Vec::with_capacity(n),
             total: f64::INFINITY,
@@ -187,7 +190,12 @@ impl<C: StateChecker + ?Sized> CostModel<'_, C> {
             if clock.interrupted().is_some() {
                 return false;
             }
-            e.state_ok[t] = self.checker.is_valid(row(t));
+            if p.clearance_weight > 0.0 {
+                let (ok, d) = self.checker.valid_and_clearance(row(t), p.clearance_distance);
+                (e.state_ok[t], e.clearance[t]) = (ok, d);
+            } else {
+                e.state_ok[t] = self.checker.is_valid(row(t));
+            }
         }
         for s in 0..n - 1 {
             if clock.interrupted().is_some() {
@@ -228,7 +236,7 @@ impl<C: StateChecker + ?Sized> CostModel<'_, C> {
             c *= p.collision_penalty;
             let qt = row(t);
             if p.clearance_weight > 0.0 {
-                let d = self.checker.clearance(qt, p.clearance_distance);
+                let d = e.clearance[t];
                 c += p.clearance_weight * ((p.clearance_distance - d) / p.clearance_distance).max(0.0);
             }
             if p.joint_limit_weight > 0.0 {
