@@ -37,7 +37,8 @@ struct ServeArgs {
     /// Address to listen on.
     #[arg(long, env = "KINPLAN_LISTEN", default_value = "127.0.0.1:50051")]
     listen: SocketAddr,
-    /// Threads of the async runtime (0: one per core).
+    /// I/O threads, each running its own single-threaded async runtime that
+    /// serves the connections handed to it round robin (0: one per core).
     #[arg(long, env = "KINPLAN_WORKER_THREADS", default_value_t = 0)]
     worker_threads: usize,
     /// Threads of the CPU pool that runs the algorithms (0: one per core).
@@ -174,10 +175,8 @@ fn client_runtime() -> Result<tokio::runtime::Runtime, String> {
 }
 
 fn loadtest(args: &LoadtestArgs) -> Result<(), String> {
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .enable_all()
-        .build()
-        .map_err(|e| e.to_string())?;
+    // Only coordinates: each connection runs on a thread of its own.
+    let runtime = client_runtime()?;
     let report = runtime.block_on(run_loadtest(args))?;
     print!("{}", report.summary());
     Ok(())
@@ -198,11 +197,11 @@ fn seconds(value: f64, flag: &str) -> Result<Duration, String> {
 }
 
 fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-    let mut runtime = tokio::runtime::Builder::new_multi_thread();
-    if args.worker_threads > 0 {
-        runtime.worker_threads(args.worker_threads);
-    }
-    let runtime = runtime.enable_all().build()?;
+    // Accepts connections, handles signals and serves metrics; the calls run
+    // on the I/O threads `serve` starts.
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
     let timeout = seconds(args.request_timeout_secs, "--request-timeout-secs")?;
     let (tls, auth_tokens) = security(&args)?;
     if tls.is_some() {
@@ -215,6 +214,7 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
         tls,
         auth_tokens,
         cpu_threads: args.cpu_threads,
+        io_threads: args.worker_threads,
         max_message_bytes: args.max_message_bytes,
         request_timeout: (!timeout.is_zero()).then_some(timeout),
         concurrency_limit: args.concurrency_limit,
