@@ -9,6 +9,13 @@ use clap::{Parser, Subcommand, ValueEnum};
 use kinplan_server::loadtest::{HealthArgs, LoadtestArgs, check_health, run_loadtest};
 use kinplan_server::service::{ServerConfig, TlsPem, Tokens, serve};
 
+/// mimalloc instead of the C library's allocator, for `serve` and `loadtest`
+/// alike: a call allocates and frees a few dozen small buffers (HTTP/2 frames,
+/// headers, messages) across threads, where glibc's malloc/free showed as
+/// several percent of both processes' CPU (issue 12, `benches/RESULTS.md`).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 #[derive(Parser)]
 #[command(name = "kinplan", version, about = "Stateless gRPC motion-planning service")]
 struct Cli {
