@@ -6,7 +6,9 @@ use std::net::SocketAddr;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use kinplan_server::loadtest::{HealthArgs, LoadtestArgs, check_health, run_loadtest};
+use kinplan_server::loadtest::{
+    HealthArgs, LoadtestArgs, MIN_WORKER_INTERVAL, check_health, run_loadtest, workers_for_rate,
+};
 use kinplan_server::service::{ServerConfig, TlsPem, Tokens, serve};
 
 /// mimalloc instead of the C library's allocator, for `serve` and `loadtest`
@@ -182,6 +184,17 @@ fn client_runtime() -> Result<tokio::runtime::Runtime, String> {
 }
 
 fn loadtest(args: &LoadtestArgs) -> Result<(), String> {
+    if args.rate > 0.0 && args.concurrency < workers_for_rate(args.rate) {
+        eprintln!(
+            "kinplan loadtest: note: {} workers at {} calls/s send every {:.2} ms each, under {} ms; \
+             latencies include the client's timer delay (use --concurrency {} or more)",
+            args.concurrency,
+            args.rate,
+            args.concurrency as f64 / args.rate * 1e3,
+            MIN_WORKER_INTERVAL.as_millis(),
+            workers_for_rate(args.rate),
+        );
+    }
     // Only coordinates: each connection runs on a thread of its own.
     let runtime = client_runtime()?;
     let report = runtime.block_on(run_loadtest(args))?;

@@ -45,7 +45,10 @@ pub struct LoadtestArgs {
     pub duration: f64,
     /// Target calls per second over all workers; 0: as fast as possible.
     /// With a rate, a call sent late because the server fell behind counts
-    /// its latency from its scheduled start (no coordinated omission).
+    /// its latency from its scheduled start (no coordinated omission). Give
+    /// enough workers that each sends at most every few milliseconds
+    /// (--concurrency ≥ rate × 3 ms): the timer wakes a worker up to 1 ms late,
+    /// and a worker whose next call is already due then counts that delay too.
     #[arg(long, default_value_t = 0.0)]
     pub rate: f64,
     /// Deadline of each call, seconds.
@@ -213,6 +216,16 @@ fn call_name(rpc: Rpc) -> &'static str {
         Rpc::Ik | Rpc::IkCold => "kinplan.v1.KinematicsService/SolveIk",
         Rpc::Score => "kinplan.v1.ScoringService/ScoreTrajectory",
     }
+}
+
+/// Shortest time between one worker's calls at a rate that keeps the timer's
+/// lateness (up to 1 ms) out of the latencies; see `--rate`.
+pub const MIN_WORKER_INTERVAL: Duration = Duration::from_millis(3);
+
+/// Workers that keep each one's interval at `MIN_WORKER_INTERVAL` or more at
+/// `rate` calls/s.
+pub fn workers_for_rate(rate: f64) -> usize {
+    (rate * MIN_WORKER_INTERVAL.as_secs_f64()).ceil().max(1.0) as usize
 }
 
 /// Runs the load test and returns its report (also written as JSON when asked).
@@ -385,6 +398,15 @@ fn cpu_seconds(pid: &str) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn workers_for_a_rate_send_at_most_every_three_milliseconds() {
+        // 20,000 calls/s × 3 ms = 60 workers, each sending every 3 ms.
+        assert_eq!(workers_for_rate(20_000.0), 60);
+        assert_eq!(workers_for_rate(1_000.0), 3);
+        assert_eq!(workers_for_rate(1_001.0), 4);
+        assert_eq!(workers_for_rate(10.0), 1);
+    }
 
     #[test]
     fn own_cpu_time_grows_with_work() {
