@@ -53,6 +53,12 @@ struct ServeArgs {
     /// Threads of the CPU pool that runs the algorithms (0: one per core).
     #[arg(long, env = "KINPLAN_CPU_THREADS", default_value_t = 0)]
     cpu_threads: usize,
+    /// Nice value (0–19) of the CPU pool's threads. The default, 10, keeps
+    /// admission and health prompt when every core computes; on a host shared
+    /// with other processes, 0 stops those from starving computed calls.
+    #[arg(long, env = "KINPLAN_CPU_NICE", default_value_t = 10,
+          value_parser = clap::value_parser!(i32).range(0..=19))]
+    cpu_nice: i32,
     /// Largest request or response message, bytes.
     #[arg(long, env = "KINPLAN_MAX_MESSAGE_BYTES", default_value_t = 16 * 1024 * 1024)]
     max_message_bytes: usize,
@@ -235,6 +241,7 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
         auth_tokens,
         cpu_threads: args.cpu_threads,
         io_threads: args.worker_threads,
+        cpu_nice: args.cpu_nice,
         max_message_bytes: args.max_message_bytes,
         request_timeout: (!timeout.is_zero()).then_some(timeout),
         concurrency_limit: args.concurrency_limit,

@@ -40,6 +40,9 @@ use kinplan_core::robot::UrdfLimits;
 pub struct ServerConfig {
     /// CPU pool threads; 0 means one per core.
     pub cpu_threads: usize,
+    /// Nice value of the CPU pool's threads (0–19; default 10, below the
+    /// I/O threads; see `service/priority.rs`).
+    pub cpu_nice: i32,
     /// I/O threads, each with its own single-threaded async runtime serving
     /// the connections handed to it round robin; 0 means one per core.
     pub io_threads: usize,
@@ -106,6 +109,7 @@ impl Default for ServerConfig {
         Self {
             cpu_threads: 0,
             io_threads: 0,
+            cpu_nice: super::priority::CPU_POOL_NICE,
             max_message_bytes: 16 * 1024 * 1024,
             request_timeout: Some(Duration::from_secs(60)),
             concurrency_limit: 256,
@@ -250,10 +254,11 @@ impl Shared {
 /// [`super::InProcess`] calls them without one.
 /// The state every kinplan service adapter shares, built from `config`.
 pub(crate) fn kinplan_shared(config: &ServerConfig) -> Shared {
-    let mut compute = Compute::new(
+    let mut compute = Compute::with_nice(
         config.cpu_threads,
         config.concurrency_limit,
         config.request_timeout,
+        config.cpu_nice,
     )
     .with_running_counter(config.running_jobs.clone());
     compute.stream_idle_timeout = config.stream_idle_timeout;
