@@ -10,8 +10,8 @@
 //! finished together; on loopback each `writev` also pays the receiver's TCP
 //! processing. A single-threaded runtime queues the woken connection task behind
 //! the calls already queued, so the replies of one read are written together
-//! (measured in `benches/RESULTS.md`, issue 12: server CPU per ForwardKinematics
-//! call about half). The CPU pool is unchanged: work that is not tiny still runs
+//! (`benches/RESULTS.md`, issue 12: server CPU per ForwardKinematics call
+//! 31 → 18 µs, one `writev` per read instead of one per call). The CPU pool is unchanged: work that is not tiny still runs
 //! there and never on these threads.
 
 use std::future::Future;
