@@ -140,3 +140,96 @@ impl IoThreads {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::{Arc, Mutex};
+
+    /// Counts the server futures dropped.
+    struct CountDrop(Arc<AtomicUsize>);
+
+    impl Drop for CountDrop {
+        fn drop(&mut self) {
+            self.0.fetch_add(1, Ordering::SeqCst);
+        }
+    }
+
+    /// A stand-in server: records which thread each connection reached, ends
+    /// Ok at the stop signal, and counts its futures dropped.
+    fn recording(seen: Arc<Mutex<Vec<String>>>, dropped: Arc<AtomicUsize>) -> Arc<ServeFn> {
+        Arc::new(move |mut connections: Connections, stop: StopSignal| {
+            let seen = seen.clone();
+            let guard = CountDrop(dropped.clone());
+            Box::pin(async move {
+                let _guard = guard;
+                tokio::pin!(stop);
+                loop {
+                    tokio::select! {
+                        () = &mut stop => return Ok(()),
+                        next = connections.next() => match next {
+                            Some(Ok(_)) => seen.lock().unwrap().push(
+                                std::thread::current().name().unwrap_or("?").to_string(),
+                            ),
+                            _ => return Ok(()),
+                        },
+                    }
+                }
+            })
+        })
+    }
+
+    async fn connection(listener: &tokio::net::TcpListener) -> tokio::net::TcpStream {
+        let addr = listener.local_addr().unwrap();
+        let (_client, accepted) = tokio::join!(tokio::net::TcpStream::connect(addr), listener.accept());
+        accepted.unwrap().0
+    }
+
+    #[tokio::test]
+    async fn connections_go_round_robin_and_stop_ends_every_thread() {
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let dropped = Arc::new(AtomicUsize::new(0));
+        let mut threads = IoThreads::start(2, recording(seen.clone(), dropped.clone())).unwrap();
+        let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+        for _ in 0..4 {
+            threads.dispatch(connection(&listener).await);
+        }
+        let started = std::time::Instant::now();
+        while seen.lock().unwrap().len() < 4 && started.elapsed().as_secs() < 10 {
+            tokio::time::sleep(std::time::Duration::from_millis(5)).await;
+        }
+        let mut names = seen.lock().unwrap().clone();
+        names.sort();
+        assert_eq!(
+            names,
+            ["kinplan-io-0", "kinplan-io-0", "kinplan-io-1", "kinplan-io-1"]
+        );
+        threads.stop();
+        threads.finished().await.unwrap();
+        assert_eq!(dropped.load(Ordering::SeqCst), 2);
+    }
+
+    #[tokio::test]
+    async fn dropping_the_threads_ends_servers_that_never_stop() {
+        let dropped = Arc::new(AtomicUsize::new(0));
+        let never: Arc<ServeFn> = {
+            let dropped = dropped.clone();
+            Arc::new(move |_connections: Connections, _stop: StopSignal| {
+                let guard = CountDrop(dropped.clone());
+                Box::pin(async move {
+                    let _guard = guard;
+                    std::future::pending::<()>().await;
+                    Ok(())
+                })
+            })
+        };
+        let threads = IoThreads::start(3, never).unwrap();
+        drop(threads);
+        let started = std::time::Instant::now();
+        while dropped.load(Ordering::SeqCst) < 3 && started.elapsed().as_secs() < 10 {
+            tokio::time::sleep(std::time::Duration::from_millis(5)).await;
+        }
+        assert_eq!(dropped.load(Ordering::SeqCst), 3);
+    }
+}
