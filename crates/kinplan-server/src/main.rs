@@ -6,8 +6,17 @@ use std::net::SocketAddr;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use kinplan_server::loadtest::{HealthArgs, LoadtestArgs, check_health, run_loadtest};
+use kinplan_server::loadtest::{
+    HealthArgs, LoadtestArgs, MIN_WORKER_INTERVAL, check_health, run_loadtest, workers_for_rate,
+};
 use kinplan_server::service::{ServerConfig, TlsPem, Tokens, serve};
+
+/// mimalloc instead of the C library's allocator, for `serve` and `loadtest`
+/// alike: a call allocates and frees a few dozen small buffers (HTTP/2 frames,
+/// headers, messages) across threads, where glibc's malloc/free showed as
+/// several percent of both processes' CPU (issue 12, `benches/RESULTS.md`).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 #[derive(Parser)]
 #[command(name = "kinplan", version, about = "Stateless gRPC motion-planning service")]
@@ -37,12 +46,19 @@ struct ServeArgs {
     /// Address to listen on.
     #[arg(long, env = "KINPLAN_LISTEN", default_value = "127.0.0.1:50051")]
     listen: SocketAddr,
-    /// Threads of the async runtime (0: one per core).
+    /// I/O threads, each running its own single-threaded async runtime that
+    /// serves the connections handed to it round robin (0: one per core).
     #[arg(long, env = "KINPLAN_WORKER_THREADS", default_value_t = 0)]
     worker_threads: usize,
     /// Threads of the CPU pool that runs the algorithms (0: one per core).
     #[arg(long, env = "KINPLAN_CPU_THREADS", default_value_t = 0)]
     cpu_threads: usize,
+    /// Nice value (0–19) of the CPU pool's threads. The default, 10, keeps
+    /// admission and health prompt when every core computes; on a host shared
+    /// with other processes, 0 stops those from starving computed calls.
+    #[arg(long, env = "KINPLAN_CPU_NICE", default_value_t = 10,
+          value_parser = clap::value_parser!(i32).range(0..=19))]
+    cpu_nice: i32,
     /// Largest request or response message, bytes.
     #[arg(long, env = "KINPLAN_MAX_MESSAGE_BYTES", default_value_t = 16 * 1024 * 1024)]
     max_message_bytes: usize,
@@ -174,10 +190,19 @@ fn client_runtime() -> Result<tokio::runtime::Runtime, String> {
 }
 
 fn loadtest(args: &LoadtestArgs) -> Result<(), String> {
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .enable_all()
-        .build()
-        .map_err(|e| e.to_string())?;
+    if args.rate > 0.0 && args.concurrency < workers_for_rate(args.rate) {
+        eprintln!(
+            "kinplan loadtest: note: {} workers at {} calls/s send every {:.2} ms each, under {} ms; \
+             latencies include the client's timer delay (use --concurrency {} or more)",
+            args.concurrency,
+            args.rate,
+            args.concurrency as f64 / args.rate * 1e3,
+            MIN_WORKER_INTERVAL.as_millis(),
+            workers_for_rate(args.rate),
+        );
+    }
+    // Only coordinates: each connection runs on a thread of its own.
+    let runtime = client_runtime()?;
     let report = runtime.block_on(run_loadtest(args))?;
     print!("{}", report.summary());
     Ok(())
@@ -198,11 +223,11 @@ fn seconds(value: f64, flag: &str) -> Result<Duration, String> {
 }
 
 fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-    let mut runtime = tokio::runtime::Builder::new_multi_thread();
-    if args.worker_threads > 0 {
-        runtime.worker_threads(args.worker_threads);
-    }
-    let runtime = runtime.enable_all().build()?;
+    // Accepts connections, handles signals and serves metrics; the calls run
+    // on the I/O threads `serve` starts.
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
     let timeout = seconds(args.request_timeout_secs, "--request-timeout-secs")?;
     let (tls, auth_tokens) = security(&args)?;
     if tls.is_some() {
@@ -215,6 +240,8 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
         tls,
         auth_tokens,
         cpu_threads: args.cpu_threads,
+        io_threads: args.worker_threads,
+        cpu_nice: args.cpu_nice,
         max_message_bytes: args.max_message_bytes,
         request_timeout: (!timeout.is_zero()).then_some(timeout),
         concurrency_limit: args.concurrency_limit,

@@ -11,5 +11,5 @@ mod workload;
 
 pub use health::{HealthArgs, check_health};
 pub use report::{LatencyReport, Report};
-pub use run::{LoadtestArgs, run_loadtest};
+pub use run::{LoadtestArgs, MIN_WORKER_INTERVAL, run_loadtest, workers_for_rate};
 pub use workload::{Rpc, Workload};

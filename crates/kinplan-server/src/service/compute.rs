@@ -91,16 +91,32 @@ impl Drop for Running {
 }
 
 impl Compute {
-    /// `threads` workers (0: one per core), at most `concurrency` requests in
-    /// the server at once, `default_timeout` for requests without a deadline.
+    /// `threads` workers (0: one per core) at nice [`super::priority::CPU_POOL_NICE`],
+    /// at most `concurrency` requests in the server at once, `default_timeout`
+    /// for requests without a deadline.
     pub fn new(threads: usize, concurrency: usize, default_timeout: Option<Duration>) -> Self {
+        Self::with_nice(
+            threads,
+            concurrency,
+            default_timeout,
+            super::priority::CPU_POOL_NICE,
+        )
+    }
+
+    /// Like [`Compute::new`], the pool's threads at nice value `nice` (0–19).
+    pub fn with_nice(
+        threads: usize,
+        concurrency: usize,
+        default_timeout: Option<Duration>,
+        nice: i32,
+    ) -> Self {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("kinplan-cpu-{i}"))
             // Explicit, so recursion depth never depends on the platform default.
             .stack_size(CPU_STACK_BYTES)
             // below the runtime's threads: admission and health stay prompt when every core computes
-            .start_handler(|_| super::priority::lower_this_thread())
+            .start_handler(move |_| super::priority::lower_this_thread(nice))
             .build()
             .expect("the CPU pool starts");
         let limit = concurrency.max(1);
@@ -266,6 +282,31 @@ mod tests {
         assert_eq!(compute.deadline_of(&req), None);
         let compute = Compute::new(1, 1, Some(Duration::from_secs(1)));
         assert!(compute.deadline_of(&req).is_some());
+    }
+
+    #[cfg(target_os = "linux")]
+    #[tokio::test]
+    async fn pool_threads_run_at_the_nice_value_given() {
+        let nice_of_this_thread =
+            || unsafe { libc::getpriority(libc::PRIO_PROCESS, libc::gettid() as libc::id_t) };
+        // Pool threads start at this thread's nice; from 0 every value is a lowering.
+        if nice_of_this_thread() != 0 {
+            return;
+        }
+        for nice in [0, 3, 10, 19] {
+            let compute = Compute::with_nice(1, 1, None, nice);
+            let seen = compute
+                .run(&Budget::new(None), move |_| nice_of_this_thread())
+                .await
+                .unwrap();
+            assert_eq!(seen, nice);
+        }
+        let clamped = Compute::with_nice(1, 1, None, 40);
+        let seen = clamped
+            .run(&Budget::new(None), move |_| nice_of_this_thread())
+            .await
+            .unwrap();
+        assert_eq!(seen, 19);
     }
 
     #[tokio::test]

@@ -16,6 +16,7 @@ mod finite;
 pub mod fuzzing;
 mod guard;
 mod inprocess;
+mod io_threads;
 mod kinematics;
 mod mobile;
 mod models;

@@ -8,6 +8,7 @@ use std::time::Duration;
 
 use tokio::net::TcpListener;
 use tokio::sync::OwnedSemaphorePermit;
+use tokio_stream::StreamExt;
 use tonic::transport::server::TcpIncoming;
 use tonic::transport::{Certificate, Identity, Server, ServerTlsConfig};
 use tonic_health::ServingStatus;
@@ -16,6 +17,7 @@ use super::auth::{AuthLayer, Tokens};
 use super::collision_models::CollisionModels;
 use super::exploration::ExplorationApi;
 use super::guard::GuardLayer;
+use super::io_threads::{Connections, IoThreads, ServeFn, StopSignal, thread_count};
 use super::kinematics::KinematicsApi;
 use super::mobile::MobileApi;
 use super::models::Resolved;
@@ -38,6 +40,12 @@ use kinplan_core::robot::UrdfLimits;
 pub struct ServerConfig {
     /// CPU pool threads; 0 means one per core.
     pub cpu_threads: usize,
+    /// Nice value of the CPU pool's threads (0–19; default 10, below the
+    /// I/O threads; see `service/priority.rs`).
+    pub cpu_nice: i32,
+    /// I/O threads, each with its own single-threaded async runtime serving
+    /// the connections handed to it round robin; 0 means one per core.
+    pub io_threads: usize,
     /// Largest request or response message, bytes.
     pub max_message_bytes: usize,
     /// Deadline for requests that bring none.
@@ -100,6 +108,8 @@ impl Default for ServerConfig {
     fn default() -> Self {
         Self {
             cpu_threads: 0,
+            io_threads: 0,
+            cpu_nice: super::priority::CPU_POOL_NICE,
             max_message_bytes: 16 * 1024 * 1024,
             request_timeout: Some(Duration::from_secs(60)),
             concurrency_limit: 256,
@@ -177,22 +187,39 @@ pub async fn serve(
         }
         builder = builder.tls_config(tls_config)?;
     }
-    let server = builder
+    let router = builder
         .layer(GuardLayer::new(cut_rx, config.request_timeout))
         .layer(AuthLayer::new(config.auth_tokens.clone()))
         .add_routes(routes)
         .add_service(health_service)
         .add_service(reflection_v1)
-        .add_service(reflection_v1alpha)
-        .serve_with_incoming_shutdown(
-            // Small replies must not wait for Nagle + delayed ACK (40 ms on loopback).
-            TcpIncoming::from(listener)
-                .with_nodelay(Some(true))
-                .with_keepalive(Some(Duration::from_secs(60))),
-            drain,
-        );
+        .add_service(reflection_v1alpha);
+    let serve_one: Arc<ServeFn> = Arc::new(move |connections: Connections, stop: StopSignal| {
+        let router = router.clone();
+        Box::pin(async move { router.serve_with_incoming_shutdown(connections, stop).await })
+    });
+    let mut threads = IoThreads::start(thread_count(config.io_threads), serve_one)?;
+    // Small replies must not wait for Nagle + delayed ACK (40 ms on loopback).
+    let mut incoming = TcpIncoming::from(listener)
+        .with_nodelay(Some(true))
+        .with_keepalive(Some(Duration::from_secs(60)));
+    tokio::pin!(drain);
+    loop {
+        tokio::select! {
+            () = &mut drain => break,
+            failed = threads.finished() => return failed,
+            accepted = incoming.next() => match accepted {
+                Some(Ok(connection)) => threads.dispatch(connection),
+                Some(Err(e)) => tracing::debug!("error accepting a connection: {e}"),
+                None => break,
+            },
+        }
+    }
+    // Closes the listening socket at once: new clients are refused, not left hanging.
+    drop(incoming);
+    threads.stop();
     tokio::select! {
-        served = server => served?,
+        served = threads.finished() => served?,
         () = cutter => {}
     }
     Ok(())
@@ -227,10 +254,11 @@ impl Shared {
 /// [`super::InProcess`] calls them without one.
 /// The state every kinplan service adapter shares, built from `config`.
 pub(crate) fn kinplan_shared(config: &ServerConfig) -> Shared {
-    let mut compute = Compute::new(
+    let mut compute = Compute::with_nice(
         config.cpu_threads,
         config.concurrency_limit,
         config.request_timeout,
+        config.cpu_nice,
     )
     .with_running_counter(config.running_jobs.clone());
     compute.stream_idle_timeout = config.stream_idle_timeout;
