@@ -6,7 +6,16 @@ same calls, one run:
 For FK and warm IK on the UR5: the mean time of `robot.fk(q)` / `robot.ik(T,
 seed=...)` against the generated stub called with a request built once, and
 the difference (the client's own overhead per call). Calls alternate, so
-drift in the machine's speed hits both alike.
+drift in the machine's speed hits both alike. Rows:
+
+- ForwardKinematics: `robot.fk(q)`, the 4x4 array returned;
+- SolveIk (warm, seed built per call): `robot.ik(T, seed=q + 0.02)`, the
+  seed's numpy addition inside the timed call (the first version of this
+  script; the stub's request holds the seed already);
+- SolveIk (warm): the same seed array made once, as the stub's request is;
+- SolveIk (warm) read: both sides also read the answer -- `.success` and
+  `.q` of the client's result, `.success` and the first solution's joints
+  as a numpy array (through a list) from the stub's reply.
 """
 from typing import Any
 
@@ -56,9 +65,23 @@ def main() -> None:
         raw, ours = interleaved_us(
             lambda: c._kinematics.SolveIk(ik_req, timeout=10), lambda: ur5.ik(T, seed=q + 0.02), n
         )
+        rows.append(("SolveIk (warm, seed built per call)", raw, ours))
+        seed = q + 0.02
+        raw, ours = interleaved_us(lambda: c._kinematics.SolveIk(ik_req, timeout=10), lambda: ur5.ik(T, seed=seed), n)
         rows.append(("SolveIk (warm)", raw, ours))
+
+        def raw_read() -> Any:
+            r = c._kinematics.SolveIk(ik_req, timeout=10)
+            return r.success, np.array(r.solutions[0].joints[:])  # through a list: the fastest way
+
+        def ours_read() -> Any:
+            r = ur5.ik(T, seed=seed)
+            return r.success, r.q
+
+        raw, ours = interleaved_us(raw_read, ours_read, n)
+        rows.append(("SolveIk (warm) read", raw, ours))
         for name, raw, ours in rows:
-            print(f"{name:18s} raw stub {raw:7.1f} us   client {ours:7.1f} us   overhead {ours - raw:6.1f} us "
+            print(f"{name:36s} raw stub {raw:7.1f} us   client {ours:7.1f} us   overhead {ours - raw:6.1f} us "
                   f"({ours / raw:.2f}x)")
 
 
