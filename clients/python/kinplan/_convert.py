@@ -107,11 +107,12 @@ def pose_values_to_matrix(px: float, py: float, pz: float, x: float, y: float, z
 
 # A ForwardKinematicsResponse holding only the tool pose with all seven values
 # non-zero (what the server sends for a built-in robot, links not asked):
-# field 1 (63 bytes) = position (field 1: three tagged doubles) and
-# orientation (field 2: four tagged doubles). Tags and lengths are read as
-# byte strings and compared, the doubles unpacked.
-_FK_TOOL_ONLY = struct.Struct("<5sd1sd1sd3sd1sd1sd1sd")
-_FK_TOOL_ONLY_TAGS = (b"\x0a\x43\x0a\x1b\x09", b"\x11", b"\x19", b"\x12\x24\x09", b"\x11", b"\x19", b"\x21")
+# field 1 (67 bytes) = position (field 1: three tagged doubles) and
+# orientation (field 2: four tagged doubles). One struct reads the 13 tag and
+# length bytes (skipping the doubles), another the 7 doubles (skipping the tags).
+_FK_TOOL_ONLY_TAGS = struct.Struct("<5B8xB8xB8x3B8xB8xB8xB8x")
+_FK_TOOL_ONLY_VALUES = struct.Struct("<5xdxdxd3xdxdxdxd")
+_FK_TOOL_ONLY_EXPECTED = (0x0A, 67, 0x0A, 27, 0x09, 0x11, 0x19, 0x12, 36, 0x09, 0x11, 0x19, 0x21)
 
 
 def tool_pose_of_fk_reply(wire: bytes) -> Optional[np.ndarray]:
@@ -119,12 +120,9 @@ def tool_pose_of_fk_reply(wire: bytes) -> Optional[np.ndarray]:
     has exactly the layout above (no links, no model id, no zero value
     omitted), read without building message objects; ``None`` for any other
     encoding (the caller then parses the message)."""
-    if len(wire) != 69:
+    if len(wire) != 69 or _FK_TOOL_ONLY_TAGS.unpack(wire) != _FK_TOOL_ONLY_EXPECTED:
         return None
-    v = _FK_TOOL_ONLY.unpack(wire)
-    if v[0::2] != _FK_TOOL_ONLY_TAGS:
-        return None
-    return pose_values_to_matrix(v[1], v[3], v[5], v[7], v[9], v[11], v[13])
+    return pose_values_to_matrix(*_FK_TOOL_ONLY_VALUES.unpack(wire))
 
 
 def as_homogeneous(t: object) -> object:

@@ -568,7 +568,11 @@ class Robot(RobotRefs, RobotKinematicsMixin):
         # the hot path: the request as bytes (reference, packed joints), the
         # answer read from its bytes when it has the usual layout
         positions, body = joints_and_field(2, q, "q")
-        self.check_limits(positions)
+        limits = self._limits()
+        lower, upper = limits._lower_list, limits._upper_list
+        if not (len(positions) == len(lower) and all(map(operator.le, lower, positions))
+                and all(map(operator.le, positions, upper))):
+            self.check_limits(positions)  # the whole check: it warns, or raises, naming the joint
         wire = self._send(_FORWARD_KINEMATICS, None, body, timeout)
         tool = tool_pose_of_fk_reply(wire)
         if tool is not None:
