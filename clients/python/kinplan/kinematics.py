@@ -18,8 +18,7 @@ from __future__ import annotations
 import queue
 import threading
 from dataclasses import dataclass, field
-from typing import (Any, Callable, Dict, Iterable, Iterator, List, Literal, Mapping, Optional,
-                    Sequence, Union)
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Literal, Mapping, Optional, Sequence, Union
 
 import grpc
 import numpy as np
@@ -711,14 +710,11 @@ class RobotKinematicsMixin:
         as S2 predicts (the relaxation's inexact solve is not accurate enough
         for Newton's fixed-point step): do not use it. "fabrik" and
         "length_relaxation" take position targets only."""
-        if isinstance(T, np.ndarray) and T.shape == (4, 4):
-            target = target_field(T)
-        else:
-            # a bare 3-vector is a position: solve for it alone
-            if _is_position(T):
-                T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
-                position_only = True
-            target = length_delimited(2, _target_wire(T))
+        matrix = isinstance(T, np.ndarray) and T.shape == (4, 4)  # the usual target: packed in one step
+        # a bare 3-vector is a position: solve for it alone
+        if not matrix and _is_position(T):
+            T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
+            position_only = True
         key = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
                damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
                max_step, distinct_tolerance, rlxa_max_iterations, history)
@@ -727,6 +723,7 @@ class RobotKinematicsMixin:
         except (KeyError, TypeError):  # first use of these arguments, or an unhashable one
             options_field = _ik_options_field(*key)
         # the request goes out as bytes built field by field: no message objects
+        target = target_field(T) if matrix else length_delimited(2, _target_wire(T))
         body = target + (b"" if seed is None else joints_field(3, seed, "seed")) + options_field
         reply = self._send(_SOLVE_IK, kinematics_pb2.SolveIkResponse, body, timeout)  # type: ignore[attr-defined]
         return IkResult.from_proto(reply)

@@ -288,3 +288,19 @@ def test_an_ik_result_built_by_hand_keeps_its_values():
     r.__dict__.pop("solutions")
     with pytest.raises(AttributeError, match="solutions"):
         r.solutions  # no proto to build it from
+
+
+def test_hand_encoded_calls_resend_the_urdf_when_the_server_lost_the_model_id(client):
+    robot = client.robot(urdf=TWO_LINK)
+    T = robot.fk([0.7, 0.0])
+    learned = robot.model_id
+    assert len(learned) == 32
+    # a model id the server never gave (as after a restart or on another replica): NOT_FOUND, then
+    # the request goes again with the URDF text, and the id is learned again
+    robot.model_id = bytes(32)
+    np.testing.assert_array_equal(robot.fk([0.7, 0.0]), T)
+    assert robot.model_id == learned
+    robot.model_id = bytes(32)
+    r = robot.ik(T, seed=[0.0, 0.0], position_only=True)
+    assert r.success and abs(r.q[0] - 0.7) < 1e-4
+    assert robot.model_id == learned
