@@ -19,7 +19,7 @@ from kinplan.v1 import common_pb2, kinematics_pb2, robot_pb2
 from test_kinematics import TWO_LINK, pose_distance, random_q
 
 
-def random_pose(rng, branch_hint=None):
+def random_pose(rng):
     q = rng.normal(size=4)
     q /= np.linalg.norm(q)
     T = np.eye(4)
@@ -28,8 +28,9 @@ def random_pose(rng, branch_hint=None):
     return T
 
 
-def spy_on_raw_calls(client):
-    """Records the bytes every raw (hand-encoded) call sends."""
+def spy_on_raw_calls(client, monkeypatch):
+    """Records the bytes every raw (hand-encoded) call sends (undone after the test:
+    the in-process client is shared by the session)."""
     sent = []
     original = client._raw_unary
 
@@ -42,7 +43,7 @@ def spy_on_raw_calls(client):
 
         return call
 
-    client._raw_unary = spy
+    monkeypatch.setattr(client, "_raw_unary", spy)
     return sent
 
 
@@ -100,9 +101,9 @@ def test_the_target_field_is_the_pose_of_the_generated_classes():
     assert target_field(I) == length_delimited(2, pose_bytes(I.astype(float)))
 
 
-def test_robot_ik_sends_the_request_the_generated_classes_build(client):
+def test_robot_ik_sends_the_request_the_generated_classes_build(client, monkeypatch):
     robot = client.robot("ur5")
-    sent = spy_on_raw_calls(client)
+    sent = spy_on_raw_calls(client, monkeypatch)
     rng = np.random.default_rng(5)
     T = robot.fk(random_q(robot, rng))
     seeds = [None, np.array([0.1, -1.0, 1.2, 0.0, 0.5, 0.3]), [0, -1, 1, 0, 1, 0], np.arange(6, dtype=np.float32)]
@@ -120,9 +121,9 @@ def test_robot_ik_sends_the_request_the_generated_classes_build(client):
         assert kinematics_pb2.SolveIkRequest.FromString(wire) == expected
 
 
-def test_robot_fk_sends_the_request_the_generated_classes_build(client):
+def test_robot_fk_sends_the_request_the_generated_classes_build(client, monkeypatch):
     robot = client.robot("franka_panda")
-    sent = spy_on_raw_calls(client)
+    sent = spy_on_raw_calls(client, monkeypatch)
     for q in (np.array([0.1, -0.2, 0.3, -1.5, 0.2, 1.0, 0.4]), [0, 0, 0, -1, 0, 1, 0]):
         robot.fk(q)
         path, wire = sent[-1]
