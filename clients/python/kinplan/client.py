@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 import json
+import operator
 import socket
 import time
 import warnings
@@ -12,7 +13,8 @@ import grpc
 import numpy as np
 import numpy.typing as npt
 
-from ._convert import joints, length_delimited, matrix_from_proto, matrix_to_proto, pose_to_matrix
+from ._convert import (joints, joints_and_field, length_delimited, matrix_from_proto, matrix_to_proto, pose_to_matrix,
+                       tool_pose_of_fk_reply)
 from .errors import JointLimitWarning, KinplanError, error_for, invalid_argument
 from .kinematics import KinematicsMixin, RobotKinematicsMixin
 from .mobile import MobileMixin
@@ -26,6 +28,8 @@ DEFAULT_TIMEOUT = 30.0
 
 
 DEFAULT_PORT = 50051
+
+_FORWARD_KINEMATICS = "/kinplan.v1.RobotService/ForwardKinematics"
 
 # Round robin over the resolved addresses; UNAVAILABLE (replica gone or not
 # yet up) is retried up to three attempts with a short backoff.
@@ -255,14 +259,19 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
 
     def _raw_unary(self, path: str, response: Any) -> Any:
         """A unary method that sends an already-encoded request (bytes) and
-        decodes the answer as `response`: the fast path of hot calls."""
-        cache = self.__dict__.setdefault("_raw_methods", {})
-        method = cache.get(path)
-        if method is None:
-            method = cache[path] = self._channel.unary_unary(
-                path, request_serializer=None, response_deserializer=response.FromString
+        decodes the answer as `response` (``None``: the answer's bytes): the
+        fast path of hot calls."""
+        try:
+            return self.__dict__["_raw_methods"][(path, response)]
+        except KeyError:
+            cache = self.__dict__.setdefault("_raw_methods", {})
+            # registered as the generated stubs register theirs (the core
+            # interns the method's path once, not per call)
+            method = cache[(path, response)] = self._channel.unary_unary(
+                path, request_serializer=None, response_deserializer=None if response is None else response.FromString,
+                _registered_method=True,
             )
-        return method
+            return method
 
     def _call(self, method: Callable[..., Any], request: Any, timeout: Optional[float]) -> Any:
         try:
@@ -349,12 +358,13 @@ class JointLimits:
         self.lower = d.lower - 1e-9
         self.upper = d.upper + 1e-9
         self.names = d.joint_names
-        self._pairs = list(zip(self.lower.tolist(), self.upper.tolist()))
+        self._lower_list: List[float] = self.lower.tolist()
+        self._upper_list: List[float] = self.upper.tolist()
 
     def check(self, q: Any, field_name: str, strict: bool) -> None:
-        if isinstance(q, list) and len(q) == len(self._pairs):
-            # one state as floats (fk, jacobian): a plain loop is the cheapest test
-            if all(lo <= v <= hi for v, (lo, hi) in zip(q, self._pairs)):
+        if isinstance(q, list) and len(q) == len(self._lower_list):
+            # one state as floats (fk, jacobian): comparisons mapped in C are the cheapest test
+            if all(map(operator.le, self._lower_list, q)) and all(map(operator.le, q, self._upper_list)):
                 return
         arr = np.asarray(q, dtype=float)
         if arr.ndim == 0 or arr.shape[-1] != len(self.lower):
@@ -461,11 +471,11 @@ class Robot(RobotRefs, RobotKinematicsMixin):
 
     def _limits(self) -> "JointLimits":
         """The chain's joint limits, fetched once per model and chain per client."""
-        cache = self.client.__dict__.setdefault("_limits_cache", {})
         key = self.limits_key()
-        limits: Optional[JointLimits] = cache.get(key)
-        if limits is None:
-            limits = cache[key] = JointLimits(self.describe())
+        try:
+            limits: JointLimits = self.client.__dict__["_limits_cache"][key]
+        except KeyError:
+            limits = self.client.__dict__.setdefault("_limits_cache", {})[key] = JointLimits(self.describe())
         return limits
 
     def limits_key(self) -> Any:
@@ -478,6 +488,30 @@ class Robot(RobotRefs, RobotKinematicsMixin):
         value of `q` (one state or rows of states) lies outside the limits:
         kinplan takes radians, and degrees are the usual cause."""
         self._limits().check(q, field_name, self.strict)
+
+    def _send(self, path: str, response: Any, body: bytes, timeout: Optional[float]) -> Any:
+        """:meth:`_call` for a request sent as bytes: this robot's reference
+        (field 1) and then `body`, the request's other fields already
+        encoded; the answer is parsed as `response` (``None``: its bytes are
+        returned, and a model id in them is the caller's to read). The same
+        retry as :meth:`_call` when a replica does not hold the model id."""
+        client = self.client
+        cached = self.__dict__.get("_ref_cache")
+        if cached is not None and cached[0] == (False, self.model_id):
+            ref_field: bytes = cached[2]
+        else:
+            ref_field = self._ref_field(self._ref())
+        method = client._raw_unary(path, response)
+        try:
+            reply = method(ref_field + body, timeout=client.timeout if timeout is None else timeout)
+        except grpc.RpcError as err:
+            if not (err.code() == grpc.StatusCode.NOT_FOUND and self.model_id and self.urdf_text):
+                raise KinplanError.from_rpc_error(err) from None
+            self.model_id = b""
+            reply = client._call(method, self._ref_field(self._ref(inline=True)) + body, timeout)
+        if response is not None and self.urdf_text is not None and reply.model_id:
+            self.model_id = reply.model_id
+        return reply
 
     def _call(self, method: Callable[..., Any], build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
         try:
@@ -520,19 +554,33 @@ class Robot(RobotRefs, RobotKinematicsMixin):
     def fk(self, q: npt.ArrayLike, *, links: bool = False, timeout: Optional[float] = None) -> Any:
         """Tool pose (4x4, base frame, metres) for joint vector `q`; with
         `links=True`, also a dict of every link's 4x4 pose."""
-        positions = joints(q)
-        self.check_limits(positions)
-        r = self._call(
-            self.client._robots.ForwardKinematics,
-            lambda ref: robot_pb2.ForwardKinematicsRequest(
-                robot=ref, joint_positions=positions, include_links=links
-            ),
-            timeout,
-        )
-        tool = pose_to_matrix(r.tool_pose)
         if links:
-            return tool, {link.name: pose_to_matrix(link.pose) for link in r.links}
-        return tool
+            positions = joints(q)
+            self.check_limits(positions)
+            r = self._call(
+                self.client._robots.ForwardKinematics,
+                lambda ref: robot_pb2.ForwardKinematicsRequest(
+                    robot=ref, joint_positions=positions, include_links=links
+                ),
+                timeout,
+            )
+            return pose_to_matrix(r.tool_pose), {link.name: pose_to_matrix(link.pose) for link in r.links}
+        # the hot path: the request as bytes (reference, packed joints), the
+        # answer read from its bytes when it has the usual layout
+        positions, body = joints_and_field(2, q, "q")
+        limits = self._limits()
+        lower, upper = limits._lower_list, limits._upper_list
+        if not (len(positions) == len(lower) and all(map(operator.le, lower, positions))
+                and all(map(operator.le, positions, upper))):
+            self.check_limits(positions)  # the whole check: it warns, or raises, naming the joint
+        wire = self._send(_FORWARD_KINEMATICS, None, body, timeout)
+        tool = tool_pose_of_fk_reply(wire)
+        if tool is not None:
+            return tool
+        r = robot_pb2.ForwardKinematicsResponse.FromString(wire)
+        if r.model_id and self.urdf_text is not None:
+            self.model_id = r.model_id
+        return pose_to_matrix(r.tool_pose)
 
     def fk_batch(self, qs: Any, *, jacobians: bool = False, timeout: Optional[float] = None) -> Any:
         """Tool poses of every row of `qs` (n x dof, rad) in one call: an

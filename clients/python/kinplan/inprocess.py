@@ -92,7 +92,7 @@ class _Unary:
             answer = self._backend.unary(self._path, wire, timeout)
         except self._error as err:
             raise _rpc_error(err) from None
-        return self._deserialize(answer)
+        return answer if self._deserialize is None else self._deserialize(answer)
 
 
 class _Answers(Iterator[Any]):

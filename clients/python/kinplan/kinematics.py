@@ -25,7 +25,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ._display import html_table
-from ._convert import joints, length_delimited, matrix_to_pose, matrix_to_proto, packed_doubles, pose_bytes, pose_to_matrix
+from ._convert import (joints, joints_field, length_delimited, matrix_to_pose, matrix_to_proto, pose_bytes,
+                       pose_to_matrix, target_field)
 from .errors import KinplanError
 from .v1 import common_pb2, kinematics_pb2, kinematics_pb2_grpc
 
@@ -290,19 +291,80 @@ class IkResult:
 
     @classmethod
     def from_proto(cls, r: kinematics_pb2.SolveIkResponse) -> "IkResult":
-        solutions = [IkSolution.from_proto(s) for s in r.solutions]
-        best = IkSolution.from_proto(r.best_attempt) if r.HasField("best_attempt") else None
-        head = solutions[0] if solutions else best
-        status = _IK_STATUS.get(r.status) or _ik_status(r.status)
-        # positional, in field order: the hot path of every IK answer
-        if head is None:
-            return cls(r.success, None, float("nan"), float("nan"), 0, status, solutions, best, r.attempts,
-                       r.total_iterations, r.elapsed_us, None, r)
-        return cls(r.success, head.q, head.position_error, head.orientation_error, head.iterations, status,
-                   solutions, best, r.attempts, r.total_iterations, r.elapsed_us, None, r)
+        """The result of a SolveIkResponse. Only ``success`` and ``raw`` are
+        read at once; every other field is built from ``raw`` when first
+        read (then kept, see :class:`_LazyIkField`), so a caller pays for
+        what it reads: an answer is most often read for ``success`` and
+        ``q`` alone. The values are those the eager build gave (``q`` is
+        ``solutions[0].q``, the same array, else ``best_attempt.q``)."""
+        out = cls.__new__(cls)
+        out.success = r.success
+        out.raw = r
+        return out
 
     def __bool__(self) -> bool:
         return self.success
+
+
+class _LazyIkField:
+    """A field of :class:`IkResult` built from ``raw`` on first read.
+
+    A non-data descriptor set on the class after the dataclass is made (so
+    ``__init__`` and ``dataclasses.fields`` are unchanged): an instance's own
+    value always wins, so it only runs for a field an answer from
+    ``IkResult.from_proto`` has not built yet, stores the value in the
+    instance and is not called again for it. The head fields (``q``, the two
+    errors, ``iterations``) are built together, from the first solution or,
+    when there is none, from ``best_attempt``."""
+
+    def __init__(self, name: str):
+        self.name = name
+
+    def __get__(self, obj: Any, owner: Any = None) -> Any:
+        if obj is None:
+            return self
+        d = obj.__dict__
+        r = d.get("raw")
+        if r is None:  # not from from_proto: the field was never set
+            raise AttributeError(f"'IkResult' object has no attribute {self.name!r}")
+        name = self.name
+        if name in _IK_HEAD_FIELDS:
+            solutions = d.get("solutions")
+            if solutions is None and len(r.solutions):
+                s = r.solutions[0]
+                d["q"] = np.array(s.joints[:])  # float64 from a list of floats; a list first: ~3x faster than asarray
+                d["position_error"], d["orientation_error"], d["iterations"] = (
+                    s.position_error, s.orientation_error, s.iterations)
+            else:
+                head = solutions[0] if solutions else obj.best_attempt
+                if head is None:
+                    d["q"], d["position_error"], d["orientation_error"], d["iterations"] = (
+                        None, float("nan"), float("nan"), 0)
+                else:
+                    d["q"], d["position_error"], d["orientation_error"], d["iterations"] = (
+                        head.q, head.position_error, head.orientation_error, head.iterations)
+        elif name == "solutions":
+            solutions = [IkSolution.from_proto(s) for s in r.solutions]
+            q = d.get("q")
+            if solutions and q is not None:
+                solutions[0].q = q  # the head's array, shared as in the eager build
+            d["solutions"] = solutions
+        elif name == "best_attempt":
+            # (with no solutions the head fields are read from it, so it is built before them)
+            d["best_attempt"] = IkSolution.from_proto(r.best_attempt) if r.HasField("best_attempt") else None
+        elif name == "status":
+            d["status"] = _IK_STATUS.get(r.status) or _ik_status(r.status)
+        else:  # attempts, total_iterations, elapsed_us
+            d[name] = getattr(r, name)
+        return d[name]
+
+
+#: The fields of the first solution (or of the best attempt) that IkResult repeats.
+_IK_HEAD_FIELDS = frozenset(("q", "position_error", "orientation_error", "iterations"))
+for _name in sorted(_IK_HEAD_FIELDS | {"status", "solutions", "best_attempt", "attempts", "total_iterations",
+                                       "elapsed_us"}):
+    setattr(IkResult, _name, _LazyIkField(_name))
+del _name
 
 
 @dataclass
@@ -648,26 +710,22 @@ class RobotKinematicsMixin:
         as S2 predicts (the relaxation's inexact solve is not accurate enough
         for Newton's fixed-point step): do not use it. "fabrik" and
         "length_relaxation" take position targets only."""
+        matrix = isinstance(T, np.ndarray) and T.shape == (4, 4)  # the usual target: packed in one step
         # a bare 3-vector is a position: solve for it alone
-        if _is_position(T):
+        if not matrix and _is_position(T):
             T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
             position_only = True
-        options_field = _ik_options_field(
-            method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
-            damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
-            max_step, distinct_tolerance, rlxa_max_iterations, history,
-        )
+        key = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
+               damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
+               max_step, distinct_tolerance, rlxa_max_iterations, history)
+        try:
+            options_field = _IK_OPTIONS_FIELD[key]
+        except (KeyError, TypeError):  # first use of these arguments, or an unhashable one
+            options_field = _ik_options_field(*key)
         # the request goes out as bytes built field by field: no message objects
-        body = (
-            length_delimited(2, _target_wire(T))
-            + packed_doubles(3, [] if seed is None else joints(seed, "seed"))
-            + options_field
-        )
-        reply = self._call(  # type: ignore[attr-defined]
-            self.client._raw_unary(_SOLVE_IK, kinematics_pb2.SolveIkResponse),  # type: ignore[attr-defined]
-            lambda ref: self._ref_field(ref) + body,  # type: ignore[attr-defined]
-            timeout,
-        )
+        target = target_field(T) if matrix else length_delimited(2, _target_wire(T))
+        body = target + (b"" if seed is None else joints_field(3, seed, "seed")) + options_field
+        reply = self._send(_SOLVE_IK, kinematics_pb2.SolveIkResponse, body, timeout)  # type: ignore[attr-defined]
         return IkResult.from_proto(reply)
 
     def ik_batch(
