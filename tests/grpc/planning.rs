@@ -552,6 +552,20 @@ async fn bad_input_is_named_by_field() {
             },
             "options.motion_resolution",
         ),
+        (
+            {
+                let mut r = request(pb::PlanAlgorithm::Ccstomp, Vec::new());
+                r.options = Some(pb::PlanOptions {
+                    stomp: Some(pb::StompOptions {
+                        initial_trajectory: 9,
+                        ..Default::default()
+                    }),
+                    ..Default::default()
+                });
+                r
+            },
+            "options.stomp.initial_trajectory",
+        ),
     ];
     for (req, field) in cases {
         let err = planning.plan(req).await.unwrap_err();

@@ -25,6 +25,13 @@ class PlanStatus(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
     PLAN_STATUS_TIMEOUT: _ClassVar[PlanStatus]
     PLAN_STATUS_CANCELLED: _ClassVar[PlanStatus]
     PLAN_STATUS_GOAL_UNREACHABLE: _ClassVar[PlanStatus]
+
+class InitialTrajectory(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
+    __slots__ = ()
+    INITIAL_TRAJECTORY_UNSPECIFIED: _ClassVar[InitialTrajectory]
+    INITIAL_TRAJECTORY_STRAIGHT_LINE: _ClassVar[InitialTrajectory]
+    INITIAL_TRAJECTORY_RRT_CONNECT_IF_BLOCKED: _ClassVar[InitialTrajectory]
+    INITIAL_TRAJECTORY_CARTESIAN_LINE: _ClassVar[InitialTrajectory]
 PLAN_ALGORITHM_UNSPECIFIED: PlanAlgorithm
 PLAN_ALGORITHM_STOMP: PlanAlgorithm
 PLAN_ALGORITHM_CCSTOMP: PlanAlgorithm
@@ -37,9 +44,13 @@ PLAN_STATUS_INVALID_GOAL: PlanStatus
 PLAN_STATUS_TIMEOUT: PlanStatus
 PLAN_STATUS_CANCELLED: PlanStatus
 PLAN_STATUS_GOAL_UNREACHABLE: PlanStatus
+INITIAL_TRAJECTORY_UNSPECIFIED: InitialTrajectory
+INITIAL_TRAJECTORY_STRAIGHT_LINE: InitialTrajectory
+INITIAL_TRAJECTORY_RRT_CONNECT_IF_BLOCKED: InitialTrajectory
+INITIAL_TRAJECTORY_CARTESIAN_LINE: InitialTrajectory
 
 class StompOptions(_message.Message):
-    __slots__ = ("timesteps", "rollouts", "max_rollouts", "max_iterations", "iterations_after_valid", "noise_stddev", "cost_sensitivity", "control_cost_weight", "collision_penalty", "kernel_half_width", "clearance_distance", "clearance_weight", "joint_limit_weight", "straight_line_start")
+    __slots__ = ("timesteps", "rollouts", "max_rollouts", "max_iterations", "iterations_after_valid", "noise_stddev", "cost_sensitivity", "control_cost_weight", "collision_penalty", "kernel_half_width", "clearance_distance", "clearance_weight", "joint_limit_weight", "straight_line_start", "initial_trajectory")
     TIMESTEPS_FIELD_NUMBER: _ClassVar[int]
     ROLLOUTS_FIELD_NUMBER: _ClassVar[int]
     MAX_ROLLOUTS_FIELD_NUMBER: _ClassVar[int]
@@ -54,6 +65,7 @@ class StompOptions(_message.Message):
     CLEARANCE_WEIGHT_FIELD_NUMBER: _ClassVar[int]
     JOINT_LIMIT_WEIGHT_FIELD_NUMBER: _ClassVar[int]
     STRAIGHT_LINE_START_FIELD_NUMBER: _ClassVar[int]
+    INITIAL_TRAJECTORY_FIELD_NUMBER: _ClassVar[int]
     timesteps: int
     rollouts: int
     max_rollouts: int
@@ -68,7 +80,8 @@ class StompOptions(_message.Message):
     clearance_weight: float
     joint_limit_weight: float
     straight_line_start: bool
-    def __init__(self, timesteps: _Optional[int] = ..., rollouts: _Optional[int] = ..., max_rollouts: _Optional[int] = ..., max_iterations: _Optional[int] = ..., iterations_after_valid: _Optional[int] = ..., noise_stddev: _Optional[_Iterable[float]] = ..., cost_sensitivity: _Optional[float] = ..., control_cost_weight: _Optional[float] = ..., collision_penalty: _Optional[float] = ..., kernel_half_width: _Optional[int] = ..., clearance_distance: _Optional[float] = ..., clearance_weight: _Optional[float] = ..., joint_limit_weight: _Optional[float] = ..., straight_line_start: _Optional[bool] = ...) -> None: ...
+    initial_trajectory: InitialTrajectory
+    def __init__(self, timesteps: _Optional[int] = ..., rollouts: _Optional[int] = ..., max_rollouts: _Optional[int] = ..., max_iterations: _Optional[int] = ..., iterations_after_valid: _Optional[int] = ..., noise_stddev: _Optional[_Iterable[float]] = ..., cost_sensitivity: _Optional[float] = ..., control_cost_weight: _Optional[float] = ..., collision_penalty: _Optional[float] = ..., kernel_half_width: _Optional[int] = ..., clearance_distance: _Optional[float] = ..., clearance_weight: _Optional[float] = ..., joint_limit_weight: _Optional[float] = ..., straight_line_start: _Optional[bool] = ..., initial_trajectory: _Optional[_Union[InitialTrajectory, str]] = ...) -> None: ...
 
 class CartesianOptions(_message.Message):
     __slots__ = ("translation_tolerance", "rotation_tolerance", "translation_weight", "rotation_weight", "translation_stddev", "rotation_stddev", "ik_iterations", "violation_penalty")

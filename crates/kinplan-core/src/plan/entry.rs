@@ -322,7 +322,7 @@ pub fn plan<C: StateChecker + ?Sized>(
                 start,
                 &goal,
                 n,
-                req.stomp.initial,
+                req.stomp.initial.for_algorithm(req.algorithm),
                 &req.rrt,
                 req.seed,
                 &clock,

@@ -509,3 +509,48 @@ fn a_shortcut_resolution_outside_zero_to_one_is_an_error_naming_it() {
     assert!(r.valid);
     assert_eq!(&r.q[..3], &req.start[..]);
 }
+
+#[test]
+fn ccstomp_starts_on_the_cartesian_line_unless_told_otherwise() {
+    // The request of the test above without a chosen start: CCSTOMP takes the
+    // Cartesian line and keeps 2 cm / 0.02 rad; from the joint line (free
+    // here, so RRT_CONNECT_IF_BLOCKED keeps it) it does not get there.
+    let chain = builtin_chain("ur5").unwrap();
+    let w = JointBoxes {
+        dof: 6,
+        limit: 2.0 * std::f64::consts::PI,
+        boxes: vec![],
+    };
+    let goal = vec![0.6, -1.0, 1.2, -1.0, 1.3, 0.0];
+    let mut req = PlanRequest {
+        start: vec![0.0, -1.2, 1.4, -0.8, 1.1, 0.2],
+        goal: Goal::Joints(goal.clone()),
+        algorithm: Algorithm::Ccstomp,
+        seed: 2,
+        ..Default::default()
+    };
+    req.stomp.timesteps = 12;
+    req.cartesian.translation_tolerance = 0.02;
+    req.cartesian.rotation_tolerance = 0.02;
+    assert_eq!(req.stomp.initial, InitialTrajectory::ForAlgorithm);
+    let within = |r: &crate::plan::PlanResult| {
+        // deviations recomputed from FK of the returned joints
+        let line = crate::plan::CartesianLine::between(&chain, &req.start, &goal);
+        let n = r.q.len() / 6;
+        r.q.chunks_exact(6).enumerate().all(|(t, q)| {
+            let d = crate::plan::deviation(&line.pose_at_waypoint(t, n), &chain.fk(q));
+            d.translation <= 0.02 + 1e-9 && d.rotation <= 0.02 + 1e-9
+        })
+    };
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert_eq!(r.status, PlanStatus::Succeeded);
+    assert!(within(&r));
+    req.stomp.initial = InitialTrajectory::RrtConnectIfBlocked;
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert!(!within(&r), "from the joint line the tolerances are not kept");
+    // STOMP's own start stays the joint line (or RRT-Connect when blocked)
+    assert_eq!(
+        InitialTrajectory::ForAlgorithm.for_algorithm(Algorithm::Stomp),
+        InitialTrajectory::RrtConnectIfBlocked
+    );
+}

@@ -96,6 +96,18 @@ pub fn plan_input(req: &pb::PlanRequest) -> Result<PlanInput, Status> {
         stomp.joint_limit_weight,
         s.joint_limit_weight,
     )?;
+    s.initial = match pb::InitialTrajectory::try_from(stomp.initial_trajectory) {
+        Ok(pb::InitialTrajectory::Unspecified) => InitialTrajectory::ForAlgorithm,
+        Ok(pb::InitialTrajectory::StraightLine) => InitialTrajectory::StraightLine,
+        Ok(pb::InitialTrajectory::RrtConnectIfBlocked) => InitialTrajectory::RrtConnectIfBlocked,
+        Ok(pb::InitialTrajectory::CartesianLine) => InitialTrajectory::CartesianLine,
+        Err(_) => {
+            return Err(invalid(
+                "options.stomp.initial_trajectory",
+                format!("unknown value {}", stomp.initial_trajectory),
+            ));
+        }
+    };
     if stomp.straight_line_start {
         s.initial = InitialTrajectory::StraightLine;
     }
