@@ -451,8 +451,9 @@ fn resampling_keeps_every_vertex_and_the_count() {
     assert_eq!((on_first, on_second), (1, 4));
 }
 
-#[test]
-fn ccstomp_from_the_cartesian_line_stays_on_it() {
+/// A UR5 in free space, CCSTOMP between two states with 2 cm / 0.02 rad
+/// tolerances: chain, world, request, goal.
+fn ur5_ccstomp_request() -> (std::sync::Arc<Chain>, JointBoxes, PlanRequest, Vec<f64>) {
     let chain = builtin_chain("ur5").unwrap();
     let w = JointBoxes {
         dof: 6,
@@ -468,9 +469,15 @@ fn ccstomp_from_the_cartesian_line_stays_on_it() {
         ..Default::default()
     };
     req.stomp.timesteps = 12;
-    req.stomp.initial = InitialTrajectory::CartesianLine;
     req.cartesian.translation_tolerance = 0.02;
     req.cartesian.rotation_tolerance = 0.02;
+    (chain, w, req, goal)
+}
+
+#[test]
+fn ccstomp_from_the_cartesian_line_stays_on_it() {
+    let (chain, w, mut req, goal) = ur5_ccstomp_request();
+    req.stomp.initial = InitialTrajectory::CartesianLine;
     let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
     assert_eq!(r.status, PlanStatus::Succeeded);
     assert_ends(&r, &req.start, &goal);
@@ -515,23 +522,7 @@ fn ccstomp_starts_on_the_cartesian_line_unless_told_otherwise() {
     // The request of the test above without a chosen start: CCSTOMP takes the
     // Cartesian line and keeps 2 cm / 0.02 rad; from the joint line (free
     // here, so RRT_CONNECT_IF_BLOCKED keeps it) it does not get there.
-    let chain = builtin_chain("ur5").unwrap();
-    let w = JointBoxes {
-        dof: 6,
-        limit: 2.0 * std::f64::consts::PI,
-        boxes: vec![],
-    };
-    let goal = vec![0.6, -1.0, 1.2, -1.0, 1.3, 0.0];
-    let mut req = PlanRequest {
-        start: vec![0.0, -1.2, 1.4, -0.8, 1.1, 0.2],
-        goal: Goal::Joints(goal.clone()),
-        algorithm: Algorithm::Ccstomp,
-        seed: 2,
-        ..Default::default()
-    };
-    req.stomp.timesteps = 12;
-    req.cartesian.translation_tolerance = 0.02;
-    req.cartesian.rotation_tolerance = 0.02;
+    let (chain, w, mut req, goal) = ur5_ccstomp_request();
     assert_eq!(req.stomp.initial, InitialTrajectory::ForAlgorithm);
     let within = |r: &crate::plan::PlanResult| {
         // deviations recomputed from FK of the returned joints
