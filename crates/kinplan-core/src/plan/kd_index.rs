@@ -26,13 +26,9 @@ pub(crate) struct KdIndex {
 }
 
 impl KdIndex {
-    pub fn with_capacity(n: usize) -> Self {
-        Self {
-            left: Vec::with_capacity(n),
-            right: Vec::with_capacity(n),
-            axis: Vec::with_capacity(n),
-            stack: Vec::with_capacity(64 * 9),
-        }
+    /// Rows indexed.
+    pub fn len(&self) -> usize {
+        self.left.len()
     }
 
     /// Indexes row `len()` of `rows` (`dof` values per row); rows must be
@@ -160,7 +156,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         for dof in [1, 2, 3, 7] {
             let mut rows = Vec::new();
-            let mut kd = KdIndex::with_capacity(16);
+            let mut kd = KdIndex::default();
             for i in 0..2000 {
                 // coarse grid values: many repeated coordinates and exact ties
                 for _ in 0..dof {

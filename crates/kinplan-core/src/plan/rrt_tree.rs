@@ -18,6 +18,8 @@ use crate::collision::StateChecker;
 /// neighbours come from a [`ColumnScan`] of the rows while the tree is
 /// small, from a [`KdIndex`] over them beyond [`ColumnScan::LARGEST`] rows
 /// (both answer the first nearest row, so the switch changes no answer).
+/// Each index holds only the rows it may be asked about: the scan the first
+/// `LARGEST`, the k-d tree all of them once the tree outgrows the scan.
 struct Tree {
     q: Vec<f64>,
     parent: Vec<u32>,
@@ -36,8 +38,6 @@ impl Tree {
     fn new(root: &[f64], capacity: usize) -> Self {
         let mut q = Vec::with_capacity(capacity * root.len());
         q.extend_from_slice(root);
-        let mut index = KdIndex::with_capacity(capacity);
-        index.insert(&q, root.len());
         let mut scan = ColumnScan::new(root.len(), capacity.min(ColumnScan::LARGEST));
         scan.push(root);
         Self {
@@ -45,7 +45,7 @@ impl Tree {
             parent: vec![u32::MAX],
             dof: root.len(),
             scan,
-            index,
+            index: KdIndex::default(),
         }
     }
     fn len(&self) -> usize {
@@ -57,7 +57,6 @@ impl Tree {
     fn push(&mut self, q: &[f64], parent: usize) -> usize {
         self.q.extend_from_slice(q);
         self.parent.push(parent as u32);
-        self.index.insert(&self.q, self.dof);
         if self.scan.len() < ColumnScan::LARGEST {
             self.scan.push(q);
         }
@@ -69,6 +68,10 @@ impl Tree {
         let found = if self.len() <= ColumnScan::LARGEST {
             self.scan.nearest(target)
         } else {
+            // rows are indexed in order, the first time and as they come
+            while self.index.len() < self.len() {
+                self.index.insert(&self.q, self.dof);
+            }
             self.index.nearest(&self.q, self.dof, target)
         };
         found.unwrap_or(0)
