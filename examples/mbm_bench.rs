@@ -133,6 +133,8 @@ struct Row {
     nodes: usize,
     /// States checked by search and shortcutting together.
     states: usize,
+    /// Of those, the padded checks (pieces of conservative proofs).
+    padded_states: usize,
     waypoints: usize,
     length: f64,
     stop: String,
@@ -157,11 +159,15 @@ struct Args {
     resolution: f64,
     shortcut_resolution: Option<f64>,
     padded: bool,
+    /// `None`: the planner's default.
+    shortcut_attempts: Option<usize>,
+    /// Only this set (`None`: all).
+    only_set: Option<String>,
     out: PathBuf,
 }
 
 fn args() -> Result<Args, String> {
-    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--out PREFIX]";
+    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--out PREFIX]";
     let mut it = std::env::args().skip(1);
     let mut a = Args {
         root: PathBuf::new(),
@@ -171,6 +177,8 @@ fn args() -> Result<Args, String> {
         resolution: CheckerParams::default().motion_resolution,
         shortcut_resolution: None,
         padded: false,
+        shortcut_attempts: None,
+        only_set: None,
         out: PathBuf::from("target/mbm_bench"),
     };
     let mut root = None;
@@ -185,6 +193,7 @@ fn args() -> Result<Args, String> {
             "--stomp" => a.stomp = num("--stomp")?,
             "--clamp-fingers" => a.clamp = true,
             "--padded" => a.padded = true,
+            "--shortcut-attempts" => a.shortcut_attempts = Some(num("--shortcut-attempts")?),
             "--shortcut-resolution" => {
                 a.shortcut_resolution = Some(
                     it.next()
@@ -198,6 +207,7 @@ fn args() -> Result<Args, String> {
                     .and_then(|v| v.parse().ok())
                     .ok_or(format!("--resolution needs a number; {usage}"))?
             }
+            "--set" => a.only_set = Some(it.next().ok_or(usage)?),
             "--out" => a.out = PathBuf::from(it.next().ok_or(usage)?),
             _ if root.is_none() && !x.starts_with("--") => root = Some(PathBuf::from(x)),
             _ => return Err(usage.into()),
@@ -211,6 +221,7 @@ fn args() -> Result<Args, String> {
 struct Counting<'a> {
     inner: &'a SceneChecker,
     states: AtomicUsize,
+    padded: AtomicUsize,
 }
 
 impl StateChecker for Counting<'_> {
@@ -226,10 +237,12 @@ impl StateChecker for Counting<'_> {
     }
     fn padded_valid(&self, q: &[f64], half_step: &[f64]) -> Option<bool> {
         self.states.fetch_add(1, Ordering::Relaxed);
+        self.padded.fetch_add(1, Ordering::Relaxed);
         self.inner.padded_valid(q, half_step)
     }
     fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
         self.states.fetch_add(1, Ordering::Relaxed);
+        self.padded.fetch_add(1, Ordering::Relaxed);
         self.inner.padded_verdict(q, half_step)
     }
     fn motion_check(&self) -> MotionCheck {
@@ -243,17 +256,14 @@ fn run_rrt<C: StateChecker>(
     s: &[f64],
     g: &[f64],
     seed: u64,
-    shortcut_resolution: Option<f64>,
+    params: &RrtParams,
 ) -> RrtOutcome {
     rrt_connect(
         chain,
         checker,
         s,
         g,
-        &RrtParams {
-            shortcut_resolution,
-            ..RrtParams::default()
-        },
+        params,
         seed,
         Some(Instant::now() + DEADLINE),
     )
@@ -268,6 +278,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut rows_by_set: Vec<(&str, Vec<Row>)> = Vec::new();
     let mut stomp_rows: Vec<StompRow> = Vec::new();
     let wall = Instant::now();
+    let rrt = RrtParams {
+        shortcut_resolution: a.shortcut_resolution,
+        shortcut_attempts: a
+            .shortcut_attempts
+            .unwrap_or(RrtParams::default().shortcut_attempts),
+        ..RrtParams::default()
+    };
     // The self-collision pairs our checker tests, for the Python anchors
     // (they use the same pairs, so both sides answer the same question).
     {
@@ -281,6 +298,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )?;
     }
     for set in SETS {
+        if a.only_set.as_ref().is_some_and(|only| only != set) {
+            continue;
+        }
         let dir = a.root.join(format!("{set}_panda"));
         let mut rows = Vec::new();
         let mut stomp_done = 0;
@@ -332,17 +352,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let counting = Counting {
                     inner: &checker,
                     states: AtomicUsize::new(0),
+                    padded: AtomicUsize::new(0),
                 };
-                let counted = run_rrt(&chain, &counting, &start, &goal, seed, a.shortcut_resolution);
-                let first = run_rrt(&chain, &checker, &start, &goal, seed, a.shortcut_resolution);
+                let counted = run_rrt(&chain, &counting, &start, &goal, seed, &rrt);
+                let first = run_rrt(&chain, &checker, &start, &goal, seed, &rrt);
                 assert_eq!(
                     counted.path, first.path,
                     "{set} {k}: not deterministic for a seed"
                 );
                 row.states = counting.states.load(Ordering::Relaxed);
+                row.padded_states = counting.padded.load(Ordering::Relaxed);
                 let mut times = vec![first.search_ns as f64 / 1e3];
                 for _ in 1..a.passes {
-                    let again = run_rrt(&chain, &checker, &start, &goal, seed, a.shortcut_resolution);
+                    let again = run_rrt(&chain, &checker, &start, &goal, seed, &rrt);
                     assert_eq!(again.path, first.path, "{set} {k}: not deterministic for a seed");
                     times.push(again.search_ns as f64 / 1e3);
                 }
@@ -405,8 +427,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Per-set summary.
     println!(
-        "RRT-Connect (RrtParams::default(): range 1.0, 100 shortcut attempts; seed = problem number), \
+        "RRT-Connect (range {}, {} shortcut attempts; seed = problem number), \
          motion resolution {} rad{}, shortcut resolution {:?}, passes = {}, fingers {}",
+        rrt.range,
+        rrt.shortcut_attempts,
         a.resolution,
         if a.padded { " padded (conservative)" } else { "" },
         a.shortcut_resolution,
@@ -427,13 +451,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut csv = std::fs::File::create(a.out.with_extension("csv"))?;
     writeln!(
         csv,
-        "set,problem,build_us,start_valid,goal_valid,stop,solved,fine_valid,fine_depth_mm,search_us,search_robust_us,shortcut_us,samples,nodes,states_checked,waypoints,length_rad"
+        "set,problem,build_us,start_valid,goal_valid,stop,solved,fine_valid,fine_depth_mm,search_us,search_robust_us,shortcut_us,samples,nodes,states_checked,waypoints,length_rad,padded_states"
     )?;
     for (set, rows) in &rows_by_set {
         for r in rows {
             writeln!(
                 csv,
-                "{set},{},{:.2},{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{},{},{},{},{:.6}",
+                "{set},{},{:.2},{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{},{},{},{},{:.6},{}",
                 r.problem,
                 r.build_us,
                 r.start_ok,
@@ -449,7 +473,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 r.nodes,
                 r.states,
                 r.waypoints,
-                r.length
+                r.length,
+                r.padded_states
             )?;
         }
         let valid: Vec<&Row> = rows.iter().filter(|r| r.start_ok && r.goal_ok).collect();
@@ -558,7 +583,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let out = json!({
         "planner": "kinplan RRT-Connect",
-        "params": {"range": RrtParams::default().range, "shortcut_attempts": RrtParams::default().shortcut_attempts,
+        "params": {"range": rrt.range, "shortcut_attempts": rrt.shortcut_attempts,
                    "motion_resolution": a.resolution, "shortcut_resolution": a.shortcut_resolution, "fine_check_step": FINE},
         "passes": a.passes,
         "fingers_clamped": a.clamp,
