@@ -37,10 +37,11 @@ pub trait StateChecker: Sync {
         interpolate_motion_valid(self, a, b, self.motion_check())
     }
 
-    /// True when `q` is within the limits and every state `q + d` with
-    /// `|d_j| ≤ half_step[j]` for each joint is free of collisions (the
-    /// robot's bodies padded by how far they can move); `None` when this
-    /// checker cannot bound its bodies' motion (the default).
+    /// True when `q` is within the limits and every state `q + s·half_step`,
+    /// `s ∈ [−1, 1]`, is free of collisions (the piece of a straight motion
+    /// around `q`, `half_step` its signed half vector; the robot's bodies
+    /// padded by how far they can move along it); `None` when this checker
+    /// cannot bound its bodies' motion (the default).
     fn padded_valid(&self, q: &[f64], half_step: &[f64]) -> Option<bool> {
         let _ = (q, half_step);
         None

@@ -23,11 +23,12 @@ const WINDOW: usize = 64;
 /// Latombe's idea with the distance test replaced by a padded overlap test):
 ///
 /// the motion is cut into `2^k ≥ span/resolution` equal pieces; a piece
-/// `[s, t]` with midpoint `m` and joint half-extent `h = |b − a|·(t − s)/2`
+/// `[s, t]` with midpoint `m` and signed half vector `h = (b − a)·(t − s)/2`
 /// is accepted when the robot at `q(m)` is within its limits and free with
-/// every body padded by its sweep bound `δ_b(h)` — every state of the piece
-/// is within `h` of `q(m)`, so no point of body `b` is farther than `δ_b(h)`
-/// from where it is at `q(m)`. A piece that fails is refused if `q(m)`
+/// every body padded by its sweep bound `δ_b(h)` along the piece
+/// (`SweepBound::pad_along`) — every state of the piece is
+/// `q(m) + σh` with `|σ| ≤ 1`, so no point of body `b` is farther than
+/// `δ_b(h)` from where it is at `q(m)`. A piece that fails is refused if `q(m)`
 /// itself collides, else halved. Pieces below [`MIN_PIECE`] or more than
 /// [`MAX_CHECKS_PER_PIECE`] checks per initial piece refuse the motion.
 /// Pieces are visited breadth first (all midpoints before any half), in
@@ -93,7 +94,7 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
             let m = 0.5 * (s + t);
             for j in 0..n {
                 q[j] = a[j] + m * delta[j];
-                half[j] = 0.5 * (t - s) * delta[j].abs();
+                half[j] = 0.5 * (t - s) * delta[j];
             }
             match checker.padded_verdict(&q[..n], &half[..n]) {
                 None | Some(PadVerdict::Collides) => return Some(false),

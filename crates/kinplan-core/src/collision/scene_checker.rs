@@ -490,7 +490,7 @@ impl StateChecker for SceneChecker {
     }
 
     /// One pose of the robot answers both questions: the padded check with
-    /// the tight pads ([`SweepBound::pad_at`]) asked only for bodies that
+    /// the tight pads along the piece (`SweepBound::pad_along`) asked only for bodies that
     /// have something within their global pads ([`SweepBound::pads`]), then,
     /// when it fails, the plain check.
     fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
@@ -512,7 +512,7 @@ impl StateChecker for SceneChecker {
         self.model.body_poses_and_axes(q, &mut poses, axes);
         let mut coarse = [0.0; MAX_BODIES];
         sweep.pads(half_step, &mut coarse);
-        let tight = |b: usize| sweep.pad_at(&self.model, b, &poses[b], axes, half_step);
+        let tight = |b: usize| sweep.pad_along(&self.model, b, &poses[b], axes, half_step);
         Some(if !self.hits_padded(&poses, &coarse, tight) {
             PadVerdict::Free
         } else if self.hits(&poses) {

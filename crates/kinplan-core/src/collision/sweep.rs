@@ -31,8 +31,28 @@
 //! ```
 //!
 //! (a prismatic `j` contributes `h_j`).
+//!
+//! Along a straight motion `q(s) = m + s·d`, `s ∈ [−1, 1]` (a piece of a
+//! motion, `d` its signed half vector), the joints' contributions to a
+//! point's velocity add as vectors, not as lengths
+//! ([`SweepBound::pad_along`]). For a chain whose joints moving `b` all turn,
+//! with `ω_j`, `o_j` joint `j`'s unit axis and a point on it at `m`,
+//! `c`, `r` the bounding sphere's centre and radius there, a point `x` of
+//! the body moves by
+//!
+//! ```text
+//! |x(s) − x(0)| ≤ |s|·|x'(0)| + s²/2 · max|x''| ≤ |v| + |Ω|·r + A/2,
+//! v = Σ_j d_j ω_j × (c − o_j),   Ω = Σ_j d_j ω_j,
+//! A = Σ_j |d_j| (2 P_j L_{j,b} + S_j),   P_j = Σ_{i<j} |d_i|,   S_j = Σ_{i≥j} |d_i| L_{i,b}
+//! ```
+//!
+//! (Taylor's theorem with the acceleration bounded everywhere: axis `j`
+//! turns at most `P_j` per unit of `s`, and `x − o_j` changes at most
+//! `P_j L_{j,b} + S_j`, so `|d/ds (ω_j × (x − o_j))| ≤ 2 P_j L_{j,b} + S_j`).
+//! The vector sum is what tightens it: the joints of an arm push a point
+//! in different directions, so `|v|` is often well below `Σ_j |d_j| ρ_{j,b}`.
 
-use nalgebra::{Isometry3, Point3};
+use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::model::{JointAxis, MAX_BODIES, RobotModel};
 use crate::robot::JointKind;
@@ -150,6 +170,48 @@ impl SweepBound {
             tail += h * lever;
         }
         sum
+    }
+
+    /// How far any point of body `b` (posed at `pose`, the joints' axes at
+    /// `axes`) moves along the straight motion `m + s·d`, `s ∈ [−1, 1]`:
+    /// the smaller of [`SweepBound::pad_at`] (which holds for the whole box
+    /// `|q_j − m_j| ≤ |d_j|`) and the segment's second-order bound of the
+    /// module doc, which needs every joint moving `b` to turn.
+    pub(crate) fn pad_along(
+        &self,
+        model: &RobotModel,
+        b: usize,
+        pose: &Isometry3<f64>,
+        axes: &[JointAxis],
+        d: &[f64],
+    ) -> f64 {
+        let boxed = self.pad_at(model, b, pose, axes, d);
+        if self.dof == 0 {
+            return boxed;
+        }
+        let levers = &self.levers[b * self.dof..(b + 1) * self.dof];
+        let body = &model.bodies[b];
+        let centre = (pose * Point3::from(body.center)).coords;
+        let (mut v, mut omega) = (Vector3::zeros(), Vector3::zeros());
+        // A = Σ_j |d_j| (2 P_j L_j + S_j) = Σ_j |d_j| 2 P_j L_j + Σ_i |d_i| L_i Σ_{j≤i} |d_j|
+        let (mut prefix, mut accel) = (0.0, 0.0);
+        for j in 0..self.dof {
+            let lever = levers[j];
+            if lever == 0.0 {
+                continue;
+            }
+            if self.prismatic[j] {
+                return boxed;
+            }
+            let (dj, axis) = (d[j], &axes[j]);
+            v += axis.direction.cross(&(centre - axis.point)) * dj;
+            omega += axis.direction * dj;
+            let h = dj.abs();
+            // joint j's own term of S_i for every i ≤ j, and 2 P_j L_j
+            accel += h * (2.0 * prefix * lever) + h * lever * (prefix + h);
+            prefix += h;
+        }
+        boxed.min(v.norm() + omega.norm() * body.radius + 0.5 * accel)
     }
 
     /// `L_{j,b}` (m per rad, or 1 for a prismatic joint).
