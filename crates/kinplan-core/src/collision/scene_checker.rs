@@ -512,7 +512,11 @@ impl StateChecker for SceneChecker {
         self.model.body_poses_and_axes(q, &mut poses, axes);
         let mut coarse = [0.0; MAX_BODIES];
         sweep.pads(half_step, &mut coarse);
-        let tight = |b: usize| sweep.pad_along(&self.model, b, &poses[b], axes, half_step);
+        let tight = |b: usize| {
+            sweep
+                .pad_along(&self.model, b, &poses[b], axes, half_step)
+                .min(coarse[b])
+        };
         Some(if !self.hits_padded(&poses, &coarse, tight) {
             PadVerdict::Free
         } else if self.hits(&poses) {
