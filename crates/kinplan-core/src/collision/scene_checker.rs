@@ -6,7 +6,8 @@
 //! for each body, the scene BVH is queried with the box around the body's
 //! bounding sphere, leaves are culled by sphere–box distance, and parry's
 //! exact test runs on the survivors; then the checked self pairs, culled by
-//! sphere–sphere distance. Nothing is allocated, so checkers are shared
+//! sphere–sphere distance. Bodies fixed to the base are tested against the
+//! scene once, when the checker is built. Nothing is allocated, so checkers are shared
 //! freely between rayon threads.
 
 use std::sync::Arc;
@@ -163,6 +164,10 @@ pub struct SceneChecker {
     world: Arc<SceneGeometry>,
     /// Body pairs tested for self-collision, `a < b`.
     self_pairs: Vec<(u16, u16)>,
+    /// Bodies tested against the scene, distal first (the likeliest to hit
+    /// something): every body but those fixed to the base and clear of the
+    /// scene, which no state can change.
+    scene_bodies: Vec<u16>,
     params: CheckerParams,
     /// How far bodies move per joint step (`None`: unbounded, cannot pad).
     sweep: Option<SweepBound>,
@@ -190,10 +195,12 @@ impl SceneChecker {
         if params.padded_motion && sweep.is_none() {
             return Err(CollisionError::CannotPad);
         }
+        let scene_bodies = scene_bodies(&model, &world);
         Ok(SceneChecker {
             model,
             world,
             self_pairs,
+            scene_bodies,
             params,
             sweep,
         })
@@ -224,16 +231,23 @@ impl SceneChecker {
         self.hits(&poses)
     }
 
+    /// The bodies' bounding-sphere centres at `poses`.
+    fn centers(&self, poses: &[Isometry3<f64>; MAX_BODIES]) -> [Vector3<f64>; MAX_BODIES] {
+        let mut centers = [Vector3::zeros(); MAX_BODIES];
+        for (b, body) in self.model.bodies.iter().enumerate() {
+            centers[b] = sphere_center(body, &poses[b]);
+        }
+        centers
+    }
+
     /// [`SceneChecker::in_collision`] on bodies already posed.
     fn hits(&self, poses: &[Isometry3<f64>; MAX_BODIES]) -> bool {
         let bodies = &self.model.bodies;
-        let mut centers = [Vector3::zeros(); MAX_BODIES];
-        // Distal bodies first: they are the likeliest to hit something.
-        for (b, body) in bodies.iter().enumerate().rev() {
-            let c = sphere_center(body, &poses[b]);
-            centers[b] = c;
-            let free = self.world.bvh.for_each_near(&c, body.radius, |leaf| {
-                !body_leaf_intersect(body, &poses[b], &c, &self.world.leaves[leaf as usize])
+        let centers = self.centers(poses);
+        for &b in &self.scene_bodies {
+            let (b, c) = (b as usize, &centers[b as usize]);
+            let free = self.world.bvh.for_each_near(c, bodies[b].radius, |leaf| {
+                !body_leaf_intersect(&bodies[b], &poses[b], c, &self.world.leaves[leaf as usize])
             });
             if !free {
                 return true;
@@ -279,16 +293,16 @@ impl SceneChecker {
             }
             fine_pads[b]
         };
-        let mut centers = [Vector3::zeros(); MAX_BODIES];
-        for (b, body) in bodies.iter().enumerate().rev() {
-            let c = sphere_center(body, &poses[b]);
-            centers[b] = c;
+        let centers = self.centers(poses);
+        for &b in &self.scene_bodies {
+            let (b, c) = (b as usize, &centers[b as usize]);
+            let body = &bodies[b];
             let free = self
                 .world
                 .bvh
-                .for_each_near(&c, body.radius + margin(coarse[b]), |leaf| {
+                .for_each_near(c, body.radius + margin(coarse[b]), |leaf| {
                     let m = fine_pad(b);
-                    !body_leaf_within(body, &poses[b], &c, &self.world.leaves[leaf as usize], m)
+                    !body_leaf_within(body, &poses[b], c, &self.world.leaves[leaf as usize], m)
                 });
             if !free {
                 return true;
@@ -442,6 +456,35 @@ impl SceneChecker {
         }
         best
     }
+}
+
+/// The bodies a [`SceneChecker`] tests against the scene, distal first:
+/// a body fixed to the base is left out when it is clear of every
+/// obstacle (touching counts, as in the checks), as it is then in every
+/// state; one that touches stays, so every state is found in collision.
+fn scene_bodies(model: &RobotModel, world: &SceneGeometry) -> Vec<u16> {
+    let links = model.chain().links();
+    let mut poses = [Isometry3::identity(); MAX_BODIES];
+    model.body_poses(&vec![0.0; model.chain().dof()], &mut poses);
+    (0..model.bodies.len())
+        .rev()
+        .filter(|&b| {
+            let body = &model.bodies[b];
+            if links[body.link].after_joint.is_some() {
+                return true;
+            }
+            let c = sphere_center(body, &poses[b]);
+            let clear = world
+                .bvh
+                .for_each_near(&c, body.radius + f64::MIN_POSITIVE, |leaf| {
+                    let leaf = &world.leaves[leaf as usize];
+                    !body_leaf_intersect(body, &poses[b], &c, leaf)
+                        && !body_leaf_within(body, &poses[b], &c, leaf, f64::MIN_POSITIVE)
+                });
+            !clear
+        })
+        .map(|b| b as u16)
+        .collect()
 }
 
 #[derive(Debug, Clone, Copy)]

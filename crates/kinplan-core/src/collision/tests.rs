@@ -323,3 +323,63 @@ fn validity_and_clearance_together_equal_the_two_queries() {
         }
     }
 }
+
+#[test]
+fn a_body_fixed_to_the_base_collides_in_every_state_or_in_none() {
+    // A 0.2 m base plate (fixed) and a 5 cm sphere on a 1 m arm turning
+    // about z: an obstacle touching the plate makes every state invalid,
+    // however the arm turns; one beside the plate's edge leaves them valid
+    // (the arm passes above it).
+    let urdf = r#"<robot name="plate">
+      <link name="base"><collision><geometry><box size="0.2 0.2 0.02"/></geometry></collision></link>
+      <link name="arm"><collision><origin xyz="1 0 0.5"/><geometry><sphere radius="0.05"/></geometry></collision></link>
+      <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+        <limit lower="-3" upper="3" effort="0" velocity="1"/></joint></robot>"#;
+    let block = |x: f64| {
+        Obstacle::new(
+            "block",
+            Isometry3::translation(x, 0.0, 0.0),
+            Geometry::Box {
+                half_extents: Vector3::repeat(0.05),
+            },
+        )
+    };
+    // faces touch at x = 0.1 (the plate's edge) when the block is at 0.15
+    let touching = checker(urdf, &[], vec![block(0.15)]);
+    let clear = checker(urdf, &[], vec![block(0.1501)]);
+    for q in [-2.5, -1.0, 0.0, 0.7, 2.9] {
+        assert!(!touching.is_valid(&[q]), "q = {q}");
+        let report = touching.report(&[q]).unwrap();
+        assert_eq!(
+            report.collisions,
+            vec![(
+                "base".to_string(),
+                Part::Obstacle {
+                    index: 0,
+                    name: "block".into()
+                }
+            )]
+        );
+        assert!(clear.is_valid(&[q]), "q = {q}");
+    }
+    let padded = |obstacles| {
+        let chain = Arc::new(parse_chain(urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
+        let model = Arc::new(RobotModel::new(chain).unwrap());
+        let acm = AllowedCollisions::adjacent(&model);
+        let world =
+            Arc::new(SceneGeometry::build(&Scene::new(obstacles, &SceneLimits::default()).unwrap()).unwrap());
+        let params = CheckerParams {
+            padded_motion: true,
+            ..CheckerParams::default()
+        };
+        SceneChecker::new(model, &acm, world, params).unwrap()
+    };
+    assert_eq!(
+        padded(vec![block(0.15)]).padded_verdict(&[0.3], &[0.01]),
+        Some(PadVerdict::Collides)
+    );
+    assert_eq!(
+        padded(vec![block(0.1501)]).padded_verdict(&[0.3], &[0.01]),
+        Some(PadVerdict::Free)
+    );
+}
