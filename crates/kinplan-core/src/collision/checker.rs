@@ -48,10 +48,12 @@ pub trait StateChecker: Sync {
     }
 
     /// [`StateChecker::padded_valid`], and when the padded check fails,
-    /// whether `q` itself is invalid ([`PadVerdict::Collides`]) or only not
-    /// proved free with the pads ([`PadVerdict::Unproved`]); `None` as
-    /// `padded_valid`. Implementations may answer both from one pose of the
-    /// robot; the default asks [`StateChecker::is_valid`] after a failure.
+    /// whether `q` itself is found invalid ([`PadVerdict::Collides`]) or
+    /// only not proved free with the pads ([`PadVerdict::Unproved`]);
+    /// `None` as `padded_valid`. Implementations may answer both from one
+    /// pose of the robot, and may test only the pair that failed with pads
+    /// (so `Unproved` does not promise a valid `q`); the default asks
+    /// [`StateChecker::is_valid`] after a failure.
     fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
         Some(match self.padded_valid(q, half_step)? {
             true => PadVerdict::Free,
@@ -74,7 +76,8 @@ pub enum PadVerdict {
     Free,
     /// The state itself collides or lies outside the limits.
     Collides,
-    /// The state is valid, but a padded body touches something.
+    /// A padded body touches something; the state itself was not found to
+    /// collide (the checker may have tested only the pair that failed).
     Unproved,
 }
 

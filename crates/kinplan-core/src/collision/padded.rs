@@ -35,7 +35,7 @@ const WINDOW: usize = 64;
 /// (`SweepBound::pad_along`) — every state of the piece is
 /// `q(m) + σh` with `|σ| ≤ 1`, so no point of body `b` is farther than
 /// `δ_b(h)` from where it is at `q(m)`. A piece that fails is refused if `q(m)`
-/// itself collides, else halved. Pieces below [`MIN_PIECE`] or more than
+/// is found to collide ([`PadVerdict::Collides`]), else halved. Pieces below [`MIN_PIECE`] or more than
 /// [`MAX_CHECKS_PER_PIECE`] checks per initial piece refuse the motion.
 /// Pieces are visited breadth first (all midpoints before any half), in
 /// windows of 64 pieces in bisection order.
