@@ -62,6 +62,17 @@ pub trait StateChecker: Sync {
         })
     }
 
+    /// [`StateChecker::padded_verdict`] for a piece some of whose robot
+    /// parts are already proved free over it: bit `i` of `proved` set means
+    /// part `i` (numbered by the checker, at most 64) need not be checked.
+    /// Parts the check proves free over this piece are added to `proved`,
+    /// so the halves of a piece that fails check only what is left. The
+    /// default ignores `proved` and proves nothing part by part.
+    fn padded_verdict_sparing(&self, q: &[f64], half_step: &[f64], proved: &mut u64) -> Option<PadVerdict> {
+        let _ = proved;
+        self.padded_verdict(q, half_step)
+    }
+
     /// How [`StateChecker::motion_valid`] checks a motion. Default: states
     /// interpolated at most 0.05 rad (or m) apart on every joint.
     fn motion_check(&self) -> MotionCheck {

@@ -35,7 +35,10 @@ const WINDOW: usize = 64;
 /// (`SweepBound::pad_along`) — every state of the piece is
 /// `q(m) + σh` with `|σ| ≤ 1`, so no point of body `b` is farther than
 /// `δ_b(h)` from where it is at `q(m)`. A piece that fails is refused if `q(m)`
-/// is found to collide ([`PadVerdict::Collides`]), else halved. Pieces below [`MIN_PIECE`] or more than
+/// is found to collide ([`PadVerdict::Collides`]), else halved; the halves
+/// skip the robot parts the check proved free over the whole piece
+/// ([`StateChecker::padded_verdict_sparing`]: a body clear of the scene
+/// over a piece is clear over its halves). Pieces below [`MIN_PIECE`] or more than
 /// [`MAX_CHECKS_PER_PIECE`] checks per initial piece refuse the motion.
 /// Pieces are visited breadth first (all midpoints before any half), in
 /// windows of 64 pieces in bisection order.
@@ -86,9 +89,9 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
                 .by_ref()
                 .take(WINDOW)
                 .enumerate()
-                .map(|(slot, i)| (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64, slot)),
+                .map(|(slot, i)| (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64, slot, 0)),
         );
-        while let Some((s, t, slot)) = queue.pop_front() {
+        while let Some((s, t, slot, mut proved)) = queue.pop_front() {
             checks += 1;
             if checks.is_multiple_of(32) && interrupted() {
                 return None;
@@ -102,11 +105,11 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
                 q[j] = a[j] + m * delta[j];
                 half[j] = 0.5 * (t - s) * delta[j];
             }
-            match checker.padded_verdict(&q[..n], &half[..n]) {
+            match checker.padded_verdict_sparing(&q[..n], &half[..n], &mut proved) {
                 None | Some(PadVerdict::Collides) => return Some(false),
                 Some(PadVerdict::Free) => {}
                 Some(PadVerdict::Unproved) if (t - s) * span < MIN_PIECE => return Some(false),
-                Some(PadVerdict::Unproved) => queue.extend([(s, m, slot), (m, t, slot)]),
+                Some(PadVerdict::Unproved) => queue.extend([(s, m, slot, proved), (m, t, slot, proved)]),
             }
         }
     }

@@ -269,21 +269,28 @@ impl SceneChecker {
     pub fn in_collision_padded(&self, q: &[f64], pads: &[f64; MAX_BODIES]) -> bool {
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
-        self.hits_padded(&poses, pads, |b| pads[b]) != PadHit::Clear
+        self.hits_padded(&poses, pads, |b| pads[b], &mut 0) != PadHit::Clear
     }
 
     /// [`SceneChecker::in_collision_padded`] on bodies already posed, with
     /// the pads in two grades: `coarse[b]`, cheap and never below the pad,
     /// finds what a body might touch; `fine(b)`, the pad itself, is asked
     /// (at most once per body) only for bodies that have something within
-    /// their coarse pad — in a cell most bodies have nothing near. The
-    /// first pair found within its pads is also tested without them
-    /// ([`PadHit::Touches`]).
+    /// their coarse pad — in a cell most bodies have nothing near. A pair
+    /// found within its pads is also tested without them
+    /// ([`PadHit::Touches`], which ends the check).
+    ///
+    /// `proved` lists what is already proved free over the piece the pads
+    /// cover and need not be checked: bit `b` the scene around body `b`,
+    /// [`SELF_PAIRS`] every self pair. What this check proves is added:
+    /// after a body is found near something the other bodies are still
+    /// checked, so that the halves of the piece check only what is left.
     fn hits_padded(
         &self,
         poses: &[Isometry3<f64>; MAX_BODIES],
         coarse: &[f64; MAX_BODIES],
         mut fine: impl FnMut(usize) -> f64,
+        proved: &mut u64,
     ) -> PadHit {
         let bodies = &self.model.bodies;
         // A zero pad still counts touching: growing by a hair keeps `≤ 0` a hit.
@@ -296,8 +303,12 @@ impl SceneChecker {
             fine_pads[b]
         };
         let centers = self.centers(poses);
+        let mut found = PadHit::Clear;
         for &b in &self.scene_bodies {
             let (b, c) = (b as usize, &centers[b as usize]);
+            if *proved & (1 << b) != 0 {
+                continue;
+            }
             let (body, pose) = (&bodies[b], &poses[b]);
             let mut near = None;
             self.world
@@ -309,9 +320,14 @@ impl SceneChecker {
                     }
                     near.is_none()
                 });
-            if let Some(touches) = near {
-                return PadHit::found(touches);
+            match near {
+                None => *proved |= 1 << b,
+                Some(true) => return PadHit::Touches,
+                Some(false) => found = PadHit::Near,
             }
+        }
+        if *proved & SELF_PAIRS != 0 {
+            return found;
         }
         for &(a, b) in &self.self_pairs {
             let (a, b) = (a as usize, b as usize);
@@ -328,7 +344,8 @@ impl SceneChecker {
                 return PadHit::found(body_body_intersect(&bodies[a], &poses[a], &bodies[b], &poses[b]));
             }
         }
-        PadHit::Clear
+        *proved |= SELF_PAIRS;
+        found
     }
 
     /// The nearest pair within `max_distance` (m), with witness points, or
@@ -496,12 +513,16 @@ fn scene_bodies(model: &RobotModel, world: &SceneGeometry) -> Vec<u16> {
         .collect()
 }
 
+/// The bit of a padded check's `proved` parts that stands for every self
+/// pair (bits 0–31 are the bodies, [`MAX_BODIES`] = 32).
+const SELF_PAIRS: u64 = 1 << 63;
+
 /// What [`SceneChecker::hits_padded`] found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum PadHit {
     /// Nothing within the pads.
     Clear,
-    /// A pair within its pads, apart without them.
+    /// A pair within its pads, and none found touching without them.
     Near,
     /// A pair within its pads that also touches without them.
     Touches,
@@ -565,6 +586,13 @@ impl StateChecker for SceneChecker {
     /// check here made the padded search and shortcutting 5–10 % slower on
     /// MotionBenchMaker: the proofs' states are rarely in collision).
     fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
+        self.padded_verdict_sparing(q, half_step, &mut 0)
+    }
+
+    /// [`StateChecker::padded_verdict`] with the parts of
+    /// [`SceneChecker::hits_padded`]: bit `b` the scene around body `b`,
+    /// [`SELF_PAIRS`] all self pairs.
+    fn padded_verdict_sparing(&self, q: &[f64], half_step: &[f64], proved: &mut u64) -> Option<PadVerdict> {
         let sweep = self.sweep.as_ref()?;
         if !self.within_limits(q) || half_step.len() != q.len() {
             return Some(PadVerdict::Collides);
@@ -588,7 +616,7 @@ impl StateChecker for SceneChecker {
                 .pad_along(&self.model, b, &poses[b], axes, half_step)
                 .min(coarse[b])
         };
-        Some(match self.hits_padded(&poses, &coarse, tight) {
+        Some(match self.hits_padded(&poses, &coarse, tight, proved) {
             PadHit::Clear => PadVerdict::Free,
             PadHit::Touches => PadVerdict::Collides,
             PadHit::Near => PadVerdict::Unproved,
