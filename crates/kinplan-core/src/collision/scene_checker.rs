@@ -590,8 +590,8 @@ impl StateChecker for SceneChecker {
     }
 
     /// [`StateChecker::padded_verdict`] with the parts of
-    /// [`SceneChecker::hits_padded`]: bit `b` the scene around body `b`,
-    /// [`SELF_PAIRS`] all self pairs.
+    /// `SceneChecker::hits_padded`: bit `b` the scene around body `b`,
+    /// `SELF_PAIRS` (bit 63) all self pairs.
     fn padded_verdict_sparing(&self, q: &[f64], half_step: &[f64], proved: &mut u64) -> Option<PadVerdict> {
         let sweep = self.sweep.as_ref()?;
         if !self.within_limits(q) || half_step.len() != q.len() {

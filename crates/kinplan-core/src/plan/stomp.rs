@@ -42,7 +42,7 @@ pub struct IterationReport<'a> {
     pub trajectory: &'a [f64],
 }
 
-/// What [`stomp_optimize`] returns.
+/// What `stomp_optimize` returns.
 #[derive(Debug, Clone)]
 pub struct StompOutcome {
     /// The best trajectory found, `timesteps × dof`, row-major.

@@ -15,7 +15,7 @@ use crate::mobile::world::World;
 /// lookahead point, where a node-to-node controller (Lyapunov) would turn at every cell.
 pub const GRID_PATH_CONTROLLER: ControllerKind = ControllerKind::PurePursuit;
 
-/// Global navigation: plans with [`plan_grid_astar`] on the known world, then follows the
+/// Global navigation: plans with [`plan_grid_astar`](crate::mobile::plan_grid_astar) on the known world, then follows the
 /// path with [`follow_path`] (the controller in `follow`, typically [`GRID_PATH_CONTROLLER`]). No
 /// grid path gives a run with outcome NO_PATH, reason [`NoPathReason::NoGridPath`], and only
 /// the start state.

@@ -11,7 +11,7 @@ use crate::mobile::path_follow::{
 use crate::mobile::pose::Pose;
 use crate::mobile::world::World;
 
-/// Simulates [`path_follow_step`](super::path_follow_step) on `chassis` from `start` along
+/// Simulates [`path_follow_step`](crate::mobile::path_follow_step) on `chassis` from `start` along
 /// `path` (optionally among obstacles, with collision detection) until the last node is
 /// reached, the time runs out, a collision happens or `should_stop()` returns true (checked
 /// every step).

@@ -26,7 +26,7 @@ pub struct NavigateParams {
     pub seed: u64,
 }
 
-/// Simulates the vector-distance navigator ([`vdf_step`](super::vdf_step)) with the range
+/// Simulates the vector-distance navigator ([`vdf_step`](crate::mobile::vdf_step)) with the range
 /// sensors of `params.sensors` (noise seeded by `params.seed`, so a run is deterministic)
 /// from `start` to `goal` among `world`'s obstacles.
 ///
