@@ -128,7 +128,7 @@ pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
     } else {
         let (budget, resolution) = (params.max_samples, resolution_of(checker));
         grow(
-            checker, &bounds, start, goal, params, false, resolution, budget, &mut rng, clock,
+            checker, &bounds, start, goal, params, false, true, resolution, budget, &mut rng, clock,
         )
     };
     let search_ns = t0.elapsed().as_nanos() as u64;
@@ -191,6 +191,7 @@ fn prove_lazily<C: StateChecker + ?Sized>(
         goal,
         params,
         false,
+        true,
         coarse,
         params.max_samples,
         rng,
@@ -214,8 +215,9 @@ fn prove_lazily<C: StateChecker + ?Sized>(
             Some(false) => {}
         }
         let budget = params.max_samples.saturating_sub(grown.samples);
+        // x → y itself was just refused
         let detour = grow(
-            checker, bounds, x, y, params, true, resolution, budget, rng, clock,
+            checker, bounds, x, y, params, true, false, resolution, budget, rng, clock,
         );
         grown.samples += detour.samples;
         grown.nodes += detour.nodes;
@@ -223,8 +225,10 @@ fn prove_lazily<C: StateChecker + ?Sized>(
             Ok(piece) => proved.extend_from_slice(&piece[dof..]),
             Err(RrtStop::SampleBudget) => {
                 let budget = params.max_samples.saturating_sub(grown.samples);
+                // the straight start → goal either failed the interpolated
+                // check, so cannot be proved, or was the edge refused
                 let whole = grow(
-                    checker, bounds, start, goal, params, true, resolution, budget, rng, clock,
+                    checker, bounds, start, goal, params, true, false, resolution, budget, rng, clock,
                 );
                 grown.samples += whole.samples;
                 grown.nodes += whole.nodes;

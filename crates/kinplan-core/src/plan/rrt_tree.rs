@@ -160,7 +160,8 @@ pub(super) struct Grown {
 /// other tree connects greedily towards the new node; the trees swap roles
 /// each sample. Tree edges are checked `padded` or as interpolated states,
 /// with pieces or steps of at most `resolution`. The straight motion is
-/// tried first. The clock is asked every sample and every connect step.
+/// tried first when `try_straight` (callers that know it blocked say
+/// `false`). The clock is asked every sample and every connect step.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn grow<C: StateChecker + ?Sized>(
     checker: &C,
@@ -169,6 +170,7 @@ pub(super) fn grow<C: StateChecker + ?Sized>(
     goal: &[f64],
     params: &RrtParams,
     padded: bool,
+    try_straight: bool,
     resolution: f64,
     budget: usize,
     rng: &mut ChaCha8Rng,
@@ -183,16 +185,17 @@ pub(super) fn grow<C: StateChecker + ?Sized>(
         q_new: vec![0.0; dof],
         buf: vec![0.0; dof],
     };
-    let straight = interior_valid_as(
-        checker,
-        start,
-        goal,
-        search.resolution,
-        padded,
-        &mut search.buf,
-        clock,
-    );
-    if straight == Some(true) {
+    let straight = try_straight
+        && interior_valid_as(
+            checker,
+            start,
+            goal,
+            search.resolution,
+            padded,
+            &mut search.buf,
+            clock,
+        ) == Some(true);
+    if straight {
         let mut path = start.to_vec();
         path.extend_from_slice(goal);
         return Grown {
