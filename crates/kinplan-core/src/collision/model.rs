@@ -78,8 +78,54 @@ pub struct RobotModel {
     /// Body indices ordered by carrying link (stable).
     by_link: Vec<usize>,
     /// Each body's frame in the frame of the joint moving its link (the
-    /// link's offset then the body's), composed once.
-    in_joint: Vec<Isometry3<f64>>,
+    /// link's offset then the body's), composed once; `None` when it is the
+    /// identity (the usual case: the body is the link's own geometry).
+    in_joint: Vec<Option<Isometry3<f64>>>,
+    /// Each joint's fixed origin and motion, shaped for [`RobotModel::pose_bodies`].
+    steps: Vec<JointStep>,
+}
+
+/// One joint of the chain as forward kinematics applies it: `frame =
+/// t · origin`, then the joint's motion. Most URDF origins turn by nothing
+/// and most revolute joints turn about their frame's z axis; both are
+/// applied without the general quaternion products.
+#[derive(Debug, Clone, Copy)]
+struct JointStep {
+    /// The origin's rotation, `None` when it is the identity.
+    rotation: Option<UnitQuaternion<f64>>,
+    translation: Vector3<f64>,
+    axis: nalgebra::Unit<Vector3<f64>>,
+    kind: JointKind,
+    /// A revolute joint about `+z` of its frame.
+    about_z: bool,
+}
+
+impl JointStep {
+    fn of(joint: &crate::robot::Joint) -> Self {
+        let rotation = joint.origin.rotation;
+        JointStep {
+            rotation: (rotation != UnitQuaternion::identity()).then_some(rotation),
+            translation: joint.origin.translation.vector,
+            axis: joint.axis,
+            kind: joint.kind,
+            about_z: joint.kind != JointKind::Prismatic && joint.axis.into_inner() == Vector3::z(),
+        }
+    }
+}
+
+/// `r · Rz(v)` for a unit quaternion `r` (w, i, j, k): the product with
+/// `(cos v/2, 0, 0, sin v/2)` written out.
+#[inline]
+fn turned_about_z(r: &UnitQuaternion<f64>, v: f64) -> UnitQuaternion<f64> {
+    let (s, c) = (0.5 * v).sin_cos();
+    let q = r.quaternion();
+    let (w, i, j, k) = (q.w, q.i, q.j, q.k);
+    UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(
+        w * c - k * s,
+        i * c + j * s,
+        j * c - i * s,
+        k * c + w * s,
+    ))
 }
 
 impl std::fmt::Debug for RobotModel {
@@ -170,13 +216,18 @@ impl RobotModel {
         by_link.sort_by_key(|&b| bodies[b].link);
         let in_joint = bodies
             .iter()
-            .map(|b| chain.links()[b.link].offset * b.offset)
+            .map(|b| {
+                let t = chain.links()[b.link].offset * b.offset;
+                (t != Isometry3::identity()).then_some(t)
+            })
             .collect();
+        let steps = chain.joints().iter().map(JointStep::of).collect();
         Ok(RobotModel {
             chain,
             bodies,
             by_link,
             in_joint,
+            steps,
         })
     }
 
@@ -228,7 +279,7 @@ impl RobotModel {
         out: &mut [Isometry3<f64>; MAX_BODIES],
         mut axes: Option<&mut [JointAxis]>,
     ) {
-        let joints = self.chain.joints();
+        let steps = &self.steps;
         let links = self.chain.links();
         let mut t = Isometry3::identity();
         let mut applied = 0;
@@ -240,26 +291,36 @@ impl RobotModel {
                 break;
             }
             if let Some(j) = link.after_joint {
-                while applied <= j && applied < joints.len() {
-                    let joint = &joints[applied];
-                    let frame = t * joint.origin;
+                while applied <= j && applied < steps.len() {
+                    let step = &steps[applied];
+                    // frame = t · origin
+                    let frame = Isometry3::from_parts(
+                        Translation3::from(t.translation.vector + t.rotation * step.translation),
+                        match &step.rotation {
+                            Some(r) => t.rotation * r,
+                            None => t.rotation,
+                        },
+                    );
                     if let Some(slot) = axes.as_deref_mut().and_then(|a| a.get_mut(applied)) {
                         *slot = JointAxis {
                             point: frame.translation.vector,
-                            direction: frame.rotation * joint.axis.into_inner(),
+                            direction: frame.rotation * step.axis.into_inner(),
                         };
                     }
                     let v = q.get(applied).copied().unwrap_or(0.0);
                     // frame · motion(v), without composing the motion's
                     // zero translation or identity rotation
-                    t = match joint.kind {
+                    t = match step.kind {
+                        JointKind::Revolute | JointKind::Continuous if step.about_z => {
+                            Isometry3::from_parts(frame.translation, turned_about_z(&frame.rotation, v))
+                        }
                         JointKind::Revolute | JointKind::Continuous => Isometry3::from_parts(
                             frame.translation,
-                            frame.rotation * UnitQuaternion::from_axis_angle(&joint.axis, v),
+                            frame.rotation * UnitQuaternion::from_axis_angle(&step.axis, v),
                         ),
                         JointKind::Prismatic => Isometry3::from_parts(
                             Translation3::from(
-                                frame.translation.vector + frame.rotation * (joint.axis.into_inner() * v),
+                                frame.translation.vector + frame.rotation * (step.axis.into_inner() * v),
                             ),
                             frame.rotation,
                         ),
@@ -269,7 +330,10 @@ impl RobotModel {
             }
             while next < self.by_link.len() && self.bodies[self.by_link[next]].link == li {
                 let b = self.by_link[next];
-                out[b] = t * self.in_joint[b];
+                out[b] = match &self.in_joint[b] {
+                    Some(offset) => t * offset,
+                    None => t,
+                };
                 next += 1;
             }
         }

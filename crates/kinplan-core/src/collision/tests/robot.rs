@@ -348,3 +348,42 @@ fn the_panda_hand_carries_two_fingers_at_the_requested_opening() {
     let wide = panda_hand_checker(0.065, ball());
     assert!((wide.proximity(&q, 1.0).unwrap().unwrap().distance - 0.015).abs() < 1e-9);
 }
+
+#[test]
+fn body_poses_equal_the_chains_link_frames_for_every_builtin_robot() {
+    // The collision model's forward kinematics (origins without rotation
+    // and z-axis joints written out) against the chain's general product of
+    // joint origins and motions, link frame · body offset: arms with x, y,
+    // −x and z axes, rotated and plain origins.
+    use crate::robot::BUILTIN_NAMES;
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let (mut frames, mut robots) = (Vec::new(), 0);
+    for name in BUILTIN_NAMES {
+        let chain = builtin_chain(name).unwrap();
+        let Ok(model) = RobotModel::new(chain.clone()) else {
+            continue;
+        };
+        robots += 1;
+        for _ in 0..20 {
+            let q: Vec<f64> = chain
+                .joints()
+                .iter()
+                .map(|j| rng.random_range(j.lower.max(-4.0)..j.upper.min(4.0)))
+                .collect();
+            let mut poses = [Isometry3::identity(); MAX_BODIES];
+            model.body_poses(&q, &mut poses);
+            chain.link_frames_into(&q, &mut frames);
+            for (b, body) in model.bodies.iter().enumerate() {
+                let expected = frames[body.link] * body.offset;
+                let (got, want) = (poses[b].to_homogeneous(), expected.to_homogeneous());
+                assert!(
+                    (got - want).abs().max() < 1e-12,
+                    "{name}, body {}: {got} vs {want}",
+                    body.name
+                );
+            }
+        }
+    }
+    assert!(robots >= 8, "only {robots} builtin robots have a collision model");
+}
