@@ -545,3 +545,74 @@ fn ccstomp_starts_on_the_cartesian_line_unless_told_otherwise() {
         InitialTrajectory::RrtConnectIfBlocked
     );
 }
+
+#[test]
+fn a_refused_motion_is_replaced_through_a_nudged_midpoint_proved_free() {
+    use crate::collision::{
+        AllowedCollisions, CheckerParams, Geometry, Obstacle, RobotModel, Scene, SceneChecker, SceneGeometry,
+        SceneLimits,
+    };
+    use crate::robot::{ChainSpec, UrdfLimits, parse_chain};
+    use nalgebra::{Isometry3, Vector3};
+    use rand::SeedableRng;
+    // A 2 cm sphere on an x–y slide (±0.5 m) and a 2 cm cube at the origin
+    // on its straight way from x = −0.1 to x = 0.1.
+    let urdf = r#"<robot name="slide"><link name="base"/><link name="px"/>
+      <link name="probe"><collision><geometry><sphere radius="0.02"/></geometry></collision></link>
+      <joint name="jx" type="prismatic"><parent link="base"/><child link="px"/><axis xyz="1 0 0"/>
+        <limit lower="-0.5" upper="0.5" effort="0" velocity="1"/></joint>
+      <joint name="jy" type="prismatic"><parent link="px"/><child link="probe"/><axis xyz="0 1 0"/>
+        <limit lower="-0.5" upper="0.5" effort="0" velocity="1"/></joint></robot>"#;
+    let checker_with = |obstacle: Obstacle| {
+        let chain =
+            std::sync::Arc::new(parse_chain(urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
+        let model = std::sync::Arc::new(RobotModel::new(chain).unwrap());
+        let acm = AllowedCollisions::adjacent(&model);
+        let scene = Scene::new(vec![obstacle], &SceneLimits::default()).unwrap();
+        let world = std::sync::Arc::new(SceneGeometry::build(&scene).unwrap());
+        let params = CheckerParams {
+            padded_motion: true,
+            ..CheckerParams::default()
+        };
+        SceneChecker::new(model, &acm, world, params).unwrap()
+    };
+    let cube = Obstacle::new(
+        "cube",
+        Isometry3::identity(),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.01),
+        },
+    );
+    let checker = checker_with(cube);
+    let (x, y) = ([-0.1, 0.0], [0.1, 0.0]);
+    let bounds = [(-0.5, 0.5), (-0.5, 0.5)];
+    assert!(!checker.motion_valid(&x, &y));
+    let fine_free = |a: &[f64], b: &[f64]| {
+        (0..=2000).all(|i| {
+            let t = f64::from(i) / 2000.0;
+            checker.is_valid(&[a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])])
+        })
+    };
+    for seed in 0..5 {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let m = rrt_connect::nudged_midpoint(&checker, &bounds, &x, &y, 0.05, &mut rng, &|| false)
+            .expect("a nudge around a 2 cm cube");
+        // clear of the cube by the sphere's radius: |m_y| > 0.03 at least
+        assert!(m[1].abs() > 0.03 && m[0].abs() < 0.5, "seed {seed}: {m:?}");
+        assert!(fine_free(&x, &m) && fine_free(&m, &y), "seed {seed}: {m:?}");
+    }
+    // a wall across the whole slide: no nudge gets through
+    let wall = Obstacle::new(
+        "wall",
+        Isometry3::identity(),
+        Geometry::Box {
+            half_extents: Vector3::new(0.01, 1.0, 1.0),
+        },
+    );
+    let checker = checker_with(wall);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+    assert_eq!(
+        rrt_connect::nudged_midpoint(&checker, &bounds, &x, &y, 0.05, &mut rng, &|| false),
+        None
+    );
+}
