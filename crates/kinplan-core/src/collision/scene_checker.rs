@@ -276,9 +276,10 @@ impl SceneChecker {
     /// the pads in two grades: `coarse[b]`, cheap and never below the pad,
     /// finds what a body might touch; `fine(b)`, the pad itself, is asked
     /// (at most once per body) only for bodies that have something within
-    /// their coarse pad — in a cell most bodies have nothing near. A pair
-    /// found within its pads is also tested without them
-    /// ([`PadHit::Touches`], which ends the check).
+    /// their coarse pad — in a cell most bodies have nothing near. Once a
+    /// pair is found within its pads, the pairs of the same kind after it
+    /// are only tested without pads ([`PadHit::Touches`], which ends the
+    /// check), so a state in collision is refused at once.
     ///
     /// `proved` lists what is already proved free over the piece the pads
     /// cover and need not be checked: bit `b` the scene around body `b`,
@@ -310,30 +311,46 @@ impl SceneChecker {
                 continue;
             }
             let (body, pose) = (&bodies[b], &poses[b]);
-            let mut near = None;
+            // once a leaf is within the pad the body is not proved; the
+            // rest of its leaves are only asked whether they touch it
+            let (mut near, mut touches) = (false, false);
             self.world
                 .bvh
                 .for_each_near(c, body.radius + margin(coarse[b]), |leaf| {
                     let leaf = &self.world.leaves[leaf as usize];
-                    if body_leaf_within(body, pose, c, leaf, fine_pad(b)) {
-                        near = Some(body_leaf_intersect(body, pose, c, leaf));
+                    if near || body_leaf_within(body, pose, c, leaf, fine_pad(b)) {
+                        near = true;
+                        touches = body_leaf_intersect(body, pose, c, leaf);
                     }
-                    near.is_none()
+                    !touches
                 });
-            match near {
-                None => *proved |= 1 << b,
-                Some(true) => return PadHit::Touches,
-                Some(false) => found = PadHit::Near,
+            if touches {
+                return PadHit::Touches;
+            }
+            if near {
+                found = PadHit::Near;
+            } else {
+                *proved |= 1 << b;
             }
         }
         if *proved & SELF_PAIRS != 0 {
             return found;
         }
+        let mut self_near = false;
         for &(a, b) in &self.self_pairs {
             let (a, b) = (a as usize, b as usize);
-            let reach = bodies[a].radius + bodies[b].radius + margin(coarse[a] + coarse[b]);
-            if (centers[a] - centers[b]).norm_squared() <= reach * reach
-                && body_body_within(
+            let (ra, rb) = (bodies[a].radius, bodies[b].radius);
+            let pad = if self_near {
+                0.0
+            } else {
+                margin(coarse[a] + coarse[b])
+            };
+            let reach = ra + rb + pad;
+            if (centers[a] - centers[b]).norm_squared() > reach * reach {
+                continue;
+            }
+            if self_near
+                || body_body_within(
                     &bodies[a],
                     &poses[a],
                     &bodies[b],
@@ -341,8 +358,15 @@ impl SceneChecker {
                     margin(fine_pad(a) + fine_pad(b)),
                 )
             {
-                return PadHit::found(body_body_intersect(&bodies[a], &poses[a], &bodies[b], &poses[b]));
+                if body_body_intersect(&bodies[a], &poses[a], &bodies[b], &poses[b]) {
+                    return PadHit::Touches;
+                }
+                self_near = true;
+                found = PadHit::Near;
             }
+        }
+        if self_near {
+            return found;
         }
         *proved |= SELF_PAIRS;
         found
@@ -526,12 +550,6 @@ enum PadHit {
     Near,
     /// A pair within its pads that also touches without them.
     Touches,
-}
-
-impl PadHit {
-    fn found(touches: bool) -> Self {
-        if touches { PadHit::Touches } else { PadHit::Near }
-    }
 }
 
 #[derive(Debug, Clone, Copy)]
