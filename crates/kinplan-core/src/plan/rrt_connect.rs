@@ -273,6 +273,20 @@ pub(super) fn nudged_midpoint<C: StateChecker + ?Sized>(
     if x.len() != y.len() || bounds.len() != x.len() {
         return None;
     }
+    // a candidate is first checked as the search checks its edges, so
+    // most blocked ones cost a few states instead of a proof
+    let mut buf = vec![0.0; x.len()];
+    let mut coarse_free = |a: &[f64], b: &[f64]| {
+        let span = a.iter().zip(b).fold(0.0_f64, |s, (u, v)| s.max((v - u).abs()));
+        let steps = (span / (resolution * LAZY_COARSENING)).ceil().clamp(1.0, 1e6) as usize;
+        (1..steps).all(|i| {
+            let t = i as f64 / steps as f64;
+            for ((q, u), v) in buf.iter_mut().zip(a).zip(b) {
+                *q = u + t * (v - u);
+            }
+            checker.is_valid(&buf)
+        })
+    };
     let mut m = vec![0.0; x.len()];
     for k in 0..NUDGES {
         let sigma = 0.05 * f64::powi(2.0, (k / 3) as i32);
@@ -282,6 +296,8 @@ pub(super) fn nudged_midpoint<C: StateChecker + ?Sized>(
             *v = (0.5 * (x[j] + y[j]) + sigma * normal).clamp(lo, hi);
         }
         if checker.is_valid(&m)
+            && coarse_free(x, &m)
+            && coarse_free(&m, y)
             && padded_motion_valid(checker, x, &m, resolution, interrupted) == Some(true)
             && padded_motion_valid(checker, &m, y, resolution, interrupted) == Some(true)
         {
