@@ -745,3 +745,39 @@ fn a_padded_check_reports_the_bodies_it_proved_and_skips_those_given() {
     );
     assert_eq!(proved & 0b11, 0b11);
 }
+
+#[test]
+fn a_padded_check_refuses_a_colliding_state_whichever_obstacle_it_meets_first() {
+    // The xyz probe (2 cm sphere) at the origin: one cube 1 cm beyond its
+    // surface (within any pad of a few cm, not touching) and one cube
+    // through it, in both scene orders: the verdict is Collides, not
+    // Unproved, whichever cube the check meets first.
+    let near = Obstacle::new(
+        "near",
+        Isometry3::translation(0.04, 0.0, 0.0),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.01),
+        },
+    );
+    let through = Obstacle::new(
+        "through",
+        Isometry3::translation(0.0, -0.015, 0.0),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.01),
+        },
+    );
+    let probe = || model_of(&super::probe_urdf(r#"<sphere radius="0.02"/>"#));
+    for obstacles in [vec![near.clone(), through.clone()], vec![through, near.clone()]] {
+        let checker = checker_with(probe(), obstacles, true);
+        assert_eq!(
+            checker.padded_verdict(&[0.0, 0.0, 0.0], &[0.03, 0.0, 0.0]),
+            Some(PadVerdict::Collides)
+        );
+    }
+    // the near cube alone: not proved with the 3 cm step, and not colliding
+    let checker = checker_with(probe(), vec![near], true);
+    assert_eq!(
+        checker.padded_verdict(&[0.0, 0.0, 0.0], &[0.03, 0.0, 0.0]),
+        Some(PadVerdict::Unproved)
+    );
+}
