@@ -53,7 +53,7 @@ pub use model::{AttachedBody, InlineMesh, MAX_BODIES, MAX_LINKS, RobotModel};
 pub use moveit::{JointRequest, MAX_YAML_BYTES, parse_joint_request, parse_planning_scene};
 pub use octree_cells::octree_cells;
 pub(crate) use padded::bisection_order;
-pub use padded::{MAX_CHECKS_PER_PIECE, MIN_PIECE, padded_motion_valid};
+pub use padded::{MAX_CHECKS_PER_PIECE, MIN_PIECE, PaddedMotion, padded_motion, padded_motion_valid};
 pub use scene::{Geometry, Obstacle, Scene, SceneLimits};
 pub use scene_checker::{CheckerParams, Part, Proximity, SceneChecker, StateReport};
 pub use sweep::SweepBound;

@@ -52,11 +52,41 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
     a: &[f64],
     b: &[f64],
     resolution: f64,
-    mut interrupted: impl FnMut() -> bool,
+    interrupted: impl FnMut() -> bool,
 ) -> Option<bool> {
+    match padded_motion(checker, a, b, resolution, interrupted) {
+        PaddedMotion::Free => Some(true),
+        PaddedMotion::Refused { .. } => Some(false),
+        PaddedMotion::Interrupted => None,
+    }
+}
+
+/// What [`padded_motion`] found about a straight motion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PaddedMotion {
+    /// Proved free.
+    Free,
+    /// Refused; `at` (in [0, 1], from `a` to `b`) is the midpoint of the
+    /// piece that refused it: a state found in collision, or a piece that
+    /// could not be proved within the limits of the check (0.5 for a
+    /// malformed motion).
+    Refused { at: f64 },
+    /// `interrupted()` said so.
+    Interrupted,
+}
+
+/// [`padded_motion_valid`], saying where a refused motion was refused.
+pub fn padded_motion<C: StateChecker + ?Sized>(
+    checker: &C,
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+    mut interrupted: impl FnMut() -> bool,
+) -> PaddedMotion {
+    let refused = |at: f64| PaddedMotion::Refused { at };
     let n = a.len();
     if n != b.len() || n > MAX_DOF || resolution.is_nan() || resolution <= 0.0 {
-        return Some(false);
+        return refused(0.5);
     }
     let mut delta = [0.0; MAX_DOF];
     for (d, (x, y)) in delta.iter_mut().zip(a.iter().zip(b)) {
@@ -65,11 +95,11 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
     let delta = &delta[..n];
     let span = delta.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
     if !span.is_finite() {
-        return Some(false);
+        return refused(0.5);
     }
     let pieces = (span / (FIRST_PIECE * resolution)).ceil().max(1.0);
     if pieces > 1e7 {
-        return Some(false);
+        return refused(0.5);
     }
     let pieces = (pieces as usize).next_power_of_two();
     let (mut q, mut half) = ([0.0; MAX_DOF], [0.0; MAX_DOF]);
@@ -93,27 +123,27 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
         );
         while let Some((s, t, slot, mut proved)) = queue.pop_front() {
             checks += 1;
+            let m = 0.5 * (s + t);
             if checks.is_multiple_of(32) && interrupted() {
-                return None;
+                return PaddedMotion::Interrupted;
             }
             if spent[slot] == MAX_CHECKS_PER_PIECE {
-                return Some(false);
+                return refused(m);
             }
             spent[slot] += 1;
-            let m = 0.5 * (s + t);
             for j in 0..n {
                 q[j] = a[j] + m * delta[j];
                 half[j] = 0.5 * (t - s) * delta[j];
             }
             match checker.padded_verdict_sparing(&q[..n], &half[..n], &mut proved) {
-                None | Some(PadVerdict::Collides) => return Some(false),
+                None | Some(PadVerdict::Collides) => return refused(m),
                 Some(PadVerdict::Free) => {}
-                Some(PadVerdict::Unproved) if (t - s) * span < MIN_PIECE => return Some(false),
+                Some(PadVerdict::Unproved) if (t - s) * span < MIN_PIECE => return refused(m),
                 Some(PadVerdict::Unproved) => queue.extend([(s, m, slot, proved), (m, t, slot, proved)]),
             }
         }
     }
-    Some(true)
+    PaddedMotion::Free
 }
 
 /// `0..count` (a power of two) in bisection order: 0, then the odd

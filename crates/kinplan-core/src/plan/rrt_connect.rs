@@ -12,7 +12,7 @@ use super::costs::{interior_valid, resolution_of};
 use super::error::{PlanError, PlanField, check_vector};
 use super::noise::{standard_normal, stream};
 use super::rrt_tree::{Grown, grow};
-use crate::collision::{StateChecker, padded_motion_valid};
+use crate::collision::{PaddedMotion, StateChecker, padded_motion, padded_motion_valid};
 use crate::robot::{Chain, JointKind};
 
 /// How RRT-Connect ended.
@@ -169,7 +169,7 @@ const LAZY_COARSENING: f64 = 4.0;
 /// ([`LAZY_COARSENING`] times the checker's resolution apart), then every
 /// edge of the path they find proved with the padded check
 /// ([`padded_motion_valid`]); an edge that cannot be proved is replaced by
-/// two through a nudged midpoint ([`nudged_midpoint`]), else by a path grown
+/// two through a nudged waypoint ([`nudged_waypoint`]), else by a path grown
 /// between its ends with padded edges, and if that fails too the whole
 /// problem is grown with padded edges. Samples count against one budget,
 /// `params.max_samples`. (On MotionBenchMaker the nudges make the padded
@@ -206,19 +206,20 @@ fn prove_lazily<C: StateChecker + ?Sized>(
     let interrupted = || clock.interrupted().is_some();
     let mut proved = start.to_vec();
     for (x, y) in found.chunks_exact(dof).zip(found.chunks_exact(dof).skip(1)) {
-        match padded_motion_valid(checker, x, y, resolution, interrupted) {
-            Some(true) => {
+        let at = match padded_motion(checker, x, y, resolution, interrupted) {
+            PaddedMotion::Free => {
                 proved.extend_from_slice(y);
                 continue;
             }
-            None => {
+            PaddedMotion::Interrupted => {
                 grown.path = Err(clock.interrupted().map_or(RrtStop::Deadline, stop_of));
                 return grown;
             }
-            Some(false) => {}
-        }
-        // x → y itself was just refused: first through a nudged midpoint
-        if let Some(m) = nudged_midpoint(checker, bounds, x, y, resolution, rng, &interrupted) {
+            PaddedMotion::Refused { at } => at,
+        };
+        // x → y itself was just refused: first through a waypoint nudged
+        // from where it was refused
+        if let Some(m) = nudged_waypoint(checker, bounds, x, y, at, resolution, rng, &interrupted) {
             proved.extend_from_slice(&m);
             proved.extend_from_slice(y);
             continue;
@@ -257,15 +258,17 @@ fn prove_lazily<C: StateChecker + ?Sized>(
 /// slower, were faster on some MotionBenchMaker sets and slower on others).
 const NUDGES: usize = 12;
 
-/// A state `m` near the midpoint of the refused motion `x → y` with both
-/// `x → m` and `m → y` proved free: the midpoint moved by Gaussian offsets
-/// whose spread doubles every few tries (0.05 to 0.8 rad or m), within
-/// `bounds`; `None` after [`NUDGES`] tries.
-pub(super) fn nudged_midpoint<C: StateChecker + ?Sized>(
+/// A state `m` near `x + at·(y − x)`, where the motion `x → y` was refused,
+/// with both `x → m` and `m → y` proved free: that state moved by Gaussian
+/// offsets whose spread doubles every few tries (0.05 to 0.8 rad or m),
+/// within `bounds`; `None` after [`NUDGES`] tries.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn nudged_waypoint<C: StateChecker + ?Sized>(
     checker: &C,
     bounds: &[(f64, f64)],
     x: &[f64],
     y: &[f64],
+    at: f64,
     resolution: f64,
     rng: &mut ChaCha8Rng,
     interrupted: &impl Fn() -> bool,
@@ -293,7 +296,7 @@ pub(super) fn nudged_midpoint<C: StateChecker + ?Sized>(
         for (j, v) in m.iter_mut().enumerate() {
             let normal = standard_normal(rng);
             let (lo, hi) = bounds[j];
-            *v = (0.5 * (x[j] + y[j]) + sigma * normal).clamp(lo, hi);
+            *v = (x[j] + at * (y[j] - x[j]) + sigma * normal).clamp(lo, hi);
         }
         if checker.is_valid(&m)
             && coarse_free(x, &m)

@@ -547,7 +547,7 @@ fn ccstomp_starts_on_the_cartesian_line_unless_told_otherwise() {
 }
 
 #[test]
-fn a_refused_motion_is_replaced_through_a_nudged_midpoint_proved_free() {
+fn a_refused_motion_is_replaced_through_a_nudged_waypoint_proved_free() {
     use crate::collision::{
         AllowedCollisions, CheckerParams, Geometry, Obstacle, RobotModel, Scene, SceneChecker, SceneGeometry,
         SceneLimits,
@@ -595,7 +595,7 @@ fn a_refused_motion_is_replaced_through_a_nudged_midpoint_proved_free() {
     };
     for seed in 0..5 {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let m = rrt_connect::nudged_midpoint(&checker, &bounds, &x, &y, 0.05, &mut rng, &|| false)
+        let m = rrt_connect::nudged_waypoint(&checker, &bounds, &x, &y, 0.5, 0.05, &mut rng, &|| false)
             .expect("a nudge around a 2 cm cube");
         // clear of the cube by the sphere's radius: |m_y| > 0.03 at least
         assert!(m[1].abs() > 0.03 && m[0].abs() < 0.5, "seed {seed}: {m:?}");
@@ -612,7 +612,7 @@ fn a_refused_motion_is_replaced_through_a_nudged_midpoint_proved_free() {
     let checker = checker_with(wall);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
     assert_eq!(
-        rrt_connect::nudged_midpoint(&checker, &bounds, &x, &y, 0.05, &mut rng, &|| false),
+        rrt_connect::nudged_waypoint(&checker, &bounds, &x, &y, 0.5, 0.05, &mut rng, &|| false),
         None
     );
 }
