@@ -785,8 +785,9 @@ fn a_padded_check_refuses_a_colliding_state_whichever_obstacle_it_meets_first() 
 #[test]
 fn a_refused_motion_says_where_it_was_refused() {
     // The swing (1 cm sphere at 1 m) turning 0 → 1.6 rad against a 1 cm
-    // cube on its circle at θ = 1.2: refused at the piece around 1.2 rad
-    // (pieces are 0.1 rad long), and proved free on the far side.
+    // cube on its circle at θ = 1.2: refused within 0.1 rad of it (first
+    // pieces are 0.2 rad long, 1.2 on a border), and proved free on the
+    // far side.
     let wall = Obstacle::new(
         "wall",
         Isometry3::translation(1.2f64.cos(), 1.2f64.sin(), 0.0),
@@ -805,9 +806,9 @@ fn a_refused_motion_says_where_it_was_refused() {
         padded_motion(&checker, &[-1.0], &[-2.5], 0.05, || false),
         PaddedMotion::Free
     );
-    // 32 pieces of a free motion: asked at the 32nd check
+    // a free motion of at least 32 pieces: asked at the 32nd check
     assert_eq!(
-        padded_motion(&checker, &[-3.0], &[-1.3], 0.05, || true),
+        padded_motion(&checker, &[-3.0], &[1.0], 0.05, || true),
         PaddedMotion::Interrupted
     );
 }
