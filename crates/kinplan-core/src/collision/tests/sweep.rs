@@ -468,10 +468,22 @@ fn the_bound_around_a_bent_elbow_covers_every_state_of_the_piece() {
     assert!(worst <= pads[1], "the tip moved {worst} > pad {}", pads[1]);
 }
 
-/// A checker that counts its padded checks.
+/// A checker that counts its padded checks; without `spare` it proves
+/// halves as the trait's default does (every part again).
 struct CountingPads<'a> {
     inner: &'a SceneChecker,
     padded: std::sync::atomic::AtomicUsize,
+    spare: bool,
+}
+
+impl<'a> CountingPads<'a> {
+    fn new(inner: &'a SceneChecker, spare: bool) -> Self {
+        CountingPads {
+            inner,
+            padded: 0.into(),
+            spare,
+        }
+    }
 }
 
 impl StateChecker for CountingPads<'_> {
@@ -489,6 +501,9 @@ impl StateChecker for CountingPads<'_> {
         self.inner.padded_verdict(q, half_step)
     }
     fn padded_verdict_sparing(&self, q: &[f64], half_step: &[f64], proved: &mut u64) -> Option<PadVerdict> {
+        if !self.spare {
+            return self.padded_verdict(q, half_step);
+        }
         self.padded.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         self.inner.padded_verdict_sparing(q, half_step, proved)
     }
@@ -496,41 +511,39 @@ impl StateChecker for CountingPads<'_> {
 
 #[test]
 fn a_motion_through_an_obstacle_is_refused_before_grazing_pieces_are_halved() {
-    // The swing (1 cm sphere at 1 m) turns 0 → 1.6 rad: 32 pieces of 0.05.
-    // A cube 0.1 mm off its circle at θ = 0.02 (piece 0, visited first)
-    // takes many halvings to prove clear; a wall across the circle
-    // at θ = 1.575 (the midpoint of piece 31, visited last) blocks the
-    // motion outright.
+    // The swing (1 cm sphere at 1 m) turns −1.6 → 1.6 rad: 16 first pieces
+    // of 0.2 (four resolutions of 0.05). A cube 0.1 mm off its circle at
+    // θ = −1.58 (piece 0, visited first) takes many halvings to prove
+    // clear; a wall across the circle at θ = 1.5 (the midpoint of piece 15,
+    // visited last) blocks the motion outright.
+    let at = |theta: f64, r: f64| Isometry3::translation(theta.cos() * r, theta.sin() * r, 0.0);
     let graze = Obstacle::new(
         "graze",
-        Isometry3::translation(0.02f64.cos() * 1.0111, 0.02f64.sin() * 1.0111, 0.0),
+        at(-1.58, 1.0111),
         Geometry::Box {
             half_extents: Vector3::repeat(0.001),
         },
     );
     let wall = Obstacle::new(
         "wall",
-        Isometry3::translation(1.575f64.cos(), 1.575f64.sin(), 0.0),
+        at(1.5, 1.0),
         Geometry::Box {
             half_extents: Vector3::repeat(0.005),
         },
     );
     let checker = checker_with(model_of(SWING), vec![graze, wall], true);
-    let (a, b) = ([0.0], [1.6]);
+    let (a, b) = ([-1.6], [1.6]);
     assert!(checker.is_valid(&a) && checker.is_valid(&b));
-    let counting = CountingPads {
-        inner: &checker,
-        padded: 0.into(),
-    };
+    let counting = CountingPads::new(&checker, true);
     assert_eq!(
         padded_motion_valid(&counting, &a, &b, 0.05, || false),
         Some(false)
     );
-    // breadth first: the 32 midpoints are checked before any piece is
+    // breadth first: the 16 midpoints are checked before any piece is
     // halved, and the wall's midpoint refuses the motion (depth first would
-    // halve piece 0 first, then check the 31 others)
+    // halve piece 0 first, then check the 15 others)
     let checks = counting.padded.into_inner();
-    assert!(checks <= 32, "{checks} padded checks");
+    assert!(checks <= 16, "{checks} padded checks");
 }
 
 #[test]
@@ -632,29 +645,6 @@ fn the_bound_along_a_piece_holds_for_its_states_and_is_tighter_than_the_box() {
     assert!(mean < 0.8, "the segment bound is no tighter: mean ratio {mean}");
 }
 
-/// The scene checker without its part-by-part proofs (the trait's default
-/// `padded_verdict_sparing`), counting its padded checks.
-struct Unspared<'a> {
-    inner: &'a SceneChecker,
-    padded: std::sync::atomic::AtomicUsize,
-}
-
-impl StateChecker for Unspared<'_> {
-    fn dof(&self) -> usize {
-        self.inner.dof()
-    }
-    fn is_valid(&self, q: &[f64]) -> bool {
-        self.inner.is_valid(q)
-    }
-    fn clearance(&self, q: &[f64], max_distance: f64) -> f64 {
-        self.inner.clearance(q, max_distance)
-    }
-    fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
-        self.padded.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        self.inner.padded_verdict(q, half_step)
-    }
-}
-
 #[test]
 fn halves_that_skip_the_parts_proved_over_their_piece_accept_more_and_stay_sound() {
     // Panda motions among posts: proving a piece's halves only for the
@@ -667,14 +657,8 @@ fn halves_that_skip_the_parts_proved_over_their_piece_accept_more_and_stay_sound
     let obstacles = posts(&mut rng);
     let plain = checker_with(model.clone(), obstacles.clone(), false);
     let padded = checker_with(model.clone(), obstacles, true);
-    let counting = CountingPads {
-        inner: &padded,
-        padded: 0.into(),
-    };
-    let unspared = Unspared {
-        inner: &padded,
-        padded: 0.into(),
-    };
+    let counting = CountingPads::new(&padded, true);
+    let unspared = CountingPads::new(&padded, false);
     let joints = model.chain().joints().to_vec();
     let (mut accepted, mut only_spared) = (0, 0);
     for _ in 0..300 {
