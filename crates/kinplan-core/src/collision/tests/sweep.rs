@@ -83,6 +83,43 @@ fn sphere_points(body: &super::super::model::Body) -> Vec<Point3<f64>> {
     points
 }
 
+/// Asserts that no bounding-sphere point (centre and poles) of any body
+/// moves farther than `pads[b]` from its place in `from` when the robot is
+/// at `q`.
+fn assert_within_pads(
+    model: &RobotModel,
+    from: &[Isometry3<f64>; MAX_BODIES],
+    q: &[f64],
+    pads: &[f64],
+    context: &str,
+) {
+    let mut at = [Isometry3::identity(); MAX_BODIES];
+    model.body_poses(q, &mut at);
+    for (b, body) in model.bodies.iter().enumerate() {
+        for p in sphere_points(body) {
+            let moved = (at[b] * p - from[b] * p).norm();
+            assert!(
+                moved <= pads[b] + 1e-12,
+                "{context}, body {b}: moved {moved} > pad {}",
+                pads[b]
+            );
+        }
+    }
+}
+
+/// The built-in Panda (no hand) as collision bodies.
+fn panda() -> Arc<RobotModel> {
+    Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap())
+}
+
+/// A state drawn uniformly within the joint limits.
+fn random_state(joints: &[crate::robot::Joint], rng: &mut ChaCha8Rng) -> Vec<f64> {
+    joints
+        .iter()
+        .map(|j| rng.random_range(j.lower..j.upper))
+        .collect()
+}
+
 /// Twelve thin posts and plates 0.35–0.8 m from the Panda's base axis.
 fn posts(rng: &mut ChaCha8Rng) -> Vec<Obstacle> {
     (0..12)
@@ -123,7 +160,7 @@ fn levers_of_a_two_link_arm_are_the_hand_derived_reaches() {
 
 #[test]
 fn no_point_of_a_panda_body_moves_farther_than_its_pad() {
-    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let model = panda();
     let sweep = SweepBound::new(&model).unwrap();
     let joints = model.chain().joints().to_vec();
     let mut rng = ChaCha8Rng::seed_from_u64(11);
@@ -133,10 +170,7 @@ fn no_point_of_a_panda_body_moves_farther_than_its_pad() {
     );
     let mut tightest = 0.0_f64;
     for _ in 0..300 {
-        let q: Vec<f64> = joints
-            .iter()
-            .map(|j| rng.random_range(j.lower..j.upper))
-            .collect();
+        let q = random_state(&joints, &mut rng);
         let dq: Vec<f64> = (0..q.len()).map(|_| rng.random_range(-0.1..0.1)).collect();
         let mut pads = [0.0; MAX_BODIES];
         sweep.pads(&dq, &mut pads);
@@ -193,7 +227,7 @@ fn a_padded_check_finds_the_graze_between_two_checked_states() {
 
 #[test]
 fn every_motion_a_padded_panda_check_accepts_is_free_at_a_fine_resolution() {
-    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let model = panda();
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let obstacles = posts(&mut rng);
     let plain = checker_with(model.clone(), obstacles.clone(), false);
@@ -201,10 +235,7 @@ fn every_motion_a_padded_panda_check_accepts_is_free_at_a_fine_resolution() {
     let joints = model.chain().joints().to_vec();
     let (mut accepted, mut plain_misses) = (0, 0);
     for _ in 0..400 {
-        let a: Vec<f64> = joints
-            .iter()
-            .map(|j| rng.random_range(j.lower..j.upper))
-            .collect();
+        let a = random_state(&joints, &mut rng);
         let b: Vec<f64> = a
             .iter()
             .zip(&joints)
@@ -267,17 +298,14 @@ fn an_unlimited_prismatic_joint_after_a_revolute_one_cannot_be_padded() {
 #[test]
 fn rrt_connect_with_padded_motions_returns_paths_free_at_a_fine_resolution() {
     use crate::plan::{Algorithm, Goal, PlanControl, PlanRequest, PlanStatus, plan};
-    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let model = panda();
     let mut rng = ChaCha8Rng::seed_from_u64(21);
     let obstacles = posts(&mut rng);
     let plain = checker_with(model.clone(), obstacles.clone(), false);
     let padded = checker_with(model.clone(), obstacles, true);
     let joints = model.chain().joints().to_vec();
     let mut random_valid = || loop {
-        let q: Vec<f64> = joints
-            .iter()
-            .map(|j| rng.random_range(j.lower..j.upper))
-            .collect();
+        let q = random_state(&joints, &mut rng);
         if padded.padded_valid(&q, &[0.0; 7]) == Some(true) {
             return q;
         }
@@ -378,21 +406,15 @@ fn a_grown_shape_hits_whatever_is_within_the_margin_and_little_beyond() {
 
 #[test]
 fn the_bound_around_a_state_holds_for_the_true_motion_and_is_tighter() {
-    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let model = panda();
     let sweep = SweepBound::new(&model).unwrap();
     let joints = model.chain().joints().to_vec();
     let mut rng = ChaCha8Rng::seed_from_u64(17);
-    let (mut at_m, mut at_s) = (
-        [Isometry3::identity(); MAX_BODIES],
-        [Isometry3::identity(); MAX_BODIES],
-    );
+    let mut at_m = [Isometry3::identity(); MAX_BODIES];
     let mut axes = [JointAxis::default(); 7];
     let (mut ratio_sum, mut ratio_count) = (0.0, 0);
     for _ in 0..300 {
-        let m: Vec<f64> = joints
-            .iter()
-            .map(|j| rng.random_range(j.lower..j.upper))
-            .collect();
+        let m = random_state(&joints, &mut rng);
         let half: Vec<f64> = (0..7).map(|_| rng.random_range(0.0..0.05)).collect();
         model.body_poses_and_axes(&m, &mut at_m, &mut axes);
         let (mut near, mut far) = ([0.0; MAX_BODIES], [0.0; MAX_BODIES]);
@@ -405,17 +427,7 @@ fn the_bound_around_a_state_holds_for_the_true_motion_and_is_tighter() {
                 .zip(&half)
                 .map(|(x, h)| x + h * if k == 0 { 1.0 } else { rng.random_range(-1.0..1.0) })
                 .collect();
-            model.body_poses(&s, &mut at_s);
-            for (b, body) in model.bodies.iter().enumerate() {
-                for p in sphere_points(body) {
-                    let moved = (at_s[b] * p - at_m[b] * p).norm();
-                    assert!(
-                        moved <= near[b] + 1e-12,
-                        "body {b}: moved {moved} > pad {}",
-                        near[b]
-                    );
-                }
-            }
+            assert_within_pads(&model, &at_m, &s, &near, "around a state");
         }
         for b in 0..model.body_count() {
             assert!(near[b] <= far[b] + 1e-15, "body {b}: {} > {}", near[b], far[b]);
@@ -595,21 +607,15 @@ fn the_bound_along_a_piece_holds_for_its_states_and_is_tighter_than_the_box() {
     // long on their largest joint: every state sampled along the piece moves
     // every bounding-sphere point within the segment bound, and on pieces of
     // one resolution that bound is mostly below the box bound.
-    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let model = panda();
     let sweep = SweepBound::new(&model).unwrap();
     let joints = model.chain().joints().to_vec();
     let mut rng = ChaCha8Rng::seed_from_u64(23);
-    let (mut at_m, mut at_s) = (
-        [Isometry3::identity(); MAX_BODIES],
-        [Isometry3::identity(); MAX_BODIES],
-    );
+    let mut at_m = [Isometry3::identity(); MAX_BODIES];
     let mut axes = [JointAxis::default(); 7];
     let mut ratios = Vec::new();
     for k in 0..400 {
-        let m: Vec<f64> = joints
-            .iter()
-            .map(|j| rng.random_range(j.lower..j.upper))
-            .collect();
+        let m = random_state(&joints, &mut rng);
         let span = [0.025, 0.1, 0.4][k % 3];
         let d: Vec<f64> = (0..7).map(|_| rng.random_range(-span..span)).collect();
         model.body_poses_and_axes(&m, &mut at_m, &mut axes);
@@ -622,17 +628,7 @@ fn the_bound_along_a_piece_holds_for_its_states_and_is_tighter_than_the_box() {
         for i in -20..=20 {
             let s = f64::from(i) / 20.0;
             let q: Vec<f64> = m.iter().zip(&d).map(|(x, dj)| x + s * dj).collect();
-            model.body_poses(&q, &mut at_s);
-            for (b, body) in model.bodies.iter().enumerate() {
-                for p in sphere_points(body) {
-                    let moved = (at_s[b] * p - at_m[b] * p).norm();
-                    assert!(
-                        moved <= along[b] + 1e-12,
-                        "body {b}, s = {s}: moved {moved} > pad {}",
-                        along[b]
-                    );
-                }
-            }
+            assert_within_pads(&model, &at_m, &q, &along, &format!("along a piece, s = {s}"));
         }
         for b in 0..model.body_count() {
             if boxed[b] > 0.0 && span == 0.025 {
@@ -652,7 +648,7 @@ fn halves_that_skip_the_parts_proved_over_their_piece_accept_more_and_stay_sound
     // the full checks accept (a body free over a piece is free over its
     // halves), every motion it accepts is free at 2 mm, and it needs no
     // more padded checks.
-    let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
+    let model = panda();
     let mut rng = ChaCha8Rng::seed_from_u64(31);
     let obstacles = posts(&mut rng);
     let plain = checker_with(model.clone(), obstacles.clone(), false);
@@ -662,10 +658,7 @@ fn halves_that_skip_the_parts_proved_over_their_piece_accept_more_and_stay_sound
     let joints = model.chain().joints().to_vec();
     let (mut accepted, mut only_spared) = (0, 0);
     for _ in 0..300 {
-        let a: Vec<f64> = joints
-            .iter()
-            .map(|j| rng.random_range(j.lower..j.upper))
-            .collect();
+        let a = random_state(&joints, &mut rng);
         let b: Vec<f64> = a
             .iter()
             .zip(&joints)
