@@ -355,7 +355,7 @@ fn tab54(pairs: usize) {
 }
 
 /// Overrides from the environment (`H`, `IK_ITERS`, `ITERS`, `AFTER_VALID`,
-/// `ROLLOUTS`, `INIT=cartesian`), for the parameter sweeps reported in PLAN_RESULTS.md.
+/// `ROLLOUTS`, `INIT=cartesian` or `INIT=rrt` for CCSTOMP's start), for the parameter sweeps reported in PLAN_RESULTS.md.
 fn env_overrides(req: &mut PlanRequest) {
     let get = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
     if let Some(h) = get("H") {
@@ -371,8 +371,12 @@ fn env_overrides(req: &mut PlanRequest) {
         req.stomp.iterations_after_valid = v as usize;
     }
     // CCSTOMP only: STOMP keeps its MoveIt-like start
-    if std::env::var("INIT").is_ok_and(|v| v == "cartesian") && req.algorithm == Algorithm::Ccstomp {
-        req.stomp.initial = kinplan_core::plan::InitialTrajectory::CartesianLine;
+    if req.algorithm == Algorithm::Ccstomp {
+        match std::env::var("INIT").as_deref() {
+            Ok("cartesian") => req.stomp.initial = kinplan_core::plan::InitialTrajectory::CartesianLine,
+            Ok("rrt") => req.stomp.initial = kinplan_core::plan::InitialTrajectory::RrtConnectIfBlocked,
+            _ => {}
+        }
     }
     if let Some(v) = get("ROLLOUTS") {
         req.stomp.rollouts = v as usize;
