@@ -593,9 +593,14 @@ fn a_refused_motion_is_replaced_through_a_nudged_waypoint_proved_free() {
             checker.is_valid(&[a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])])
         })
     };
+    let clock = super::clock::Clock {
+        start: Instant::now(),
+        deadline: None,
+        should_stop: &|| false,
+    };
     for seed in 0..5 {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let m = rrt_connect::nudged_waypoint(&checker, &bounds, &x, &y, 0.5, 0.05, &mut rng, &|| false)
+        let m = rrt_connect::nudged_waypoint(&checker, &bounds, &x, &y, 0.5, 0.05, &mut rng, &clock)
             .expect("a nudge around a 2 cm cube");
         // clear of the cube by the sphere's radius: |m_y| > 0.03 at least
         assert!(m[1].abs() > 0.03 && m[0].abs() < 0.5, "seed {seed}: {m:?}");
@@ -612,7 +617,23 @@ fn a_refused_motion_is_replaced_through_a_nudged_waypoint_proved_free() {
     let checker = checker_with(wall);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
     assert_eq!(
-        rrt_connect::nudged_waypoint(&checker, &bounds, &x, &y, 0.5, 0.05, &mut rng, &|| false),
+        rrt_connect::nudged_waypoint(&checker, &bounds, &x, &y, 0.5, 0.05, &mut rng, &clock),
+        None
+    );
+    // and a caller that asks to stop gets no waypoint, even around the cube
+    let checker = checker_with(Obstacle::new(
+        "cube",
+        Isometry3::identity(),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.01),
+        },
+    ));
+    let stopped = super::clock::Clock {
+        should_stop: &|| true,
+        ..clock
+    };
+    assert_eq!(
+        rrt_connect::nudged_waypoint(&checker, &bounds, &x, &y, 0.5, 0.05, &mut rng, &stopped),
         None
     );
 }
