@@ -276,9 +276,10 @@ impl SceneChecker {
     /// the pads in two grades: `coarse[b]`, cheap and never below the pad,
     /// finds what a body might touch; `fine(b)`, the pad itself, is asked
     /// (at most once per body) only for bodies that have something within
-    /// their coarse pad — in a cell most bodies have nothing near. Once a
-    /// pair is found within its pads, the pairs of the same kind after it
-    /// are only tested without pads ([`PadHit::Touches`], which ends the
+    /// their coarse pad — in a cell most bodies have nothing near. Once an
+    /// obstacle is found within a body's pad, that body's further obstacles
+    /// are only tested without pads, and once a self pair is found within
+    /// its pads, so are the further self pairs ([`PadHit::Touches`] ends the
     /// check), so a state in collision is refused at once.
     ///
     /// `proved` lists what is already proved free over the piece the pads
@@ -510,8 +511,9 @@ impl SceneChecker {
 
 /// The bodies a [`SceneChecker`] tests against the scene, distal first:
 /// a body fixed to the base is left out when it is clear of every
-/// obstacle (touching counts, as in the checks), as it is then in every
-/// state; one that touches stays, so every state is found in collision.
+/// obstacle by both the plain and the padded test (touching counts, as in
+/// the checks), as it is then in every state; one that touches stays, so
+/// every state is found in collision.
 fn scene_bodies(model: &RobotModel, world: &SceneGeometry) -> Vec<u16> {
     let links = model.chain().links();
     let mut poses = [Isometry3::identity(); MAX_BODIES];
@@ -600,9 +602,10 @@ impl StateChecker for SceneChecker {
     /// One pose of the robot answers both questions: the padded check with
     /// the tight pads along the piece (`SweepBound::pad_along`) asked only for bodies that
     /// have something within their global pads ([`SweepBound::pads`]); when
-    /// it fails, the failing pair alone is tested without pads (a full plain
-    /// check here made the padded search and shortcutting 5–10 % slower on
-    /// MotionBenchMaker: the proofs' states are rarely in collision).
+    /// it fails, only the pairs it met are tested without pads (see
+    /// `SceneChecker::hits_padded`; a full plain check here made the padded
+    /// search and shortcutting 5–10 % slower on MotionBenchMaker: the
+    /// proofs' states are rarely in collision).
     fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
         self.padded_verdict_sparing(q, half_step, &mut 0)
     }
