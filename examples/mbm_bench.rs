@@ -7,8 +7,11 @@
 //! tar xjf ../shared/bench/mbm/panda_problems.tar.bz2 -C target/mbm
 //! cargo build --release -p kinplan-core --example mbm_bench
 //! target/release/examples/mbm_bench target/mbm/problems [--passes 10] [--stomp 10]
-//!     [--clamp-fingers] [--out target/mbm_bench]
+//!     [--clamp-fingers] [--padded] [--set NAME] [--problems 3,17,42] [--out target/mbm_bench]
 //! ```
+//!
+//! `--problems` keeps only the listed problem numbers (say the band around a
+//! set's median, to profile what the median measures).
 //!
 //! Per problem: the scene is parsed and built once (`build` time, apart from
 //! planning); start and goal are checked with the state checker — a problem
@@ -19,7 +22,9 @@
 //! quantity VAMP's `result.nanoseconds` measures); shortcutting is timed
 //! apart. With `--passes N` every problem is planned N times (same seed, so
 //! the same path) and the per-problem median is the "robust" time, as the
-//! VAMP anchor script does.
+//! VAMP anchor script does; the per-problem minimum is written too
+//! (`search_min_us`, `search_min_median_us`), the least disturbed by other
+//! load when two builds are compared on a shared host.
 //!
 //! Independent check: every returned path is walked segment by segment at
 //! ≤ 0.01 rad per joint (all `ceil(span/0.01)` steps in order, ends
@@ -128,6 +133,9 @@ struct Row {
     fine_depth_mm: f64,
     search_us: f64,
     search_robust_us: f64,
+    /// Fastest of the passes: the least disturbed by other load on the
+    /// machine, for comparing two builds on a shared host.
+    search_min_us: f64,
     shortcut_us: f64,
     samples: usize,
     nodes: usize,
@@ -163,11 +171,13 @@ struct Args {
     shortcut_attempts: Option<usize>,
     /// Only this set (`None`: all).
     only_set: Option<String>,
+    /// Only these problem numbers (`None`: all), e.g. a median band to profile.
+    only_problems: Option<Vec<usize>>,
     out: PathBuf,
 }
 
 fn args() -> Result<Args, String> {
-    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--out PREFIX]";
+    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--problems N,N,...] [--out PREFIX]";
     let mut it = std::env::args().skip(1);
     let mut a = Args {
         root: PathBuf::new(),
@@ -179,6 +189,7 @@ fn args() -> Result<Args, String> {
         padded: false,
         shortcut_attempts: None,
         only_set: None,
+        only_problems: None,
         out: PathBuf::from("target/mbm_bench"),
     };
     let mut root = None;
@@ -208,6 +219,12 @@ fn args() -> Result<Args, String> {
                     .ok_or(format!("--resolution needs a number; {usage}"))?
             }
             "--set" => a.only_set = Some(it.next().ok_or(usage)?),
+            "--problems" => {
+                let list = it.next().ok_or(usage)?;
+                let numbers: Result<Vec<usize>, _> = list.split(',').map(str::parse).collect();
+                a.only_problems =
+                    Some(numbers.map_err(|_| format!("--problems needs numbers like 3,17,42; {usage}"))?);
+            }
             "--out" => a.out = PathBuf::from(it.next().ok_or(usage)?),
             _ if root.is_none() && !x.starts_with("--") => root = Some(PathBuf::from(x)),
             _ => return Err(usage.into()),
@@ -313,7 +330,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for k in 1..=100usize {
             let scene_path = dir.join(format!("scene{k:04}.yaml"));
             let request_path = dir.join(format!("request{k:04}.yaml"));
-            if !Path::new(&scene_path).exists() {
+            let wanted = a.only_problems.as_ref().is_none_or(|only| only.contains(&k));
+            if !wanted || !Path::new(&scene_path).exists() {
                 continue;
             }
             let scene_text = std::fs::read_to_string(&scene_path)?;
@@ -376,6 +394,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 row.search_us = times[0];
                 row.search_robust_us = median(&times);
+                row.search_min_us = times.iter().copied().fold(f64::INFINITY, f64::min);
                 row.shortcut_us = first.shortcut_ns as f64 / 1e3;
                 row.samples = first.samples;
                 row.nodes = first.nodes;
@@ -457,13 +476,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut csv = std::fs::File::create(a.out.with_extension("csv"))?;
     writeln!(
         csv,
-        "set,problem,build_us,start_valid,goal_valid,stop,solved,fine_valid,fine_depth_mm,search_us,search_robust_us,shortcut_us,samples,nodes,states_checked,waypoints,length_rad,padded_states"
+        "set,problem,build_us,start_valid,goal_valid,stop,solved,fine_valid,fine_depth_mm,search_us,search_robust_us,shortcut_us,samples,nodes,states_checked,waypoints,length_rad,padded_states,search_min_us"
     )?;
     for (set, rows) in &rows_by_set {
         for r in rows {
             writeln!(
                 csv,
-                "{set},{},{:.2},{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{},{},{},{},{:.6},{}",
+                "{set},{},{:.2},{},{},{},{},{},{:.3},{:.3},{:.3},{:.3},{},{},{},{},{:.6},{},{:.3}",
                 r.problem,
                 r.build_us,
                 r.start_ok,
@@ -480,7 +499,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 r.states,
                 r.waypoints,
                 r.length,
-                r.padded_states
+                r.padded_states,
+                r.search_min_us
             )?;
         }
         let valid: Vec<&Row> = rows.iter().filter(|r| r.start_ok && r.goal_ok).collect();
@@ -496,6 +516,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect();
         let t1: Vec<f64> = solved.iter().map(|r| r.search_us).collect();
         let tr: Vec<f64> = solved.iter().map(|r| r.search_robust_us).collect();
+        let tmin: Vec<f64> = solved.iter().map(|r| r.search_min_us).collect();
         let sc: Vec<f64> = solved.iter().map(|r| r.shortcut_us).collect();
         let bu: Vec<f64> = rows.iter().map(|r| r.build_us).collect();
         let len: Vec<f64> = solved.iter().map(|r| r.length).collect();
@@ -532,6 +553,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "search_p95_us": percentile(&t1, 95.0),
                 "search_robust_median_us": median(&tr),
                 "search_robust_p95_us": percentile(&tr, 95.0),
+                "search_min_median_us": median(&tmin),
                 "shortcut_median_us": median(&sc),
                 "build_median_us": median(&bu),
                 "length_median_rad": median(&len),

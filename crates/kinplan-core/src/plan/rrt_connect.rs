@@ -177,6 +177,7 @@ const LAZY_COARSENING: f64 = 4.0;
 /// where the edge was refused rather than from its midpoint a further
 /// 14–24 % on the bookshelves: a grown detour took ~0.3 ms, most of the
 /// proof's time in the median problems.)
+#[inline(never)] // one call per search; a named frame for profilers
 fn prove_lazily<C: StateChecker + ?Sized>(
     checker: &C,
     bounds: &[(f64, f64)],
