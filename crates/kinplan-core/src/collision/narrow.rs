@@ -127,9 +127,13 @@ pub(crate) fn body_body_contact(
 /// True when a body at `pa` overlaps a scene leaf.
 #[inline]
 pub(crate) fn body_leaf_intersect(a: &Body, pa: &Isometry3<f64>, center: &Vector3<f64>, leaf: &Leaf) -> bool {
-    if leaf.aabb.distance_squared(center) > a.radius * a.radius {
-        return false;
-    }
+    leaf.aabb.distance_squared(center) <= a.radius * a.radius && shapes_intersect_leaf(a, pa, leaf)
+}
+
+/// [`body_leaf_intersect`] without the bounding-sphere cull, for callers
+/// that culled the leaf with the same sphere already (the BVH query).
+#[inline]
+pub(crate) fn shapes_intersect_leaf(a: &Body, pa: &Isometry3<f64>, leaf: &Leaf) -> bool {
     a.shapes.iter().any(|sa| match overlap(&sa.fast, pa, &leaf.fast) {
         Some(hit) => hit,
         None => intersect(

@@ -19,7 +19,7 @@ use super::bvh::Aabb;
 use super::model::{JointAxis, MAX_BODIES, MAX_LINKS, RobotModel};
 use super::narrow::{
     Witness, body_body_contact, body_body_intersect, body_body_within, body_leaf_contact,
-    body_leaf_intersect, body_leaf_within, sphere_center,
+    body_leaf_intersect, body_leaf_within, shapes_intersect_leaf, sphere_center,
 };
 use super::sweep::SweepBound;
 use super::world::SceneGeometry;
@@ -246,8 +246,9 @@ impl SceneChecker {
         let centers = self.centers(poses);
         for &b in &self.scene_bodies {
             let (b, c) = (b as usize, &centers[b as usize]);
+            // the query's sphere is the body's: leaves arrive culled by it
             let free = self.world.bvh.for_each_near(c, bodies[b].radius, |leaf| {
-                !body_leaf_intersect(&bodies[b], &poses[b], c, &self.world.leaves[leaf as usize])
+                !shapes_intersect_leaf(&bodies[b], &poses[b], &self.world.leaves[leaf as usize])
             });
             if !free {
                 return true;
