@@ -35,6 +35,7 @@ mod convert;
 mod error;
 mod fast;
 mod fast_box;
+mod fixed_frame;
 mod model;
 mod moveit;
 mod narrow;
@@ -43,6 +44,7 @@ mod padded;
 mod scene;
 mod scene_checker;
 mod sweep;
+mod trig;
 mod world;
 
 pub use acm::{AcmParams, AllowReason, AllowedCollisions};

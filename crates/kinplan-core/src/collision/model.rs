@@ -11,7 +11,9 @@ use parry3d_f64::shape::SharedShape;
 
 use super::convert::{pose_to_parry, vec_to_parry};
 use super::fast::RobotFast;
+use super::fixed_frame::{FixedFrame, column, turned};
 use super::scene::{SceneLimits, validate_mesh};
+use super::trig::sin_cos;
 use super::world::primitive_shape;
 use super::{CollisionError, Geometry};
 use crate::robot::{Chain, CollisionShape, JointKind, Shape};
@@ -80,20 +82,18 @@ pub struct RobotModel {
     /// Each body's frame in the frame of the joint moving its link (the
     /// link's offset then the body's), composed once; `None` when it is the
     /// identity (the usual case: the body is the link's own geometry).
-    in_joint: Vec<Option<Isometry3<f64>>>,
+    in_joint: Vec<Option<FixedFrame>>,
     /// Each joint's fixed origin and motion, shaped for [`RobotModel::pose_bodies`].
     steps: Vec<JointStep>,
 }
 
 /// One joint of the chain as forward kinematics applies it: `frame =
-/// t · origin`, then the joint's motion. Most URDF origins turn by nothing
-/// and most revolute joints turn about their frame's z axis; both are
-/// applied without the general quaternion products.
+/// t · origin`, then the joint's motion. URDF origins are applied in the
+/// shape they have ([`FixedFrame`]) and most revolute joints turn about
+/// their frame's z axis; neither needs the general quaternion products.
 #[derive(Debug, Clone, Copy)]
 struct JointStep {
-    /// The origin's rotation, `None` when it is the identity.
-    rotation: Option<UnitQuaternion<f64>>,
-    translation: Vector3<f64>,
+    origin: FixedFrame,
     axis: nalgebra::Unit<Vector3<f64>>,
     kind: JointKind,
     /// A revolute joint about `+z` of its frame.
@@ -102,10 +102,8 @@ struct JointStep {
 
 impl JointStep {
     fn of(joint: &crate::robot::Joint) -> Self {
-        let rotation = joint.origin.rotation;
         JointStep {
-            rotation: (rotation != UnitQuaternion::identity()).then_some(rotation),
-            translation: joint.origin.translation.vector,
+            origin: FixedFrame::of(&joint.origin),
             axis: joint.axis,
             kind: joint.kind,
             about_z: joint.kind != JointKind::Prismatic && joint.axis.into_inner() == Vector3::z(),
@@ -113,19 +111,12 @@ impl JointStep {
     }
 }
 
-/// `r · Rz(v)` for a unit quaternion `r` (w, i, j, k): the product with
+/// `r · Rz(v)` for a unit quaternion `r`: the product with
 /// `(cos v/2, 0, 0, sin v/2)` written out.
 #[inline]
 fn turned_about_z(r: &UnitQuaternion<f64>, v: f64) -> UnitQuaternion<f64> {
-    let (s, c) = (0.5 * v).sin_cos();
-    let q = r.quaternion();
-    let (w, i, j, k) = (q.w, q.i, q.j, q.k);
-    UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(
-        w * c - k * s,
-        i * c + j * s,
-        j * c - i * s,
-        k * c + w * s,
-    ))
+    let (s, c) = sin_cos(0.5 * v);
+    turned(r, 2, c, s)
 }
 
 impl std::fmt::Debug for RobotModel {
@@ -218,7 +209,7 @@ impl RobotModel {
             .iter()
             .map(|b| {
                 let t = chain.links()[b.link].offset * b.offset;
-                (t != Isometry3::identity()).then_some(t)
+                Some(FixedFrame::of(&t)).filter(|f| !f.is_identity())
             })
             .collect();
         let steps = chain.joints().iter().map(JointStep::of).collect();
@@ -293,18 +284,15 @@ impl RobotModel {
             if let Some(j) = link.after_joint {
                 while applied <= j && applied < steps.len() {
                     let step = &steps[applied];
-                    // frame = t · origin
-                    let frame = Isometry3::from_parts(
-                        Translation3::from(t.translation.vector + t.rotation * step.translation),
-                        match &step.rotation {
-                            Some(r) => t.rotation * r,
-                            None => t.rotation,
-                        },
-                    );
+                    let frame = step.origin.after(&t);
                     if let Some(slot) = axes.as_deref_mut().and_then(|a| a.get_mut(applied)) {
                         *slot = JointAxis {
                             point: frame.translation.vector,
-                            direction: frame.rotation * step.axis.into_inner(),
+                            direction: if step.about_z {
+                                column(&frame.rotation, 2)
+                            } else {
+                                frame.rotation * step.axis.into_inner()
+                            },
                         };
                     }
                     let v = q.get(applied).copied().unwrap_or(0.0);
@@ -331,7 +319,7 @@ impl RobotModel {
             while next < self.by_link.len() && self.bodies[self.by_link[next]].link == li {
                 let b = self.by_link[next];
                 out[b] = match &self.in_joint[b] {
-                    Some(offset) => t * offset,
+                    Some(offset) => offset.after(&t),
                     None => t,
                 };
                 next += 1;
