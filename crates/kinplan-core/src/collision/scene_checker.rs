@@ -7,8 +7,9 @@
 //! bounding sphere, leaves are culled by sphere–box distance, and parry's
 //! exact test runs on the survivors; then the checked self pairs, culled by
 //! sphere–sphere distance. Bodies fixed to the base are tested against the
-//! scene once, when the checker is built. Nothing is allocated, so checkers are shared
-//! freely between rayon threads.
+//! scene once, when the checker is built, and moving bodies whose reach
+//! meets no obstacle not at all (`scene_bodies`). Nothing is allocated, so
+//! checkers are shared freely between rayon threads.
 
 use std::sync::Arc;
 
@@ -24,6 +25,7 @@ use super::narrow::{
 use super::sweep::SweepBound;
 use super::world::SceneGeometry;
 use super::{CollisionError, MotionCheck, PadVerdict, StateChecker};
+use crate::robot::JointKind;
 
 /// Joints of the chains whose padded checks keep their axes in a small buffer.
 const SMALL_CHAIN: usize = 16;
@@ -165,8 +167,8 @@ pub struct SceneChecker {
     /// Body pairs tested for self-collision, `a < b`.
     self_pairs: Vec<(u16, u16)>,
     /// Bodies tested against the scene, distal first (the likeliest to hit
-    /// something): every body but those fixed to the base and clear of the
-    /// scene, which no state can change.
+    /// something): every body but those no state can bring to an obstacle
+    /// ([`scene_bodies`]).
     scene_bodies: Vec<u16>,
     params: CheckerParams,
     /// How far bodies move per joint step (`None`: unbounded, cannot pad).
@@ -195,7 +197,7 @@ impl SceneChecker {
         if params.padded_motion && sweep.is_none() {
             return Err(CollisionError::CannotPad);
         }
-        let scene_bodies = scene_bodies(&model, &world);
+        let scene_bodies = scene_bodies(&model, &world, sweep.as_ref());
         Ok(SceneChecker {
             model,
             world,
@@ -510,21 +512,41 @@ impl SceneChecker {
     }
 }
 
-/// The bodies a [`SceneChecker`] tests against the scene, distal first:
-/// a body fixed to the base is left out when it is clear of every
-/// obstacle by both the plain and the padded test (touching counts, as in
-/// the checks), as it is then in every state; one that touches stays, so
-/// every state is found in collision.
-fn scene_bodies(model: &RobotModel, world: &SceneGeometry) -> Vec<u16> {
-    let links = model.chain().links();
+/// The bodies a [`SceneChecker`] tests against the scene, distal first.
+/// Left out are the bodies no state can bring to an obstacle:
+///
+/// * a body fixed to the base that is clear of every obstacle by both the
+///   plain and the padded test (touching counts, as in the checks); one
+///   that touches stays, so every state is found in collision;
+/// * a moving body whose reach is clear of every obstacle's box: when the
+///   first joint turns, every point of body `b` stays within its lever
+///   `L_{0,b}` ([`SweepBound`]) of that joint's origin, whatever the
+///   state, so a body whose sphere of that radius meets no box never
+///   touches the scene (a shoulder link far from a shelf; padded checks
+///   then accept at least what they accepted with it).
+fn scene_bodies(model: &RobotModel, world: &SceneGeometry, sweep: Option<&SweepBound>) -> Vec<u16> {
+    let chain = model.chain();
+    let links = chain.links();
     let mut poses = [Isometry3::identity(); MAX_BODIES];
-    model.body_poses(&vec![0.0; model.chain().dof()], &mut poses);
+    let mut axes = vec![JointAxis::default(); chain.dof()];
+    model.body_poses_and_axes(&vec![0.0; chain.dof()], &mut poses, &mut axes);
+    // The first joint's origin, where every moving body's reach is centred
+    // (no joint moves it), when that joint turns.
+    let anchor = chain
+        .joints()
+        .first()
+        .filter(|j| j.kind != JointKind::Prismatic)
+        .and(axes.first().map(|a| a.point));
     (0..model.bodies.len())
         .rev()
         .filter(|&b| {
             let body = &model.bodies[b];
             if links[body.link].after_joint.is_some() {
-                return true;
+                let reach = sweep.map(|s| s.lever(b, 0)).filter(|r| *r > 0.0);
+                return match (anchor, reach) {
+                    (Some(anchor), Some(reach)) => !world.bvh.for_each_near(&anchor, reach, |_| false),
+                    _ => true,
+                };
             }
             let c = sphere_center(body, &poses[b]);
             let clear = world

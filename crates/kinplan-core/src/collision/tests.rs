@@ -6,8 +6,11 @@ use std::sync::Arc;
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
 use super::*;
-use crate::robot::{ChainSpec, UrdfLimits, parse_chain};
+use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
 mod robot;
 mod sweep;
@@ -322,6 +325,58 @@ fn validity_and_clearance_together_equal_the_two_queries() {
             );
         }
     }
+}
+
+#[test]
+fn bodies_out_of_reach_of_every_obstacle_are_skipped_without_changing_a_verdict() {
+    // A 20 cm box where the Panda's hand and forearm reach (0.6 m out, at
+    // the shoulder's height) but its shoulder links (within 0.5 m of joint
+    // 1's origin) never do: the checker leaves those out of its scene
+    // tests; every verdict must still be that of the report, which tests
+    // every body against every obstacle.
+    let chain = builtin_chain("franka_panda").unwrap();
+    let model = Arc::new(RobotModel::new(chain.clone()).unwrap());
+    let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
+    let block = Obstacle::new(
+        "block",
+        Isometry3::translation(0.6, 0.0, 0.4),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.1),
+        },
+    );
+    let world =
+        Arc::new(SceneGeometry::build(&Scene::new(vec![block], &SceneLimits::default()).unwrap()).unwrap());
+    let checker = SceneChecker::new(model, &acm, world, CheckerParams::default()).unwrap();
+    let sweep = SweepBound::new(checker.model()).unwrap();
+    // link 1's reach from joint 1's origin (0, 0, 0.333) stops short of the box
+    assert!(sweep.lever(1, 0) < 0.5 - 0.1, "{}", sweep.lever(1, 0));
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let (mut valid, mut invalid) = (0, 0);
+    for _ in 0..3000 {
+        let q: Vec<f64> = chain
+            .joints()
+            .iter()
+            .map(|j| rng.random_range(j.lower..=j.upper))
+            .collect();
+        let expected = checker.report(&q).unwrap().is_valid();
+        assert_eq!(checker.is_valid(&q), expected, "{q:?}");
+        if expected {
+            valid += 1;
+        } else if checker
+            .report(&q)
+            .unwrap()
+            .collisions
+            .iter()
+            .any(|(_, o)| matches!(o, Part::Obstacle { .. }))
+        {
+            invalid += 1;
+        }
+    }
+    eprintln!("valid {valid}, hitting the box {invalid}");
+    assert!(
+        valid > 100 && invalid > 30,
+        "valid {valid}, hitting the box {invalid}"
+    );
 }
 
 #[test]

@@ -688,15 +688,19 @@ fn halves_that_skip_the_parts_proved_over_their_piece_accept_more_and_stay_sound
 fn a_padded_check_reports_the_bodies_it_proved_and_skips_those_given() {
     // The two-link arm stretched along x; a 2 cm cube 2 cm beside link 2's
     // sphere (centre 1.3 m out): turning joint 2 by ±0.1 rad may bring the
-    // sphere 3.5 cm sideways, so link 2 is not proved, link 1 is.
-    let cube = Obstacle::new(
-        "cube",
-        Isometry3::translation(1.3, 0.08, 0.0),
-        Geometry::Box {
-            half_extents: Vector3::repeat(0.01),
-        },
-    );
-    let checker = checker_with(model_of(TWO_LINK), vec![cube], true);
+    // sphere 3.5 cm sideways, so link 2 is not proved. A second cube 19 cm
+    // beside link 1's sphere, within its reach: joint 1 does not move, so
+    // link 1 is proved.
+    let cube = |x: f64, y: f64| {
+        Obstacle::new(
+            "cube",
+            Isometry3::translation(x, y, 0.0),
+            Geometry::Box {
+                half_extents: Vector3::repeat(0.01),
+            },
+        )
+    };
+    let checker = checker_with(model_of(TWO_LINK), vec![cube(1.3, 0.08), cube(0.5, 0.3)], true);
     let (q, half) = ([0.0, 0.0], [0.0, 0.1]);
     let mut proved = 0u64;
     assert_eq!(
