@@ -655,10 +655,14 @@ impl StateChecker for SceneChecker {
         self.model.body_poses_and_axes(q, &mut poses, axes);
         let mut coarse = [0.0; MAX_BODIES];
         sweep.pads(half_step, &mut coarse);
+        // the piece's prefix sums, once, when a first body needs its tight pad
+        let mut sums = None;
         let tight = |b: usize| {
-            sweep
-                .pad_along(&self.model, b, &poses[b], axes, half_step)
-                .min(coarse[b])
+            let pad = match sums.get_or_insert_with(|| sweep.piece_sums(axes, half_step)) {
+                Some(sums) => sweep.pad_along_with(&self.model, b, &poses[b], axes, half_step, sums),
+                None => sweep.pad_along(&self.model, b, &poses[b], axes, half_step),
+            };
+            pad.min(coarse[b])
         };
         Some(match self.hits_padded(&poses, &coarse, tight, proved) {
             PadHit::Clear => PadVerdict::Free,

@@ -51,6 +51,12 @@
 //! `P_j L_{j,b} + S_j`, so `|d/ds (ω_j × (x − o_j))| ≤ 2 P_j L_{j,b} + S_j`).
 //! The vector sum is what tightens it: the joints of an arm push a point
 //! in different directions, so `|v|` is often well below `Σ_j |d_j| ρ_{j,b}`.
+//!
+//! In a serial chain the joints moving body `b` are the first ones, `0..=k_b`,
+//! so the sums are prefix sums, shared by every body of a piece
+//! ([`PieceSums`]): `v = Ω_{k_b} × c − M_{k_b}` with `Ω_k = Σ_{j≤k} d_j ω_j`,
+//! `M_k = Σ_{j≤k} d_j ω_j × o_j`, and `A = Σ_{j≤k_b} L_{j,b} w_j` with
+//! `w_j = |d_j| (3 P_j + |d_j|)` (the two terms of `A` regrouped by joint).
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
@@ -65,6 +71,21 @@ pub struct SweepBound {
     levers: Vec<f64>,
     /// Joints that translate instead of turning.
     prismatic: Vec<bool>,
+    /// The last joint moving each body (`None`: fixed to the base).
+    last: Vec<Option<usize>>,
+}
+
+/// Chains up to this many joints (arms have 6 or 7) share their prefix sums ([`PieceSums`]);
+/// longer ones bound each body on its own.
+const SHARED_SUMS: usize = 8;
+
+/// The prefix sums of one piece `m + s·d` that [`SweepBound::pad_along`]
+/// needs for every body (module doc): `Ω_k`, `M_k` and the weights `w_j`.
+#[derive(Debug, Clone)]
+pub(crate) struct PieceSums {
+    omega: [Vector3<f64>; SHARED_SUMS],
+    moment: [Vector3<f64>; SHARED_SUMS],
+    weight: [f64; SHARED_SUMS],
 }
 
 impl SweepBound {
@@ -98,10 +119,16 @@ impl SweepBound {
             }
         }
         let prismatic = joints.iter().map(|j| j.kind == JointKind::Prismatic).collect();
+        let last = model
+            .bodies
+            .iter()
+            .map(|body| links[body.link].after_joint.map(|j| j.min(dof.max(1) - 1)))
+            .collect();
         levers.iter().all(|v| v.is_finite()).then_some(SweepBound {
             dof,
             levers,
             prismatic,
+            last,
         })
     }
 
@@ -180,8 +207,72 @@ impl SweepBound {
     /// hold as well; callers may take the smaller. `pad_at` is not asked
     /// besides: on pieces of a few resolutions it is rarely the smaller and
     /// costs a square root per joint (MotionBenchMaker padded search 9 %
-    /// faster without it).
+    /// faster without it). Callers asking for several bodies of one piece
+    /// share the sums: [`SweepBound::piece_sums`], [`SweepBound::pad_along_with`].
     pub(crate) fn pad_along(
+        &self,
+        model: &RobotModel,
+        b: usize,
+        pose: &Isometry3<f64>,
+        axes: &[JointAxis],
+        d: &[f64],
+    ) -> f64 {
+        match self.piece_sums(axes, d) {
+            Some(sums) => self.pad_along_with(model, b, pose, axes, d, &sums),
+            None => self.pad_along_alone(model, b, pose, axes, d),
+        }
+    }
+
+    /// The prefix sums of the piece `m + s·d` (joints' axes at `m` in
+    /// `axes`); `None` for chains longer than [`SHARED_SUMS`] joints.
+    pub(crate) fn piece_sums(&self, axes: &[JointAxis], d: &[f64]) -> Option<PieceSums> {
+        if self.dof > SHARED_SUMS || axes.len() < self.dof || d.len() < self.dof {
+            return None;
+        }
+        let mut sums = PieceSums {
+            omega: [Vector3::zeros(); SHARED_SUMS],
+            moment: [Vector3::zeros(); SHARED_SUMS],
+            weight: [0.0; SHARED_SUMS],
+        };
+        let (mut omega, mut moment, mut prefix) = (Vector3::zeros(), Vector3::zeros(), 0.0);
+        for j in 0..self.dof {
+            let (dj, axis) = (d[j], &axes[j]);
+            let turn = axis.direction * dj;
+            omega += turn;
+            moment += turn.cross(&axis.point);
+            let h = dj.abs();
+            (sums.omega[j], sums.moment[j], sums.weight[j]) = (omega, moment, h * (3.0 * prefix + h));
+            prefix += h;
+        }
+        Some(sums)
+    }
+
+    /// [`SweepBound::pad_along`] from the piece's shared sums.
+    pub(crate) fn pad_along_with(
+        &self,
+        model: &RobotModel,
+        b: usize,
+        pose: &Isometry3<f64>,
+        axes: &[JointAxis],
+        d: &[f64],
+        sums: &PieceSums,
+    ) -> f64 {
+        let Some(k) = self.last[b].filter(|_| self.dof > 0) else {
+            return 0.0; // fixed to the base
+        };
+        if self.prismatic[..=k].iter().any(|&p| p) {
+            return self.pad_at(model, b, pose, axes, d);
+        }
+        let levers = &self.levers[b * self.dof..=b * self.dof + k];
+        let body = &model.bodies[b];
+        let centre = (pose * Point3::from(body.center)).coords;
+        let v = sums.omega[k].cross(&centre) - sums.moment[k];
+        let accel: f64 = levers.iter().zip(&sums.weight[..=k]).map(|(l, w)| l * w).sum();
+        v.norm() + sums.omega[k].norm() * body.radius + 0.5 * accel
+    }
+
+    /// [`SweepBound::pad_along`] summing over the joints for this body alone.
+    fn pad_along_alone(
         &self,
         model: &RobotModel,
         b: usize,
