@@ -271,8 +271,9 @@ impl SweepBound {
         v.norm() + sums.omega[k].norm() * body.radius + 0.5 * accel
     }
 
-    /// [`SweepBound::pad_along`] summing over the joints for this body alone.
-    fn pad_along_alone(
+    /// [`SweepBound::pad_along`] summing over the joints for this body alone
+    /// (chains longer than [`SHARED_SUMS`] joints).
+    pub(crate) fn pad_along_alone(
         &self,
         model: &RobotModel,
         b: usize,

@@ -625,6 +625,15 @@ fn the_bound_along_a_piece_holds_for_its_states_and_is_tighter_than_the_box() {
         let boxed: Vec<f64> = (0..model.body_count())
             .map(|b| sweep.pad_at(&model, b, &at_m[b], &axes, &d))
             .collect();
+        // the sums shared by a piece's bodies and the sum over one body's
+        // joints are the same bound, regrouped (the latter serves long chains)
+        for (b, shared) in along.iter().enumerate() {
+            let alone = sweep.pad_along_alone(&model, b, &at_m[b], &axes, &d);
+            assert!(
+                (shared - alone).abs() <= 1e-12 * (1.0 + alone),
+                "body {b}: {shared} vs {alone}"
+            );
+        }
         for i in -20..=20 {
             let s = f64::from(i) / 20.0;
             let q: Vec<f64> = m.iter().zip(&d).map(|(x, dj)| x + s * dj).collect();
