@@ -48,21 +48,22 @@ impl Aabb {
         }
     }
 
-    /// Whether the boxes meet (touching counts). The six comparisons are
+    /// Whether the boxes meet (touching counts; a NaN bound counts as
+    /// meeting, so a broken query is never culled). The six comparisons are
     /// combined with `&`, not `&&`: one branch instead of six hard-to-predict
     /// ones on the BVH's hottest line.
     #[inline]
     pub fn intersects(&self, o: &Aabb) -> bool {
-        (self.min.x <= o.max.x)
-            & (o.min.x <= self.max.x)
-            & (self.min.y <= o.max.y)
-            & (o.min.y <= self.max.y)
-            & (self.min.z <= o.max.z)
-            & (o.min.z <= self.max.z)
+        !(self.min.x > o.max.x)
+            & !(o.min.x > self.max.x)
+            & !(self.min.y > o.max.y)
+            & !(o.min.y > self.max.y)
+            & !(self.min.z > o.max.z)
+            & !(o.min.z > self.max.z)
     }
 
-    /// Squared distance from `p` to the box (0 inside; 0 when `p` has a
-    /// NaN coordinate, so a broken query is never culled). Plain comparisons
+    /// Squared distance from `p` to the box (0 inside; a NaN coordinate of
+    /// `p` adds nothing, so a broken query is never culled on its axis). Plain comparisons
     /// rather than `f64::max`, whose NaN rule costs extra instructions on
     /// this hot path (half the BVH's work).
     #[inline]
@@ -194,6 +195,8 @@ impl Bvh {
     /// Calls `visit(item)` for every item whose box lies within `radius` of
     /// `center` (the sphere test is tighter than its bounding box at the
     /// corners), until `visit` returns `false`. Returns `false` when stopped.
+    /// A NaN centre coordinate matches every box along its axis and a NaN
+    /// radius every box (never a silent "nothing near").
     #[inline]
     pub fn for_each_near(
         &self,
@@ -220,7 +223,7 @@ impl Bvh {
                 let s = node.start as usize;
                 let e = s + node.count as usize;
                 for (item, aabb) in self.order[s..e].iter().zip(&self.sorted[s..e]) {
-                    if aabb.distance_squared(center) <= r2 && !visit(*item) {
+                    if !(aabb.distance_squared(center) > r2) && !visit(*item) {
                         return false;
                     }
                 }
@@ -329,6 +332,46 @@ mod tests {
                 .collect();
             assert_eq!(found, expected);
         }
+    }
+
+    #[test]
+    fn a_sphere_query_reports_exactly_the_boxes_within_its_radius() {
+        // The grid of the test above; a box is within r of c when the point
+        // of the box nearest c (c clamped into it) is within r.
+        let mut boxes = Vec::new();
+        for i in 0..1000 {
+            let c = Vector3::new((i % 10) as f64, ((i / 10) % 10) as f64, (i / 100) as f64) * 1.5;
+            boxes.push(Aabb::around_sphere(&c, 0.5));
+        }
+        let bvh = Bvh::build(&boxes);
+        let near = |c: &Vector3<f64>, r: f64| {
+            let mut found = Vec::new();
+            bvh.for_each_near(c, r, |i| {
+                found.push(i);
+                true
+            });
+            found.sort();
+            found
+        };
+        for (k, r) in [0.1, 0.7, 1.3, 2.0, 6.0].iter().enumerate() {
+            let c = Vector3::new(3.3 + k as f64, 4.1, 7.9 - k as f64);
+            let expected: Vec<u32> = (0..1000u32)
+                .filter(|&i| {
+                    let b = &boxes[i as usize];
+                    let nearest = c.zip_zip_map(&b.min, &b.max, |v, lo, hi| v.clamp(lo, hi));
+                    (nearest - c).norm() <= *r
+                })
+                .collect();
+            assert!(!expected.is_empty() || *r < 0.5);
+            assert_eq!(near(&c, *r), expected, "r = {r}");
+        }
+        // a broken query is never answered "nothing near": a NaN coordinate
+        // stands for any value on its axis, a NaN radius for any radius
+        let all: Vec<u32> = (0..1000).collect();
+        assert_eq!(near(&Vector3::repeat(f64::NAN), 0.1), all);
+        assert_eq!(near(&Vector3::new(3.0, 4.0, 5.0), f64::NAN), all);
+        let row: Vec<u32> = (0..10).collect(); // the boxes along x at y = z = 0
+        assert_eq!(near(&Vector3::new(f64::NAN, 0.0, 0.0), 0.1), row);
     }
 
     #[test]
