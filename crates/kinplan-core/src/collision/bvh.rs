@@ -53,6 +53,7 @@ impl Aabb {
     /// combined with `&`, not `&&`: one branch instead of six hard-to-predict
     /// ones on the BVH's hottest line.
     #[inline]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(a > b)`: true for NaN, on purpose
     pub fn intersects(&self, o: &Aabb) -> bool {
         !(self.min.x > o.max.x)
             & !(o.min.x > self.max.x)
@@ -198,6 +199,7 @@ impl Bvh {
     /// A NaN centre coordinate matches every box along its axis and a NaN
     /// radius every box (never a silent "nothing near").
     #[inline]
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(d² > r²)`: true for NaN, on purpose
     pub fn for_each_near(
         &self,
         center: &Vector3<f64>,
