@@ -25,7 +25,9 @@ pub use error::{PlanError, PlanField};
 pub use params::{CartesianParams, InitialTrajectory, RrtParams, StompParams};
 pub use rrt_connect::{RrtOutcome, RrtStop, rrt_connect};
 pub use stomp::{IterationReport, StompOutcome, StompStop};
-pub use stomp_matrices::{ACCELERATION_STENCIL, PADDING, StompMatrices, finite_difference_matrix};
+pub use stomp_matrices::{
+    ACCELERATION_STENCIL, MatricesError, PADDING, StompMatrices, finite_difference_matrix,
+};
 pub use timing::{MIN_SEGMENT_TIME, TimingParams, time_parameterize};
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ use super::cartesian::{CartesianLine, Deviation, cartesian_noise, noise_ik_param
 use super::clock::{Clock, Interrupt};
 use super::costs::{CostModel, Evaluation, resolution_of};
 use super::noise::{standard_normal, stream};
-use super::stomp_matrices::StompMatrices;
+use super::stomp_matrices::{MatricesError, StompMatrices};
 use super::{CartesianParams, StompParams};
 use crate::collision::StateChecker;
 use crate::ik::IkSolver;
@@ -105,7 +105,22 @@ pub(crate) fn stomp_optimize<C: StateChecker + ?Sized>(
     let dof = chain.dof();
     let n = params.timesteps;
     let free = n - 2;
-    let mats = StompMatrices::new(free, 1.0).expect("R is positive definite for every size >= 1");
+    let mats = match StompMatrices::new(free, &|| clock.interrupted().is_some()) {
+        Ok(m) => m,
+        Err(MatricesError::Stopped | MatricesError::Empty) => {
+            // Validated parameters have free ≥ 1: only an interruption lands here.
+            return StompOutcome {
+                trajectory: initial.to_vec(),
+                valid: false,
+                cost_history: Vec::new(),
+                iterations: 0,
+                first_valid: None,
+                stop: interrupt_stop(clock.interrupted().unwrap_or(Interrupt::Deadline)),
+                deviation: Vec::new(),
+                noise_ik: (0, 0),
+            };
+        }
+    };
     let model = CostModel {
         chain,
         checker,
@@ -145,6 +160,7 @@ pub(crate) fn stomp_optimize<C: StateChecker + ?Sized>(
     let mut iterations = 0;
     let mut weights = vec![0.0; params.max_rollouts + 1];
     let mut delta = vec![DVector::<f64>::zeros(free); dof];
+    let mut update = DVector::<f64>::zeros(free);
     let should_stop = clock.should_stop;
     let ik_stop = move || clock.interrupted().is_some() || should_stop();
 
@@ -198,8 +214,7 @@ pub(crate) fn stomp_optimize<C: StateChecker + ?Sized>(
                             for v in slot.z.iter_mut() {
                                 *v = standard_normal(&mut rng);
                             }
-                            slot.x
-                                .gemv(params.stddev(d), &mats.covariance_factor, &slot.z, 0.0);
+                            mats.sample_noise(params.stddev(d), &slot.z, &mut slot.x);
                             for t in 0..free {
                                 slot.eps[(t + 1) * dof + d] = slot.x[t];
                             }
@@ -254,7 +269,7 @@ pub(crate) fn stomp_optimize<C: StateChecker + ?Sized>(
         // θ' = θ + M δθ, clamped into the limits.
         cand_q.copy_from_slice(&theta);
         for (d, dv) in delta.iter().enumerate() {
-            let update = &mats.m * dv;
+            mats.project(dv, &mut update);
             let (lo, hi) = model.limits[d];
             for t in 0..free {
                 let v = &mut cand_q[(t + 1) * dof + d];

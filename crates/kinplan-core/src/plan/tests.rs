@@ -155,6 +155,35 @@ fn a_10_ms_budget_answers_within_about_10_ms() {
     }
 }
 
+/// Regression: STOMP's setup was cubic in the timesteps and could not be
+/// interrupted (10,000 timesteps answered long after any deadline and held
+/// gigabytes). The banded matrices build in linear memory and poll the clock.
+#[test]
+fn stomp_with_the_most_timesteps_answers_by_its_deadline() {
+    let chain = planar3();
+    let w = PlanarWorld::planar3_blocked();
+    for budget_ms in [5, 60] {
+        let mut req = blocked_request(Algorithm::Stomp);
+        req.stomp.timesteps = 10_000;
+        req.stomp.initial = InitialTrajectory::StraightLine;
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let t0 = Instant::now();
+        let r = pool.install(|| {
+            let ctl = PlanControl {
+                deadline: Some(t0 + Duration::from_millis(budget_ms)),
+                ..Default::default()
+            };
+            plan(&chain, &w, &req, ctl).unwrap()
+        });
+        let took = t0.elapsed();
+        assert!(
+            took < Duration::from_millis(budget_ms + 40),
+            "{budget_ms} ms budget took {took:?}"
+        );
+        assert_eq!(r.status, PlanStatus::Timeout, "{budget_ms} ms budget");
+    }
+}
+
 #[test]
 fn cancellation_is_a_status() {
     let chain = planar3();
