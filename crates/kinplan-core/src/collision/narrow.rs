@@ -38,8 +38,14 @@ fn intersect(p1: &Pose, s1: &SharedShape, p2: &Pose, s2: &SharedShape) -> bool {
     query::intersection_test(p1, &**s1, p2, &**s2).map_or(true, |i| i.intersecting)
 }
 
+/// The contact of two parry shapes when their signed distance is below
+/// `margin`. A nearest-pair search passes the best distance so far as the
+/// margin, which is a negative penetration depth once a pair overlaps; parry's
+/// prediction distance must not be negative (a mesh loosens its boxes by
+/// it), so parry is asked with `max(margin, 0)` and deeper-or-not is left to
+/// the caller, which keeps the smallest distance.
 fn contact(p1: &Pose, s1: &SharedShape, p2: &Pose, s2: &SharedShape, margin: f64) -> Option<Witness> {
-    match query::contact(p1, &**s1, p2, &**s2, margin) {
+    match query::contact(p1, &**s1, p2, &**s2, margin.max(0.0)) {
         Ok(Some(c)) => Some(Witness {
             distance: c.dist,
             a: point_from_parry(c.point1),

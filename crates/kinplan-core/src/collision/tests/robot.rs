@@ -387,3 +387,44 @@ fn body_poses_equal_the_chains_link_frames_for_every_builtin_robot() {
     }
     assert!(robots >= 8, "only {robots} builtin robots have a collision model");
 }
+
+/// Regression: a state that penetrates two obstacles panicked in parry
+/// ("loosening margin must be non-negative") when the deeper search passed the
+/// first penetration depth on to a mesh as its prediction distance. The
+/// clearance is the deeper of the two penetrations, whichever comes first.
+#[test]
+fn a_state_penetrating_a_mesh_and_a_sphere_has_a_clearance_in_either_order() {
+    let at = Isometry3::translation(-0.4223, -0.1914, 0.4184);
+    let tetra = || {
+        Obstacle::new(
+            "tetra",
+            at,
+            Geometry::Mesh {
+                vertices: vec![
+                    Point3::new(0.0, 0.0, 0.0),
+                    Point3::new(0.1, 0.0, 0.0),
+                    Point3::new(0.0, 0.1, 0.0),
+                    Point3::new(0.0, 0.0, 0.1),
+                ],
+                indices: vec![0, 1, 2, 0, 1, 3, 0, 2, 3, 1, 2, 3],
+            },
+        )
+    };
+    let sphere = || Obstacle::new("ball", at, Geometry::Sphere { radius: 0.05 });
+    let q = [0.0, -1.5, 1.5, 0.0, 0.0, 0.0];
+    let mut depths = Vec::new();
+    for obstacles in [vec![tetra(), sphere()], vec![sphere(), tetra()]] {
+        let model = Arc::new(RobotModel::new(builtin_chain("ur5").unwrap()).unwrap());
+        let acm = AllowedCollisions::adjacent(&model);
+        let scene = Scene::new(obstacles, &SceneLimits::default()).unwrap();
+        let world = Arc::new(SceneGeometry::build(&scene).unwrap());
+        let c = SceneChecker::new(model, &acm, world, CheckerParams::default()).unwrap();
+        assert!(c.in_collision(&q));
+        let d = c.clearance(&q, 0.5);
+        assert!(d < 0.0, "a penetrating state has a negative clearance, got {d}");
+        let p = c.proximity(&q, 0.5).unwrap().unwrap();
+        assert!(p.distance <= d + 1e-12);
+        depths.push(d);
+    }
+    assert!((depths[0] - depths[1]).abs() < 1e-9, "order changed the depth: {depths:?}");
+}
