@@ -33,7 +33,11 @@ pub enum OctreeError {
     #[error("{field} is not finite")]
     NonFinite { field: &'static str },
     #[error("scan beams could cross {cells} cells, more than the limit {limit}")]
-    ScanTooLarge { cells: u64, limit: usize },
+    ScanTooLarge { cells: u64, limit: u64 },
+    #[error("scan updates at least {cells} distinct cells, more than the tree's limit of {limit} nodes")]
+    ScanTooManyCells { cells: u64, limit: usize },
+    #[error("the scan grew the tree past its limit of {limit} nodes")]
+    TreeGrewTooLarge { limit: usize },
     #[error("{field}: expected {expected} values, got {got}")]
     WrongLength {
         field: &'static str,

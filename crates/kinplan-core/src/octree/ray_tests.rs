@@ -265,3 +265,111 @@ fn insert_scan_gives_octomaps_tree_byte_for_byte() {
     let theirs = Octree::read_ot(expected, &OctreeLimits::default()).unwrap();
     assert_eq!(theirs.write_bt(), t.write_bt());
 }
+
+/// `n` points on a sphere of radius `r` (m) about the origin, by a golden-angle spiral.
+fn sphere_points(n: usize, r: f32) -> Vec<[f32; 3]> {
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let rho = (1.0 - z * z).sqrt();
+            let phi = i as f32 * 2.399_963;
+            [r * rho * phi.cos(), r * rho * phi.sin(), r * z]
+        })
+        .collect()
+}
+
+/// Regression: 300 points on a 300 m sphere at 1 cm (a 3.6 KB request) grew the
+/// tree to 27 million nodes before the node limit was looked at. The distinct
+/// cells are now counted as the beams are traced, batch by batch, and the scan is
+/// refused once they pass the limit — with the tree unchanged.
+#[test]
+fn a_scan_with_more_cells_than_the_node_limit_is_refused_while_traced() {
+    let mut t = Octree::new(0.01).unwrap();
+    let p = ScanParams {
+        max_nodes: 5_000_000,
+        ..ScanParams::default()
+    };
+    let t0 = std::time::Instant::now();
+    let err = t
+        .insert_scan(&sphere_points(300, 300.0), &[0.0; 3], &p, &|| false)
+        .unwrap_err();
+    assert!(
+        matches!(err, OctreeError::ScanTooManyCells { limit: 5_000_000, .. }),
+        "{err}"
+    );
+    assert!(t.is_empty(), "a refused scan leaves the tree unchanged");
+    assert!(t0.elapsed() < std::time::Duration::from_secs(5), "took {:?}", t0.elapsed());
+}
+
+#[test]
+fn a_scan_whose_beams_cross_too_many_cells_is_refused_before_tracing() {
+    let mut t = Octree::new(0.1).unwrap();
+    // one beam of 10 cells along x: 11 cells counted (‖Δkey‖₁ + 1)
+    let p = ScanParams {
+        max_traced_cells: 10,
+        ..ScanParams::default()
+    };
+    let calls = std::sync::atomic::AtomicUsize::new(0);
+    let stop = || {
+        calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        false
+    };
+    let err = t
+        .insert_scan(&[[1.05, 0.05, 0.05]], &[0.05, 0.05, 0.05], &p, &stop)
+        .unwrap_err();
+    assert_eq!(err, OctreeError::ScanTooLarge { cells: 11, limit: 10 });
+    assert_eq!(calls.into_inner(), 0, "refused before any beam was traced");
+    let ok = ScanParams {
+        max_traced_cells: 11,
+        ..ScanParams::default()
+    };
+    let s = t
+        .insert_scan(&[[1.05, 0.05, 0.05]], &[0.05, 0.05, 0.05], &ok, &|| false)
+        .unwrap();
+    assert_eq!((s.free_cells, s.occupied_cells), (10, 1));
+}
+
+#[test]
+fn the_update_stops_when_the_tree_passes_its_node_limit() {
+    // three cells in a row below one path from the root:
+    // 20 in all
+    let mut t = Octree::new(0.1).unwrap();
+    let p = ScanParams {
+        max_nodes: 19,
+        ..ScanParams::default()
+    };
+    let err = t
+        .insert_scan(&[[0.25, 0.05, 0.05]], &[0.05, 0.05, 0.05], &p, &|| false)
+        .unwrap_err();
+    assert_eq!(err, OctreeError::TreeGrewTooLarge { limit: 19 });
+    // the same scan fits a limit of 20 nodes
+    let mut t = Octree::new(0.1).unwrap();
+    let p = ScanParams {
+        max_nodes: 20,
+        ..ScanParams::default()
+    };
+    let s = t
+        .insert_scan(&[[0.25, 0.05, 0.05]], &[0.05, 0.05, 0.05], &p, &|| false)
+        .unwrap();
+    assert_eq!(s.nodes, 20);
+}
+
+#[test]
+fn a_long_scan_stops_within_a_chunk_of_its_stop_flag() {
+    // 2,000 beams of about 2,000 cells: 4 million cells, dozens of chunks on each
+    // path; the flag rises after the third look
+    for dense_limit_cells in [1 << 27, 0] {
+        let mut t = Octree::new(0.01).unwrap();
+        let p = ScanParams {
+            dense_limit_cells,
+            ..ScanParams::default()
+        };
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        let stop = || calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= 3;
+        let s = t
+            .insert_scan(&sphere_points(2_000, 12.0), &[0.0; 3], &p, &stop)
+            .unwrap();
+        assert_eq!(s.status, ScanStatus::Cancelled);
+        assert!(t.is_empty(), "stopped while tracing: the tree is unchanged");
+    }
+}

@@ -8,7 +8,7 @@ use nalgebra::{Isometry3, Point3};
 use rayon::prelude::*;
 
 use super::key::OcKey;
-use super::{Octree, OctreeError};
+use super::{Octree, OctreeError, OctreeLimits};
 
 /// Options of [`Octree::insert_scan`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -20,14 +20,20 @@ pub struct ScanParams {
     /// (OctoMap's `discretize`). Default false.
     pub discretize: bool,
     /// Largest key box (cells) traced into dense bitsets (one bit per cell and set,
-    /// per worker); larger scans fall back to sorted key vectors. Default 2^27
+    /// per worker); larger scans collect sorted key vectors. Default 2^27
     /// (16 MiB per bitset).
     pub dense_limit_cells: usize,
-    /// Above `dense_limit_cells` the beams' keys are collected in vectors; a scan whose
-    /// beams could cross more cells than this (upper bound `Σ (‖Δkey‖₁ + 1)`) is refused
-    /// with [`OctreeError::ScanTooLarge`] instead of allocating without bound.
-    /// Default 2^26 (512 MiB of keys at most).
-    pub max_sorted_keys: usize,
+    /// Most cells the beams may cross in all, counted before any is traced as
+    /// `Σ_beams min(‖key(p) − key(o)‖₁ + 1, 3·max_range/resolution + 4)` — the
+    /// scan's work. A scan over it is refused with [`OctreeError::ScanTooLarge`].
+    /// Default 2^28.
+    pub max_traced_cells: u64,
+    /// Most nodes the tree may hold. A scan that updates more distinct cells than
+    /// this (every updated cell is a leaf until pruned) is refused with
+    /// [`OctreeError::ScanTooManyCells`] while its beams are traced, and the update
+    /// stops with [`OctreeError::TreeGrewTooLarge`] once the tree grows past it.
+    /// Default [`OctreeLimits::default`]'s `max_nodes`.
+    pub max_nodes: usize,
 }
 
 impl Default for ScanParams {
@@ -36,7 +42,8 @@ impl Default for ScanParams {
             max_range: -1.0,
             discretize: false,
             dense_limit_cells: 1 << 27,
-            max_sorted_keys: 1 << 26,
+            max_traced_cells: 1 << 28,
+            max_nodes: OctreeLimits::default().max_nodes,
         }
     }
 }
@@ -56,7 +63,10 @@ impl ScanParams {
 pub enum ScanStatus {
     /// Every beam was integrated.
     Inserted,
-    /// `should_stop` returned true while the beams were traced; the tree is unchanged.
+    /// `should_stop` returned true. Seen while the beams were traced, the tree is
+    /// unchanged; seen while the cells were updated, the cells updated so far keep
+    /// their update (each cell's update is whole): discard the tree when the scan
+    /// must go in all or not at all.
     Cancelled,
 }
 
@@ -91,6 +101,65 @@ pub struct PinholeIntrinsics {
 /// Free cells, end-point cells (Morton codes) and skipped points of one chunk of beams.
 type ChunkKeys = (Vec<u64>, Vec<u64>, usize);
 
+/// A scan's cells to update: bits over the key box (with the map from a bit to its
+/// key) or sorted Morton codes.
+enum CellSet {
+    Dense(Vec<u64>, Box<dyn Fn(usize) -> OcKey>),
+    Sorted(Vec<u64>),
+}
+
+impl CellSet {
+    /// The keys in ascending bit or Morton order.
+    fn iter(&self) -> Box<dyn Iterator<Item = OcKey> + '_> {
+        match self {
+            CellSet::Dense(bits, key_of) => Box::new(bits.iter().enumerate().flat_map(move |(w, &word)| {
+                let mut b = word;
+                std::iter::from_fn(move || {
+                    (b != 0).then(|| {
+                        let i = w * 64 + b.trailing_zeros() as usize;
+                        b &= b - 1;
+                        key_of(i)
+                    })
+                })
+            })),
+            CellSet::Sorted(codes) => Box::new(codes.iter().map(|&m| unmorton(m))),
+        }
+    }
+}
+
+/// The cells one scan updates: free (end points removed) and occupied.
+struct ScanCells {
+    free: CellSet,
+    occupied: CellSet,
+    skipped: usize,
+}
+
+/// The union of two sorted, deduplicated vectors, sorted and deduplicated.
+fn merge_sorted(a: &[u64], b: &[u64]) -> Vec<u64> {
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        match a[i].cmp(&b[j]) {
+            std::cmp::Ordering::Less => {
+                out.push(a[i]);
+                i += 1;
+            }
+            std::cmp::Ordering::Greater => {
+                out.push(b[j]);
+                j += 1;
+            }
+            std::cmp::Ordering::Equal => {
+                out.push(a[i]);
+                i += 1;
+                j += 1;
+            }
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
+    out
+}
+
 /// Morton code of a key (x in bit 0): sorting by it makes successive updates share
 /// their path from the root.
 #[inline]
@@ -123,6 +192,33 @@ fn unmorton(m: u64) -> OcKey {
     [squeeze(m), squeeze(m >> 1), squeeze(m >> 2)]
 }
 
+/// Cells traced between two looks at the stop flag (a chunk of beams), so a
+/// stop is seen within about a millisecond of tracing.
+const CHUNK_CELLS: u64 = 1 << 16;
+
+/// Cells traced per batch on the sorted path before the batch's keys are
+/// merged into the scan's sets and their size is checked against the node
+/// limit: bounds the keys held at once.
+const BATCH_CELLS: u64 = 1 << 22;
+
+/// Cell updates between two looks at the stop flag and the node count.
+const UPDATES_PER_CHECK: usize = 4096;
+
+/// Memory the dense path's per-worker bitsets may take in all (bytes); fewer
+/// workers trace a large key box.
+const DENSE_BUDGET_BYTES: usize = 256 << 20;
+
+/// What a scan will trace, worked out before any beam is: the beams' key box,
+/// the chunks of beams with their cell counts, and the total.
+struct ScanPlan {
+    /// Key box of the origin and every usable end point: all beams lie inside it.
+    lo: OcKey,
+    dims: [usize; 3],
+    /// Consecutive point ranges of at most [`CHUNK_CELLS`] cells each (a single
+    /// longer beam is a chunk of its own), with their cell counts.
+    chunks: Vec<(std::ops::Range<usize>, u64)>,
+}
+
 impl Octree {
     /// Integrates a point cloud measured from `origin` (m, map frame; coordinates are
     /// rounded to f32 as OctoMap's `point3d`). For each point p: if `max_range ≤ 0` or
@@ -132,9 +228,13 @@ impl Octree {
     /// occupied only, and each set element gets one update (`+hit` or `+miss` log-odds,
     /// clamped) — the same tree as OctoMap's `insertPointCloud(…, lazy_eval = false)`.
     ///
-    /// Beams are traced in parallel (rayon) into dense bitsets over the scan's key box\n    /// (or, beyond `dense_limit_cells`, sorted Morton-code vectors).
-    /// `should_stop` is polled per chunk of 4,096 beams (1,024 on the sorted path); when
-    /// it fires the tree is left unchanged.
+    /// Cost, bounded before the work starts: the cells the beams can cross are counted
+    /// first (`ScanParams::max_traced_cells`); beams are traced in parallel (rayon) in
+    /// chunks of about 65,536 cells into dense bitsets over the scan's key box (workers
+    /// limited so their bitsets stay within 256 MiB) or, beyond `dense_limit_cells`, into
+    /// sorted Morton-code vectors merged batch by batch, refused once they hold more
+    /// distinct cells than `max_nodes`; the update stops once the tree holds more than
+    /// `max_nodes` nodes. `should_stop` is polled per chunk and every 4,096 updates.
     ///
     /// ```
     /// use kinplan_core::octree::{CellState, Octree, ScanParams};
@@ -179,91 +279,7 @@ impl Octree {
         } else {
             points
         };
-        let max_range = params.max_range;
-        // key box of the origin and every usable point: all beams lie inside it
-        let ko = self.key_of_f32(origin).expect("checked above");
-        let (mut lo, mut hi) = (ko, ko);
-        for p in pts {
-            if let Some(k) = p
-                .iter()
-                .all(|v| v.is_finite())
-                .then(|| self.key_of_f32(p))
-                .flatten()
-            {
-                for i in 0..3 {
-                    lo[i] = lo[i].min(k[i]);
-                    hi[i] = hi[i].max(k[i]);
-                }
-            }
-        }
-        let dims = [0, 1, 2].map(|i| (hi[i] - lo[i]) as usize + 1);
-        let cells = dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]);
-        if cells <= params.dense_limit_cells {
-            return Ok(self.insert_dense(pts, origin, max_range, lo, dims, points.len(), t0, should_stop));
-        }
-        // bound the keys the sorted path could collect before allocating for them
-        let cut_bound = if max_range > 0.0 {
-            3 * (max_range * self.resolution_factor) as u64 + 4
-        } else {
-            u64::MAX
-        };
-        let mut bound = 0u64;
-        for p in pts {
-            if let Some(k) = p
-                .iter()
-                .all(|v| v.is_finite())
-                .then(|| self.key_of_f32(p))
-                .flatten()
-            {
-                let l1: u64 = (0..3).map(|i| (k[i] as i64 - ko[i] as i64).unsigned_abs()).sum();
-                bound = bound.saturating_add((l1 + 1).min(cut_bound));
-            } else if max_range > 0.0 && p.iter().all(|v| v.is_finite()) {
-                bound = bound.saturating_add(cut_bound);
-            }
-        }
-        if bound > params.max_sorted_keys as u64 {
-            return Err(OctreeError::ScanTooLarge {
-                cells: bound,
-                limit: params.max_sorted_keys,
-            });
-        }
-        let chunks: Vec<Option<ChunkKeys>> = pts
-            .par_chunks(1024)
-            .map(|chunk| {
-                if should_stop() {
-                    return None;
-                }
-                let mut ray = Vec::with_capacity(512);
-                let (mut free, mut occ, mut skipped) = (Vec::new(), Vec::with_capacity(chunk.len()), 0usize);
-                for p in chunk {
-                    if p.iter().any(|v| !v.is_finite()) {
-                        skipped += 1;
-                        continue;
-                    }
-                    let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-                    let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
-                    if max_range < 0.0 || norm <= max_range {
-                        if self.compute_ray_keys(origin, p, &mut ray) {
-                            free.extend(ray.iter().map(morton));
-                        }
-                        match self.key_of_f32(p) {
-                            Some(k) => occ.push(morton(&k)),
-                            None => skipped += 1,
-                        }
-                    } else {
-                        let n = norm as f32;
-                        let m = max_range as f32;
-                        let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                        if self.compute_ray_keys(origin, &e, &mut ray) {
-                            free.extend(ray.iter().map(morton));
-                        }
-                    }
-                }
-                free.sort_unstable();
-                free.dedup();
-                Some((free, occ, skipped))
-            })
-            .collect();
+        let plan = self.plan_scan(pts, origin, params)?;
         let mut stats = ScanStats {
             status: ScanStatus::Cancelled,
             points: points.len(),
@@ -274,20 +290,275 @@ impl Octree {
             trace_us: 0,
             update_us: 0,
         };
-        if chunks.iter().any(Option::is_none) {
-            stats.trace_us = t0.elapsed().as_micros() as u64;
+        let cells = plan.dims[0]
+            .saturating_mul(plan.dims[1])
+            .saturating_mul(plan.dims[2]);
+        let traced = if cells <= params.dense_limit_cells {
+            self.trace_dense(pts, origin, params.max_range, &plan, should_stop)
+        } else {
+            self.trace_sorted(pts, origin, params, &plan, should_stop)?
+        };
+        stats.trace_us = t0.elapsed().as_micros() as u64;
+        let Some(cells) = traced else {
             return Ok(stats);
+        };
+        stats.skipped_points = cells.skipped;
+        let t1 = Instant::now();
+        let (hit, miss) = (self.model.hit, self.model.miss);
+        let mut updates = 0usize;
+        for (keys, delta, is_free) in [(&cells.free, miss, true), (&cells.occupied, hit, false)] {
+            for key in keys.iter() {
+                if updates % UPDATES_PER_CHECK == 0 {
+                    if self.num_nodes > params.max_nodes {
+                        return Err(OctreeError::TreeGrewTooLarge { limit: params.max_nodes });
+                    }
+                    if should_stop() {
+                        stats.update_us = t1.elapsed().as_micros() as u64;
+                        stats.nodes = self.num_nodes;
+                        return Ok(stats);
+                    }
+                }
+                self.update_key(&key, delta);
+                if is_free {
+                    stats.free_cells += 1;
+                } else {
+                    stats.occupied_cells += 1;
+                }
+                updates += 1;
+            }
         }
-        let (mut free, mut occ) = (Vec::new(), Vec::new());
-        for (f, o, s) in chunks.into_iter().flatten() {
-            free.extend_from_slice(&f);
-            occ.extend_from_slice(&o);
-            stats.skipped_points += s;
+        if self.num_nodes > params.max_nodes {
+            return Err(OctreeError::TreeGrewTooLarge { limit: params.max_nodes });
         }
-        free.par_sort_unstable();
-        free.dedup();
-        occ.par_sort_unstable();
-        occ.dedup();
+        stats.update_us = t1.elapsed().as_micros() as u64;
+        stats.nodes = self.num_nodes;
+        stats.status = ScanStatus::Inserted;
+        Ok(stats)
+    }
+
+    /// Counts the cells each beam can cross (`‖Δkey‖₁ + 1`, at most the cut beam's
+    /// `3·max_range/resolution + 4`; 0 for a point that is skipped), refuses the scan
+    /// when the total passes `max_traced_cells`, and cuts the points into chunks.
+    fn plan_scan(&self, pts: &[[f32; 3]], origin: &[f32; 3], params: &ScanParams) -> Result<ScanPlan, OctreeError> {
+        let max_range = params.max_range;
+        let cut_bound = if max_range > 0.0 {
+            3 * (max_range * self.resolution_factor).min(1e15) as u64 + 4
+        } else {
+            u64::MAX
+        };
+        let ko = self.key_of_f32(origin).ok_or(OctreeError::OutOfBounds { field: "origin" })?;
+        let (mut lo, mut hi) = (ko, ko);
+        let mut chunks = Vec::new();
+        let (mut total, mut chunk_cells, mut chunk_start) = (0u64, 0u64, 0usize);
+        for (i, p) in pts.iter().enumerate() {
+            let finite = p.iter().all(|v| v.is_finite());
+            let cost = match finite.then(|| self.key_of_f32(p)).flatten() {
+                Some(k) => {
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(k[a]);
+                        hi[a] = hi[a].max(k[a]);
+                    }
+                    let l1: u64 = (0..3).map(|a| (k[a] as i64 - ko[a] as i64).unsigned_abs()).sum();
+                    (l1 + 1).min(cut_bound)
+                }
+                // a far point still casts its cut beam
+                None if finite && max_range > 0.0 => cut_bound,
+                None => 0,
+            };
+            total = total.saturating_add(cost);
+            if chunk_cells > 0 && chunk_cells + cost > CHUNK_CELLS {
+                chunks.push((chunk_start..i, chunk_cells));
+                (chunk_start, chunk_cells) = (i, 0);
+            }
+            chunk_cells += cost;
+        }
+        if chunk_start < pts.len() {
+            chunks.push((chunk_start..pts.len(), chunk_cells));
+        }
+        if total > params.max_traced_cells {
+            return Err(OctreeError::ScanTooLarge {
+                cells: total,
+                limit: params.max_traced_cells,
+            });
+        }
+        // a cut beam of a far point can leave the end points' box: widen it by the cut
+        if max_range > 0.0 && pts.iter().any(|p| p.iter().all(|v| v.is_finite()) && self.key_of_f32(p).is_none()) {
+            let reach = (cut_bound / 3).min(65535) as u16;
+            for a in 0..3 {
+                lo[a] = lo[a].min(ko[a].saturating_sub(reach));
+                hi[a] = hi[a].max(ko[a].saturating_add(reach));
+            }
+        }
+        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a]) as usize + 1);
+        Ok(ScanPlan { lo, dims, chunks })
+    }
+
+    /// Traces every beam into two bitsets over the key box (free, end points), one
+    /// pair per worker, merges them by OR and clears free bits that are end points.
+    /// `None` when `should_stop` fired.
+    fn trace_dense(
+        &self,
+        pts: &[[f32; 3]],
+        origin: &[f32; 3],
+        max_range: f64,
+        plan: &ScanPlan,
+        should_stop: &(dyn Fn() -> bool + Sync),
+    ) -> Option<ScanCells> {
+        let (lo, dims) = (plan.lo, plan.dims);
+        let words = (dims[0] * dims[1] * dims[2]).div_ceil(64);
+        let index = |k: &OcKey| {
+            ((k[2] - lo[2]) as usize * dims[1] + (k[1] - lo[1]) as usize) * dims[0] + (k[0] - lo[0]) as usize
+        };
+        let strides = [1, dims[0], dims[0] * dims[1]];
+        let workers = rayon::current_num_threads()
+            .min((DENSE_BUDGET_BYTES / (16 * words)).max(1))
+            .min(plan.chunks.len())
+            .max(1);
+        type Acc = (Vec<u64>, Vec<u64>, usize);
+        let traced: Vec<Option<Acc>> = (0..workers)
+            .into_par_iter()
+            .map(|w| {
+                let (mut free, mut occ, mut skipped) = (vec![0u64; words], vec![0u64; words], 0usize);
+                for (range, _) in plan.chunks.iter().skip(w).step_by(workers) {
+                    if should_stop() {
+                        return None;
+                    }
+                    for p in &pts[range.clone()] {
+                        if p.iter().any(|v| !v.is_finite()) {
+                            skipped += 1;
+                            continue;
+                        }
+                        let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+                        let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
+                        let mut mark = |_: &OcKey, i: usize| {
+                            free[i >> 6] |= 1 << (i & 63);
+                        };
+                        if max_range < 0.0 || norm <= max_range {
+                            self.visit_ray_cells(origin, p, &lo, strides, &mut mark);
+                            match self.key_of_f32(p) {
+                                Some(k) => {
+                                    let i = index(&k);
+                                    occ[i >> 6] |= 1 << (i & 63);
+                                }
+                                None => skipped += 1,
+                            }
+                        } else {
+                            let (n, m) = (norm as f32, max_range as f32);
+                            let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
+                            self.visit_ray_cells(origin, &e, &lo, strides, &mut mark);
+                        }
+                    }
+                }
+                Some((free, occ, skipped))
+            })
+            .collect();
+        let mut traced = traced.into_iter();
+        let (mut free, mut occ, mut skipped) = traced.next()??;
+        for acc in traced {
+            let (f, o, s) = acc?;
+            free.iter_mut().zip(&f).for_each(|(x, y)| *x |= y);
+            occ.iter_mut().zip(&o).for_each(|(x, y)| *x |= y);
+            skipped += s;
+        }
+        for (f, o) in free.iter_mut().zip(&occ) {
+            *f &= !o;
+        }
+        let key_of = move |i: usize| {
+            let x = i % dims[0];
+            let y = (i / dims[0]) % dims[1];
+            let z = i / (dims[0] * dims[1]);
+            [lo[0] + x as u16, lo[1] + y as u16, lo[2] + z as u16]
+        };
+        Some(ScanCells {
+            free: CellSet::Dense(free, Box::new(key_of)),
+            occupied: CellSet::Dense(occ, Box::new(key_of)),
+            skipped,
+        })
+    }
+
+    /// Traces the beams batch by batch into sorted, deduplicated Morton-code vectors,
+    /// merging each batch into the scan's sets; refuses the scan once the sets hold
+    /// more than `max_nodes` cells. `Ok(None)` when `should_stop` fired.
+    fn trace_sorted(
+        &self,
+        pts: &[[f32; 3]],
+        origin: &[f32; 3],
+        params: &ScanParams,
+        plan: &ScanPlan,
+        should_stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Option<ScanCells>, OctreeError> {
+        let max_range = params.max_range;
+        let (mut free, mut occ, mut skipped) = (Vec::<u64>::new(), Vec::<u64>::new(), 0usize);
+        let mut next = 0;
+        while next < plan.chunks.len() {
+            let mut end = next;
+            let mut batch_cells = 0u64;
+            while end < plan.chunks.len() && (end == next || batch_cells + plan.chunks[end].1 <= BATCH_CELLS) {
+                batch_cells += plan.chunks[end].1;
+                end += 1;
+            }
+            let traced: Vec<Option<ChunkKeys>> = plan.chunks[next..end]
+                .par_iter()
+                .map(|(range, cells)| {
+                    if should_stop() {
+                        return None;
+                    }
+                    let mut ray = Vec::with_capacity(512);
+                    let mut chunk_free = Vec::with_capacity(*cells as usize);
+                    let (mut chunk_occ, mut chunk_skipped) = (Vec::with_capacity(range.len()), 0usize);
+                    for p in &pts[range.clone()] {
+                        if p.iter().any(|v| !v.is_finite()) {
+                            chunk_skipped += 1;
+                            continue;
+                        }
+                        let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+                        let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
+                        if max_range < 0.0 || norm <= max_range {
+                            if self.compute_ray_keys(origin, p, &mut ray) {
+                                chunk_free.extend(ray.iter().map(morton));
+                            }
+                            match self.key_of_f32(p) {
+                                Some(k) => chunk_occ.push(morton(&k)),
+                                None => chunk_skipped += 1,
+                            }
+                        } else {
+                            let n = norm as f32;
+                            let m = max_range as f32;
+                            let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
+                            if self.compute_ray_keys(origin, &e, &mut ray) {
+                                chunk_free.extend(ray.iter().map(morton));
+                            }
+                        }
+                    }
+                    chunk_free.sort_unstable();
+                    chunk_free.dedup();
+                    chunk_occ.sort_unstable();
+                    chunk_occ.dedup();
+                    Some((chunk_free, chunk_occ, chunk_skipped))
+                })
+                .collect();
+            let (mut batch_free, mut batch_occ) = (Vec::new(), Vec::new());
+            for chunk in traced {
+                let Some((f, o, s)) = chunk else {
+                    return Ok(None);
+                };
+                batch_free.extend_from_slice(&f);
+                batch_occ.extend_from_slice(&o);
+                skipped += s;
+            }
+            for (set, batch) in [(&mut free, &mut batch_free), (&mut occ, &mut batch_occ)] {
+                batch.par_sort_unstable();
+                batch.dedup();
+                *set = merge_sorted(set, batch);
+            }
+            if free.len() + occ.len() > params.max_nodes {
+                return Err(OctreeError::ScanTooManyCells {
+                    cells: (free.len() + occ.len()) as u64,
+                    limit: params.max_nodes,
+                });
+            }
+            next = end;
+        }
         // occupied wins: drop free cells that are also end points (both sorted)
         let mut j = 0;
         free.retain(|m| {
@@ -296,134 +567,11 @@ impl Octree {
             }
             !(j < occ.len() && occ[j] == *m)
         });
-        stats.trace_us = t0.elapsed().as_micros() as u64;
-        let t1 = Instant::now();
-        let (hit, miss) = (self.model.hit, self.model.miss);
-        for m in &free {
-            self.update_key(&unmorton(*m), miss);
-        }
-        for m in &occ {
-            self.update_key(&unmorton(*m), hit);
-        }
-        stats.update_us = t1.elapsed().as_micros() as u64;
-        stats.free_cells = free.len();
-        stats.occupied_cells = occ.len();
-        stats.nodes = self.num_nodes;
-        stats.status = ScanStatus::Inserted;
-        Ok(stats)
-    }
-
-    /// Traces every beam into two bitsets over the key box (free, end points), merges
-    /// the workers' sets by OR, clears free bits that are end points, and updates the
-    /// cells in x-fastest order — the same sets, so the same tree, as the sorted path.
-    #[allow(clippy::too_many_arguments)]
-    fn insert_dense(
-        &mut self,
-        pts: &[[f32; 3]],
-        origin: &[f32; 3],
-        max_range: f64,
-        lo: OcKey,
-        dims: [usize; 3],
-        given: usize,
-        t0: Instant,
-        should_stop: &(dyn Fn() -> bool + Sync),
-    ) -> ScanStats {
-        let words = (dims[0] * dims[1] * dims[2]).div_ceil(64);
-        let index = |k: &OcKey| {
-            ((k[2] - lo[2]) as usize * dims[1] + (k[1] - lo[1]) as usize) * dims[0] + (k[0] - lo[0]) as usize
-        };
-        let strides = [1, dims[0], dims[0] * dims[1]];
-        let this = &*self;
-        type Acc = (Vec<u64>, Vec<u64>, usize, bool);
-        let empty = || -> Acc { (vec![0u64; words], vec![0u64; words], 0, false) };
-        let (mut free, occ, skipped, stopped) = pts
-            .par_chunks(4096)
-            .fold(empty, |mut acc, chunk| {
-                if acc.3 || should_stop() {
-                    acc.3 = true;
-                    return acc;
-                }
-                for p in chunk {
-                    if p.iter().any(|v| !v.is_finite()) {
-                        acc.2 += 1;
-                        continue;
-                    }
-                    let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-                    let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
-                    let free = &mut acc.0;
-                    let mut mark = |_: &OcKey, i: usize| {
-                        free[i >> 6] |= 1 << (i & 63);
-                    };
-                    if max_range < 0.0 || norm <= max_range {
-                        this.visit_ray_cells(origin, p, &lo, strides, &mut mark);
-                        match this.key_of_f32(p) {
-                            Some(k) => {
-                                let i = index(&k);
-                                acc.1[i >> 6] |= 1 << (i & 63);
-                            }
-                            None => acc.2 += 1,
-                        }
-                    } else {
-                        let (n, m) = (norm as f32, max_range as f32);
-                        let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                        this.visit_ray_cells(origin, &e, &lo, strides, &mut mark);
-                    }
-                }
-                acc
-            })
-            .reduce(empty, |mut a, b| {
-                for (x, y) in a.0.iter_mut().zip(&b.0) {
-                    *x |= y;
-                }
-                for (x, y) in a.1.iter_mut().zip(&b.1) {
-                    *x |= y;
-                }
-                (a.0, a.1, a.2 + b.2, a.3 || b.3)
-            });
-        let mut stats = ScanStats {
-            status: ScanStatus::Cancelled,
-            points: given,
-            skipped_points: skipped,
-            free_cells: 0,
-            occupied_cells: 0,
-            nodes: self.num_nodes,
-            trace_us: 0,
-            update_us: 0,
-        };
-        if stopped {
-            stats.trace_us = t0.elapsed().as_micros() as u64;
-            return stats;
-        }
-        for (f, o) in free.iter_mut().zip(&occ) {
-            *f &= !o;
-        }
-        stats.trace_us = t0.elapsed().as_micros() as u64;
-        let t1 = Instant::now();
-        let key_of = |i: usize| {
-            let x = i % dims[0];
-            let y = (i / dims[0]) % dims[1];
-            let z = i / (dims[0] * dims[1]);
-            [lo[0] + x as u16, lo[1] + y as u16, lo[2] + z as u16]
-        };
-        let (hit, miss) = (self.model.hit, self.model.miss);
-        for (bits, delta, count) in [
-            (&free, miss, &mut stats.free_cells),
-            (&occ, hit, &mut stats.occupied_cells),
-        ] {
-            for (w, &word) in bits.iter().enumerate() {
-                let mut b = word;
-                while b != 0 {
-                    let i = w * 64 + b.trailing_zeros() as usize;
-                    b &= b - 1;
-                    self.update_key(&key_of(i), delta);
-                    *count += 1;
-                }
-            }
-        }
-        stats.update_us = t1.elapsed().as_micros() as u64;
-        stats.nodes = self.num_nodes;
-        stats.status = ScanStatus::Inserted;
-        stats
+        Ok(Some(ScanCells {
+            free: CellSet::Sorted(free),
+            occupied: CellSet::Sorted(occ),
+            skipped,
+        }))
     }
 
     /// Inserts a depth image: pixel `(u, v)` (row-major, `width` per row) with depth

@@ -120,6 +120,7 @@ impl ExplorationService for ExplorationApi {
         let params = ScanParams {
             max_range: finite("max_range", req.max_range.unwrap_or(-1.0))?,
             discretize: req.discretize,
+            max_nodes: MAX_OCTREE_NODES,
             ..ScanParams::default()
         };
         let scan = match &req.scan {

@@ -10,7 +10,10 @@ use kinplan_core::octree::OctreeError;
 /// limits) naming `field`, the request field the octree input came from.
 pub fn octree_error(field: &str, e: OctreeError) -> Status {
     match e {
-        OctreeError::TooManyNodes { .. } | OctreeError::ScanTooLarge { .. } => {
+        OctreeError::TooManyNodes { .. }
+        | OctreeError::ScanTooLarge { .. }
+        | OctreeError::ScanTooManyCells { .. }
+        | OctreeError::TreeGrewTooLarge { .. } => {
             too_large(field, e.to_string())
         }
         _ => invalid(field, e.to_string()),
