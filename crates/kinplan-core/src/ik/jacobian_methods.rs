@@ -33,14 +33,14 @@ use crate::robot::Chain;
 const MU_MAX: f64 = 1e8;
 /// Progress that resets the stall counter: the squared error must fall below this
 /// fraction of its value at the last reset (≈ 5 % on the error norm). Was 0.99; 0.9 ends
-/// failed attempts (typically creeping along a joint limit) 10–30 % sooner, which cuts
-/// iterations per target by 1–15 % on the benchmark arms at equal success
-/// (IK_RESULTS.md §0).
+/// failed attempts (typically creeping along a joint limit) sooner, which cuts
+/// iterations per target on the benchmark arms at equal success
+/// (`benches/IK_RESULTS.md` §0).
 const STALL_PROGRESS: f64 = 0.9;
 /// Orthogonality tolerance of the Jacobi SVD behind each Jacobian-inverse and LM step
 /// (see [`SvdWorkspace::with_orthogonality`]): a step accurate to ~1e-4 relative
 /// converges as fast as an exact one (identical iteration counts on every benchmark arm
-/// at 1e-4 and 1e-3; 1e-2 costs 1–4 % more) and needs ~15 % fewer sweeps than the
+/// at 1e-4 and 1e-3; 1e-2 costs more) and needs fewer sweeps than the
 /// default 1e-10. Newton keeps the default.
 pub(crate) const STEP_ORTHOGONALITY: f64 = 1e-4;
 

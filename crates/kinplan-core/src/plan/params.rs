@@ -6,8 +6,8 @@ use super::error::{PlanError, PlanField, require};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum InitialTrajectory {
     /// The algorithm's own start: [`Self::CartesianLine`] for CCSTOMP (its
-    /// cost is measured against that line; on S0 §3.3 it succeeds on every
-    /// seed where the RRT-Connect start succeeds on 41 %),
+    /// cost is measured against that line; on S0 §3.3 it succeeds far more
+    /// often than the RRT-Connect start, `benches/RESULTS.md`),
     /// [`Self::RrtConnectIfBlocked`] for STOMP.
     #[default]
     ForAlgorithm,
