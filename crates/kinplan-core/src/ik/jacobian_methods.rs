@@ -1,5 +1,5 @@
 //! Jacobian inverse, Levenberg–Marquardt and Newton iterations (S2 §3.1,
-//! ALGORITHMS.md §2), each with the SVD pseudoinverse or angle relaxation as the
+//! docs/inverse-kinematics.md#jacobian-methods), each with the SVD pseudoinverse or angle relaxation as the
 //! linear solver. One attempt from the joints in the workspace.
 //!
 //! With the geometric Jacobian `J(q)` (rows: linear, angular velocity, base frame; only

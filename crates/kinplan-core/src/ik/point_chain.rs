@@ -199,7 +199,7 @@ pub(crate) fn run(
 /// The S2 Fig. 27 construction for a 3-D revolute chain: joint origins `pᵢ` (`points[i]`,
 /// `i < n`), the tool point `pₙ`, and a virtual point `vᵢ = pᵢ + h zᵢ` on every joint
 /// axis (index `n + 1 + i`). Links, with their current lengths: `pᵢ–pᵢ₊₁`, `pᵢ–vᵢ` (h),
-/// `vᵢ–pᵢ₋₁` and `vᵢ–pᵢ₊₁` (the spec's "both neighbours", Pythagoras), and `vᵢ₋₁–vᵢ`.
+/// `vᵢ–pᵢ₋₁` and `vᵢ–pᵢ₊₁` (S2's "both neighbours", Pythagoras), and `vᵢ₋₁–vᵢ`.
 /// The last one makes `{pᵢ₋₁, vᵢ₋₁, pᵢ, vᵢ}` a tetrahedron with all six edges fixed —
 /// one rigid link body hinged on the axis `pᵢ–vᵢ` it shares with the next — so the
 /// structure keeps exactly the `n` joint rotations as its motions (checked by the rank

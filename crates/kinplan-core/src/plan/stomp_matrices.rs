@@ -1,4 +1,4 @@
-//! STOMP's fixed matrices (ALGORITHMS.md §4): the finite-difference
+//! STOMP's fixed matrices (docs/planning.md#stomp): the finite-difference
 //! acceleration matrix A, the control-cost matrix R = AᵀA, the noise
 //! covariance R⁻¹ (normalised) with its Cholesky factor, and the smoothing
 //! projection M.
