@@ -18,8 +18,8 @@
 //! joints, as in a projected Newton method (Bertsekas 1982). Before the solve, a joint on
 //! a limit whose descent direction `(Jᵀe)ₖ` points outward is bound (its column of `J`
 //! zeroed); after it, a joint on a limit whose step still points outward is bound too
-//! and the step re-solved. Binding by the gradient first cut the re-solves per target
-//! from 8.6 to 2.5 on the Panda (`benches/IK_RESULTS.md`).
+//! and the step re-solved. Binding by the gradient first saves most of the re-solves on
+//! arms that often meet a limit, such as the Panda (`benches/IK_RESULTS.md`).
 
 use nalgebra::Isometry3;
 use rand_chacha::ChaCha8Rng;
