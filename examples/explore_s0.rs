@@ -1,5 +1,5 @@
 //! The exploration experiments of S0 §5.2–5.3 with kinplan's loop
-//! (issue 13): the IRB 4600 with a simulated Kinect v2 explores the
+//! (docs/exploration.md#the-exploration-loop): the IRB 4600 with a simulated Kinect v2 explores the
 //! reference cells.
 //!
 //! - `scene <open|walled>`: one run, printed per iteration.

@@ -1,4 +1,4 @@
-//! MotionBenchMaker Panda runner (issue 10): per problem set, how many
+//! MotionBenchMaker Panda runner: per problem set, how many
 //! problems are valid for our geometry, how many RRT-Connect solves, how long
 //! planning takes and how long the paths are — with every returned path
 //! re-checked independently.

@@ -1,4 +1,4 @@
-//! The planner experiments of issue 10 with the parry3d `SceneChecker`:
+//! The planner experiments (S0 §3.3, §5.3) with the parry3d `SceneChecker`:
 //!
 //! - `s33`: S0 §3.3 — KR 210 R2700 extra between two states with one
 //!   obstacle between them; CCSTOMP with t_t = 1 m, t_r = 0.2 rad,

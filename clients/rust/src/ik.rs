@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::pb::{self, kinematics_service_client::KinematicsServiceClient};
 use crate::robot::Robot;
 
-/// IK algorithm (ALGORITHMS.md §2–3). CCD, FABRIK and length relaxation need
+/// IK algorithm (docs/inverse-kinematics.md). CCD, FABRIK and length relaxation need
 /// [`IkOptions::position_only`] except CCD, which also takes poses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum IkMethod {
@@ -22,7 +22,7 @@ pub enum IkMethod {
     LengthRelaxation,
 }
 
-/// Linear solver of the Jacobian methods (ALGORITHMS.md §1). S2 predicts, and
+/// Linear solver of the Jacobian methods (docs/linear-solvers.md). S2 predicts, and
 /// the server's benchmarks confirm, that Newton with angle relaxation
 /// practically never converges; LM or the Jacobian inverse with either solver do.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -99,7 +99,7 @@ pub enum Goal {
     Pose(Isometry3<f64>),
 }
 
-/// Planner (ALGORITHMS.md §4).
+/// Planner (docs/planning.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Algorithm {
     #[default]

@@ -16,15 +16,15 @@ pub const MAX_CHECKS_PER_PIECE: usize = 64;
 /// Longest first piece, in resolutions: a piece is proved with pads that
 /// grow with its length, so longer pieces are cheaper to prove than several
 /// short ones while the halving refines them where obstacles are near
-/// (MotionBenchMaker padded search: four resolutions 3–8 % faster than two
-/// on most sets, eight slower).
+/// (four resolutions was the best of two, four and eight on the
+/// MotionBenchMaker problems, `benches/RESULTS.md`).
 const FIRST_PIECE: f64 = 4.0;
 /// Pieces proved together, breadth first (bounds the queue at
 /// `WINDOW · (MAX_CHECKS_PER_PIECE + 1)` entries whatever the motion's length).
 const WINDOW: usize = 64;
 
 /// True when no state of the straight motion `a → b` collides (the motion
-/// check of ALGORITHMS.md §4 and issue 10, made conservative), proved piece
+/// check of docs/planning.md#collision-cost-and-motion-checks, made conservative), proved piece
 /// by piece (conservative advancement over joint space, Schwarzer, Saha and
 /// Latombe's idea with the distance test replaced by a padded overlap test):
 ///

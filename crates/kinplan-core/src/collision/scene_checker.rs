@@ -626,9 +626,8 @@ impl StateChecker for SceneChecker {
     /// the tight pads along the piece (`SweepBound::pad_along`) asked only for bodies that
     /// have something within their global pads ([`SweepBound::pads`]); when
     /// it fails, only the pairs it met are tested without pads (see
-    /// `SceneChecker::hits_padded`; a full plain check here made the padded
-    /// search and shortcutting 5–10 % slower on MotionBenchMaker: the
-    /// proofs' states are rarely in collision).
+    /// `SceneChecker::hits_padded`; a full plain check here only adds work,
+    /// since the proofs' states are rarely in collision).
     fn padded_verdict(&self, q: &[f64], half_step: &[f64]) -> Option<PadVerdict> {
         self.padded_verdict_sparing(q, half_step, &mut 0)
     }

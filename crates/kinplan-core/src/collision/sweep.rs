@@ -206,8 +206,7 @@ impl SweepBound {
     /// whole box `|q_j − m_j| ≤ |d_j|`). The global [`SweepBound::pads`]
     /// hold as well; callers may take the smaller. `pad_at` is not asked
     /// besides: on pieces of a few resolutions it is rarely the smaller and
-    /// costs a square root per joint (MotionBenchMaker padded search 9 %
-    /// faster without it). Callers asking for several bodies of one piece
+    /// costs a square root per joint. Callers asking for several bodies of one piece
     /// share the sums: [`SweepBound::piece_sums`], [`SweepBound::pad_along_with`].
     pub(crate) fn pad_along(
         &self,

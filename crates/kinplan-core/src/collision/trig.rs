@@ -1,7 +1,6 @@
 //! Sine and cosine for forward kinematics, inlined: every checked state
-//! turns each joint once, and the C library's `sincos` (a call, a rounding
-//! mode saved and restored, table lookups) was about 7 % of the padded
-//! search's time on MotionBenchMaker.
+//! turns each joint once, and the C library's `sincos` is a call (a rounding
+//! mode saved and restored, table lookups) on that hot path.
 //!
 //! Method (the classic one of fdlibm's kernels): reduce `x = k·π/2 + r`,
 //! `|r| ≤ π/4`, with π/2 split in two parts so that `r` keeps full

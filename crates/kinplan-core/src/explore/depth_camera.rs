@@ -1,5 +1,5 @@
 //! A simulated depth camera: a pinhole image rendered by casting one ray per
-//! pixel against a scene (ALGORITHMS.md §5; S0 §5 used a Kinect v2 in Gazebo).
+//! pixel against a scene (docs/exploration.md#the-exploration-loop; S0 §5 used a Kinect v2 in Gazebo).
 
 use nalgebra::{Isometry3, Point3};
 use rand::SeedableRng;

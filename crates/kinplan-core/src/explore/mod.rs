@@ -1,4 +1,4 @@
-//! Exploration of an unknown cell end to end (ALGORITHMS.md §5, S0 §4–5): a
+//! Exploration of an unknown cell end to end (docs/exploration.md#the-exploration-loop, S0 §4–5): a
 //! simulated depth camera, reference scenes, and the loop NBV → IK → plan →
 //! execute → scan → insert.
 

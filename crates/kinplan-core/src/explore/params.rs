@@ -37,7 +37,7 @@ impl Default for StopRule {
     }
 }
 
-/// Options of [`explore`](super::explore) (ALGORITHMS.md §5, S0 §4–5). The
+/// Options of [`explore`](super::explore) (docs/exploration.md#the-exploration-loop, S0 §4–5). The
 /// world frame is the robot's base frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExploreParams {

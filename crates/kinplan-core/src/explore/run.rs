@@ -292,7 +292,7 @@ fn record_failure(record: &mut Vec<(Point3<f64>, u32)>, p: Point3<f64>, radius: 
 }
 
 /// Explores `params.region` with a depth camera on `world.chain`, starting
-/// at joints `start` (ALGORITHMS.md §5, S0 §4–5):
+/// at joints `start` (docs/exploration.md#the-exploration-loop, S0 §4–5):
 ///
 /// 1. Scan at the start and at each of `initial_offsets` (S0's initial
 ///    motion of the last joints), then return to the start.

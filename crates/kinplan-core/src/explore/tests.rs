@@ -229,7 +229,7 @@ fn the_deadline_stops_the_loop_between_stages() {
         truth: &truth,
     };
     let t0 = Instant::now();
-    // well below the whole run's length in a release build (~240 ms), so
+    // well below the whole run's length in a release build, so
     // the deadline, not the end of the candidates, stops it
     let ctl = ExploreControl {
         deadline: Some(t0 + Duration::from_millis(40)),

@@ -1,5 +1,5 @@
 //! Cyclic coordinate descent for any serial chain (revolute, continuous, prismatic),
-//! position or full-pose targets (ALGORITHMS.md §2, heuristics).
+//! position or full-pose targets (docs/inverse-kinematics.md#heuristics).
 //!
 //! One iteration is a sweep from the tip joint to the root. Joint `i` (world axis `z`,
 //! origin `o`) is moved to the optimum of `Σₖ ‖Rₖ(θ) aₖ − bₖ‖²` over the tool points

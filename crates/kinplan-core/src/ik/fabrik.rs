@@ -1,4 +1,4 @@
-//! FABRIK on a point chain (Aristidou & Lasenby 2011; ALGORITHMS.md §2).
+//! FABRIK on a point chain (Aristidou & Lasenby 2011; docs/inverse-kinematics.md#heuristics).
 
 use nalgebra::Vector3;
 

@@ -1,5 +1,5 @@
 //! Jacobian inverse, Levenberg–Marquardt and Newton iterations (S2 §3.1,
-//! ALGORITHMS.md §2), each with the SVD pseudoinverse or angle relaxation as the
+//! docs/inverse-kinematics.md#jacobian-methods), each with the SVD pseudoinverse or angle relaxation as the
 //! linear solver. One attempt from the joints in the workspace.
 //!
 //! With the geometric Jacobian `J(q)` (rows: linear, angular velocity, base frame; only
@@ -18,8 +18,8 @@
 //! joints, as in a projected Newton method (Bertsekas 1982). Before the solve, a joint on
 //! a limit whose descent direction `(Jᵀe)ₖ` points outward is bound (its column of `J`
 //! zeroed); after it, a joint on a limit whose step still points outward is bound too
-//! and the step re-solved. Binding by the gradient first cut the re-solves per target
-//! from 8.6 to 2.5 on the Panda (`benches/IK_RESULTS.md`).
+//! and the step re-solved. Binding by the gradient first saves most of the re-solves on
+//! arms that often meet a limit, such as the Panda (`benches/IK_RESULTS.md`).
 
 use nalgebra::Isometry3;
 use rand_chacha::ChaCha8Rng;
@@ -33,14 +33,14 @@ use crate::robot::Chain;
 const MU_MAX: f64 = 1e8;
 /// Progress that resets the stall counter: the squared error must fall below this
 /// fraction of its value at the last reset (≈ 5 % on the error norm). Was 0.99; 0.9 ends
-/// failed attempts (typically creeping along a joint limit) 10–30 % sooner, which cuts
-/// iterations per target by 1–15 % on the benchmark arms at equal success
-/// (IK_RESULTS.md §0).
+/// failed attempts (typically creeping along a joint limit) sooner, which cuts
+/// iterations per target on the benchmark arms at equal success
+/// (`benches/IK_RESULTS.md` §0).
 const STALL_PROGRESS: f64 = 0.9;
 /// Orthogonality tolerance of the Jacobi SVD behind each Jacobian-inverse and LM step
 /// (see [`SvdWorkspace::with_orthogonality`]): a step accurate to ~1e-4 relative
 /// converges as fast as an exact one (identical iteration counts on every benchmark arm
-/// at 1e-4 and 1e-3; 1e-2 costs 1–4 % more) and needs ~15 % fewer sweeps than the
+/// at 1e-4 and 1e-3; 1e-2 costs more) and needs fewer sweeps than the
 /// default 1e-10. Newton keeps the default.
 pub(crate) const STEP_ORTHOGONALITY: f64 = 1e-4;
 

@@ -1,5 +1,5 @@
-//! Length relaxation (S2 §4.1, ALGORITHMS.md §2): fixed points stay put, the others are
-//! moved along their links until every link length holds.
+//! Length relaxation (S2 §4.1, docs/inverse-kinematics.md#length-relaxation): fixed points
+//! stay put, the others are moved along their links until every link length holds.
 
 use nalgebra::Vector3;
 

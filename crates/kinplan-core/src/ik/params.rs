@@ -5,7 +5,7 @@ use std::time::Duration;
 use super::{IkError, IkParam};
 use crate::linalg::{LinearSolverKind, RlxaParams};
 
-/// IK algorithm (ALGORITHMS.md §2).
+/// IK algorithm (docs/inverse-kinematics.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
 pub enum IkMethod {
     /// `J Δq = e`, `q ← q + Δq` (S2 eq. 33/35).

@@ -21,11 +21,9 @@ use crate::robot::Chain;
 /// 3-D length relaxation: one sweep pair, then the angles are read back and the points
 /// rebuilt from the true pose (relax, then project onto the revolute chain). Relaxing the
 /// rigid construction ([`build_virtual_graph`]) to convergence before reading back, as S2
-/// describes it, converges too slowly: a sweep costs ~20 µs on a 6–7 joint arm and the
-/// lengths need hundreds of them. Measured (position targets, TRAC-IK protocol, 5 ms,
-/// 1e-5 m; UR5 / KR 210 / Panda / iiwa): 1 sweep per read-back 92.9 / 90.9 / 78.1 /
-/// 90.6 % (1 500 targets); 3 sweeps 13–39 %; 10 sweeps 0 %, and still 12–24 % with an
-/// unlimited iteration cap (200 targets).
+/// describes it, converges too slowly: the lengths need hundreds of sweeps. One sweep
+/// per read-back solves the most targets; more sweeps per read-back solve far fewer,
+/// even without an iteration cap (`benches/IK_RESULTS.md`).
 const VIRTUAL_SWEEPS_PER_READ_BACK: usize = 1;
 /// Outer iterations (read-backs) without 1 % progress before the attempt is abandoned.
 const STALL_OUTER: usize = 10;
@@ -201,7 +199,7 @@ pub(crate) fn run(
 /// The S2 Fig. 27 construction for a 3-D revolute chain: joint origins `pᵢ` (`points[i]`,
 /// `i < n`), the tool point `pₙ`, and a virtual point `vᵢ = pᵢ + h zᵢ` on every joint
 /// axis (index `n + 1 + i`). Links, with their current lengths: `pᵢ–pᵢ₊₁`, `pᵢ–vᵢ` (h),
-/// `vᵢ–pᵢ₋₁` and `vᵢ–pᵢ₊₁` (the spec's "both neighbours", Pythagoras), and `vᵢ₋₁–vᵢ`.
+/// `vᵢ–pᵢ₋₁` and `vᵢ–pᵢ₊₁` (S2's "both neighbours", Pythagoras), and `vᵢ₋₁–vᵢ`.
 /// The last one makes `{pᵢ₋₁, vᵢ₋₁, pᵢ, vᵢ}` a tetrahedron with all six edges fixed —
 /// one rigid link body hinged on the axis `pᵢ–vᵢ` it shares with the next — so the
 /// structure keeps exactly the `n` joint rotations as its motions (checked by the rank

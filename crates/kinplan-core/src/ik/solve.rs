@@ -290,7 +290,7 @@ pub(crate) fn run_attempt(
     }
 }
 
-/// Solves inverse kinematics for `chain` (ALGORITHMS.md §2).
+/// Solves inverse kinematics for `chain` (docs/inverse-kinematics.md).
 ///
 /// The first attempt starts at `seed` (default: middle of the limits); further attempts
 /// start at joints drawn uniformly inside the limits from a ChaCha8 RNG seeded with

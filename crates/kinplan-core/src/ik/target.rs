@@ -111,7 +111,7 @@ impl PoseError {
     }
 }
 
-/// Pose error of `current` against `target` (ALGORITHMS.md §2): position difference
+/// Pose error of `current` against `target` (docs/inverse-kinematics.md): position difference
 /// `p* − p` plus the orientation error as the rotation vector of `R* Rᵀ`, both in the
 /// base frame, so that `e ≈ J Δq` for the geometric Jacobian.
 ///

@@ -154,8 +154,8 @@ pub struct TrackResult {
 }
 
 /// Tracks a Cartesian path: step `k` is solved from the joints of step `k − 1` (the
-/// first from `seed`), with the same IK options each step (ALGORITHMS.md §2, S2 §3.2
-/// Tab. 5/6). `params.ik.time_budget` bounds the whole path; `should_stop` is checked
+/// first from `seed`), with the same IK options each step (docs/inverse-kinematics.md#path-tracking,
+/// S2 §3.2 Tab. 5/6). `params.ik.time_budget` bounds the whole path; `should_stop` is checked
 /// every iteration.
 ///
 /// ```

@@ -1,4 +1,5 @@
-//! Angle relaxation (RLXA), the randomised iterative solver of S2 §2 (ALGORITHMS.md §1).
+//! Angle relaxation (RLXA), the randomised iterative solver of S2 §2
+//! (docs/linear-solvers.md#angle-relaxation-rlxa).
 
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
@@ -290,8 +291,9 @@ fn sample_open_unit<R: Rng + ?Sized>(rng: &mut R) -> f64 {
 
 /// Solves `A x = b` (any m×n, any rank) by angle relaxation from `x₀ = 0`.
 ///
-/// Iteration (S2 §2, Fig. 6; ALGORITHMS.md §1): with `r = b − A x` and `λ ~ U(0,1)` drawn
-/// from `rng`, `x ← x + (λ‖r‖/n) · diag(1/‖aⱼ‖) · sign(Aᵀ r)`, stopping at
+/// Iteration (S2 §2, Fig. 6; docs/linear-solvers.md#angle-relaxation-rlxa): with
+/// `r = b − A x` and `λ ~ U(0,1)` drawn from `rng`,
+/// `x ← x + (λ‖r‖/n) · diag(1/‖aⱼ‖) · sign(Aᵀ r)`, stopping at
 /// `‖r‖ < tolerance` ([`SolveStatus::Converged`]) or the iteration cap
 /// ([`SolveStatus::IterationCap`]). Approaches the unique solution, the minimum-norm
 /// solution, or the least-squares residual (reproduced by tests, not assumed).

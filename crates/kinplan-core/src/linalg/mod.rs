@@ -1,7 +1,7 @@
 //! Small dense linear solvers for Jacobian systems: SVD pseudoinverse and angle relaxation (RLXA).
 //!
 //! Both solve `A x = b` for any m×n `A` (any rank) and report a [`LinearSolution`];
-//! "did not reach the tolerance" is a [`SolveStatus`], not an error. Spec: ALGORITHMS.md §1.
+//! "did not reach the tolerance" is a [`SolveStatus`], not an error. Spec: docs/linear-solvers.md.
 
 mod angle_relaxation;
 mod error;

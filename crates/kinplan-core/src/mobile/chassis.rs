@@ -1,4 +1,4 @@
-//! Chassis models (S1 §3.1–3.3, spec §6): parameters, presets, command saturation and the
+//! Chassis models (S1 §3.1–3.3, docs/mobile.md#chassis): parameters, presets, command saturation and the
 //! pose integrator shared by every controller.
 
 use serde::{Deserialize, Serialize};

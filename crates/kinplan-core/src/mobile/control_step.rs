@@ -1,4 +1,4 @@
-//! One step of a stateless controller (ALGORITHMS.md §6): the controller's memory comes in
+//! One step of a stateless controller (docs/mobile.md): the controller's memory comes in
 //! and goes out as an opaque token ([`decode_token`] / [`encode_token`]), so a server can
 //! answer each step without keeping anything between calls. The vector-distance navigator
 //! senses the world itself when it is given no readings.

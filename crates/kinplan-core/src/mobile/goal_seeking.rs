@@ -68,7 +68,7 @@ pub struct SteeringCommand {
     pub distance: f64,
 }
 
-/// One step of S1 §4.2.1 (spec §6): Z = |G − P|, Ω = atan2(y_G − y, x_G − x),
+/// One step of S1 §4.2.1 (docs/mobile.md#goal-seeking): Z = |G − P|, Ω = atan2(y_G − y, x_G − x),
 /// δ = clamp(wrap(Ω − θ), ±δ_max), θ̇ = v tanδ / (a + b); speed v while Z ≥ v·dt, else
 /// Z / (2 dt) (the step halves the remaining distance). The caller stops when Z decreases by
 /// less than `epsilon` per step ([`goal_seeking_finished`]).

@@ -97,8 +97,8 @@ pub fn lyapunov_value(e: f64, alpha: f64, theta: f64, params: &LyapunovParams) -
     0.5 * (params.lambda * e * e + alpha * alpha + params.h * theta * theta)
 }
 
-/// The Aicardi et al. (1995) law (spec §6; S1 §4.2.3). In the goal frame (goal at the
-/// origin, heading 0) with robot position (ξ, η) and heading φ:
+/// The Aicardi et al. (1995) law (docs/mobile.md#lyapunov-pose-controller; S1 §4.2.3). In
+/// the goal frame (goal at the origin, heading 0) with robot position (ξ, η) and heading φ:
 ///
 /// e = √(ξ² + η²), Θ = atan2(−η, −ξ) (bearing of robot→goal), α = wrap(Θ − φ),
 /// v = γ e cos α,  ω = k α + γ (cos α · sin α / α)(α + h Θ),

@@ -1,4 +1,4 @@
-//! Mobile robots (spec §6, source S1): chassis kinematics, pose controllers, vector-distance
+//! Mobile robots (docs/mobile.md, source S1): chassis kinematics, pose controllers, vector-distance
 //! local navigation, a grid A* global planner and a simulator with collision detection.
 
 mod angle;

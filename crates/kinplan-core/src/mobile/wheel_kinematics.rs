@@ -1,5 +1,5 @@
-//! Wheel kinematics (S1 §3.1–3.3, spec §6): body twist ↔ wheel angular speeds and steering
-//! angles for every chassis.
+//! Wheel kinematics (S1 §3.1–3.3, docs/mobile.md#chassis): body twist ↔ wheel angular speeds
+//! and steering angles for every chassis.
 
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;

@@ -1,4 +1,4 @@
-//! The exact frustum count of unknown cells (ALGORITHMS.md §5 step 3, S0 eq. 4.2's c):
+//! The exact frustum count of unknown cells (docs/exploration.md#information-gain, S0 eq. 4.2's c):
 //! octree culling against the frustum's planes with per-node known-cell counts, and
 //! boundary cubes of unknown space counted row by row.
 

@@ -1,5 +1,5 @@
-//! Candidate views from frontier cells and the potential field (ALGORITHMS.md §5
-//! step 1, S0 §4.1 eq. 4.1).
+//! Candidate views from frontier cells and the potential field (docs/exploration.md#candidates,
+//! S0 §4.1 eq. 4.1).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -242,7 +242,7 @@ fn one_leaf(tree: &Octree, key: &OcKey, depth: u8) -> bool {
     !tree.has_children(n)
 }
 
-/// Potential field of the frontier cell `key` (S0 eq. 4.1, ALGORITHMS.md §5 step 1):
+/// Potential field of the frontier cell `key` (S0 eq. 4.1, docs/exploration.md#candidates):
 /// `F = Σ F_p − Σ F_o` over every depth-16 cell `k + o` within `radius` (m) of the
 /// cell's centre — `0 < ‖o·res‖ ≤ radius` — where an unknown cell attracts and a known
 /// (free or occupied) cell repels with `o·res/‖o·res‖²` (unit direction over distance,

@@ -1,5 +1,5 @@
 //! Information gain of a view: S0's volume intersection as an exact frustum-culled
-//! count of unknown cells, and ray-cast gains (ALGORITHMS.md §5 step 3).
+//! count of unknown cells, and ray-cast gains (docs/exploration.md#information-gain).
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
@@ -56,8 +56,8 @@ pub struct GainWorkspace {
     seen: Vec<u64>,
 }
 
-/// Unknown depth-16 cells of `tree` whose centres lie inside `frustum` (ALGORITHMS.md §5
-/// step 3, S0 eq. 4.2's c), counted exactly by culling octree cubes against the six
+/// Unknown depth-16 cells of `tree` whose centres lie inside `frustum` (docs/exploration.md#information-gain,
+/// S0 eq. 4.2's c), counted exactly by culling octree cubes against the six
 /// planes ([`FrustumCounter`], which see). Builds the tree's known-cell counts on every
 /// call; for many views of one tree build one [`FrustumCounter`] and reuse it.
 ///

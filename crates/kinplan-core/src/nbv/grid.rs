@@ -1,7 +1,7 @@
 //! A dense grid of depth-16 cell states over one key box, filled from the tree in one
 //! pass, so that the frontier test (26 neighbours per cell) and the potential field
 //! (every cell within the radius) read bytes instead of descending the tree per cell
-//! (ALGORITHMS.md §5 step 1, S0 §4.1).
+//! (docs/exploration.md#candidates, S0 §4.1).
 
 use nalgebra::Vector3;
 use rayon::prelude::*;

@@ -1,6 +1,6 @@
 //! Next-best-view selection on occupancy octrees: frontier candidates with a potential
 //! field, ORF → PTF → IGF filters, information gain by frustum intersection or ray
-//! casting, utility and IK reachability (ALGORITHMS.md §5, S0 §4).
+//! casting, utility and IK reachability (docs/exploration.md, S0 §4).
 
 mod camera;
 mod count;

@@ -29,7 +29,7 @@ impl Default for Weights {
     }
 }
 
-/// Options of [`next_best_view`](super::next_best_view) (ALGORITHMS.md §5).
+/// Options of [`next_best_view`](super::next_best_view) (docs/exploration.md).
 #[derive(Debug, Clone, PartialEq)]
 pub struct NbvParams {
     /// Box searched for frontier cells (m, map frame); `None` = the known bounds of

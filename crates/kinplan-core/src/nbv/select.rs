@@ -1,5 +1,5 @@
 //! The NBV pipeline: candidates, ORF → PTF → IGF, utility, IK reachability
-//! (ALGORITHMS.md §5, S0 §4).
+//! (docs/exploration.md, S0 §4).
 
 use std::time::Instant;
 
@@ -136,7 +136,7 @@ pub fn estimate_reach(chain: &Chain) -> f64 {
 }
 
 /// Ranks candidate views of `tree` for `camera` now at `current_pose` (optical frame →
-/// map) — ALGORITHMS.md §5 / S0 §4:
+/// map) — docs/exploration.md / S0 §4:
 /// 1. candidates: frontier cells (free, ≥ `frontier_unknown_ratio` unknown
 ///    neighbours), each looking along its potential field `F = ΣF_p − ΣF_o` from a
 ///    stand-off, plus `extra_candidates`;

@@ -1,5 +1,5 @@
 //! Known depth-16 cells below every node, built in one pass, so that a query can
-//! take the unknown volume of a whole subtree in closed form (ALGORITHMS.md §5 step 3:
+//! take the unknown volume of a whole subtree in closed form (docs/exploration.md#information-gain:
 //! the frustum count of unknown cells).
 
 use super::key::TREE_DEPTH;

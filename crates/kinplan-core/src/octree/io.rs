@@ -1,6 +1,6 @@
 //! OctoMap's `.bt` (binary, max-likelihood) and `.ot` (full, log-odds) formats and the
 //! ROS `octomap_msgs/Octomap` node bytes, read iteratively with an explicit stack
-//! bounded by the tree depth (ALGORITHMS.md §5, "OctoMap interoperability").
+//! bounded by the tree depth (docs/octree.md#file-and-message-formats).
 
 use super::header::{BT_FIRST_LINE, Header, OT_FIRST_LINE, parse_header, write_header};
 use super::key::TREE_DEPTH;

@@ -1,5 +1,5 @@
 //! OctoMap's discrete addressing: keys, child indices and key ↔ coordinate maps
-//! (ALGORITHMS.md §5, "OctoMap interoperability").
+//! (docs/octree.md#layout-and-keys).
 
 /// Levels below the root; a key has 16 bits per axis.
 pub const TREE_DEPTH: u8 = 16;

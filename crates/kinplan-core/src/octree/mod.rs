@@ -1,5 +1,5 @@
 //! OctoMap-compatible occupancy octree: keys, arena nodes, `.bt`/`.ot`/ROS-message IO,
-//! queries, ray casting and scan integration (ALGORITHMS.md §5).
+//! queries, ray casting and scan integration (docs/octree.md).
 
 mod counts;
 mod error;

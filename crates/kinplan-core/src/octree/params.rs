@@ -3,7 +3,7 @@
 use super::OctreeError;
 use super::key::logodds;
 
-/// OctoMap's occupancy sensor model (ALGORITHMS.md §5; OctoMap's `OcTree` defaults).
+/// OctoMap's occupancy sensor model (docs/octree.md#values-and-updates; OctoMap's `OcTree` defaults).
 /// Probabilities are stored as f32 log-odds `ln(p/(1−p))`, exactly as OctoMap stores
 /// them, so updates round the same way.
 #[derive(Debug, Clone, Copy, PartialEq)]

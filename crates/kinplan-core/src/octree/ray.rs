@@ -1,6 +1,6 @@
 //! Ray casting over keys: the 3-D DDA of Amanatides & Woo with OctoMap's
 //! `computeRayKeys` and `castRay` semantics, in OctoMap's f32/f64 arithmetic so the same
-//! cells come out (ALGORITHMS.md §5).
+//! cells come out (docs/octree.md#rays-and-scans).
 
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;

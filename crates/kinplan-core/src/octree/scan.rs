@@ -1,6 +1,6 @@
 //! Scan integration with OctoMap's `insertPointCloud` model: free cells along each
 //! beam, occupied at the end points, each cell updated once per scan, occupied
-//! preferred over free (ALGORITHMS.md §5).
+//! preferred over free (docs/octree.md#rays-and-scans).
 
 use std::time::Instant;
 

@@ -18,7 +18,7 @@ fn geb079() -> Option<Vec<u8>> {
 fn geb079_reads_with_octomaps_counts_and_writes_back_identical() {
     let Some(bytes) = geb079() else { return };
     let t = Octree::read_bt(&bytes, &OctreeLimits::default()).unwrap();
-    // figures OctoMap reports for this file (ALGORITHMS.md §5)
+    // figures OctoMap reports for this file (docs/octree.md#file-and-message-formats)
     assert_eq!(t.num_nodes(), 532_566);
     assert_eq!(t.leaf_counts(), (143_729, 284_415));
     assert_eq!(t.resolution(), 0.08);

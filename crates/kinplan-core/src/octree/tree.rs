@@ -1,5 +1,5 @@
 //! The arena octree: nodes stored by value in blocks of eight siblings, no `Box` per
-//! node, OctoMap's update / expand / prune rules (ALGORITHMS.md §5).
+//! node, OctoMap's update / expand / prune rules (docs/octree.md#values-and-updates).
 
 use super::OctreeError;
 use super::key::{OcKey, TREE_DEPTH, child_index};

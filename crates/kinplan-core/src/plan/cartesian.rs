@@ -1,4 +1,4 @@
-//! CCSTOMP's two extensions (ALGORITHMS.md §4, S0 §3.1–3.2): the straight
+//! CCSTOMP's two extensions (docs/planning.md#ccstomp, S0 §3.1–3.2): the straight
 //! Cartesian reference line with the per-waypoint deviation and cost, and the
 //! Cartesian normal-distribution noise generator.
 

@@ -18,7 +18,7 @@ pub(crate) struct ColumnScan {
 const BLOCK: usize = 128;
 
 impl ColumnScan {
-    /// Rows above which the k-d tree answers faster (measured on the
+    /// Rows above which the k-d tree answers faster (chosen on the
     /// MotionBenchMaker Panda problems).
     pub const LARGEST: usize = 4096;
 

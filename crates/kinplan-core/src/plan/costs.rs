@@ -1,4 +1,4 @@
-//! STOMP's per-timestep costs (ALGORITHMS.md §4): collision (penalty smoothed
+//! STOMP's per-timestep costs (docs/planning.md#stomp): collision (penalty smoothed
 //! over a window, plus the distance cost), joint limits, control
 //! (acceleration) and, for CCSTOMP, the Cartesian distance to the straight
 //! line.

@@ -22,7 +22,7 @@ use crate::score::{Rows, ScoreInput, ScoreParams, Scores, TrajectoryData, score}
 /// Which planner [`plan`] runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Algorithm {
-    /// STOMP with joint-space noise (ALGORITHMS.md §4).
+    /// STOMP with joint-space noise (docs/planning.md#stomp).
     #[default]
     Stomp,
     /// STOMP with S0's Cartesian noise generator and Cartesian distance cost.
@@ -188,7 +188,7 @@ fn validate(chain: &Chain, checker_dof: usize, req: &PlanRequest) -> Result<(), 
 }
 
 /// Plans a trajectory for `chain` from `req.start` to `req.goal` in the world
-/// of `checker` (ALGORITHMS.md §4).
+/// of `checker` (docs/planning.md).
 ///
 /// 1. Invalid parameters → `Err`; everything else is a [`PlanStatus`].
 /// 2. Start (and a joint goal) checked with `checker.is_valid`. A pose goal is

@@ -6,8 +6,8 @@ use super::error::{PlanError, PlanField, require};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum InitialTrajectory {
     /// The algorithm's own start: [`Self::CartesianLine`] for CCSTOMP (its
-    /// cost is measured against that line; on S0 §3.3 it succeeds on every
-    /// seed where the RRT-Connect start succeeds on 41 %),
+    /// cost is measured against that line; on S0 §3.3 it succeeds far more
+    /// often than the RRT-Connect start, `benches/RESULTS.md`),
     /// [`Self::RrtConnectIfBlocked`] for STOMP.
     #[default]
     ForAlgorithm,
@@ -36,7 +36,7 @@ impl InitialTrajectory {
     }
 }
 
-/// Options of STOMP (ALGORITHMS.md §4). Defaults follow MoveIt 2's STOMP
+/// Options of STOMP (docs/planning.md#stomp). Defaults follow MoveIt 2's STOMP
 /// plugin (40 timesteps, 15 rollouts, 25 kept at most, sensitivity 0.5,
 /// control-cost weight 0.1, 50 iterations).
 #[derive(Debug, Clone, PartialEq)]
@@ -173,7 +173,7 @@ impl StompParams {
     }
 }
 
-/// Options of the two CCSTOMP extensions (ALGORITHMS.md §4, S0 §3.1–3.2).
+/// Options of the two CCSTOMP extensions (docs/planning.md#ccstomp, S0 §3.1–3.2).
 /// Defaults are S0 §3.3's experiment.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CartesianParams {

@@ -159,10 +159,8 @@ pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
 
 /// How much coarser than the checker's resolution the lazy search
 /// interpolates: its states only guide the search (the proof is the check).
-/// On the MotionBenchMaker Panda problems, with the proofs' pads bounded
-/// along each piece, four times as coarse searches 10 % faster than twice
-/// (median over all sets; three: 6 %; six: 6 %; eight: slower, the proofs
-/// fail more often).
+/// Coarser searches faster until the proofs start failing more often; four
+/// was the best of two to eight on the MotionBenchMaker Panda problems.
 const LAZY_COARSENING: f64 = 4.0;
 
 /// The padded search, lazily: trees grown with interpolated edge checks
@@ -172,11 +170,9 @@ const LAZY_COARSENING: f64 = 4.0;
 /// two through a nudged waypoint ([`nudged_waypoint`]), else by a path grown
 /// between its ends with padded edges, and if that fails too the whole
 /// problem is grown with padded edges. Samples count against one budget,
-/// `params.max_samples`. (On MotionBenchMaker the nudges made the padded
-/// search 6–13 % faster on the bookshelf and cage sets, and nudging from
-/// where the edge was refused rather than from its midpoint a further
-/// 14–24 % on the bookshelves: a grown detour took ~0.3 ms, most of the
-/// proof's time in the median problems.)
+/// `params.max_samples`. (A grown detour is the costly part of a proof, so
+/// the nudges come first, spread around where the edge was refused rather
+/// than around its midpoint.)
 #[inline(never)] // one call per search; a named frame for profilers
 fn prove_lazily<C: StateChecker + ?Sized>(
     checker: &C,
@@ -257,8 +253,8 @@ fn prove_lazily<C: StateChecker + ?Sized>(
     grown
 }
 
-/// Nudges tried before a padded detour (16 or 24, spreading slower, were
-/// faster on some MotionBenchMaker sets and slower on others).
+/// Nudges tried before a padded detour (more nudges, spreading slower, were
+/// no better overall on the MotionBenchMaker problems).
 const NUDGES: usize = 12;
 
 /// A state `m` near `x + at·(y − x)`, where the motion `x → y` was refused,

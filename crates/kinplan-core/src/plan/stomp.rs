@@ -1,4 +1,4 @@
-//! The STOMP iteration (ALGORITHMS.md §4), with joint-space noise (STOMP) or
+//! The STOMP iteration (docs/planning.md#stomp), with joint-space noise (STOMP) or
 //! the Cartesian noise generator and cost (CCSTOMP).
 
 use nalgebra::DVector;
@@ -77,7 +77,7 @@ struct Rollout<'c> {
 /// Runs STOMP from `initial` (`timesteps × dof`, row-major; its first and
 /// last rows are the fixed start and goal).
 ///
-/// Per iteration (ALGORITHMS.md §4): K rollouts `θ + ε_k` — joint noise
+/// Per iteration (docs/planning.md#stomp): K rollouts `θ + ε_k` — joint noise
 /// `ε_d = σ_d L z` with `L Lᵀ = R⁻¹/max R⁻¹`, or with `cartesian` the noise of
 /// S0 §3.1 per waypoint — plus up to `max_rollouts − K` best earlier rollouts
 /// (their noise taken as `θ_k − θ`) and the noiseless current one; costs

@@ -1,4 +1,4 @@
-//! STOMP's fixed matrices (ALGORITHMS.md §4), kept banded: the control-cost
+//! STOMP's fixed matrices (docs/planning.md#stomp), kept banded: the control-cost
 //! matrix R = AᵀA of the finite-difference acceleration matrix A, the noise
 //! covariance R⁻¹ (normalised) and the smoothing projection M, all applied
 //! through R's banded Cholesky factor — no dense `free × free` matrix is ever

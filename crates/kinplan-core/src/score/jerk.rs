@@ -75,7 +75,7 @@ pub fn third_derivative_weights(t: [f64; 4]) -> [f64; 4] {
 /// Cartesian space (S0 eq. 2.12, 2.14): `slowdown = c · √P + d`.
 /// The print of eq. 2.12 reads `1000·√2/2·√x + ∛4` (typeset garbled); eq. 2.14
 /// repeats it with a trailing `+ 4` that eq. 2.12 lacks — we follow eq. 2.12
-/// (ALGORITHMS.md §3); set `cartesian_offset` to `∛4 + 4` for the other reading.
+/// (docs/scoring.md#criteria); set `cartesian_offset` to `∛4 + 4` for the other reading.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JerkPeakParams {
     /// `a`, slowdown per decade of joint pseudo-jerk (dimensionless). Default 3.

@@ -1,4 +1,4 @@
-//! Which joint limits the S2 PTP cycle time (ALGORITHMS.md §3.3) of a robot
+//! Which joint limits the S2 PTP cycle time (docs/scoring.md#ptp-cycle-time-and-time-potential) of a robot
 //! uses: the limits a caller gives, else the speed limits of the robot model.
 
 use std::fmt;

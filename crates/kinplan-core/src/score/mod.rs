@@ -3,7 +3,7 @@
 //!
 //! Pure functions over already computed data (joints, tool poses, robot
 //! points); `robot_points` alone turns a robot model into those data. No
-//! transport types. Spec: ALGORITHMS.md §3.
+//! transport types. Spec: docs/scoring.md.
 
 mod compare;
 mod criteria;

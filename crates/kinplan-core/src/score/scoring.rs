@@ -102,7 +102,7 @@ pub struct ScoreReport {
     pub cycle_time: Option<CycleTime>,
 }
 
-/// Scores one trajectory on every criterion of S0 §2 (ALGORITHMS.md §3) and,
+/// Scores one trajectory on every criterion of S0 §2 (docs/scoring.md#criteria) and,
 /// with joint limits, the PTP cycle time of S2 §3.3.
 ///
 /// With waypoints `i = 0 … n−1`, joints `j`, tool positions `p_i`, tool

@@ -63,8 +63,8 @@ pub(crate) fn check_system(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<(), Lin
     Ok(())
 }
 
-/// Solves `A x = b` in the least-squares, minimum-norm sense: `x = A⁺ b` (ALGORITHMS.md §1,
-/// the reference the RLXA properties are measured against).
+/// Solves `A x = b` in the least-squares, minimum-norm sense: `x = A⁺ b`
+/// (docs/linear-solvers.md#svd-pseudoinverse, the reference the RLXA properties are measured against).
 ///
 /// Uses nalgebra's SVD (`A = U Σ Vᵀ`, `x = V Σ⁺ Uᵀ b`, singular values below
 /// `relative_tolerance · σ_max` dropped); falls back to the one-sided Jacobi SVD of

@@ -23,8 +23,8 @@ use super::{PseudoinverseParams, check_system};
 /// `τ` (default `1e-10`; see [`with_orthogonality`](Self::with_orthogonality)). When `W`
 /// has at most 8 rows (every 6×n and 3×n IK Jacobian with n ≤ 8) the sweeps run on
 /// fixed-size stack arrays padded to an even length, visiting the pairs in round-robin
-/// order (disjoint pairs in a row, so their rotations overlap in the pipeline; ~9 %
-/// fewer sweeps than row-cyclic order on Panda Jacobians), with the squared column norms
+/// order (disjoint pairs in a row, so their rotations overlap in the pipeline; fewer
+/// sweeps than row-cyclic order on Panda Jacobians), with the squared column norms
 /// cached across a sweep (`‖wᵢ'‖² = α − tγ`, `‖wⱼ'‖² = β + tγ`, recomputed at the start
 /// of each sweep), the rotation from two square roots, and AVX2 code when the CPU has
 /// it; larger shapes use general slice code in row-cyclic order. All are cyclic
@@ -65,7 +65,7 @@ impl SvdWorkspace {
     /// converging by (inexact Newton; Dembo, Eisenstat & Steihaug 1982) when the unknown
     /// is the step itself: the Jacobian-inverse and Levenberg–Marquardt steps use `1e-4`,
     /// which leaves their iteration counts unchanged on every benchmark arm and saves
-    /// ~15 % of the sweeps (`benches/IK_RESULTS.md`). Not when the unknown is the new
+    /// sweeps (`benches/IK_RESULTS.md`). Not when the unknown is the new
     /// iterate (Newton's `J q_{k+1} = J q_k + e`): its error `τ‖q‖` does not shrink with
     /// `e`, so Newton keeps the default.
     pub fn with_orthogonality(mut self, tolerance: f64) -> Self {
