@@ -13,8 +13,9 @@ import grpc
 import numpy as np
 import numpy.typing as npt
 
-from ._convert import (joints, joints_and_field, length_delimited, matrix_from_proto, matrix_to_proto, pose_to_matrix,
-                       tool_pose_of_fk_reply)
+from ._codec import FK_JOINTS, ROBOT_REF, joints, joints_and_field, length_delimited, read_fk_reply
+from ._convert import matrix_from_proto, matrix_to_proto, pose_to_matrix
+from ._rotation import poses_to_matrices
 from .errors import JointLimitWarning, KinplanError, error_for, invalid_argument
 from .kinematics import KinematicsMixin, RobotKinematicsMixin
 from .mobile import MobileMixin
@@ -432,7 +433,7 @@ class RobotRefs:
             ref: common_pb2.RobotRef = cached[1]
             return ref
         ref = self._new_ref(inline)
-        self.__dict__["_ref_cache"] = (key, ref, length_delimited(1, ref.SerializeToString()))
+        self.__dict__["_ref_cache"] = (key, ref, length_delimited(ROBOT_REF, ref.SerializeToString()))
         return ref
 
     def _ref_field(self, ref: common_pb2.RobotRef) -> bytes:
@@ -441,7 +442,7 @@ class RobotRefs:
         if cached is not None and cached[1] is ref:
             encoded: bytes = cached[2]
             return encoded
-        return length_delimited(1, ref.SerializeToString())
+        return length_delimited(ROBOT_REF, ref.SerializeToString())
 
     def _new_ref(self, inline: bool) -> common_pb2.RobotRef:
         ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link)
@@ -567,20 +568,16 @@ class Robot(RobotRefs, RobotKinematicsMixin):
             return pose_to_matrix(r.tool_pose), {link.name: pose_to_matrix(link.pose) for link in r.links}
         # the hot path: the request as bytes (reference, packed joints), the
         # answer read from its bytes when it has the usual layout
-        positions, body = joints_and_field(2, q, "q")
+        positions, body = joints_and_field(FK_JOINTS, q, "q")
         limits = self._limits()
         lower, upper = limits._lower_list, limits._upper_list
         if not (len(positions) == len(lower) and all(map(operator.le, lower, positions))
                 and all(map(operator.le, positions, upper))):
             self.check_limits(positions)  # the whole check: it warns, or raises, naming the joint
-        wire = self._send(_FORWARD_KINEMATICS, None, body, timeout)
-        tool = tool_pose_of_fk_reply(wire)
-        if tool is not None:
-            return tool
-        r = robot_pb2.ForwardKinematicsResponse.FromString(wire)
-        if r.model_id and self.urdf_text is not None:
-            self.model_id = r.model_id
-        return pose_to_matrix(r.tool_pose)
+        tool, model_id = read_fk_reply(self._send(_FORWARD_KINEMATICS, None, body, timeout))
+        if model_id and self.urdf_text is not None:
+            self.model_id = model_id
+        return tool
 
     def fk_batch(self, qs: Any, *, jacobians: bool = False, timeout: Optional[float] = None) -> Any:
         """Tool poses of every row of `qs` (n x dof, rad) in one call: an
@@ -605,22 +602,9 @@ class Robot(RobotRefs, RobotKinematicsMixin):
     @staticmethod
     def _batch_reply(r: Any, dof: int, jacobians: bool) -> Any:
         """The (n, 4, 4) poses (and (n, 6, dof) Jacobians) of a batch FK reply."""
-        p = np.asarray(r.tool_poses.data, dtype=np.float64).reshape(-1, 7)
-        x, y, z, w = p[:, 3], p[:, 4], p[:, 5], p[:, 6]
-        T = np.zeros((len(p), 4, 4))
-        T[:, 0, 0] = 1 - 2 * (y * y + z * z)
-        T[:, 0, 1] = 2 * (x * y - z * w)
-        T[:, 0, 2] = 2 * (x * z + y * w)
-        T[:, 1, 0] = 2 * (x * y + z * w)
-        T[:, 1, 1] = 1 - 2 * (x * x + z * z)
-        T[:, 1, 2] = 2 * (y * z - x * w)
-        T[:, 2, 0] = 2 * (x * z - y * w)
-        T[:, 2, 1] = 2 * (y * z + x * w)
-        T[:, 2, 2] = 1 - 2 * (x * x + y * y)
-        T[:, :3, 3] = p[:, :3]
-        T[:, 3, 3] = 1.0
+        T = poses_to_matrices(np.asarray(r.tool_poses.data, dtype=np.float64))
         if jacobians:
-            J = np.asarray(r.jacobians.data, dtype=np.float64).reshape(len(p), 6, dof)
+            J = np.asarray(r.jacobians.data, dtype=np.float64).reshape(len(T), 6, dof)
             return T, J
         return T
 

@@ -25,8 +25,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ._display import html_table
-from ._convert import (joints, joints_field, length_delimited, matrix_to_pose, matrix_to_proto, pose_bytes,
-                       pose_to_matrix, target_field)
+from ._codec import IK_OPTIONS, IK_SEED, IK_TARGET, joints, joints_field, length_delimited, target_field
+from ._convert import matrix_to_pose, matrix_to_proto, pose_bytes, pose_to_matrix
 from .errors import KinplanError
 from .v1 import common_pb2, kinematics_pb2, kinematics_pb2_grpc
 
@@ -123,9 +123,9 @@ def _ik_options_field(*args: Any) -> bytes:
     try:
         cached = _IK_OPTIONS_FIELD.get(args)
     except TypeError:  # an unhashable argument: no cache
-        return length_delimited(4, _build_ik_options(*args).SerializeToString())
+        return length_delimited(IK_OPTIONS, _build_ik_options(*args).SerializeToString())
     if cached is None:
-        cached = length_delimited(4, _build_ik_options(*args).SerializeToString())
+        cached = length_delimited(IK_OPTIONS, _build_ik_options(*args).SerializeToString())
         if len(_IK_OPTIONS_FIELD) < 256:
             _IK_OPTIONS_FIELD[args] = cached
     return cached
@@ -723,8 +723,8 @@ class RobotKinematicsMixin:
         except (KeyError, TypeError):  # first use of these arguments, or an unhashable one
             options_field = _ik_options_field(*key)
         # the request goes out as bytes built field by field: no message objects
-        target = target_field(T) if matrix else length_delimited(2, _target_wire(T))
-        body = target + (b"" if seed is None else joints_field(3, seed, "seed")) + options_field
+        target = target_field(T) if matrix else length_delimited(IK_TARGET, _target_wire(T))
+        body = target + (b"" if seed is None else joints_field(IK_SEED, seed, "seed")) + options_field
         reply = self._send(_SOLVE_IK, kinematics_pb2.SolveIkResponse, body, timeout)  # type: ignore[attr-defined]
         return IkResult.from_proto(reply)
 

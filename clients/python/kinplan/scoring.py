@@ -14,6 +14,7 @@ from typing import Any, Callable, Dict, Iterable, Iterator, List, Mapping, Optio
 
 import numpy as np
 
+from ._codec import trajectory_message
 from .v1 import common_pb2, scoring_pb2, scoring_pb2_grpc
 
 #: Robot-point choices for RDM, by name.
@@ -243,33 +244,9 @@ def _rank(name: str) -> int:
     return CRITERIA.index(name) if name in CRITERIA else len(CRITERIA)
 
 
-def _varint(n: int) -> bytes:
-    out = bytearray()
-    while True:
-        byte, n = n & 0x7F, n >> 7
-        out.append(byte | (0x80 if n else 0))
-        if not n:
-            return bytes(out)
-
-
 def _encode_rows(arr: np.ndarray, ts: Optional[np.ndarray]) -> common_pb2.JointTrajectory:
-    """A JointTrajectory of an (n x m) float array, encoded with numpy and
-    parsed once by protobuf: one JointPoint per row (field 2), its positions
-    packed (field 1), its time (field 2, fixed64) when given. Builds the same
-    message as one JointPoint per row, ~30x faster for long trajectories."""
-    n, m = arr.shape
-    positions = b"\x0a" + _varint(8 * m)
-    point_len = len(positions) + 8 * m + (9 if ts is not None else 0)
-    head = b"\x12" + _varint(point_len) + positions
-    width = len(head) + point_len - len(positions)
-    buf = np.empty((n, width), dtype=np.uint8)
-    buf[:, : len(head)] = np.frombuffer(head, dtype=np.uint8)
-    end = len(head) + 8 * m
-    buf[:, len(head) : end] = np.ascontiguousarray(arr, dtype="<f8").view(np.uint8).reshape(n, 8 * m)
-    if ts is not None:
-        buf[:, end] = 0x11
-        buf[:, end + 1 :] = np.ascontiguousarray(ts, dtype="<f8").view(np.uint8).reshape(n, 8)
-    return common_pb2.JointTrajectory.FromString(buf.tobytes())
+    """A JointTrajectory of an (n x m) float array (see :func:`kinplan._codec.trajectory_message`)."""
+    return trajectory_message(arr, ts)
 
 
 def _check_trajectory_limits(check: Any, q: Any) -> None:
