@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .explore import ReferenceScene
+from .exploration_loop import ReferenceScene
 
 
 def s0_open_cell(client: Any, seed: int = 1) -> ReferenceScene:
