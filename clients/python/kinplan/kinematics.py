@@ -323,7 +323,7 @@ class IkSolution:
     def from_proto(cls, s: kinematics_pb2.IkSolution) -> "IkSolution":
         # positional, in field order: the hot path of every IK answer
         return cls(
-            np.array(s.joints[:], dtype=float),  # a list first: ~3x faster than asarray for a few values
+            np.array(s.joints[:], dtype=float),  # a list first: cheaper than asarray for a few values
             s.position_error,
             s.orientation_error,
             s.iterations,
@@ -420,7 +420,7 @@ class _LazyIkField:
             solutions = d.get("solutions")
             if solutions is None and len(r.solutions):
                 s = r.solutions[0]
-                d["q"] = np.array(s.joints[:])  # float64 from a list of floats; a list first: ~3x faster than asarray
+                d["q"] = np.array(s.joints[:])  # float64 from a list of floats (cheaper than asarray here)
                 d["position_error"], d["orientation_error"], d["iterations"] = (
                     s.position_error, s.orientation_error, s.iterations)
             else:
