@@ -16,13 +16,14 @@ from ._channel import (DEFAULT_PORT, DEFAULT_TIMEOUT, _BearerToken, _channel_opt
 from ._services import Call, Stubs
 from ._services import exploration as _exploration
 from ._services import kinematics as _kinematics
+from ._services import mobile as _mobile
 from ._services import robot as _robot
 from ._services.robot import RobotRefs, check_robot_args
 from .description import JointLimits, RobotDescription
 from .errors import KinplanError, invalid_argument
 from .exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
 from .kinematics import LinearSolution
-from .mobile import Mobile
+from .mobile import MobileRun, Obstacle as MobileObstacle, StepResult, WheelKinematics
 from .octree import Octree, Views
 from .planning import Obstacle, Plan, StateChecks
 from .robot import Robot
@@ -451,11 +452,114 @@ class Client:
             timeout=timeout)
 
 
+class Mobile:
+    """The MobileService calls; reach it as ``client.mobile``."""
+
+    def __init__(self, client: Any):
+        self._client = client
+
+    def wheels(
+        self,
+        chassis: str = "differential",
+        twist: Optional[Sequence[float]] = None,
+        *,
+        wheels: Optional[Mapping[str, Any]] = None,
+        chassis_params: Optional[Mapping[str, float]] = None,
+        timeout: Optional[float] = None,
+    ) -> WheelKinematics:
+        """Inverse kinematics of ``twist`` = (vx, vy, ω), or forward kinematics
+        of ``wheels`` (a dict as in :class:`WheelKinematics`)."""
+        out: WheelKinematics = self._client._run(_mobile.wheels(chassis, twist, wheels, chassis_params), timeout)
+        return out
+
+    def step(
+        self,
+        state: Sequence[float],
+        *,
+        chassis: str = "differential",
+        controller: str = "lyapunov",
+        path: Optional[Iterable[Sequence[float]]] = None,
+        goal: Optional[Sequence[float]] = None,
+        gains: Optional[Mapping[str, Any]] = None,
+        params: Optional[Mapping[str, Any]] = None,
+        sensors: Optional[Mapping[str, Any]] = None,
+        readings: Optional[Iterable[float]] = None,
+        world: Optional[Iterable[MobileObstacle]] = None,
+        robot_radius: Optional[float] = None,
+        seed: int = 0,
+        dt: Optional[float] = None,
+        token: Union[bytes, StepResult, None] = b"",
+        chassis_params: Optional[Mapping[str, float]] = None,
+        timeout: Optional[float] = None,
+    ) -> StepResult:
+        """One stateless controller step. Path followers take ``path`` and
+        ``gains``; "vector_distance" takes ``goal``, ``params`` (navigator),
+        ``sensors`` and either ``readings`` (gaps from the rim, m) or a
+        ``world`` to sense. Pass the previous result (or its ``token``) as
+        ``token=`` to continue; empty starts a fresh controller."""
+        call = _mobile.step(state, chassis, controller, path, goal, gains, params, sensors, readings, world,
+                            robot_radius, seed, dt, token, chassis_params)
+        out: StepResult = self._client._run(call, timeout)
+        return out
+
+    def follow(
+        self,
+        chassis: str = "differential",
+        start: Sequence[float] = (0.0, 0.0, 0.0),
+        path: Iterable[Sequence[float]] = (),
+        controller: str = "lyapunov",
+        gains: Optional[Mapping[str, Any]] = None,
+        *,
+        world: Optional[Iterable[MobileObstacle]] = None,
+        robot_radius: Optional[float] = None,
+        dt: Optional[float] = None,
+        max_time: Optional[float] = None,
+        chassis_params: Optional[Mapping[str, float]] = None,
+        timeout: Optional[float] = None,
+    ) -> MobileRun:
+        """Simulates ``controller`` along ``path`` ([(x, y[, θ]), ...]; a
+        heading is honoured on the last node) from ``start`` = (x, y, θ),
+        optionally among obstacles (collisions end the run)."""
+        call = _mobile.follow(chassis, start, path, controller, gains, world, robot_radius, dt, max_time,
+                              chassis_params)
+        out: MobileRun = self._client._run(call, timeout)
+        return out
+
+    def navigate(
+        self,
+        chassis: str = "differential",
+        start: Sequence[float] = (0.0, 0.0, 0.0),
+        goal: Sequence[float] = (0.0, 0.0),
+        world: Optional[Iterable[MobileObstacle]] = None,
+        robot_radius: Optional[float] = None,
+        *,
+        navigator: str = "vector_distance",
+        params: Optional[Mapping[str, Any]] = None,
+        sensors: Optional[Mapping[str, Any]] = None,
+        seed: int = 0,
+        controller: str = "pure_pursuit",
+        gains: Optional[Mapping[str, Any]] = None,
+        astar: Optional[Mapping[str, Any]] = None,
+        dt: Optional[float] = None,
+        max_time: Optional[float] = None,
+        chassis_params: Optional[Mapping[str, float]] = None,
+        timeout: Optional[float] = None,
+    ) -> MobileRun:
+        """Simulates navigation from ``start`` to ``goal`` = (x, y) among
+        ``world``: the vector-distance navigator (``params``, ``sensors``,
+        noise ``seed``) or ``navigator="grid_astar"`` (``astar`` options, then
+        ``controller`` with ``gains`` follows the grid path)."""
+        call = _mobile.navigate(chassis, start, goal, world, robot_radius, navigator, params, sensors, seed,
+                                controller, gains, astar, dt, max_time, chassis_params)
+        out: MobileRun = self._client._run(call, timeout)
+        return out
+
+
 def _deprecated(old: str, new: str) -> None:
     """The DeprecationWarning of a per-robot call made on the client (the aliases of one release)."""
     warnings.warn(f"Client.{old}(robot, ...) is deprecated and goes in the next release: use {new}",
                   DeprecationWarning, stacklevel=3)
 
 
-__all__ = ["DEFAULT_PORT", "DEFAULT_TIMEOUT", "Client", "JointLimits", "Robot", "RobotDescription", "RobotRefs",
+__all__ = ["DEFAULT_PORT", "DEFAULT_TIMEOUT", "Client", "JointLimits", "Mobile", "Robot", "RobotDescription", "RobotRefs",
            "normalize_target"]

@@ -8,8 +8,8 @@ from __future__ import annotations
 import operator
 import queue
 import threading
-from typing import (TYPE_CHECKING, Any, Callable, Dict, Iterable, Iterator, List, Literal, Mapping, Optional, Sequence,
-                    Tuple, Union, overload)
+from typing import (TYPE_CHECKING, Any, Callable, Dict, Iterable, Iterator, Literal, Mapping, Optional, Sequence, Tuple,
+                    Union, overload)
 
 import grpc
 import numpy as np
@@ -24,8 +24,8 @@ from ._services import scoring as _scoring
 from ._services.robot import RobotRefs
 from .description import JointLimits, RobotDescription
 from .errors import KinplanError
-from .kinematics import (IK_SHORTCUTS, IkBatchResult, IkMethodName, IkOptions, IkResult, LinearSolverName,
-                         TrackResult, _IK_OPTIONS_FIELD, resolve_ik_args)
+from .kinematics import (IkBatchResult, IkMethodName, IkOptions, IkResult, LinearSolverName, TrackResult,
+                         resolve_ik_args)
 from .planning import Obstacle, Plan, StateChecks
 from .scoring import Comparison, Scores, Trajectory, _check_trajectory_limits
 from .v1 import common_pb2, kinematics_pb2

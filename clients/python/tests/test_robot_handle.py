@@ -145,6 +145,7 @@ def test_the_asyncio_robot_has_the_same_calls(server_address):
     ("kinplan.kinematics", "kinplan.robot", ["IkStream"]),
     ("kinplan.client", "kinplan.robot", ["Robot"]),
     ("kinplan.client", "kinplan.description", ["RobotDescription", "JointLimits"]),
+    ("kinplan.mobile", "kinplan.client", ["Mobile"]),
 ])
 def test_old_module_paths_still_import_the_same_objects(old, new, names):
     for name in names:

@@ -1,6 +1,6 @@
 """The layer the blocking and the asyncio clients share, one module per
 gRPC service (:mod:`.robot`, :mod:`.kinematics`, :mod:`.planning`,
-:mod:`.scoring`, :mod:`.exploration`).
+:mod:`.scoring`, :mod:`.exploration`, :mod:`.mobile`).
 
 Each function there takes a call's Python arguments, checks them, and
 returns a :class:`Call`: the stub method to call, the request (for a call

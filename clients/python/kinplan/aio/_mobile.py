@@ -1,24 +1,13 @@
 """``kinplan.aio.Client.mobile``: the MobileService calls for asyncio, with
-the arguments, results and errors of :class:`kinplan.mobile.Mobile`.
-Requests and replies are built and read by :mod:`kinplan.mobile`'s
-functions; each method only awaits its call."""
+the arguments, results and errors of :class:`kinplan.client.Mobile`.
+Requests and replies are built and read by :mod:`kinplan._services.mobile`;
+each method only awaits its call."""
 from __future__ import annotations
 
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
-from ..mobile import (
-    MobileRun,
-    Obstacle,
-    StepResult,
-    WheelKinematics,
-    _follow_request,
-    _navigate_request,
-    _step_reply,
-    _step_request,
-    _wheels_reply,
-    _wheels_request,
-)
-from ..v1 import mobile_pb2_grpc
+from .._services import mobile as _mobile
+from ..mobile import MobileRun, Obstacle, StepResult, WheelKinematics
 
 
 class AsyncMobile:
@@ -27,7 +16,6 @@ class AsyncMobile:
 
     def __init__(self, client: Any):
         self._client = client
-        self._stub = mobile_pb2_grpc.MobileServiceStub(client._channel)
 
     async def wheels(
         self,
@@ -39,8 +27,8 @@ class AsyncMobile:
         timeout: Optional[float] = None,
     ) -> WheelKinematics:
         """As :meth:`kinplan.mobile.Mobile.wheels`."""
-        req = _wheels_request(chassis, twist, wheels, chassis_params)
-        return _wheels_reply(await self._client._call(self._stub.WheelKinematics, req, timeout))
+        out: WheelKinematics = await self._client._run(_mobile.wheels(chassis, twist, wheels, chassis_params), timeout)
+        return out
 
     async def step(
         self,
@@ -64,9 +52,10 @@ class AsyncMobile:
     ) -> StepResult:
         """As :meth:`kinplan.mobile.Mobile.step` (pass the previous result or
         its ``token`` to continue)."""
-        req = _step_request(state, chassis, controller, path, goal, gains, params, sensors, readings, world,
+        call = _mobile.step(state, chassis, controller, path, goal, gains, params, sensors, readings, world,
                             robot_radius, seed, dt, token, chassis_params)
-        return _step_reply(req, await self._client._call(self._stub.ControlStep, req, timeout))
+        out: StepResult = await self._client._run(call, timeout)
+        return out
 
     async def follow(
         self,
@@ -84,9 +73,10 @@ class AsyncMobile:
         timeout: Optional[float] = None,
     ) -> MobileRun:
         """As :meth:`kinplan.mobile.Mobile.follow`."""
-        req = _follow_request(chassis, start, path, controller, gains, world, robot_radius, dt, max_time,
+        call = _mobile.follow(chassis, start, path, controller, gains, world, robot_radius, dt, max_time,
                               chassis_params)
-        return MobileRun.from_proto(await self._client._call(self._stub.FollowPath, req, timeout))
+        out: MobileRun = await self._client._run(call, timeout)
+        return out
 
     async def navigate(
         self,
@@ -109,6 +99,7 @@ class AsyncMobile:
         timeout: Optional[float] = None,
     ) -> MobileRun:
         """As :meth:`kinplan.mobile.Mobile.navigate`."""
-        req = _navigate_request(chassis, start, goal, world, robot_radius, navigator, params, sensors, seed,
+        call = _mobile.navigate(chassis, start, goal, world, robot_radius, navigator, params, sensors, seed,
                                 controller, gains, astar, dt, max_time, chassis_params)
-        return MobileRun.from_proto(await self._client._call(self._stub.Navigate, req, timeout))
+        out: MobileRun = await self._client._run(call, timeout)
+        return out
