@@ -576,6 +576,14 @@ def __getattr__(name: str) -> Any:
         from .robot import IkStream
 
         return IkStream
+    if name == "KinematicsMixin":  # the client mixins of earlier releases: the classes that now hold their methods
+        from .client import Client
+
+        return Client
+    if name == "RobotKinematicsMixin":  # the client mixins of earlier releases: the classes that now hold their methods
+        from .robot import Robot
+
+        return Robot
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

@@ -292,4 +292,8 @@ def __getattr__(name: str) -> Any:
         from .client import Mobile
 
         return Mobile
+    if name == "MobileMixin":  # the client mixins of earlier releases: the classes that now hold their methods
+        from .client import Client
+
+        return Client
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

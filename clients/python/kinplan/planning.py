@@ -303,3 +303,12 @@ def _vec(v: Any, present: bool) -> List[float]:
 
 __all__ = ["ALGORITHMS", "Box", "Capsule", "Cylinder", "Mesh", "Obstacle", "OctreeObstacle", "Plan", "Sphere",
            "StateChecks", "scene_to_proto"]
+
+
+def __getattr__(name: str) -> Any:
+    """The client mixins of earlier releases: the classes that now hold their methods."""
+    if name == "PlanningMixin":
+        from .client import Client
+
+        return Client
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -326,3 +326,12 @@ __all__ = [
     "score_options",
     "trajectory_to_proto",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """The client mixins of earlier releases: the classes that now hold their methods."""
+    if name == "ScoringMixin":
+        from .client import Client
+
+        return Client
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
