@@ -99,7 +99,6 @@ def target_to_pose(T: Any) -> common_pb2.Pose:
     return matrix_to_pose(T)
 
 
-_SOLVE_IK = "/kinplan.v1.KinematicsService/SolveIk"
 
 
 def _target_wire(T: Any) -> bytes:

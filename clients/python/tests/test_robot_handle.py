@@ -159,3 +159,28 @@ def test_old_module_paths_still_import_the_same_objects(old, new, names):
             assert getattr(importlib.import_module(old), name) is kinplan.Client or name == "RobotKinematicsMixin"
             continue
         assert getattr(importlib.import_module(old), name) is getattr(importlib.import_module(new), name)
+
+
+def test_ik_options_and_the_robot_calls_type_check(tmp_path):
+    pytest.importorskip("mypy.api")
+    from test_typing import check
+
+    out = check(tmp_path, """
+        import numpy as np
+        import kinplan
+
+        def use(c: kinplan.Client) -> float:
+            robot = c.robot("ur5")
+            o = kinplan.IkOptions(method="newton", max_restarts=5, return_history=True)
+            answer = robot.ik(np.eye(4), options=o, max_restarts=0)
+            plan = robot.plan(np.zeros(6), np.ones(6), scene=[kinplan.Sphere(0.1, [0.5, 0.0, 0.3])])
+            checks = robot.check(plan.q)
+            return robot.score(plan.q)["JD"] + float(checks.clearance.min()) + answer.position_error
+
+        def wrong() -> None:
+            kinplan.IkOptions(method="lmm")
+            kinplan.IkOptions(max_restart=3)
+    """)
+    assert "Literal['lmm']" in out, out
+    assert 'Unexpected keyword argument "max_restart"' in out, out
+    assert out.count("error:") == 2, out
