@@ -29,7 +29,7 @@ with kinplan.Client(address, timeout=60) as c:
     fig = plt.figure(figsize=(7, 6))
     ax = fig.add_subplot(projection="3d")
     for algorithm, stomp in [("rrt_connect", None), ("stomp", None), ("ccstomp", {"timesteps": 10})]:
-        plan = c.plan(ur5, start=start, goal=goal, algorithm=algorithm, scene=[ball], seed=1, stomp=stomp)
+        plan = ur5.plan(start, goal, algorithm=algorithm, scene=[ball], seed=1, stomp=stomp)
         # the tool path at 0.02 rad joint steps
         dense: List[np.ndarray] = []
         for a, b in zip(plan.q[:-1], plan.q[1:]):

@@ -36,7 +36,7 @@ q = np.column_stack(
 )
 
 with kinplan.Client(address, timeout=10) as c:
-    scores = c.score("kuka_kr210_r2700_extra", q, series=True)
+    scores = c.robot("kuka_kr210_r2700_extra").score(q, series=True)
 
 series = scores.series
 assert series is not None, "series=True returns the per-waypoint series"

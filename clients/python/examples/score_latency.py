@@ -1,4 +1,4 @@
-"""Round-trip latency of Client.score for a 10,000-waypoint KR 210 trajectory
+"""Round-trip latency of Robot.score for a 10,000-waypoint KR 210 trajectory
 from Python: numpy -> JointTrajectory, gRPC, FK and every criterion on the
 server, reply -> Scores.
 
@@ -35,13 +35,13 @@ with kinplan.Client(address, timeout=30, max_message_bytes=64 * 1024 * 1024) as 
     robot = c.robot("kuka_kr210_r2700_extra")
     for series in (False, True):
         for _ in range(3):
-            c.score(robot, q, series=series)
+            robot.score(q, series=series)
         samples = []
         for _ in range(calls):
             t0 = time.perf_counter()
-            c.score(robot, q, series=series)
+            robot.score(q, series=series)
             samples.append(time.perf_counter() - t0)
-        report("Client.score" + (" (series)" if series else ""), samples)
+        report("Robot.score" + (" (series)" if series else ""), samples)
     build = []
     for _ in range(calls):
         t0 = time.perf_counter()

@@ -5,7 +5,8 @@
 ...     T = c.robot("ur5").fk([0, -1.57, 1.57, 0, 0, 0])
 """
 from ._convert import matrix_to_pose, pose_to_matrix
-from .client import Client, Robot, RobotDescription
+from .client import Client
+from .description import RobotDescription
 from .errors import (
     Cancelled,
     DeadlineExceeded,
@@ -17,11 +18,12 @@ from .errors import (
     ResourceExhausted,
     Unavailable,
 )
-from .local import LocalServer
-from .exploration import Octree, Views
+from .local_server import LocalServer
+from .octree import Octree, Views
 from . import scenes
-from .explore import ExploreStep, ExploreSummary, ReferenceScene
-from .kinematics import IkBatchResult, IkResult, IkSolution, IkStream, LinearSolution, TrackResult
+from .exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
+from .kinematics import IkBatchResult, IkOptions, IkResult, IkSolution, LinearSolution, TrackResult
+from .robot import IkStream, Robot
 from .mobile import Mobile, MobileRun, StepResult, WheelKinematics
 from .planning import Box, Capsule, Cylinder, Mesh, OctreeObstacle, Plan, Sphere, StateChecks
 from .scoring import Comparison, Scores
@@ -43,6 +45,7 @@ __all__ = [
     "StateChecks",
     "Comparison",
     "IkBatchResult",
+    "IkOptions",
     "IkResult",
     "IkSolution",
     "IkStream",

@@ -1,165 +1,39 @@
-"""The kinplan client: a channel, robots, and numpy conversions."""
+"""The blocking client: :class:`Client` holds the channel and the calls that
+are not about one robot; ``client.robot(name)`` gives the :class:`Robot`
+handle of every call about one (:mod:`kinplan.robot`)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-import json
-import operator
-import socket
 import time
 import warnings
-from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
 import grpc
 import numpy as np
 import numpy.typing as npt
 
-from ._convert import (joints, joints_and_field, length_delimited, matrix_from_proto, matrix_to_proto, pose_to_matrix,
-                       tool_pose_of_fk_reply)
-from .errors import JointLimitWarning, KinplanError, error_for, invalid_argument
-from .kinematics import KinematicsMixin, RobotKinematicsMixin
-from .mobile import MobileMixin
-from .explore import ExploreMixin
-from .exploration import ExplorationMixin
-from .planning import PlanningMixin
-from .scoring import ScoringMixin
-from .v1 import common_pb2, robot_pb2, robot_pb2_grpc
+from ._channel import (DEFAULT_PORT, DEFAULT_TIMEOUT, _BearerToken, _channel_options, _no_server, _pem,
+                       normalize_target)
+from ._services import Call, Stubs
+from ._services import exploration as _exploration
+from ._services import kinematics as _kinematics
+from ._services import mobile as _mobile
+from ._services import robot as _robot
+from ._services.robot import RobotRefs, check_robot_args
+from .description import JointLimits, RobotDescription
+from .errors import KinplanError, invalid_argument
+from .exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
+from .kinematics import LinearSolution
+from .mobile import MobileRun, Obstacle as MobileObstacle, StepResult, WheelKinematics
+from .octree import Octree, Views
+from .planning import Obstacle, Plan, StateChecks
+from .robot import Robot
+from .scoring import Comparison, Scores, Trajectory
 
-DEFAULT_TIMEOUT = 30.0
-
-
-DEFAULT_PORT = 50051
-
-_FORWARD_KINEMATICS = "/kinplan.v1.RobotService/ForwardKinematics"
-
-# Round robin over the resolved addresses; UNAVAILABLE (replica gone or not
-# yet up) is retried up to three attempts with a short backoff.
-_REPLICA_SERVICE_CONFIG = json.dumps(
-    {
-        "loadBalancingConfig": [{"round_robin": {}}],
-        "methodConfig": [
-            {
-                "name": [{}],
-                "retryPolicy": {
-                    "maxAttempts": 3,
-                    "initialBackoff": "0.01s",
-                    "maxBackoff": "0.2s",
-                    "backoffMultiplier": 2,
-                    "retryableStatusCodes": ["UNAVAILABLE"],
-                },
-            }
-        ],
-    }
-)
+#: The old private names of the request helpers, for code that imported them from here.
+_check_robot_args = check_robot_args
 
 
-def normalize_target(target: Union[str, Sequence[str]]) -> str:
-    """A gRPC target from what people type: "host" gets port 50051,
-    "http://host:port" loses its scheme, several addresses become one
-    "ipv4:a:p,b:p" target; "dns:///..." and other gRPC targets pass."""
-    if not isinstance(target, str):
-        parts = [str(t) for t in target]
-    else:
-        if target.startswith(("dns:", "ipv4:", "ipv6:", "unix:")):
-            return target
-        if target.startswith("https://"):
-            raise invalid_argument("target", "TLS is not supported by this client; give host:port")
-        parts = [p.strip() for p in target.split(",") if p.strip()]
-    if not parts:
-        raise invalid_argument("target", "no address given")
-    out = []
-    for p in parts:
-        p = p.removeprefix("http://").rstrip("/")
-        if "/" in p:
-            raise invalid_argument("target", f"{p!r} is not host[:port]")
-        bracketed = p.startswith("[")
-        has_port = (bracketed and "]:" in p) or (not bracketed and p.count(":") == 1)
-        if p.count(":") > 1 and not bracketed:
-            p = f"[{p}]"  # a bare IPv6 address
-        out.append(p if has_port else f"{p}:{DEFAULT_PORT}")
-    if len(out) == 1:
-        return out[0]
-    # gRPC's ipv4:/ipv6: targets take literal addresses: resolve host names once
-    resolved = []
-    for o in out:
-        host, port = o.rsplit(":", 1)
-        if not host.startswith("["):
-            try:
-                socket.inet_aton(host)
-            except OSError:
-                host = socket.gethostbyname(host)
-        resolved.append(f"{host}:{port}")
-    scheme = "ipv6" if any(o.startswith("[") for o in resolved) else "ipv4"
-    return f"{scheme}:{','.join(resolved)}"
-
-
-def _channel_options(target: str, max_message_bytes: int) -> List[Any]:
-    """grpc channel options for a normalized target (blocking and asyncio clients)."""
-    options: List[Any] = [
-        ("grpc.max_send_message_length", max_message_bytes),
-        ("grpc.max_receive_message_length", max_message_bytes),
-    ]
-    if target.startswith(("dns:", "ipv4:", "ipv6:")):
-        # Replicas are identical and every call is stateless, so a call
-        # that finds its replica gone is retried on another.
-        options.append(("grpc.service_config", _REPLICA_SERVICE_CONFIG))
-        options.append(("grpc.enable_retries", 1))
-    if target.startswith(("ipv4:", "ipv6:")):
-        # the default :authority would be the whole address list, which
-        # HTTP/2 servers refuse (RST_STREAM PROTOCOL_ERROR)
-        options.append(("grpc.default_authority", "kinplan"))
-    return options
-
-
-def _pem(v: Union[str, bytes]) -> bytes:
-    """PEM bytes, or the content of the file a string names."""
-    if isinstance(v, bytes):
-        return v
-    with open(v, "rb") as f:
-        return f.read()
-
-
-class _BearerToken(
-    grpc.UnaryUnaryClientInterceptor,
-    grpc.UnaryStreamClientInterceptor,
-    grpc.StreamUnaryClientInterceptor,
-    grpc.StreamStreamClientInterceptor,
-):
-    """Adds ``authorization: Bearer <token>`` to every call."""
-
-    def __init__(self, token: str):
-        if not token or any(c in token for c in "\r\n"):
-            raise invalid_argument("token", "must be a non-empty single line")
-        self._header = ("authorization", f"Bearer {token}")
-
-    def _details(self, d: Any) -> Any:
-        metadata = list(d.metadata or []) + [self._header]
-        return _CallDetails(d.method, d.timeout, metadata, d.credentials, d.wait_for_ready, d.compression)
-
-    def intercept_unary_unary(self, continuation, details, request):  # type: ignore[no-untyped-def]
-        return continuation(self._details(details), request)
-
-    def intercept_unary_stream(self, continuation, details, request):  # type: ignore[no-untyped-def]
-        return continuation(self._details(details), request)
-
-    def intercept_stream_unary(self, continuation, details, requests):  # type: ignore[no-untyped-def]
-        return continuation(self._details(details), requests)
-
-    def intercept_stream_stream(self, continuation, details, requests):  # type: ignore[no-untyped-def]
-        return continuation(self._details(details), requests)
-
-
-class _CallDetails(grpc.ClientCallDetails):
-    def __init__(self, method: Any, timeout: Any, metadata: Any, credentials: Any, wait_for_ready: Any,
-                 compression: Any) -> None:
-        self.method = method
-        self.timeout = timeout
-        self.metadata = metadata
-        self.credentials = credentials
-        self.wait_for_ready = wait_for_ready
-        self.compression = compression
-
-
-class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, MobileMixin, KinematicsMixin):
+class Client:
     """A connection to a kinplan server.
 
     `timeout` (seconds) is the default deadline of every call; each method
@@ -208,7 +82,7 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
             if token is not None:
                 channel = grpc.intercept_channel(channel, _BearerToken(token))
         self._channel = channel
-        self._robots = robot_pb2_grpc.RobotServiceStub(self._channel)
+        self._stubs = Stubs(channel)
         if wait_for_ready:
             self.wait_for_ready(timeout)
 
@@ -242,7 +116,7 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         """Round-trip time (s) of the cheapest call (ListRobots); raises
         :class:`kinplan.errors.Unavailable` when no server answers."""
         t0 = time.perf_counter()
-        self._call(self._robots.ListRobots, robot_pb2.ListRobotsRequest(), timeout)
+        self._run(_robot.list_robots(), timeout)
         return time.perf_counter() - t0
 
     def __repr__(self) -> str:
@@ -279,19 +153,44 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         except grpc.RpcError as err:
             raise KinplanError.from_rpc_error(err) from None
 
+    def _run(self, call: Call[Any], timeout: Optional[float]) -> Any:
+        """Runs a unary :class:`kinplan._services.Call` that is not about a robot."""
+        return call.read(self._call(self._stubs.method(call), call.request, timeout))
+
+    def _stream(self, call: Call[Any], request: Any, timeout: Optional[float]) -> Iterator[Any]:
+        """The messages of a server-streaming `call`, each read; its errors as :class:`KinplanError`."""
+        t = self.timeout if timeout is None else timeout
+        try:
+            for message in self._stubs.method(call)(request, timeout=t):
+                yield call.read(message)
+        except grpc.RpcError as err:
+            raise KinplanError.from_rpc_error(err) from None
+
+    # the generated stubs, for code that calls them directly
+    @property
+    def _robots(self) -> Any:
+        return self._stubs["robot"]
+
+    @property
+    def _kinematics(self) -> Any:
+        return self._stubs["kinematics"]
+
+    @property
+    def _planning(self) -> Any:
+        return self._stubs["planning"]
+
+    @property
+    def _scoring(self) -> Any:
+        return self._stubs["scoring"]
+
+    @property
+    def _exploration(self) -> Any:
+        return self._stubs["exploration"]
+
     def list_robots(self, *, timeout: Optional[float] = None) -> List[Dict[str, Any]]:
         """The built-in robots: name, dof, description, base and tip links."""
-        reply = self._call(self._robots.ListRobots, robot_pb2.ListRobotsRequest(), timeout)
-        return [
-            {
-                "name": r.name,
-                "dof": r.dof,
-                "description": r.description,
-                "base_link": r.base_link,
-                "tip_link": r.tip_link,
-            }
-            for r in reply.robots
-        ]
+        out: List[Dict[str, Any]] = self._run(_robot.list_robots(), timeout)
+        return out
 
     def robot(
         self,
@@ -301,336 +200,366 @@ class Client(ExploreMixin, ExplorationMixin, PlanningMixin, ScoringMixin, Mobile
         base_link: str = "",
         tip_link: str = "",
         strict: bool = False,
-    ) -> "Robot":
-        """A built-in robot by `name`, or a model sent as `urdf` text.
+    ) -> Robot:
+        """A built-in robot by `name`, or a model sent as `urdf` text: the
+        handle of every call about it (``fk``, ``ik``, ``plan``, ``check``,
+        ``score``, ...).
 
         Joint values outside the robot's limits (usually degrees given where
         radians are meant) raise a :class:`kinplan.JointLimitWarning` in
-        ``fk``, ``fk_batch``, ``jacobian`` and ``Client.score``; with
+        ``fk``, ``fk_batch``, ``jacobian`` and ``score``; with
         `strict=True` they raise :class:`kinplan.InvalidArgument` instead."""
-        _check_robot_args(name, urdf)
+        check_robot_args(name, urdf)
         return Robot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link, strict=strict)
 
-
-@dataclass
-class RobotDescription:
-    """A robot's chain as the server sees it. Limits in rad (m for prismatic
-    joints); infinite for unlimited joints; max_velocity 0 when unknown."""
-
-    name: str
-    base_link: str
-    tip_link: str
-    joint_names: List[str]
-    joint_types: List[str]
-    lower: np.ndarray
-    upper: np.ndarray
-    max_velocity: np.ndarray
-    link_names: List[str]
-    model_id: bytes = b""
-    raw: Any = field(default=None, repr=False)
+    def _robot_of(self, robot: Any) -> Robot:
+        """A robot, or a built-in's name made into one."""
+        if robot is None:
+            raise ValueError("robot= is required (a name or client.robot(...))")
+        return self.robot(robot) if isinstance(robot, str) else robot
 
     @property
-    def dof(self) -> int:
-        return len(self.joint_names)
+    def mobile(self) -> Mobile:
+        """The MobileService calls: wheel kinematics, controller steps and simulated runs."""
+        m = self.__dict__.get("_mobile")
+        if m is None:
+            m = self.__dict__["_mobile"] = Mobile(self)
+        return m
 
-    @classmethod
-    def from_proto(cls, r: robot_pb2.DescribeRobotResponse) -> "RobotDescription":
-        return cls(
-            name=r.name,
-            base_link=r.base_link,
-            tip_link=r.tip_link,
-            joint_names=[j.name for j in r.joints],
-            joint_types=[robot_pb2.JointType.Name(j.type).removeprefix("JOINT_TYPE_").lower() for j in r.joints],
-            lower=np.array([j.lower for j in r.joints]),
-            upper=np.array([j.upper for j in r.joints]),
-            max_velocity=np.array([j.max_velocity for j in r.joints]),
-            link_names=[link.name for link in r.links],
-            model_id=r.model_id,
-            raw=r,
+    # ---- calls not about one robot -------------------------------------------------------------------------------
+
+    def solve_linear(
+        self,
+        A: Any,
+        b: Any,
+        method: Optional[str] = "svd",
+        *,
+        max_iterations: Optional[int] = None,
+        tolerance: Optional[float] = None,
+        relative_tolerance: Optional[float] = None,
+        rng_seed: int = 0,
+        history: bool = False,
+        singular_value_tolerance: Optional[float] = None,
+        timeout: Optional[float] = None,
+    ) -> LinearSolution:
+        """Solves ``A x = b`` for any m x n ``A``: ``method="svd"`` (least
+        squares, minimum norm) or ``"angle_relaxation"`` /
+        ``"angle_relaxation_safeguarded"`` (RLXA: ``max_iterations``, default
+        20,000; ``tolerance`` on |b - A x|, default 0.01; ``rng_seed``;
+        ``history=True`` returns the residual after every iteration)."""
+        call = _kinematics.solve_linear(A, b, method, max_iterations, tolerance, relative_tolerance, rng_seed,
+                                        history, singular_value_tolerance)
+        out: LinearSolution = self._run(call, timeout)
+        return out
+
+    def next_best_view(
+        self,
+        octree: Any,
+        *,
+        camera_pose: Any = None,
+        robot: Any = None,
+        camera_mount: Any = None,
+        candidate_poses: Sequence[Any] = (),
+        weights: Optional[Sequence[float]] = None,
+        gain: str = "intersection",
+        ray_fraction: Optional[float] = None,
+        max_results: int = 10,
+        camera: Optional[Dict[str, Any]] = None,
+        timeout: Optional[float] = None,
+        **options: Any,
+    ) -> Views:
+        """Ranked next views of the unknown space in ``octree`` (an
+        :class:`Octree` or a ``.bt`` file's bytes). ``weights`` = (w_i, w_d,
+        w_r); ``gain`` one of "intersection", "rays", "occlusion_aware",
+        "unobserved_voxels"; ``robot`` (optional, a robot or a built-in's name) adds the reach filter and IK
+        checks of the best candidates; further ``options`` are the fields of
+        ``NbvOptions`` (e.g. ``frontier_unknown_ratio=0.3``)."""
+        call = _exploration.next_best_view(octree, camera_pose, camera_mount, candidate_poses, weights, gain,
+                                           ray_fraction, max_results, camera, options, robot is not None)
+        if robot is not None:
+            out: Views = self._robot_of(robot)._run(call, timeout)
+            return out
+        views: Views = self._run(call, timeout)
+        return views
+
+    def insert_scan(
+        self,
+        octree: Optional[Octree],
+        points: Any,
+        origin: Any = None,
+        *,
+        resolution: float = 0.05,
+        max_range: Optional[float] = None,
+        discretize: bool = False,
+        timeout: Optional[float] = None,
+    ) -> Octree:
+        """Inserts ``points`` (n x 3, world frame, metres) seen from ``origin``
+        (3-vector or 4x4 sensor pose) with OctoMap's sensor model; a new tree at
+        ``resolution`` when ``octree`` is None. Returns the updated tree."""
+        out: Octree = self._run(_exploration.insert_scan(octree, points, origin, resolution, max_range, discretize),
+                                timeout)
+        return out
+
+    def octree_info(self, octree: Any, *, box: Any = None, timeout: Optional[float] = None) -> Dict[str, Any]:
+        """Resolution, node and leaf counts, bounds, and free / occupied /
+        unknown volume (m^3) inside ``box`` = (min xyz, max xyz) or the bounds."""
+        out: Dict[str, Any] = self._run(_exploration.octree_info(octree, box), timeout)
+        return out
+
+    def reference_scene(self, name: str = "s0_open_cell", *, seed: int = 1,
+                        timeout: Optional[float] = None) -> ReferenceScene:
+        """The reference cell ``name`` ("s0_open_cell" or "s0_walled_cell")
+        built with ``seed``."""
+        out: ReferenceScene = self._run(_exploration.reference_scene(name, seed), timeout)
+        return out
+
+    def explore(
+        self,
+        robot: Any = None,
+        *,
+        scene: Union[ReferenceScene, Sequence[Obstacle]],
+        start: Any = None,
+        region: Optional[Tuple[npt.ArrayLike, npt.ArrayLike]] = None,
+        planner: str = "rrt_connect",
+        weights: Optional[Sequence[float]] = None,
+        seed: int = 0,
+        resolution: Optional[float] = None,
+        pixel_stride: Optional[int] = None,
+        known_ratio: Optional[float] = None,
+        max_iterations: Optional[int] = None,
+        max_consecutive_failures: Optional[int] = None,
+        camera: Optional[Mapping[str, Any]] = None,
+        camera_mount: Any = None,
+        nbv: Optional[Mapping[str, Any]] = None,
+        plan_options: Optional[Mapping[str, Any]] = None,
+        timeout: Optional[float] = None,
+        **options: Any,
+    ) -> Iterator[Union[ExploreStep, ExploreSummary]]:
+        """Explores ``region`` = (min xyz, max xyz) of the simulated ``scene``
+        with a depth camera on ``robot`` from joints ``start`` (all three
+        taken from ``scene`` when it is a :class:`ReferenceScene`; ``robot``
+        may be a built-in's name): yields an
+        :class:`ExploreStep` per iteration, then the :class:`ExploreSummary`.
+        ``planner``: "rrt_connect", "stomp" or "ccstomp"; ``weights`` =
+        (w_i, w_d, w_r) of the NBV utility (S0's IG1_T025_R01 = (1, 0.25, 0.1)
+        by default). ``nbv`` takes ``NbvOptions`` fields, ``plan_options``
+        ``PlanOptions`` fields (e.g. ``{"stomp": {"timesteps": 20}}``), and
+        further ``options`` the remaining ``ExploreRequest`` fields
+        (``noise_stddev``, ``candidates_per_iteration``, ``plan_time_budget``,
+        ``time_budget``)."""
+        call = _exploration.explore(
+            self.robot, robot, scene, start, region, planner, weights, seed, resolution, pixel_stride, known_ratio,
+            max_iterations, max_consecutive_failures, camera, camera_mount, nbv, plan_options, options,
         )
+        yield from self._stream(call, call.request, timeout)
+
+    # ---- the per-robot calls of earlier releases -----------------------------------------------------------------
+
+    def plan(
+        self,
+        robot: Any,
+        *,
+        start: Any,
+        goal: Any = None,
+        pose: Any = None,
+        algorithm: str = "rrt_connect",
+        scene: Optional[Sequence[Obstacle]] = None,
+        seed: int = 0,
+        time_budget: Optional[float] = None,
+        motion_resolution: Optional[float] = None,
+        padded_motion: bool = False,
+        return_cost_history: bool = True,
+        stomp: Optional[Mapping[str, Any]] = None,
+        cartesian: Optional[Mapping[str, Any]] = None,
+        rrt_connect: Optional[Mapping[str, Any]] = None,
+        timing: Optional[Mapping[str, Any]] = None,
+        timeout: Optional[float] = None,
+    ) -> Plan:
+        """Deprecated alias of :meth:`kinplan.Robot.plan`, kept for one
+        release: ``client.plan(robot, start=...)`` is
+        ``robot.plan(start, ...)`` (``robot`` may be a built-in's name)."""
+        _deprecated("plan", "robot.plan(start, goal, ...)")
+        return self._robot_of(robot).plan(
+            start, goal, pose=pose, algorithm=algorithm, scene=scene, seed=seed, time_budget=time_budget,
+            motion_resolution=motion_resolution, padded_motion=padded_motion,
+            return_cost_history=return_cost_history, stomp=stomp, cartesian=cartesian, rrt_connect=rrt_connect,
+            timing=timing, timeout=timeout)
+
+    def plan_stream(self, robot: Any, *, start: Any, goal: Any = None, pose: Any = None,
+                    algorithm: str = "stomp", scene: Optional[Sequence[Obstacle]] = None, seed: int = 0,
+                    timeout: Optional[float] = None, **options: Any) -> Iterator[Union[np.ndarray, Plan]]:
+        """Deprecated alias of :meth:`kinplan.Robot.plan_stream`, kept for one release."""
+        _deprecated("plan_stream", "robot.plan_stream(start, goal, ...)")
+        yield from self._robot_of(robot).plan_stream(start, goal, pose=pose, algorithm=algorithm, scene=scene,
+                                                 seed=seed, timeout=timeout, **options)
+
+    def check_states(
+        self,
+        robot: Any,
+        qs: Any,
+        scene: Optional[Sequence[Obstacle]] = None,
+        *,
+        max_distance: float = 1.0,
+        timeout: Optional[float] = None,
+    ) -> StateChecks:
+        """Deprecated alias of :meth:`kinplan.Robot.check`, kept for one
+        release: ``client.check_states(robot, qs, scene)`` is ``robot.check(qs, scene)``."""
+        _deprecated("check_states", "robot.check(qs, scene)")
+        return self._robot_of(robot).check(qs, scene, max_distance=max_distance, timeout=timeout)
+
+    def score(
+        self,
+        robot: Any,
+        q: Trajectory,
+        timestamps: Optional[Iterable[float]] = None,
+        weights: Optional[Iterable[float]] = None,
+        series: bool = False,
+        *,
+        robot_points: Optional[str] = None,
+        max_velocity: Optional[Iterable[float]] = None,
+        max_acceleration: Optional[Iterable[float]] = None,
+        jerk_peaks: Optional[Mapping[str, Any]] = None,
+        potential_tolerance: Optional[float] = None,
+        timeout: Optional[float] = None,
+    ) -> Scores:
+        """Deprecated alias of :meth:`kinplan.Robot.score`, kept for one
+        release: ``client.score(robot, q)`` is ``robot.score(q)``."""
+        _deprecated("score", "robot.score(q)")
+        return self._robot_of(robot).score(
+            q, timestamps, weights, series, robot_points=robot_points, max_velocity=max_velocity,
+            max_acceleration=max_acceleration, jerk_peaks=jerk_peaks, potential_tolerance=potential_tolerance,
+            timeout=timeout)
+
+    def compare(
+        self,
+        sets: Mapping[str, Sequence[Trajectory]],
+        robot: Any = None,
+        *,
+        weights: Optional[Iterable[float]] = None,
+        robot_points: Optional[str] = None,
+        max_velocity: Optional[Iterable[float]] = None,
+        max_acceleration: Optional[Iterable[float]] = None,
+        jerk_peaks: Optional[Mapping[str, Any]] = None,
+        potential_tolerance: Optional[float] = None,
+        timeout: Optional[float] = None,
+    ) -> Comparison:
+        """Deprecated alias of :meth:`kinplan.Robot.compare`, kept for one
+        release: ``client.compare(sets, robot=r)`` is ``r.compare(sets)``."""
+        _deprecated("compare", "robot.compare(sets)")
+        return self._robot_of(robot).compare(
+            sets, weights=weights, robot_points=robot_points, max_velocity=max_velocity,
+            max_acceleration=max_acceleration, jerk_peaks=jerk_peaks, potential_tolerance=potential_tolerance,
+            timeout=timeout)
 
 
-class JointLimits:
-    """A chain's joint limits for the client-side guard against degrees: a
-    value outside [lower, upper] (1e-9 of slack) warns, or raises when strict."""
+class Mobile:
+    """The MobileService calls; reach it as ``client.mobile``."""
 
-    def __init__(self, d: RobotDescription):
-        self.lower = d.lower - 1e-9
-        self.upper = d.upper + 1e-9
-        self.names = d.joint_names
-        self._lower_list: List[float] = self.lower.tolist()
-        self._upper_list: List[float] = self.upper.tolist()
+    def __init__(self, client: Any):
+        self._client = client
 
-    def check(self, q: Any, field_name: str, strict: bool) -> None:
-        if isinstance(q, list) and len(q) == len(self._lower_list):
-            # one state as floats (fk, jacobian): comparisons mapped in C are the cheapest test
-            if all(map(operator.le, self._lower_list, q)) and all(map(operator.le, q, self._upper_list)):
-                return
-        arr = np.asarray(q, dtype=float)
-        if arr.ndim == 0 or arr.shape[-1] != len(self.lower):
-            return  # the server names a wrong length
-        outside = (arr < self.lower) | (arr > self.upper)
-        if not outside.any():
-            return
-        where = np.argwhere(outside)[0]
-        j = int(where[-1])
-        value = float(arr[tuple(where)])
-        message = (
-            f"{int(outside.sum())} joint value(s) outside the limits, e.g. {self.names[j]} = {value:.6g} not in "
-            f"[{self.lower[j] + 1e-9:.6g}, {self.upper[j] - 1e-9:.6g}]; kinplan takes radians (m for prismatic "
-            "joints): degrees? use np.radians(...)"
-        )
-        if strict:
-            raise invalid_argument(field_name, message)
-        warnings.warn(f"{field_name}: {message}", JointLimitWarning, stacklevel=4)
+    def wheels(
+        self,
+        chassis: str = "differential",
+        twist: Optional[Sequence[float]] = None,
+        *,
+        wheels: Optional[Mapping[str, Any]] = None,
+        chassis_params: Optional[Mapping[str, float]] = None,
+        timeout: Optional[float] = None,
+    ) -> WheelKinematics:
+        """Inverse kinematics of ``twist`` = (vx, vy, ω), or forward kinematics
+        of ``wheels`` (a dict as in :class:`WheelKinematics`)."""
+        out: WheelKinematics = self._client._run(_mobile.wheels(chassis, twist, wheels, chassis_params), timeout)
+        return out
+
+    def step(
+        self,
+        state: Sequence[float],
+        *,
+        chassis: str = "differential",
+        controller: str = "lyapunov",
+        path: Optional[Iterable[Sequence[float]]] = None,
+        goal: Optional[Sequence[float]] = None,
+        gains: Optional[Mapping[str, Any]] = None,
+        params: Optional[Mapping[str, Any]] = None,
+        sensors: Optional[Mapping[str, Any]] = None,
+        readings: Optional[Iterable[float]] = None,
+        world: Optional[Iterable[MobileObstacle]] = None,
+        robot_radius: Optional[float] = None,
+        seed: int = 0,
+        dt: Optional[float] = None,
+        token: Union[bytes, StepResult, None] = b"",
+        chassis_params: Optional[Mapping[str, float]] = None,
+        timeout: Optional[float] = None,
+    ) -> StepResult:
+        """One stateless controller step. Path followers take ``path`` and
+        ``gains``; "vector_distance" takes ``goal``, ``params`` (navigator),
+        ``sensors`` and either ``readings`` (gaps from the rim, m) or a
+        ``world`` to sense. Pass the previous result (or its ``token``) as
+        ``token=`` to continue; empty starts a fresh controller."""
+        call = _mobile.step(state, chassis, controller, path, goal, gains, params, sensors, readings, world,
+                            robot_radius, seed, dt, token, chassis_params)
+        out: StepResult = self._client._run(call, timeout)
+        return out
+
+    def follow(
+        self,
+        chassis: str = "differential",
+        start: Sequence[float] = (0.0, 0.0, 0.0),
+        path: Iterable[Sequence[float]] = (),
+        controller: str = "lyapunov",
+        gains: Optional[Mapping[str, Any]] = None,
+        *,
+        world: Optional[Iterable[MobileObstacle]] = None,
+        robot_radius: Optional[float] = None,
+        dt: Optional[float] = None,
+        max_time: Optional[float] = None,
+        chassis_params: Optional[Mapping[str, float]] = None,
+        timeout: Optional[float] = None,
+    ) -> MobileRun:
+        """Simulates ``controller`` along ``path`` ([(x, y[, θ]), ...]; a
+        heading is honoured on the last node) from ``start`` = (x, y, θ),
+        optionally among obstacles (collisions end the run)."""
+        call = _mobile.follow(chassis, start, path, controller, gains, world, robot_radius, dt, max_time,
+                              chassis_params)
+        out: MobileRun = self._client._run(call, timeout)
+        return out
+
+    def navigate(
+        self,
+        chassis: str = "differential",
+        start: Sequence[float] = (0.0, 0.0, 0.0),
+        goal: Sequence[float] = (0.0, 0.0),
+        world: Optional[Iterable[MobileObstacle]] = None,
+        robot_radius: Optional[float] = None,
+        *,
+        navigator: str = "vector_distance",
+        params: Optional[Mapping[str, Any]] = None,
+        sensors: Optional[Mapping[str, Any]] = None,
+        seed: int = 0,
+        controller: str = "pure_pursuit",
+        gains: Optional[Mapping[str, Any]] = None,
+        astar: Optional[Mapping[str, Any]] = None,
+        dt: Optional[float] = None,
+        max_time: Optional[float] = None,
+        chassis_params: Optional[Mapping[str, float]] = None,
+        timeout: Optional[float] = None,
+    ) -> MobileRun:
+        """Simulates navigation from ``start`` to ``goal`` = (x, y) among
+        ``world``: the vector-distance navigator (``params``, ``sensors``,
+        noise ``seed``) or ``navigator="grid_astar"`` (``astar`` options, then
+        ``controller`` with ``gains`` follows the grid path)."""
+        call = _mobile.navigate(chassis, start, goal, world, robot_radius, navigator, params, sensors, seed,
+                                controller, gains, astar, dt, max_time, chassis_params)
+        out: MobileRun = self._client._run(call, timeout)
+        return out
 
 
-def _check_robot_args(name: Optional[str], urdf: Optional[str]) -> None:
-    """`Client.robot`'s checks (blocking and asyncio): one of a name or a URDF
-    text, and a URDF that is not a file's path."""
-    if (name is None) == (urdf is None):
-        raise invalid_argument("name", "give exactly one of name or urdf=")
-    if urdf is not None and "<" not in urdf and urdf.strip().lower().endswith((".urdf", ".xml")):
-        raise invalid_argument(
-            "urdf",
-            f"{urdf!r} looks like a file path; urdf= takes the document's text: urdf=open(path).read()",
-        )
+def _deprecated(old: str, new: str) -> None:
+    """The DeprecationWarning of a per-robot call made on the client (the aliases of one release)."""
+    warnings.warn(f"Client.{old}(robot, ...) is deprecated and goes in the next release: use {new}",
+                  DeprecationWarning, stacklevel=3)
 
 
-def _urdf_request(keep_capsules: bool) -> Callable[[common_pb2.RobotRef], robot_pb2.DescribeRobotRequest]:
-    """The DescribeRobotRequest of :meth:`Robot.urdf` for a robot reference
-    (shared by the blocking and asyncio clients)."""
-    def build(ref: common_pb2.RobotRef) -> robot_pb2.DescribeRobotRequest:
-        return robot_pb2.DescribeRobotRequest(robot=ref, include_urdf=True, keep_capsules=keep_capsules)
-
-    return build
-
-
-def _no_server(target: str, timeout: Optional[float]) -> KinplanError:
-    """The :class:`kinplan.errors.Unavailable` of a ``wait_for_ready`` that timed out."""
-    return error_for(grpc.StatusCode.UNAVAILABLE, f"no server at {target} within {timeout} s", [])
-
-
-class RobotRefs:
-    """How a robot names itself in requests (shared by :class:`Robot` and
-    :class:`kinplan.aio.AsyncRobot`): by name, by model id once the server
-    has given one, else (or when resending) the URDF text."""
-
-    name: Optional[str]
-    urdf_text: Optional[str]
-    base_link: str
-    tip_link: str
-    model_id: bytes
-
-    def _ref(self, inline: bool = False) -> common_pb2.RobotRef:
-        """The RobotRef of this robot's next request: by name, by model id once
-        the server has given one, else (or with `inline`) the URDF text.
-        Cached while the model id stays the same; callers copy it, never change it."""
-        key = (inline, self.model_id)
-        cached = self.__dict__.get("_ref_cache")
-        if cached is not None and cached[0] == key:
-            ref: common_pb2.RobotRef = cached[1]
-            return ref
-        ref = self._new_ref(inline)
-        self.__dict__["_ref_cache"] = (key, ref, length_delimited(1, ref.SerializeToString()))
-        return ref
-
-    def _ref_field(self, ref: common_pb2.RobotRef) -> bytes:
-        """`ref` (from :meth:`_ref`) encoded as field 1 of a request, cached with it."""
-        cached = self.__dict__.get("_ref_cache")
-        if cached is not None and cached[1] is ref:
-            encoded: bytes = cached[2]
-            return encoded
-        return length_delimited(1, ref.SerializeToString())
-
-    def _new_ref(self, inline: bool) -> common_pb2.RobotRef:
-        ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link)
-        if self.name is not None:
-            ref.name = self.name
-        elif self.model_id and not inline:
-            ref.model_id = self.model_id
-        else:
-            ref.urdf = self.urdf_text or ""
-        return ref
-
-
-class Robot(RobotRefs, RobotKinematicsMixin):
-    """A robot on a server. Inline URDFs are sent once, then referred to by
-    the content hash the server returns; if a replica does not hold it
-    (NOT_FOUND), the URDF is sent again by itself."""
-
-    def __init__(self, client: Client, *, name: Optional[str], urdf: Optional[str], base_link: str, tip_link: str,
-                 strict: bool = False):
-        self.client = client
-        self.name = name
-        self.urdf_text = urdf
-        self.base_link = base_link
-        self.tip_link = tip_link
-        self.strict = strict
-        self.model_id: bytes = b""
-
-    def _limits(self) -> "JointLimits":
-        """The chain's joint limits, fetched once per model and chain per client."""
-        key = self.limits_key()
-        try:
-            limits: JointLimits = self.client.__dict__["_limits_cache"][key]
-        except KeyError:
-            limits = self.client.__dict__.setdefault("_limits_cache", {})[key] = JointLimits(self.describe())
-        return limits
-
-    def limits_key(self) -> Any:
-        """What identifies this robot's chain in a client's cache."""
-        return (self.name, None if self.urdf_text is None else hash(self.urdf_text), self.base_link, self.tip_link)
-
-    def check_limits(self, q: Any, field_name: str = "q") -> None:
-        """Warns with :class:`kinplan.JointLimitWarning` (raises
-        :class:`kinplan.InvalidArgument` when the robot is strict) if a joint
-        value of `q` (one state or rows of states) lies outside the limits:
-        kinplan takes radians, and degrees are the usual cause."""
-        self._limits().check(q, field_name, self.strict)
-
-    def _send(self, path: str, response: Any, body: bytes, timeout: Optional[float]) -> Any:
-        """:meth:`_call` for a request sent as bytes: this robot's reference
-        (field 1) and then `body`, the request's other fields already
-        encoded; the answer is parsed as `response` (``None``: its bytes are
-        returned, and a model id in them is the caller's to read). The same
-        retry as :meth:`_call` when a replica does not hold the model id."""
-        client = self.client
-        cached = self.__dict__.get("_ref_cache")
-        if cached is not None and cached[0] == (False, self.model_id):
-            ref_field: bytes = cached[2]
-        else:
-            ref_field = self._ref_field(self._ref())
-        method = client._raw_unary(path, response)
-        try:
-            reply = method(ref_field + body, timeout=client.timeout if timeout is None else timeout)
-        except grpc.RpcError as err:
-            if not (err.code() == grpc.StatusCode.NOT_FOUND and self.model_id and self.urdf_text):
-                raise KinplanError.from_rpc_error(err) from None
-            self.model_id = b""
-            reply = client._call(method, self._ref_field(self._ref(inline=True)) + body, timeout)
-        if response is not None and self.urdf_text is not None and reply.model_id:
-            self.model_id = reply.model_id
-        return reply
-
-    def _call(self, method: Callable[..., Any], build: Callable[[common_pb2.RobotRef], Any], timeout: Optional[float]) -> Any:
-        try:
-            reply = self.client._call(method, build(self._ref()), timeout)
-        except KinplanError as err:
-            if not (err.code == grpc.StatusCode.NOT_FOUND and self.model_id and self.urdf_text):
-                raise
-            self.model_id = b""
-            reply = self.client._call(method, build(self._ref(inline=True)), timeout)
-        model_id = getattr(reply, "model_id", b"")
-        if model_id and self.urdf_text is not None:
-            self.model_id = model_id
-        return reply
-
-    def describe(self, *, timeout: Optional[float] = None) -> RobotDescription:
-        r = self._call(
-            self.client._robots.DescribeRobot,
-            lambda ref: robot_pb2.DescribeRobotRequest(robot=ref),
-            timeout,
-        )
-        return RobotDescription.from_proto(r)
-
-    def urdf(self, *, keep_capsules: bool = False, timeout: Optional[float] = None) -> str:
-        """The robot's URDF text: a built-in's from the server, in standard URDF
-        (each ``<capsule>``, a ROS extension urdfdom and pinocchio refuse,
-        written as a cylinder and two end spheres) unless `keep_capsules`;
-        an inline model's own text as given."""
-        if self.urdf_text is not None:
-            return self.urdf_text
-        return str(self._call(self.client._robots.DescribeRobot, _urdf_request(keep_capsules), timeout).urdf)
-
-    @overload
-    def fk(self, q: npt.ArrayLike, *, links: Literal[False] = False,
-           timeout: Optional[float] = None) -> npt.NDArray[np.float64]: ...
-
-    @overload
-    def fk(self, q: npt.ArrayLike, *, links: Literal[True],
-           timeout: Optional[float] = None) -> Tuple[npt.NDArray[np.float64], Dict[str, npt.NDArray[np.float64]]]: ...
-
-    def fk(self, q: npt.ArrayLike, *, links: bool = False, timeout: Optional[float] = None) -> Any:
-        """Tool pose (4x4, base frame, metres) for joint vector `q`; with
-        `links=True`, also a dict of every link's 4x4 pose."""
-        if links:
-            positions = joints(q)
-            self.check_limits(positions)
-            r = self._call(
-                self.client._robots.ForwardKinematics,
-                lambda ref: robot_pb2.ForwardKinematicsRequest(
-                    robot=ref, joint_positions=positions, include_links=links
-                ),
-                timeout,
-            )
-            return pose_to_matrix(r.tool_pose), {link.name: pose_to_matrix(link.pose) for link in r.links}
-        # the hot path: the request as bytes (reference, packed joints), the
-        # answer read from its bytes when it has the usual layout
-        positions, body = joints_and_field(2, q, "q")
-        limits = self._limits()
-        lower, upper = limits._lower_list, limits._upper_list
-        if not (len(positions) == len(lower) and all(map(operator.le, lower, positions))
-                and all(map(operator.le, positions, upper))):
-            self.check_limits(positions)  # the whole check: it warns, or raises, naming the joint
-        wire = self._send(_FORWARD_KINEMATICS, None, body, timeout)
-        tool = tool_pose_of_fk_reply(wire)
-        if tool is not None:
-            return tool
-        r = robot_pb2.ForwardKinematicsResponse.FromString(wire)
-        if r.model_id and self.urdf_text is not None:
-            self.model_id = r.model_id
-        return pose_to_matrix(r.tool_pose)
-
-    def fk_batch(self, qs: Any, *, jacobians: bool = False, timeout: Optional[float] = None) -> Any:
-        """Tool poses of every row of `qs` (n x dof, rad) in one call: an
-        (n, 4, 4) array; with `jacobians=True` also the (n, 6, dof)
-        Jacobians (rows 0-2 linear, 3-5 angular, base frame)."""
-        arr = np.ascontiguousarray(qs, dtype=np.float64)
-        if arr.ndim == 1:
-            arr = arr[None, :]
-        if arr.ndim != 2 or arr.shape[0] == 0:
-            raise invalid_argument("qs", f"must be n x dof with n >= 1, got shape {arr.shape}")
-        self.check_limits(arr, "qs")
-        matrix = matrix_to_proto(arr)
-        r = self._call(
-            self.client._robots.ForwardKinematicsBatch,
-            lambda ref: robot_pb2.ForwardKinematicsBatchRequest(
-                robot=ref, joint_positions=matrix, include_jacobians=jacobians
-            ),
-            timeout,
-        )
-        return self._batch_reply(r, arr.shape[1], jacobians)
-
-    @staticmethod
-    def _batch_reply(r: Any, dof: int, jacobians: bool) -> Any:
-        """The (n, 4, 4) poses (and (n, 6, dof) Jacobians) of a batch FK reply."""
-        p = np.asarray(r.tool_poses.data, dtype=np.float64).reshape(-1, 7)
-        x, y, z, w = p[:, 3], p[:, 4], p[:, 5], p[:, 6]
-        T = np.zeros((len(p), 4, 4))
-        T[:, 0, 0] = 1 - 2 * (y * y + z * z)
-        T[:, 0, 1] = 2 * (x * y - z * w)
-        T[:, 0, 2] = 2 * (x * z + y * w)
-        T[:, 1, 0] = 2 * (x * y + z * w)
-        T[:, 1, 1] = 1 - 2 * (x * x + z * z)
-        T[:, 1, 2] = 2 * (y * z - x * w)
-        T[:, 2, 0] = 2 * (x * z - y * w)
-        T[:, 2, 1] = 2 * (y * z + x * w)
-        T[:, 2, 2] = 1 - 2 * (x * x + y * y)
-        T[:, :3, 3] = p[:, :3]
-        T[:, 3, 3] = 1.0
-        if jacobians:
-            J = np.asarray(r.jacobians.data, dtype=np.float64).reshape(len(p), 6, dof)
-            return T, J
-        return T
-
-    def jacobian(self, q: npt.ArrayLike, *, timeout: Optional[float] = None) -> np.ndarray:
-        """6 x n geometric Jacobian in the base frame (rows: vx, vy, vz, wx, wy, wz)."""
-        positions = joints(q)
-        self.check_limits(positions)
-        r = self._call(
-            self.client._robots.Jacobian,
-            lambda ref: robot_pb2.JacobianRequest(robot=ref, joint_positions=positions),
-            timeout,
-        )
-        return matrix_from_proto(r.jacobian)
+__all__ = ["DEFAULT_PORT", "DEFAULT_TIMEOUT", "Client", "JointLimits", "Mobile", "Robot", "RobotDescription", "RobotRefs",
+           "normalize_target"]

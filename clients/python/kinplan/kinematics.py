@@ -15,20 +15,15 @@ proto/kinplan/v1/kinematics.proto).
 """
 from __future__ import annotations
 
-import queue
-import threading
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, Iterable, Iterator, List, Literal, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, Iterator, List, Literal, Mapping, Optional, Tuple
 
-import grpc
 import numpy as np
-import numpy.typing as npt
 
 from ._display import html_table
-from ._convert import (joints, joints_field, length_delimited, matrix_to_pose, matrix_to_proto, pose_bytes,
-                       pose_to_matrix, target_field)
-from .errors import KinplanError
-from .v1 import common_pb2, kinematics_pb2, kinematics_pb2_grpc
+from ._codec import IK_OPTIONS, length_delimited
+from ._convert import matrix_to_pose, pose_bytes, pose_to_matrix
+from .v1 import common_pb2, kinematics_pb2
 
 #: IK methods by name (``None``: the server default, Levenberg-Marquardt).
 #: IK method names (aliases: "levenberg_marquardt", "ji").
@@ -104,7 +99,6 @@ def target_to_pose(T: Any) -> common_pb2.Pose:
     return matrix_to_pose(T)
 
 
-_SOLVE_IK = "/kinplan.v1.KinematicsService/SolveIk"
 
 
 def _target_wire(T: Any) -> bytes:
@@ -123,9 +117,9 @@ def _ik_options_field(*args: Any) -> bytes:
     try:
         cached = _IK_OPTIONS_FIELD.get(args)
     except TypeError:  # an unhashable argument: no cache
-        return length_delimited(4, _build_ik_options(*args).SerializeToString())
+        return length_delimited(IK_OPTIONS, _build_ik_options(*args).SerializeToString())
     if cached is None:
-        cached = length_delimited(4, _build_ik_options(*args).SerializeToString())
+        cached = length_delimited(IK_OPTIONS, _build_ik_options(*args).SerializeToString())
         if len(_IK_OPTIONS_FIELD) < 256:
             _IK_OPTIONS_FIELD[args] = cached
     return cached
@@ -214,6 +208,99 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
     return o
 
 
+#: The IkOptions fields in the order :func:`ik_options` takes them (its last
+#: keyword, ``history``, is the proto's ``return_history``).
+IK_OPTION_FIELDS = ("method", "linear_solver", "position_tolerance", "orientation_tolerance", "position_only",
+                    "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits",
+                    "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations",
+                    "return_history")
+#: The keyword shortcuts of ``robot.ik`` and friends, in the same order.
+IK_SHORTCUTS = IK_OPTION_FIELDS[:-1] + ("history",)
+
+
+@dataclass(frozen=True)
+class IkOptions:
+    """The options of an IK request, field for field the proto's
+    ``kinplan.v1.IkOptions`` (and the Rust client's ``IkOptions``);
+    ``None`` means the server's documented default.
+
+    ``method``: "lm" (Levenberg-Marquardt), "jacobian_inverse", "newton",
+    "ccd", "fabrik", "length_relaxation"; ``linear_solver`` (Jacobian
+    methods): "svd", "angle_relaxation", "angle_relaxation_safeguarded";
+    tolerances in m and rad; ``max_restarts`` random restarts drawn from
+    ``rng_seed``; ``num_solutions`` distinct solutions (two differ when a
+    joint differs by more than ``distinct_tolerance``); ``joint_limits``
+    "clamp" or "ignore"; ``time_budget`` in s; ``adaptive_damping``,
+    ``damping`` and ``max_step`` steer the Jacobian step;
+    ``rlxa_max_iterations`` caps the angle-relaxation solve;
+    ``return_history`` returns each solution's per-iteration errors.
+
+    Pass it as ``robot.ik(T, options=IkOptions(...))`` (also ``ik_batch``,
+    ``track``, ``stream_ik``); a keyword shortcut given beside it
+    (``robot.ik(T, options=o, max_restarts=0)``) replaces that field when it
+    is not the keyword's default. Frozen: ``dataclasses.replace(o, ...)``
+    makes a variant."""
+
+    method: Optional[IkMethodName] = "lm"
+    linear_solver: Optional[LinearSolverName] = "svd"
+    position_tolerance: Optional[float] = None
+    orientation_tolerance: Optional[float] = None
+    position_only: bool = False
+    max_iterations: Optional[int] = None
+    damping: Optional[float] = None
+    max_restarts: Optional[int] = None
+    num_solutions: Optional[int] = None
+    rng_seed: int = 0
+    joint_limits: Optional[Literal["clamp", "ignore"]] = None
+    time_budget: Optional[float] = None
+    adaptive_damping: Optional[bool] = None
+    max_step: Optional[float] = None
+    distinct_tolerance: Optional[float] = None
+    rlxa_max_iterations: Optional[int] = None
+    return_history: bool = False
+
+    def __post_init__(self) -> None:
+        _choice(METHODS, self.method, "method")
+        _choice(LINEAR_SOLVERS, self.linear_solver, "linear_solver")
+        _choice(JOINT_LIMITS, self.joint_limits, "joint_limits")
+
+    def args(self) -> Tuple[Any, ...]:
+        """The fields in :data:`IK_OPTION_FIELDS` order (:func:`ik_options`'s arguments)."""
+        return tuple(getattr(self, name) for name in IK_OPTION_FIELDS)
+
+    def to_proto(self) -> kinematics_pb2.IkOptions:
+        return ik_options_of_args(self.args())
+
+
+#: The shortcuts' defaults: a shortcut at its default leaves the field of ``options`` as it is.
+_SHORTCUT_DEFAULTS = IkOptions().args()
+
+
+def resolve_ik_args(options: Optional[IkOptions], args: Tuple[Any, ...]) -> Tuple[Any, ...]:
+    """The options of a call: `args` (the shortcuts, in :data:`IK_SHORTCUTS`
+    order) over `options`; a shortcut at its default keeps the field of `options`."""
+    if options is None:
+        return args
+    if not isinstance(options, IkOptions):
+        raise TypeError(f"options must be a kinplan.IkOptions, got {type(options).__name__}")
+    return tuple(o if (a is d or a == d) else a for a, d, o in zip(args, _SHORTCUT_DEFAULTS, options.args()))
+
+
+def ik_args(method: Any, linear_solver: Any, shortcuts: Mapping[str, Any]) -> Tuple[Any, ...]:
+    """The arguments of :func:`ik_options` from a method, a linear solver and
+    keyword shortcuts (``TypeError`` naming an unknown one)."""
+    unknown = set(shortcuts) - set(IK_SHORTCUTS[2:])
+    if unknown:
+        raise TypeError(f"unknown IK options: {sorted(unknown)}")
+    defaults = dict(zip(IK_SHORTCUTS, _SHORTCUT_DEFAULTS))
+    return (method, linear_solver) + tuple(shortcuts.get(k, defaults[k]) for k in IK_SHORTCUTS[2:])
+
+
+def ik_options_of_args(args: Tuple[Any, ...]) -> kinematics_pb2.IkOptions:
+    """:func:`ik_options` of arguments in :data:`IK_SHORTCUTS` order."""
+    return ik_options(args[0], args[1], **dict(zip(IK_SHORTCUTS[2:], args[2:])))
+
+
 @dataclass
 class IkSolution:
     """One answer: joints ``q`` (rad, m for prismatic joints), errors of its
@@ -235,7 +322,7 @@ class IkSolution:
     def from_proto(cls, s: kinematics_pb2.IkSolution) -> "IkSolution":
         # positional, in field order: the hot path of every IK answer
         return cls(
-            np.array(s.joints[:], dtype=float),  # a list first: ~3x faster than asarray for a few values
+            np.array(s.joints[:], dtype=float),  # a list first: cheaper than asarray for a few values
             s.position_error,
             s.orientation_error,
             s.iterations,
@@ -332,7 +419,7 @@ class _LazyIkField:
             solutions = d.get("solutions")
             if solutions is None and len(r.solutions):
                 s = r.solutions[0]
-                d["q"] = np.array(s.joints[:])  # float64 from a list of floats; a list first: ~3x faster than asarray
+                d["q"] = np.array(s.joints[:])  # float64 from a list of floats (cheaper than asarray here)
                 d["position_error"], d["orientation_error"], d["iterations"] = (
                     s.position_error, s.orientation_error, s.iterations)
             else:
@@ -482,381 +569,33 @@ class LinearSolution:
         return self.status == "converged"
 
 
-def _track_request(poses: Any, seed: Optional[npt.ArrayLike], line: Optional[Mapping[str, Any]],
-                   circle: Optional[Mapping[str, Any]], method: Optional[str], linear_solver: Optional[str],
-                   stop_on_failure: bool, options: Dict[str, Any],
-                   ) -> Callable[[common_pb2.RobotRef], kinematics_pb2.TrackPathRequest]:
-    """The TrackPathRequest of :meth:`RobotKinematicsMixin.track`'s arguments
-    for a robot reference (shared by the blocking and asyncio clients)."""
-    o = ik_options(method, linear_solver, **options)
-    seed_list = [] if seed is None else joints(seed, "seed")
-    kwargs: Dict[str, Any] = {}
-    if poses is not None:
-        kwargs["poses"] = _targets(poses)
-    if line is not None:
-        spec = dict(line)
-        lp = kinematics_pb2.LinePath(steps=int(spec.pop("steps", 0)))
-        if spec.get("start") is not None:
-            lp.start.CopyFrom(target_to_pose(spec["start"]))
-        spec.pop("start", None)
-        if spec.get("end") is not None:
-            lp.end.CopyFrom(target_to_pose(spec["end"]))
-        spec.pop("end", None)
-        if spec:
-            raise ValueError(f"unknown line keys {sorted(spec)}")
-        kwargs["line"] = lp
-    if circle is not None:
-        spec = dict(circle)
-        cp = kinematics_pb2.CirclePath(angle_step=float(spec.pop("angle_step", 0.0)), steps=int(spec.pop("steps", 0)))
-        if spec.get("start") is not None:
-            cp.start.CopyFrom(target_to_pose(spec["start"]))
-        spec.pop("start", None)
-        for key in ("centre", "normal"):
-            value = spec.pop(key, spec.pop("center", None) if key == "centre" else None)
-            if value is not None:
-                v = np.asarray(value, dtype=float).ravel()
-                getattr(cp, key).CopyFrom(common_pb2.Vec3(x=v[0], y=v[1], z=v[2]))
-        if spec:
-            raise ValueError(f"unknown circle keys {sorted(spec)}")
-        kwargs["circle"] = cp
+def __getattr__(name: str) -> Any:
+    """``IkStream`` moved to :mod:`kinplan.robot` with the rest of the blocking robot."""
+    if name == "IkStream":
+        from .robot import IkStream
 
-    def build(ref: common_pb2.RobotRef) -> kinematics_pb2.TrackPathRequest:
-        return kinematics_pb2.TrackPathRequest(
-            robot=ref, seed=seed_list, options=o, stop_on_failure=stop_on_failure, **kwargs
-        )
+        return IkStream
+    if name == "KinematicsMixin":  # the client mixins of earlier releases: the classes that now hold their methods
+        from .client import Client
 
-    return build
+        return Client
+    if name == "RobotKinematicsMixin":  # the client mixins of earlier releases: the classes that now hold their methods
+        from .robot import Robot
 
-
-def _solve_linear_request(A: Any, b: Any, method: Optional[str], max_iterations: Optional[int],
-                          tolerance: Optional[float], relative_tolerance: Optional[float], rng_seed: int,
-                          history: bool, singular_value_tolerance: Optional[float],
-                          ) -> kinematics_pb2.SolveLinearSystemRequest:
-    """The SolveLinearSystemRequest of :meth:`KinematicsMixin.solve_linear`'s arguments."""
-    a = np.asarray(A, dtype=float)
-    if a.ndim != 2:
-        raise ValueError(f"A must be two-dimensional, got shape {a.shape}")
-    rhs = np.asarray(b, dtype=float).ravel()
-    request = kinematics_pb2.SolveLinearSystemRequest(
-        a=matrix_to_proto(a),
-        b=rhs.tolist(),
-        method=_choice(LINEAR_SOLVERS, method, "method"),
-        max_iterations=int(max_iterations or 0),
-        rng_seed=int(rng_seed),
-        record_history=bool(history),
-    )
-    if tolerance is not None:
-        request.tolerance = float(tolerance)
-    if relative_tolerance is not None:
-        request.relative_tolerance = float(relative_tolerance)
-    if singular_value_tolerance is not None:
-        request.singular_value_tolerance = float(singular_value_tolerance)
-    return request
-
-
-def _linear_solution(reply: kinematics_pb2.SolveLinearSystemResponse) -> LinearSolution:
-    """The :class:`LinearSolution` of a SolveLinearSystem reply."""
-    return LinearSolution(
-        x=np.asarray(reply.x, dtype=float),
-        residual_norm=reply.residual_norm,
-        iterations=reply.iterations,
-        status=kinematics_pb2.LinearSolveStatus.Name(reply.status).removeprefix("LINEAR_SOLVE_STATUS_").lower(),
-        history=np.asarray(reply.residual_history, dtype=float),
-        elapsed_us=reply.elapsed_us,
-    )
-
-
-class IkStream:
-    """A ``StreamIk`` call: send targets, read answers in order, each
-    warm-started from the previous answer. Use as a context manager::
-
-        with robot.stream_ik(time_budget=0.004) as s:
-            for T in targets:
-                r = s.solve(T)            # send + wait: one controller cycle
-            s.send(T1); s.send(T2)        # or pipeline...
-            a1, a2 = next(s), next(s)     # ...and read the answers in order
-
-    Each answer is an :class:`IkResult` with ``sequence`` set. A bad target
-    ends the stream: the next read raises :class:`KinplanError` naming the
-    field and the message's sequence number.
-    """
-
-    _END = object()
-
-    def __init__(self, robot: Any, options: kinematics_pb2.IkOptions, seed: Optional[npt.ArrayLike], timeout: Optional[float]):
-        self._robot = robot
-        self._options = options
-        self._seed = None if seed is None else joints(seed, "seed")
-        self._queue: "queue.Queue[Any]" = queue.Queue()
-        self._sequence = 0
-        self._first = True
-        self._lock = threading.Lock()
-        self._closed = False
-        stub = robot.client._kinematics
-        self._call = stub.StreamIk(self._requests(), timeout=timeout)
-
-    def _requests(self) -> Iterator[kinematics_pb2.StreamIkRequest]:
-        while True:
-            item = self._queue.get()
-            if item is IkStream._END:
-                return
-            yield item
-
-    def send(self, T: Any, seed: Optional[npt.ArrayLike] = None) -> int:
-        """Queues a target; returns its sequence number."""
-        if self._closed:
-            raise RuntimeError("the stream is closed")
-        with self._lock:
-            self._sequence += 1
-            msg = kinematics_pb2.StreamIkRequest(sequence=self._sequence, target=target_to_pose(T))
-            if self._first:
-                msg.robot.CopyFrom(self._robot._ref(inline=self._robot.urdf_text is not None))
-                msg.options.CopyFrom(self._options)
-                if self._seed is not None and seed is None:
-                    seed = self._seed
-                self._first = False
-            if seed is not None:
-                msg.seed.extend(joints(seed, "seed"))
-            self._queue.put(msg)
-            return self._sequence
-
-    def __next__(self) -> IkResult:
-        try:
-            reply = next(self._call)
-        except grpc.RpcError as err:
-            raise KinplanError.from_rpc_error(err) from None
-        out = IkResult.from_proto(reply.result)
-        out.sequence = reply.sequence
-        return out
-
-    def __iter__(self) -> "IkStream":
-        return self
-
-    def solve(self, T: Any, seed: Optional[npt.ArrayLike] = None) -> IkResult:
-        """Sends one target and waits for its answer."""
-        self.send(T, seed)
-        return next(self)
-
-    def close(self) -> None:
-        """Ends the request side; the server then ends the stream."""
-        if not self._closed:
-            self._closed = True
-            self._queue.put(IkStream._END)
-
-    def cancel(self) -> None:
-        self.close()
-        self._call.cancel()
-
-    def __enter__(self) -> "IkStream":
-        return self
-
-    def __exit__(self, *exc: Any) -> None:
-        self.close()
-        # drain what is left so that the call ends cleanly
-        try:
-            for _ in self._call:
-                pass
-        except grpc.RpcError:
-            pass
-
-
-class RobotKinematicsMixin:
-    """Adds :meth:`ik`, :meth:`ik_batch`, :meth:`track` and :meth:`stream_ik`
-    to :class:`kinplan.Robot`."""
-
-    def ik(
-        self,
-        T: Any,
-        seed: Optional[npt.ArrayLike] = None,
-        method: Optional[IkMethodName] = "lm",
-        linear_solver: Optional[LinearSolverName] = "svd",
-        *,
-        max_restarts: Optional[int] = None,
-        num_solutions: Optional[int] = None,
-        position_tolerance: Optional[float] = None,
-        orientation_tolerance: Optional[float] = None,
-        position_only: bool = False,
-        max_iterations: Optional[int] = None,
-        damping: Optional[float] = None,
-        rng_seed: int = 0,
-        joint_limits: Optional[Literal["clamp", "ignore"]] = None,
-        time_budget: Optional[float] = None,
-        adaptive_damping: Optional[bool] = None,
-        max_step: Optional[float] = None,
-        distinct_tolerance: Optional[float] = None,
-        rlxa_max_iterations: Optional[int] = None,
-        history: bool = False,
-        timeout: Optional[float] = None,
-    ) -> IkResult:
-        """Joints that put the tool at ``T`` (4x4, or (position, quaternion
-        xyzw), or a bare position 3-vector, which means ``position_only``),
-        base frame. ``method``: "lm" (default), "jacobian_inverse",
-        "newton", "ccd", "fabrik", "length_relaxation"; ``linear_solver``
-        (Jacobian methods): "svd" (default), "angle_relaxation",
-        "angle_relaxation_safeguarded". Tolerances in m and rad (default
-        1e-5); ``max_restarts`` (default 200) random restarts from
-        ``rng_seed``; ``num_solutions`` distinct solutions ranked by distance
-        to ``seed``. Further options: ``max_iterations``, ``damping``,
-        ``rng_seed``, ``joint_limits`` ("clamp"/"ignore"), ``time_budget``
-        (s; default: the call's deadline), ``adaptive_damping``,
-        ``max_step``, ``distinct_tolerance``, ``rlxa_max_iterations``,
-        ``history`` (True: each solution carries its per-iteration errors).
-
-        Which combinations converge (1,000 random reachable targets per arm,
-        5 ms budget, ``benches/IK_RESULTS.md`` §0.5): "lm", "jacobian_inverse"
-        and "newton" with "svd" solve 100 % on all six built-in arms in
-        ~20-30 us median; with "angle_relaxation" 84-96 % (slower); "ccd"
-        20-58 % on 6-axis arms; "newton" + "angle_relaxation" solves 0 %,
-        as S2 predicts (the relaxation's inexact solve is not accurate enough
-        for Newton's fixed-point step): do not use it. "fabrik" and
-        "length_relaxation" take position targets only."""
-        matrix = isinstance(T, np.ndarray) and T.shape == (4, 4)  # the usual target: packed in one step
-        # a bare 3-vector is a position: solve for it alone
-        if not matrix and _is_position(T):
-            T = (np.asarray(T, dtype=float), np.array([0.0, 0.0, 0.0, 1.0]))
-            position_only = True
-        key = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
-               damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
-               max_step, distinct_tolerance, rlxa_max_iterations, history)
-        try:
-            options_field = _IK_OPTIONS_FIELD[key]
-        except (KeyError, TypeError):  # first use of these arguments, or an unhashable one
-            options_field = _ik_options_field(*key)
-        # the request goes out as bytes built field by field: no message objects
-        target = target_field(T) if matrix else length_delimited(2, _target_wire(T))
-        body = target + (b"" if seed is None else joints_field(3, seed, "seed")) + options_field
-        reply = self._send(_SOLVE_IK, kinematics_pb2.SolveIkResponse, body, timeout)  # type: ignore[attr-defined]
-        return IkResult.from_proto(reply)
-
-    def ik_batch(
-        self,
-        Ts: Any,
-        seed: Optional[npt.ArrayLike] = None,
-        method: Optional[str] = "lm",
-        linear_solver: Optional[str] = "svd",
-        *,
-        timeout: Optional[float] = None,
-        **options: Any,
-    ) -> IkBatchResult:
-        """Solves every target of ``Ts`` (n x 4 x 4 array, or a list of 4x4
-        matrices / (position, quaternion) pairs) in parallel on the server,
-        each from ``seed``: one joint vector for all targets, or an (n x dof)
-        array with one seed per target. Options as :meth:`ik`; ``time_budget`` is per
-        target, the call's deadline bounds the batch."""
-        o = ik_options(method, linear_solver, **options)
-        targets = _targets(Ts)
-        seed_arr = None if seed is None else np.asarray(seed, dtype=np.float64)
-        per_target = None
-        seed_list: List[float] = []
-        if seed_arr is not None and seed_arr.ndim == 2:
-            per_target = matrix_to_proto(seed_arr)
-        elif seed is not None:
-            seed_list = joints(seed, "seed")
-        reply = self._call(  # type: ignore[attr-defined]
-            self.client._kinematics.SolveIkBatch,  # type: ignore[attr-defined]
-            lambda ref: kinematics_pb2.SolveIkBatchRequest(
-                robot=ref, targets=targets, seed=seed_list, options=o, seeds=per_target
-            ),
-            timeout,
-        )
-        return IkBatchResult(
-            results=[IkResult.from_proto(r) for r in reply.results],
-            succeeded=reply.succeeded,
-            elapsed_us=reply.elapsed_us,
-        )
-
-    def track(
-        self,
-        poses: Any = None,
-        seed: Optional[npt.ArrayLike] = None,
-        *,
-        line: Optional[Mapping[str, Any]] = None,
-        circle: Optional[Mapping[str, Any]] = None,
-        method: Optional[str] = "lm",
-        linear_solver: Optional[str] = "svd",
-        stop_on_failure: bool = False,
-        timeout: Optional[float] = None,
-        **options: Any,
-    ) -> TrackResult:
-        """Follows a Cartesian path step by step, each step warm-started from
-        the previous one (no restarts unless ``max_restarts`` is given).
-        Give exactly one of ``poses`` (n x 4 x 4, or a list of targets),
-        ``line={"end": T, "steps": 20, "start": T0}`` or ``circle={"centre":
-        (x, y, z), "normal": (0, 0, 1), "angle_step": pi/50, "steps": 100,
-        "start": T0}`` (``start`` defaults to the tool pose at ``seed``).
-        ``seed`` defaults to the middle of the joint limits. Options as
-        :meth:`ik`; ``time_budget`` bounds the whole path."""
-        build = _track_request(poses, seed, line, circle, method, linear_solver, stop_on_failure, options)
-        reply = self._call(self.client._kinematics.TrackPath, build, timeout)  # type: ignore[attr-defined]
-        return TrackResult.from_proto(reply)
-
-    def stream_ik(
-        self,
-        seed: Optional[npt.ArrayLike] = None,
-        method: Optional[str] = "lm",
-        linear_solver: Optional[str] = "svd",
-        *,
-        timeout: Optional[float] = None,
-        **options: Any,
-    ) -> IkStream:
-        """Opens a ``StreamIk`` call (see :class:`IkStream`). The first
-        target starts from ``seed`` (default: middle of the limits), every
-        later one from the previous answer. Options as :meth:`ik` (default
-        ``max_restarts`` 0; ``time_budget`` per target). ``timeout`` bounds
-        the whole stream (default: none -- a controller's stream lasts as
-        long as the controller runs)."""
-        o = ik_options(method, linear_solver, **options)
-        return IkStream(self, o, seed, timeout)
-
-
-class KinematicsMixin:
-    """Adds :meth:`solve_linear` (and the stub the robots' IK calls use) to
-    :class:`kinplan.Client`."""
-
-    @property
-    def _kinematics(self) -> kinematics_pb2_grpc.KinematicsServiceStub:
-        stub = self.__dict__.get("_kinematics_stub")
-        if stub is None:
-            stub = kinematics_pb2_grpc.KinematicsServiceStub(self._channel)  # type: ignore[attr-defined]
-            self.__dict__["_kinematics_stub"] = stub
-        return stub
-
-    def solve_linear(
-        self,
-        A: Any,
-        b: Any,
-        method: Optional[str] = "svd",
-        *,
-        max_iterations: Optional[int] = None,
-        tolerance: Optional[float] = None,
-        relative_tolerance: Optional[float] = None,
-        rng_seed: int = 0,
-        history: bool = False,
-        singular_value_tolerance: Optional[float] = None,
-        timeout: Optional[float] = None,
-    ) -> LinearSolution:
-        """Solves ``A x = b`` for any m x n ``A``: ``method="svd"`` (least
-        squares, minimum norm) or ``"angle_relaxation"`` /
-        ``"angle_relaxation_safeguarded"`` (RLXA: ``max_iterations``, default
-        20,000; ``tolerance`` on |b - A x|, default 0.01; ``rng_seed``;
-        ``history=True`` returns the residual after every iteration)."""
-        request = _solve_linear_request(A, b, method, max_iterations, tolerance, relative_tolerance, rng_seed,
-                                        history, singular_value_tolerance)
-        reply = self._call(self._kinematics.SolveLinearSystem, request, timeout)  # type: ignore[attr-defined]
-        return _linear_solution(reply)
+        return Robot
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 __all__ = [
+    "IK_OPTION_FIELDS",
     "IkBatchResult",
+    "IkOptions",
     "IkResult",
     "IkSolution",
-    "IkStream",
     "JOINT_LIMITS",
-    "KinematicsMixin",
     "LINEAR_SOLVERS",
     "LinearSolution",
     "METHODS",
-    "RobotKinematicsMixin",
     "TrackResult",
     "ik_options",
     "target_to_pose",

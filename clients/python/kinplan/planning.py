@@ -1,21 +1,21 @@
 """Motion planning in a collision scene: STOMP, CCSTOMP (S0's Cartesian-
 constrained STOMP) and RRT-Connect, and validity checks of joint states.
 
-``Client.plan(robot, start=q0, goal=q1 | pose=T, algorithm="ccstomp",
-scene=[kinplan.Box(...), ...])`` returns a :class:`Plan`; ``Client.check_states
-(robot, qs, scene)`` a :class:`StateChecks`. Obstacles are placed in the
+``robot.plan(start=q0, goal=q1 | pose=T, algorithm="ccstomp",
+scene=[kinplan.Box(...), ...])`` returns a :class:`Plan`; ``robot.check(qs,
+scene)`` a :class:`StateChecks`. Obstacles are placed in the
 robot's base frame; units are metres and radians (proto/kinplan/v1/planning.proto).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, List, Optional, Sequence, Union
 
 import numpy as np
 
 from ._display import html_table
-from ._convert import joints, matrix_to_pose
-from .v1 import common_pb2, planning_pb2, planning_pb2_grpc
+from ._convert import matrix_to_pose
+from .v1 import common_pb2, planning_pb2
 
 #: Planner names accepted by ``algorithm=``.
 ALGORITHMS = {
@@ -199,7 +199,7 @@ class Plan:
     trajectory is collision-free (and, for CCSTOMP, within the Cartesian
     tolerances). ``deviation`` is n x 2: the tool's translation (m) and
     rotation (rad) from the straight Cartesian line between the start and goal
-    tool poses. ``scores`` holds the S0 criteria (see ``Client.score``)."""
+    tool poses. ``scores`` holds the S0 criteria (see ``Robot.score``)."""
 
     status: str
     message: str
@@ -301,172 +301,14 @@ def _vec(v: Any, present: bool) -> List[float]:
     return [v.x, v.y, v.z] if present else [np.nan] * 3
 
 
-def _plan_request(
-    start: Any,
-    goal: Any,
-    pose: Any,
-    algorithm: str,
-    scene: Optional[Sequence[Obstacle]],
-    seed: int,
-    time_budget: Optional[float],
-    motion_resolution: Optional[float],
-    padded_motion: bool,
-    return_cost_history: bool,
-    stomp: Optional[Mapping[str, Any]],
-    cartesian: Optional[Mapping[str, Any]],
-    rrt_connect: Optional[Mapping[str, Any]],
-    timing: Optional[Mapping[str, Any]],
-) -> Callable[[common_pb2.RobotRef], planning_pb2.PlanRequest]:
-    """The PlanRequest of :meth:`PlanningMixin.plan`'s arguments for a robot
-    reference (shared by the blocking and asyncio clients)."""
-    if (goal is None) == (pose is None):
-        raise ValueError("give exactly one of goal= (joints) or pose= (4x4 tool pose)")
-    if algorithm not in ALGORITHMS:
-        raise ValueError(f"algorithm must be one of {sorted(ALGORITHMS)}, got {algorithm!r}")
-    options = planning_pb2.PlanOptions(
-        stomp=planning_pb2.StompOptions(**dict(stomp or {})),
-        cartesian=planning_pb2.CartesianOptions(**dict(cartesian or {})),
-        rrt_connect=planning_pb2.RrtConnectOptions(**dict(rrt_connect or {})),
-        timing=planning_pb2.TimingOptions(**dict(timing or {})),
-        return_cost_history=return_cost_history,
-    )
-    if time_budget is not None:
-        options.time_budget = float(time_budget)
-    if motion_resolution is not None:
-        options.motion_resolution = float(motion_resolution)
-    options.padded_motion = bool(padded_motion)
-    proto_scene = scene_to_proto(scene)
-
-    def build(ref: common_pb2.RobotRef) -> planning_pb2.PlanRequest:
-        req = planning_pb2.PlanRequest(
-            robot=ref,
-            start=joints(start, "start"),
-            scene=proto_scene,
-            algorithm=ALGORITHMS[algorithm],
-            options=options,
-            seed=int(seed),
-        )
-        if goal is not None:
-            req.goal_joints.positions.extend(joints(goal, "goal"))
-        else:
-            req.goal_pose.CopyFrom(_pose(pose))
-        return req
-
-    return build
+__all__ = ["ALGORITHMS", "Box", "Capsule", "Cylinder", "Mesh", "Obstacle", "OctreeObstacle", "Plan", "Sphere",
+           "StateChecks", "scene_to_proto"]
 
 
-def _plan_stream_request(start: Any, goal: Any, pose: Any, algorithm: str, scene: Optional[Sequence[Obstacle]],
-                         seed: int, options: Dict[str, Any]) -> Callable[[common_pb2.RobotRef], planning_pb2.PlanRequest]:
-    """The PlanRequest of :meth:`PlanningMixin.plan_stream`'s arguments
-    (`options` those of :meth:`PlanningMixin.plan`; TypeError on others)."""
-    options = dict(options)
-    build = _plan_request(
-        start, goal, pose, algorithm, scene, seed, options.pop("time_budget", None),
-        options.pop("motion_resolution", None), options.pop("padded_motion", False),
-        options.pop("return_cost_history", True),
-        options.pop("stomp", None), options.pop("cartesian", None), options.pop("rrt_connect", None),
-        options.pop("timing", None),
-    )
-    if options:
-        raise TypeError(f"unknown options: {sorted(options)}")
-    return build
+def __getattr__(name: str) -> Any:
+    """The client mixins of earlier releases: the classes that now hold their methods."""
+    if name == "PlanningMixin":
+        from .client import Client
 
-
-def _plan_stream_message(m: planning_pb2.PlanStreamResponse) -> Union[np.ndarray, Plan]:
-    """The trajectory (waypoints x dof) or final :class:`Plan` a PlanStream message carries."""
-    if m.HasField("result"):
-        return Plan.from_proto(m.result)
-    return np.array([list(p.positions) for p in m.trajectory.points], dtype=float)
-
-
-class PlanningMixin:
-    """``Client.plan``, ``Client.plan_stream`` and ``Client.check_states``."""
-
-    def _planning(self) -> planning_pb2_grpc.PlanningServiceStub:
-        stub = getattr(self, "_planning_stub", None)
-        if stub is None:
-            stub = planning_pb2_grpc.PlanningServiceStub(self._channel)  # type: ignore[attr-defined]
-            self._planning_stub = stub
-        return stub
-
-    def plan(
-        self,
-        robot: Any,
-        *,
-        start: Any,
-        goal: Any = None,
-        pose: Any = None,
-        algorithm: str = "rrt_connect",
-        scene: Optional[Sequence[Obstacle]] = None,
-        seed: int = 0,
-        time_budget: Optional[float] = None,
-        motion_resolution: Optional[float] = None,
-        padded_motion: bool = False,
-        return_cost_history: bool = True,
-        stomp: Optional[Mapping[str, Any]] = None,
-        cartesian: Optional[Mapping[str, Any]] = None,
-        rrt_connect: Optional[Mapping[str, Any]] = None,
-        timing: Optional[Mapping[str, Any]] = None,
-        timeout: Optional[float] = None,
-    ) -> Plan:
-        """Plans from ``start`` to ``goal`` (joints) or ``pose`` (4x4 tool pose)
-        among ``scene``'s obstacles. ``algorithm``: "rrt_connect", "stomp" or
-        "ccstomp". ``stomp``, ``cartesian``, ``rrt_connect`` and ``timing`` take
-        the fields of the proto messages of those names (e.g.
-        ``stomp={"timesteps": 10}``, ``cartesian={"translation_tolerance": 1.0}``);
-        unset fields take the documented defaults. ``padded_motion=True``
-        checks motions conservatively (no state of an accepted motion
-        collides; slower); by default states ``motion_resolution`` apart are
-        checked (an obstacle thinner than one step can be grazed). The same ``seed`` gives the
-        same answer."""
-        build = _plan_request(
-            start, goal, pose, algorithm, scene, seed, time_budget, motion_resolution, padded_motion,
-            return_cost_history, stomp, cartesian, rrt_connect, timing,
-        )
-        reply = robot._call(self._planning().Plan, build, timeout)
-        return Plan.from_proto(reply)
-
-    def plan_stream(self, robot: Any, *, start: Any, goal: Any = None, pose: Any = None,
-                    algorithm: str = "stomp", scene: Optional[Sequence[Obstacle]] = None, seed: int = 0,
-                    timeout: Optional[float] = None, **options: Any) -> Iterator[Union[np.ndarray, Plan]]:
-        """Yields the trajectory (waypoints x dof) after every STOMP / CCSTOMP
-        iteration, then the final :class:`Plan` (for animations). ``options``
-        are those of :meth:`plan`."""
-        build = _plan_stream_request(start, goal, pose, algorithm, scene, seed, options)
-        from .errors import KinplanError
-        import grpc
-
-        t = self.timeout if timeout is None else timeout  # type: ignore[attr-defined]
-        try:
-            for m in self._planning().PlanStream(build(robot._ref()), timeout=t):
-                yield _plan_stream_message(m)
-        except grpc.RpcError as err:
-            raise KinplanError.from_rpc_error(err) from None
-
-    def check_states(
-        self,
-        robot: Any,
-        qs: Any,
-        scene: Optional[Sequence[Obstacle]] = None,
-        *,
-        max_distance: float = 1.0,
-        timeout: Optional[float] = None,
-    ) -> StateChecks:
-        """Validity and clearance of each row of ``qs`` (n x dof) in ``scene``."""
-        arr = np.asarray(qs, dtype=float)
-        if arr.ndim == 1:
-            arr = arr[None, :]
-        if arr.ndim != 2:
-            raise ValueError(f"qs must be n x dof, got shape {arr.shape}")
-        proto_scene = scene_to_proto(scene)
-
-        def build(ref: common_pb2.RobotRef) -> planning_pb2.CheckStateRequest:
-            return planning_pb2.CheckStateRequest(
-                robot=ref,
-                states=[planning_pb2.JointState(positions=row) for row in arr.tolist()],
-                scene=proto_scene,
-                max_distance=float(max_distance),
-            )
-
-        reply = robot._call(self._planning().CheckState, build, timeout)
-        return StateChecks.from_proto(reply)
+        return Client
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,8 +1,8 @@
 """Trajectory scoring: the S0 criteria, the PTP cycle time and set comparison.
 
-``Client.score(robot, q)`` returns a :class:`Scores` mapping keyed by the
+``robot.score(q)`` returns a :class:`Scores` mapping keyed by the
 criteria's names ("CD", "JD", "OC", "OC_geodesic", "CPC", "RDM", "JJ", "CJ",
-"JMJ", "CMJ", "JJP", "CJP", "cycle_time"); ``Client.compare({...}, robot=...)``
+"JMJ", "CMJ", "JJP", "CJP", "cycle_time"); ``robot.compare({...})``
 returns a :class:`Comparison` table (mean, variance, sum per set and criterion,
 the form of S0 Tab. 5.3-5.5) that turns into a pandas DataFrame when pandas is
 installed. Units: metres, radians, seconds (see proto/kinplan/v1/scoring.proto).
@@ -10,11 +10,12 @@ installed. Units: metres, radians, seconds (see proto/kinplan/v1/scoring.proto).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
-from .v1 import common_pb2, scoring_pb2, scoring_pb2_grpc
+from ._codec import trajectory_message
+from .v1 import common_pb2, scoring_pb2
 
 #: Robot-point choices for RDM, by name.
 ROBOT_POINTS = {
@@ -165,7 +166,7 @@ def _ordered(criteria: Mapping[str, float]) -> Dict[str, float]:
 
 
 class Comparison:
-    """Per-set, per-criterion statistics of :meth:`ScoringMixin.compare`.
+    """Per-set, per-criterion statistics of :meth:`kinplan.Robot.compare`.
 
     ``c["rrt"]["OC"]["mean"]``; ``c.labels``, ``c.criteria``;
     ``c.scores["rrt"]`` is each trajectory's criteria; ``c.rows()`` the long
@@ -243,33 +244,9 @@ def _rank(name: str) -> int:
     return CRITERIA.index(name) if name in CRITERIA else len(CRITERIA)
 
 
-def _varint(n: int) -> bytes:
-    out = bytearray()
-    while True:
-        byte, n = n & 0x7F, n >> 7
-        out.append(byte | (0x80 if n else 0))
-        if not n:
-            return bytes(out)
-
-
 def _encode_rows(arr: np.ndarray, ts: Optional[np.ndarray]) -> common_pb2.JointTrajectory:
-    """A JointTrajectory of an (n x m) float array, encoded with numpy and
-    parsed once by protobuf: one JointPoint per row (field 2), its positions
-    packed (field 1), its time (field 2, fixed64) when given. Builds the same
-    message as one JointPoint per row, ~30x faster for long trajectories."""
-    n, m = arr.shape
-    positions = b"\x0a" + _varint(8 * m)
-    point_len = len(positions) + 8 * m + (9 if ts is not None else 0)
-    head = b"\x12" + _varint(point_len) + positions
-    width = len(head) + point_len - len(positions)
-    buf = np.empty((n, width), dtype=np.uint8)
-    buf[:, : len(head)] = np.frombuffer(head, dtype=np.uint8)
-    end = len(head) + 8 * m
-    buf[:, len(head) : end] = np.ascontiguousarray(arr, dtype="<f8").view(np.uint8).reshape(n, 8 * m)
-    if ts is not None:
-        buf[:, end] = 0x11
-        buf[:, end + 1 :] = np.ascontiguousarray(ts, dtype="<f8").view(np.uint8).reshape(n, 8)
-    return common_pb2.JointTrajectory.FromString(buf.tobytes())
+    """A JointTrajectory of an (n x m) float array (see :func:`kinplan._codec.trajectory_message`)."""
+    return trajectory_message(arr, ts)
 
 
 def _check_trajectory_limits(check: Any, q: Any) -> None:
@@ -338,114 +315,23 @@ def score_options(
     return o
 
 
-def _compare_request(
-    sets: Mapping[str, Sequence[Trajectory]],
-    weights: Optional[Iterable[float]],
-    robot_points: Optional[str],
-    max_velocity: Optional[Iterable[float]],
-    max_acceleration: Optional[Iterable[float]],
-    jerk_peaks: Optional[Mapping[str, Any]],
-    potential_tolerance: Optional[float],
-) -> Callable[[common_pb2.RobotRef], scoring_pb2.CompareTrajectoriesRequest]:
-    """The CompareTrajectoriesRequest of :meth:`ScoringMixin.compare`'s
-    arguments for a robot reference (shared by the blocking and asyncio clients)."""
-    request_sets = [
-        scoring_pb2.TrajectorySet(label=label, trajectories=[trajectory_to_proto(q) for q in trajectories])
-        for label, trajectories in sets.items()
-    ]
-    options = score_options(weights, False, robot_points, max_velocity, max_acceleration, jerk_peaks, potential_tolerance)
-
-    def build(ref: common_pb2.RobotRef) -> scoring_pb2.CompareTrajectoriesRequest:
-        return scoring_pb2.CompareTrajectoriesRequest(robot=ref, sets=request_sets, options=options)
-
-    return build
-
-
-class ScoringMixin:
-    """Adds :meth:`score` and :meth:`compare` to :class:`kinplan.Client`."""
-
-    @property
-    def _scoring(self) -> scoring_pb2_grpc.ScoringServiceStub:
-        stub = self.__dict__.get("_scoring_stub")
-        if stub is None:
-            stub = scoring_pb2_grpc.ScoringServiceStub(self._channel)  # type: ignore[attr-defined]
-            self.__dict__["_scoring_stub"] = stub
-        return stub
-
-    def _robot_of(self, robot: Any) -> Any:
-        if robot is None:
-            raise ValueError("robot= is required (a name or client.robot(...))")
-        return self.robot(robot) if isinstance(robot, str) else robot  # type: ignore[attr-defined]
-
-    def score(
-        self,
-        robot: Any,
-        q: Trajectory,
-        timestamps: Optional[Iterable[float]] = None,
-        weights: Optional[Iterable[float]] = None,
-        series: bool = False,
-        *,
-        robot_points: Optional[str] = None,
-        max_velocity: Optional[Iterable[float]] = None,
-        max_acceleration: Optional[Iterable[float]] = None,
-        jerk_peaks: Optional[Mapping[str, Any]] = None,
-        potential_tolerance: Optional[float] = None,
-        timeout: Optional[float] = None,
-    ) -> Scores:
-        """Scores one joint trajectory.
-
-        ``robot``: a built-in name or ``client.robot(...)``; ``q``: (n x
-        joints) array, list of waypoints or a JointTrajectory (rad, m for
-        prismatic joints); ``timestamps``: seconds per waypoint, adds the
-        time-scaled jerk; ``weights``: CPC weight per joint; ``series``: also
-        return the per-waypoint series. ``robot_points``: "link_origins"
-        (default), "collision_vertices" or "none" (no RDM). ``max_velocity`` /
-        ``max_acceleration``: per joint, for the cycle time (default: the
-        model's speed limits, no ramps). ``jerk_peaks``: JerkPeakOptions
-        fields, e.g. ``{"joint_log_gain": 3, "slowdown_floor": 0}``.
-        """
-        r = self._robot_of(robot)
-        _check_trajectory_limits(r.check_limits, q)
-        traj = trajectory_to_proto(q, timestamps)
-        options = score_options(weights, series, robot_points, max_velocity, max_acceleration, jerk_peaks, potential_tolerance)
-        reply = r._call(
-            self._scoring.ScoreTrajectory,
-            lambda ref: scoring_pb2.ScoreTrajectoryRequest(robot=ref, trajectory=traj, options=options),
-            timeout,
-        )
-        return Scores.from_proto(reply)
-
-    def compare(
-        self,
-        sets: Mapping[str, Sequence[Trajectory]],
-        robot: Any = None,
-        *,
-        weights: Optional[Iterable[float]] = None,
-        robot_points: Optional[str] = None,
-        max_velocity: Optional[Iterable[float]] = None,
-        max_acceleration: Optional[Iterable[float]] = None,
-        jerk_peaks: Optional[Mapping[str, Any]] = None,
-        potential_tolerance: Optional[float] = None,
-        timeout: Optional[float] = None,
-    ) -> Comparison:
-        """Scores labelled sets of trajectories, e.g. ``{"rrt": [q1, q2],
-        "ccstomp": [q3]}``, and returns per set and criterion the mean,
-        variance and sum (S0 Tab. 5.3-5.5) as a :class:`Comparison`."""
-        r = self._robot_of(robot)
-        build = _compare_request(sets, weights, robot_points, max_velocity, max_acceleration, jerk_peaks,
-                                 potential_tolerance)
-        return Comparison(r._call(self._scoring.CompareTrajectories, build, timeout))
-
-
 __all__ = [
     "CRITERIA",
     "Comparison",
     "CycleTime",
     "Peak",
-    "ScoringMixin",
     "Scores",
     "Series",
     "TimePotential",
     "score_options",
     "trajectory_to_proto",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """The client mixins of earlier releases: the classes that now hold their methods."""
+    if name == "ScoringMixin":
+        from .client import Client
+
+        return Client
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,0 +1,86 @@
+"""What a robot is, as the server describes it: :class:`RobotDescription`,
+and the joint limits the clients check joint values against."""
+from __future__ import annotations
+
+import operator
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, List
+
+import numpy as np
+
+from .errors import JointLimitWarning, invalid_argument
+from .v1 import robot_pb2
+
+
+@dataclass
+class RobotDescription:
+    """A robot's chain as the server sees it. Limits in rad (m for prismatic
+    joints); infinite for unlimited joints; max_velocity 0 when unknown."""
+
+    name: str
+    base_link: str
+    tip_link: str
+    joint_names: List[str]
+    joint_types: List[str]
+    lower: np.ndarray
+    upper: np.ndarray
+    max_velocity: np.ndarray
+    link_names: List[str]
+    model_id: bytes = b""
+    raw: Any = field(default=None, repr=False)
+
+    @property
+    def dof(self) -> int:
+        return len(self.joint_names)
+
+    @classmethod
+    def from_proto(cls, r: robot_pb2.DescribeRobotResponse) -> "RobotDescription":
+        return cls(
+            name=r.name,
+            base_link=r.base_link,
+            tip_link=r.tip_link,
+            joint_names=[j.name for j in r.joints],
+            joint_types=[robot_pb2.JointType.Name(j.type).removeprefix("JOINT_TYPE_").lower() for j in r.joints],
+            lower=np.array([j.lower for j in r.joints]),
+            upper=np.array([j.upper for j in r.joints]),
+            max_velocity=np.array([j.max_velocity for j in r.joints]),
+            link_names=[link.name for link in r.links],
+            model_id=r.model_id,
+            raw=r,
+        )
+
+
+class JointLimits:
+    """A chain's joint limits for the client-side guard against degrees: a
+    value outside [lower, upper] (1e-9 of slack) warns, or raises when strict."""
+
+    def __init__(self, d: RobotDescription):
+        self.lower = d.lower - 1e-9
+        self.upper = d.upper + 1e-9
+        self.names = d.joint_names
+        self._lower_list: List[float] = self.lower.tolist()
+        self._upper_list: List[float] = self.upper.tolist()
+
+    def check(self, q: Any, field_name: str, strict: bool) -> None:
+        if isinstance(q, list) and len(q) == len(self._lower_list):
+            # one state as floats (fk, jacobian): comparisons mapped in C are the cheapest test
+            if all(map(operator.le, self._lower_list, q)) and all(map(operator.le, q, self._upper_list)):
+                return
+        arr = np.asarray(q, dtype=float)
+        if arr.ndim == 0 or arr.shape[-1] != len(self.lower):
+            return  # the server names a wrong length
+        outside = (arr < self.lower) | (arr > self.upper)
+        if not outside.any():
+            return
+        where = np.argwhere(outside)[0]
+        j = int(where[-1])
+        value = float(arr[tuple(where)])
+        message = (
+            f"{int(outside.sum())} joint value(s) outside the limits, e.g. {self.names[j]} = {value:.6g} not in "
+            f"[{self.lower[j] + 1e-9:.6g}, {self.upper[j] - 1e-9:.6g}]; kinplan takes radians (m for prismatic "
+            "joints): degrees? use np.radians(...)"
+        )
+        if strict:
+            raise invalid_argument(field_name, message)
+        warnings.warn(f"{field_name}: {message}", JointLimitWarning, stacklevel=4)

@@ -1,0 +1,156 @@
+"""OctoMap trees (:class:`Octree`) and the ranked next-best views of one
+(:class:`Views`): the values of ``Client.insert_scan``, ``octree_info`` and
+``next_best_view`` (proto/kinplan/v1/exploration.proto; S0 §4).
+
+Trees travel as :class:`Octree` values: the node bytes of an OctoMap ``.bt``
+(or ``.ot``) file without its text header, as ROS ``octomap_msgs/Octomap``
+carries them. ``Octree.from_bt(open("map.bt", "rb").read())`` reads a file's
+bytes; the server never opens a file.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional
+
+import numpy as np
+
+from .v1 import common_pb2, exploration_pb2
+
+GAINS = {
+    "intersection": exploration_pb2.GAIN_METHOD_INTERSECTION,
+    "rays": exploration_pb2.GAIN_METHOD_RAYS,
+    "occlusion_aware": exploration_pb2.GAIN_METHOD_OCCLUSION_AWARE,
+    "unobserved_voxels": exploration_pb2.GAIN_METHOD_UNOBSERVED_VOXELS,
+}
+
+
+@dataclass
+class Octree:
+    """An OctoMap tree: node bytes, resolution (m), binary (.bt) or full (.ot)."""
+
+    data: bytes
+    resolution: float
+    binary: bool = True
+    tree_id: str = "OcTree"
+
+    @classmethod
+    def from_bt(cls, content: bytes) -> "Octree":
+        """A whole ``.bt`` file's bytes (header lines ``id``, ``res``, ``data``)."""
+        from .planning import OctreeObstacle
+
+        o = OctreeObstacle.from_bt_file_bytes(content)
+        return cls(data=o.data, resolution=o.resolution, binary=True, tree_id=o.tree_id)
+
+    def to_bt(self) -> bytes:
+        """The tree as a ``.bt`` file OctoMap reads (binary trees only)."""
+        if not self.binary:
+            raise ValueError("only a binary tree can be written as .bt")
+        header = (
+            f"# Octomap OcTree binary file\nid {self.tree_id}\nsize 0\nres {self.resolution}\ndata\n"
+        )
+        # OctoMap reads `size` but recounts the nodes; 0 would be refused by
+        # kinplan's own reader, so count the nodes (2 bytes each).
+        header = header.replace("size 0", f"size {_count_binary_nodes(self.data)}")
+        return header.encode() + self.data
+
+    def occupied_cells(self) -> np.ndarray:
+        """Centres (n x 3, m, world frame) of the occupied leaves of a binary
+        tree, any depth (a pruned leaf at depth d stands for 2^(16-d) cells a
+        side), decoded from the .bt node bytes: 2 bits per child, 01 free
+        leaf, 10 occupied leaf, 11 inner node; child i at depth d from bit
+        15 - d of the keys, i = x + 2y + 4z."""
+        if not self.binary:
+            raise ValueError("only a binary tree's nodes are decoded")
+        data, out, i = self.data, [], 0
+        stack = [((0, 0, 0), 0)] if data else []  # (key of the node's lowest corner, depth)
+        while stack:
+            (kx, ky, kz), depth = stack.pop()
+            bits = data[i] | (data[i + 1] << 8)
+            i += 2
+            half = 1 << (15 - depth)
+            children = []
+            for c in range(8):
+                kind = (bits >> (2 * c)) & 3
+                key = (kx + half * (c & 1), ky + half * ((c >> 1) & 1), kz + half * ((c >> 2) & 1))
+                if kind == 2:
+                    size = half * self.resolution
+                    out.append((np.array(key) - 32768) * self.resolution + size / 2)
+                elif kind == 3:
+                    children.append((key, depth + 1))
+            stack.extend(reversed(children))  # depth first, children in order 0..7
+        return np.array(out, dtype=float).reshape(-1, 3)
+
+    def to_proto(self) -> common_pb2.Octree:
+        return common_pb2.Octree(id=self.tree_id, resolution=self.resolution, binary=self.binary, data=self.data)
+
+    @classmethod
+    def from_proto(cls, o: common_pb2.Octree) -> "Octree":
+        return cls(data=o.data, resolution=o.resolution, binary=o.binary, tree_id=o.id)
+
+    def __repr__(self) -> str:
+        kind = "binary" if self.binary else "full"
+        return f"Octree({kind}, resolution={self.resolution} m, {len(self.data)} bytes)"
+
+
+def _count_binary_nodes(data: bytes) -> int:
+    """Nodes of a .bt node stream: each node is 2 bytes, children with
+    children (bits 11) follow depth first."""
+    count, pending, i = 0, 1, 0
+    while pending:
+        if i + 2 > len(data):
+            raise ValueError("truncated binary octree")
+        pending -= 1
+        count += 1
+        bits = data[i] | (data[i + 1] << 8)
+        i += 2
+        pending += sum(1 for c in range(8) if (bits >> (2 * c)) & 3 == 3)
+    return count
+
+
+@dataclass
+class Views:
+    """Ranked candidate views. ``poses`` is k x 4 x 4 (camera optical frame in
+    the world; +z looks), ``utility`` f = w_d D + w_r R + w_i Ig, ``gain`` Ig,
+    ``distance`` D, ``rotation`` R, ``reachable`` True/False/None (not
+    checked), ``joints`` the IK solutions (None where not reachable)."""
+
+    poses: np.ndarray
+    utility: np.ndarray
+    gain: np.ndarray
+    distance: np.ndarray
+    rotation: np.ndarray
+    unknown_cells: np.ndarray
+    frontier: np.ndarray
+    reachable: List[Optional[bool]]
+    joints: List[Optional[np.ndarray]]
+    stages: Dict[str, float]
+    status: str
+    weights: Dict[str, float]
+    raw: Any = field(default=None, repr=False)
+
+    def __len__(self) -> int:
+        return len(self.utility)
+
+    def __repr__(self) -> str:
+        best = f", best f={self.utility[0]:.3f}" if len(self) else ""
+        return f"Views({len(self)} candidates{best}, status={self.status})"
+
+    def to_pandas(self) -> Any:
+        import pandas as pd
+
+        return pd.DataFrame(
+            {
+                "x": self.poses[:, 0, 3] if len(self) else [],
+                "y": self.poses[:, 1, 3] if len(self) else [],
+                "z": self.poses[:, 2, 3] if len(self) else [],
+                "utility": self.utility,
+                "Ig": self.gain,
+                "D": self.distance,
+                "R": self.rotation,
+                "unknown_cells": self.unknown_cells,
+                "reachable": self.reachable,
+            }
+        )
+
+
+__all__ = ["GAINS", "Octree", "Views"]
