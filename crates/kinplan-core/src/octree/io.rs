@@ -47,11 +47,13 @@ impl Octree {
         read_body(bytes, &h, limits, true)
     }
 
-    /// Reads a `.ot` file (`# Octomap OcTree file`, id `OcTree`): per node, depth
-    /// first, an f32 log-odds (little-endian) and a byte of child-exists bits.
+    /// Reads a `.ot` file (`# Octomap OcTree file`, id `OcTree` or `ColorOcTree`):
+    /// per node, depth first, an f32 log-odds (little-endian), for a `ColorOcTree`
+    /// three colour bytes (r, g, b: read and dropped, as a colour has no say in
+    /// occupancy), and a byte of child-exists bits.
     pub fn read_ot(bytes: &[u8], limits: &OctreeLimits) -> Result<Octree, OctreeError> {
         let h = parse_header(bytes, OT_FIRST_LINE)?;
-        if h.id != "OcTree" {
+        if h.id != "OcTree" && h.id != "ColorOcTree" {
             return Err(OctreeError::UnsupportedTreeType {
                 id: h.id,
                 format: ".ot",
@@ -71,7 +73,7 @@ impl Octree {
         data: &[u8],
         limits: &OctreeLimits,
     ) -> Result<Octree, OctreeError> {
-        let ok = id == "OcTree" || (binary && id == "ColorOcTree");
+        let ok = id == "OcTree" || id == "ColorOcTree";
         if !ok {
             let format = if binary { "binary message" } else { "full message" };
             return Err(OctreeError::UnsupportedTreeType {
@@ -90,7 +92,7 @@ impl Octree {
         let end = if binary {
             read_binary_nodes(&mut t, data, 0, limits)?
         } else {
-            read_full_nodes(&mut t, data, 0, limits)?
+            read_full_nodes(&mut t, data, 0, limits, FullNode::of(id))?
         };
         if end != data.len() {
             return Err(OctreeError::TrailingBytes {
@@ -157,7 +159,7 @@ fn read_body(bytes: &[u8], h: &Header, limits: &OctreeLimits, binary: bool) -> R
     } else if binary {
         read_binary_nodes(&mut t, bytes, h.data_offset, limits)?
     } else {
-        read_full_nodes(&mut t, bytes, h.data_offset, limits)?
+        read_full_nodes(&mut t, bytes, h.data_offset, limits, FullNode::of(&h.id))?
     };
     if t.num_nodes as u64 != h.size {
         return Err(OctreeError::SizeMismatch {
@@ -277,17 +279,48 @@ fn read_binary_nodes(
     Ok(pos)
 }
 
+/// The node record of a full (`.ot`) stream.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum FullNode {
+    /// `OcTree`: f32 log-odds, child bits.
+    Plain,
+    /// `ColorOcTree`: f32 log-odds, r, g, b, child bits.
+    Color,
+}
+
+impl FullNode {
+    fn of(id: &str) -> Self {
+        if id == "ColorOcTree" {
+            FullNode::Color
+        } else {
+            FullNode::Plain
+        }
+    }
+
+    fn bytes(self) -> usize {
+        match self {
+            FullNode::Plain => 5,
+            FullNode::Color => 8,
+        }
+    }
+}
+
 /// Reads `.ot` node bytes from `pos`; returns the offset after the last node.
 fn read_full_nodes(
     t: &mut Octree,
     bytes: &[u8],
     mut pos: usize,
     limits: &OctreeLimits,
+    node: FullNode,
 ) -> Result<usize, OctreeError> {
-    let avail = (bytes.len().saturating_sub(pos) / 5).min(limits.max_nodes / 8 + 1);
+    let size = node.bytes();
+    let avail = (bytes.len().saturating_sub(pos) / size).min(limits.max_nodes / 8 + 1);
     t.blocks.reserve(avail / 4);
     let read_node = |pos: usize| -> Result<(f32, u8), OctreeError> {
-        let b = take::<5>(bytes, pos)?;
+        let b = bytes.get(pos..pos + size).ok_or_else(|| OctreeError::Truncated {
+            offset: bytes.len(),
+            needed: pos + size - bytes.len(),
+        })?;
         let v = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
         if !v.is_finite() {
             return Err(OctreeError::BadNodeData {
@@ -295,10 +328,10 @@ fn read_full_nodes(
                 reason: "log-odds value is not finite",
             });
         }
-        Ok((v, b[4]))
+        Ok((v, b[size - 1]))
     };
     let (v, mask) = read_node(pos)?;
-    pos += 5;
+    pos += size;
     t.root = Some(Node::leaf(v));
     t.num_nodes = 1;
     let attach = |t: &mut Octree, loc: Loc, mask: u8| {
@@ -330,7 +363,7 @@ fn read_full_nodes(
         if child_depth == TREE_DEPTH && cmask != 0 {
             return Err(OctreeError::TooDeep { offset: pos });
         }
-        pos += 5;
+        pos += size;
         t.num_nodes += 1;
         check_count(t, limits, pos)?;
         let child = t.node(loc).block * 8 + i as u32;

@@ -3,7 +3,9 @@
 
 use nalgebra::Point3;
 
-use super::key::{OcKey, TREE_DEPTH, child_key, coord_to_key_axis, key_at_depth, key_to_coord_axis_at};
+use super::key::{
+    OcKey, TREE_DEPTH, TREE_MAX_VAL, child_key, coord_to_key_axis, key_at_depth, key_to_coord_axis_at,
+};
 use super::tree::{CellState, Node};
 use super::{Octree, OctreeError};
 
@@ -164,38 +166,58 @@ impl Octree {
         Ok(())
     }
 
-    /// Free, occupied and unknown volume (m³) inside the box `[min, max]` (m), exact
-    /// up to the key grid: the box is snapped outward to whole depth-16 cells.
+    /// Free, occupied and unknown volume (m³) inside the box `[min, max]` (m), exact:
+    /// every cube counts the part of it inside the box,
+    /// `Π_i max(0, min(hi_i, max_i) − max(lo_i, min_i))` — a box of zero volume has
+    /// none, and a cell that only touches the box's faces adds nothing.
     pub fn volumes_in_box(&self, min: &Point3<f64>, max: &Point3<f64>) -> Result<BoxVolumes, OctreeError> {
-        let (kmin, kmax) = self.box_keys(min, max)?;
-        let r3 = self.resolution.powi(3);
         let mut v = BoxVolumes::default();
         self.for_each_in_box(min, max, TREE_DEPTH, StateFilter::ALL, |c| {
-            let span = 1u32 << (TREE_DEPTH - c.depth);
-            let mut cells = 1.0;
+            let half = c.size / 2.0;
+            let mut inside = 1.0;
             for i in 0..3 {
-                let lo = (c.key[i] as u32).max(kmin[i] as u32);
-                let hi = (c.key[i] as u32 + span - 1).min(kmax[i] as u32);
-                cells *= (hi + 1 - lo) as f64;
+                let lo = (c.center[i] - half).max(min[i]);
+                let hi = (c.center[i] + half).min(max[i]);
+                inside *= (hi - lo).max(0.0);
             }
             match c.state {
-                CellState::Free => v.free += cells * r3,
-                CellState::Occupied => v.occupied += cells * r3,
-                CellState::Unknown => v.unknown += cells * r3,
+                CellState::Free => v.free += inside,
+                CellState::Occupied => v.occupied += inside,
+                CellState::Unknown => v.unknown += inside,
             }
         })?;
         Ok(v)
     }
 
+    /// The depth-16 keys of the cells containing `min` and `max` on each axis (a
+    /// closed box: a cell touching its upper face is visited, and counts no volume in
+    /// [`volumes_in_box`](Self::volumes_in_box)). A coordinate on the cube's upper
+    /// edge (`32768·res`) belongs to the last cell, so a box of the tree's whole cube
+    /// is accepted; coordinates beyond the cube are errors.
     fn box_keys(&self, min: &Point3<f64>, max: &Point3<f64>) -> Result<(OcKey, OcKey), OctreeError> {
-        let kmin = self.key_of(min)?;
-        let kmax = self.key_of(max)?;
-        if (0..3).any(|i| kmin[i] > kmax[i]) {
-            return Err(OctreeError::InvalidParam {
-                field: "box",
-                value: 0.0,
-                reason: "min must not exceed max",
-            });
+        const NAMES: [&str; 3] = ["x", "y", "z"];
+        let f = self.resolution_factor;
+        let edge = TREE_MAX_VAL as f64;
+        let mut kmin = [0u16; 3];
+        let mut kmax = [0u16; 3];
+        for i in 0..3 {
+            let field = NAMES[i];
+            if !(min[i].is_finite() && max[i].is_finite()) {
+                return Err(OctreeError::NonFinite { field });
+            }
+            if min[i] > max[i] {
+                return Err(OctreeError::InvalidParam {
+                    field: "box",
+                    value: 0.0,
+                    reason: "min must not exceed max",
+                });
+            }
+            let (a, b) = ((min[i] * f).floor(), (max[i] * f).floor());
+            if !(a >= -edge && b <= edge) {
+                return Err(OctreeError::OutOfBounds { field });
+            }
+            kmin[i] = (a.min(edge - 1.0) as i32 + TREE_MAX_VAL) as u16;
+            kmax[i] = (b.min(edge - 1.0) as i32 + TREE_MAX_VAL) as u16;
         }
         Ok((kmin, kmax))
     }
@@ -243,7 +265,7 @@ impl Octree {
         let big = 32768.0 * self.resolution;
         self.for_each_in_box(
             &Point3::new(-big, -big, -big),
-            &Point3::new(big * 0.999_999, big * 0.999_999, big * 0.999_999),
+            &Point3::new(big, big, big),
             TREE_DEPTH,
             StateFilter {
                 free: true,

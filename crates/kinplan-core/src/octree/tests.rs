@@ -244,24 +244,32 @@ fn box_volumes_match_a_cell_by_cell_count() {
     let t = random_tree(3, 4000, 0.1);
     let (min, max) = (Point3::new(-1.23, -0.71, -0.4), Point3::new(0.88, 1.31, 0.52));
     let v = t.volumes_in_box(&min, &max).unwrap();
+    // every depth-16 cell the box reaches, weighted by the part of it inside the box
     let (k0, k1) = (t.key_of(&min).unwrap(), t.key_of(&max).unwrap());
-    let (mut f, mut o, mut u) = (0usize, 0usize, 0usize);
+    let r = 0.1f64;
+    let inside = |k: u16, i: usize| {
+        let lo = (k as f64 - 32768.0) * r;
+        ((lo + r).min(max[i]) - lo.max(min[i])).max(0.0)
+    };
+    let (mut f, mut o, mut u) = (0.0, 0.0, 0.0);
     for x in k0[0]..=k1[0] {
         for y in k0[1]..=k1[1] {
             for z in k0[2]..=k1[2] {
+                let w = inside(x, 0) * inside(y, 1) * inside(z, 2);
                 match t.state_of_key(&[x, y, z]) {
-                    CellState::Free => f += 1,
-                    CellState::Occupied => o += 1,
-                    CellState::Unknown => u += 1,
+                    CellState::Free => f += w,
+                    CellState::Occupied => o += w,
+                    CellState::Unknown => u += w,
                 }
             }
         }
     }
-    let c = 0.1f64.powi(3);
-    assert!(f > 0 && o > 0 && u > 0);
-    assert!((v.free - f as f64 * c).abs() < 1e-9);
-    assert!((v.occupied - o as f64 * c).abs() < 1e-9);
-    assert!((v.unknown - u as f64 * c).abs() < 1e-9);
+    assert!(f > 0.0 && o > 0.0 && u > 0.0);
+    assert!((v.free - f).abs() < 1e-9, "{} vs {f}", v.free);
+    assert!((v.occupied - o).abs() < 1e-9);
+    assert!((v.unknown - u).abs() < 1e-9);
+    let whole = (0..3).map(|i| max[i] - min[i]).product::<f64>();
+    assert!((v.free + v.occupied + v.unknown - whole).abs() < 1e-9);
     // at depth 14 every reported cube is at most 4 cells wide and still covers the box
     let mut n = 0;
     t.for_each_in_box(&min, &max, 14, StateFilter::ALL, |c| {
@@ -329,4 +337,80 @@ fn cached_search_agrees_with_search_from_the_root() {
         }
         assert_eq!(t.search_key_cached(&k, &mut cache), t.search_key(&k, 16), "{k:?}");
     }
+}
+
+/// Regressions: a tree whose known bounds are the whole key cube (a root with eight
+/// leaves) was refused by its own default box, and a box of zero volume, or one
+/// ending on a cell boundary, counted a layer of cells beyond its upper faces.
+#[test]
+fn boxes_on_the_cube_edge_and_on_cell_boundaries_count_exactly() {
+    use nalgebra::Point3;
+    let lim = OctreeLimits::default();
+    // 0x66 0x66: the root's eight children are leaves (binary form)
+    let t = Octree::from_message_data(true, "OcTree", 0.1, &[0x66, 0x66], &lim).unwrap();
+    let (lo, hi) = t.known_bounds().unwrap();
+    let big = 3276.8;
+    assert_eq!(
+        (lo, hi),
+        (Point3::new(-big, -big, -big), Point3::new(big, big, big))
+    );
+    let v = t.volumes_in_box(&lo, &hi).unwrap();
+    // 0x66 = 0b01_10_01_10 per byte: children alternate occupied (01) and free (10)
+    let half = (2.0 * big).powi(3) / 2.0;
+    assert!((v.free - half).abs() < 1e-9 * half, "{v:?}");
+    assert!((v.occupied - half).abs() < 1e-9 * half, "{v:?}");
+    assert_eq!(v.unknown, 0.0);
+    // zero volume, anywhere
+    for p in [Point3::new(0.0, 0.0, 0.0), Point3::new(0.05, -0.13, 0.2)] {
+        let v = t.volumes_in_box(&p, &p).unwrap();
+        assert_eq!((v.free, v.occupied, v.unknown), (0.0, 0.0, 0.0));
+    }
+    // a box of exactly one cell, on its boundaries
+    let mut one = Octree::new(0.1).unwrap();
+    one.update_key(&[32768, 32768, 32768], -1.0);
+    let v = one
+        .volumes_in_box(&Point3::new(0.0, 0.0, 0.0), &Point3::new(0.1, 0.1, 0.1))
+        .unwrap();
+    assert!((v.free - 1e-3).abs() < 1e-12, "{v:?}");
+    assert!(
+        v.unknown.abs() < 1e-12,
+        "no cell beyond the box's upper faces: {v:?}"
+    );
+    assert!(
+        t.volumes_in_box(&Point3::new(0.0, 0.0, 0.0), &Point3::new(3276.9, 0.0, 0.0))
+            .is_err()
+    );
+}
+
+/// A ColorOcTree `.ot` (OctoMap's `ColorOcTreeNode` writes its log-odds, then r, g,
+/// b, then the child bits) reads as the same occupancy tree as its plain form; the
+/// colour file is built here from the plain one by inserting three colour bytes
+/// into every 5-byte node record.
+#[test]
+fn a_color_octree_full_file_reads_as_its_occupancy() {
+    let t = random_tree(5, 600, 0.1);
+    let plain = t.write_ot();
+    let header_end = plain.windows(5).position(|w| w == b"data\n").unwrap() + 5;
+    let header = std::str::from_utf8(&plain[..header_end]).unwrap();
+    assert!(header.contains("id OcTree\n"));
+    let mut color = header.replace("id OcTree\n", "id ColorOcTree\n").into_bytes();
+    let nodes = &plain[header_end..];
+    assert_eq!(nodes.len() % 5, 0);
+    for (i, record) in nodes.chunks_exact(5).enumerate() {
+        color.extend_from_slice(&record[..4]);
+        color.extend_from_slice(&[i as u8, 7, 200]);
+        color.push(record[4]);
+    }
+    let lim = OctreeLimits::default();
+    let back = Octree::read_ot(&color, &lim).unwrap();
+    assert_eq!(back.write_ot(), plain);
+    // the node bytes alone, as a ROS message carries them
+    let color_header = header_end + "Color".len();
+    let msg = Octree::from_message_data(false, "ColorOcTree", 0.1, &color[color_header..], &lim).unwrap();
+    assert_eq!(msg.write_ot(), plain);
+    // cut inside a record: an error, not a panic
+    assert!(matches!(
+        Octree::read_ot(&color[..color.len() - 3], &lim),
+        Err(OctreeError::Truncated { .. })
+    ));
 }
