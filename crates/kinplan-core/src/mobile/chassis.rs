@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use super::error::{MobileError, check_positive, check_range};
+use super::error::{MobileError, check_dimension, check_positive, check_range};
 use super::field::{ChassisKind, ChassisParam, MobileField};
 use super::pose::{Pose, Twist, integrate_twist};
 
@@ -193,32 +193,34 @@ impl Chassis {
         }
     }
 
-    /// Checks every dimension and limit (positive and finite; steering limit in (0, 90°)).
+    /// Checks every dimension and limit: lengths (wheelbase, track, wheel radius,
+    /// centre distance) in [1e-6, 1e3] m (`MIN_DIMENSION`, `MAX_DIMENSION`), speeds positive and
+    /// finite, steering limit in (0, 90°).
     pub fn validate(&self) -> Result<(), MobileError> {
         let field = |kind, param| MobileField::Chassis { kind, param };
         let steer_limit = FRAC_PI_2 - 1e-6;
         match self {
             Chassis::Tricycle(p) => {
                 let f = |param| field(ChassisKind::Tricycle, param);
-                check_positive(f(ChassisParam::Wheelbase), p.wheelbase)?;
-                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_dimension(f(ChassisParam::Wheelbase), p.wheelbase)?;
+                check_dimension(f(ChassisParam::WheelRadius), p.wheel_radius)?;
                 check_positive(f(ChassisParam::MaxSpeed), p.max_speed)?;
                 check_positive(f(ChassisParam::MaxSteer), p.max_steer)?;
                 check_range(f(ChassisParam::MaxSteer), p.max_steer, 0.0, steer_limit)
             }
             Chassis::Car(p) => {
                 let f = |param| field(ChassisKind::Car, param);
-                check_positive(f(ChassisParam::Wheelbase), p.wheelbase)?;
-                check_positive(f(ChassisParam::Track), p.track)?;
-                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_dimension(f(ChassisParam::Wheelbase), p.wheelbase)?;
+                check_dimension(f(ChassisParam::Track), p.track)?;
+                check_dimension(f(ChassisParam::WheelRadius), p.wheel_radius)?;
                 check_positive(f(ChassisParam::MaxSpeed), p.max_speed)?;
                 check_positive(f(ChassisParam::MaxSteer), p.max_steer)?;
                 check_range(f(ChassisParam::MaxSteer), p.max_steer, 0.0, steer_limit)
             }
             Chassis::Omni(p) => {
                 let f = |param| field(ChassisKind::Omni, param);
-                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
-                check_positive(f(ChassisParam::CenterDistance), p.center_distance)?;
+                check_dimension(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_dimension(f(ChassisParam::CenterDistance), p.center_distance)?;
                 check_positive(f(ChassisParam::MaxWheelSpeed), p.max_wheel_speed)?;
                 check_range(
                     f(ChassisParam::FirstWheelAngle),
@@ -229,8 +231,8 @@ impl Chassis {
             }
             Chassis::Differential(p) => {
                 let f = |param| field(ChassisKind::Differential, param);
-                check_positive(f(ChassisParam::WheelRadius), p.wheel_radius)?;
-                check_positive(f(ChassisParam::Track), p.track)?;
+                check_dimension(f(ChassisParam::WheelRadius), p.wheel_radius)?;
+                check_dimension(f(ChassisParam::Track), p.track)?;
                 check_positive(f(ChassisParam::MaxWheelSpeed), p.max_wheel_speed)
             }
         }
@@ -405,8 +407,14 @@ mod tests {
             ..DifferentialParams::default()
         });
         assert!(
-            matches!(bad.validate(), Err(MobileError::NotPositive { field, .. }) if field == MobileField::Chassis { kind: ChassisKind::Differential, param: ChassisParam::WheelRadius })
+            matches!(bad.validate(), Err(MobileError::OutOfRange { field, min, .. }) if min == 1e-6 && field == MobileField::Chassis { kind: ChassisKind::Differential, param: ChassisParam::WheelRadius })
         );
+        // a radius too small to divide by (a wheel speed of v / r overflows)
+        let tiny = Chassis::Differential(DifferentialParams {
+            wheel_radius: 1e-300,
+            ..DifferentialParams::default()
+        });
+        assert!(matches!(tiny.validate(), Err(MobileError::OutOfRange { .. })));
         let nan = c.saturate(Twist::unicycle(f64::NAN, 0.0));
         assert_eq!(nan.0, Twist::ZERO);
     }

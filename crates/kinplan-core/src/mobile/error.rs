@@ -113,6 +113,17 @@ pub(crate) fn check_positive(field: MobileField, value: f64) -> Result<(), Mobil
     }
 }
 
+/// Smallest chassis length accepted (m): a wheel of a micrometre is no wheel,
+/// and dividing by a smaller one overflows.
+pub const MIN_DIMENSION: f64 = 1e-6;
+/// Largest chassis length accepted (m).
+pub const MAX_DIMENSION: f64 = 1e3;
+
+/// A chassis length: finite and within [`MIN_DIMENSION`], [`MAX_DIMENSION`] m.
+pub(crate) fn check_dimension(field: MobileField, value: f64) -> Result<(), MobileError> {
+    check_range(field, value, MIN_DIMENSION, MAX_DIMENSION)
+}
+
 pub(crate) fn check_range(field: MobileField, value: f64, min: f64, max: f64) -> Result<(), MobileError> {
     check_finite(field, value)?;
     if (min..=max).contains(&value) {

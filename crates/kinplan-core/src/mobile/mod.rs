@@ -25,7 +25,7 @@ pub use chassis::{
     CarParams, Chassis, ChassisStep, DifferentialParams, OmniParams, Saturation, TricycleParams,
 };
 pub use control_step::{ControlStep, StepController, StepOptions, StepReport, control_step};
-pub use error::MobileError;
+pub use error::{MAX_DIMENSION, MIN_DIMENSION, MobileError};
 pub use field::{
     AstarField, ChassisKind, ChassisParam, Component, FollowField, FollowParam, LyapunovParam, MobileField,
     ObstaclePart, PurePursuitParam, SensorField, SimField, SteeringParam, VdfField, WheelField,

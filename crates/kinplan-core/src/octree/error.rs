@@ -8,7 +8,7 @@ pub enum OctreeError {
     BadHeader { offset: usize, reason: String },
     #[error("tree type '{id}' is not supported for {format}")]
     UnsupportedTreeType { id: String, format: &'static str },
-    #[error("resolution {0} m is not finite and > 0")]
+    #[error("resolution {0} m is outside [1e-4, 1e3] m")]
     BadResolution(f64),
     #[error("node data truncated at byte {offset}: {needed} more bytes needed")]
     Truncated { offset: usize, needed: usize },

@@ -298,7 +298,11 @@ fn a_scan_with_more_cells_than_the_node_limit_is_refused_while_traced() {
         "{err}"
     );
     assert!(t.is_empty(), "a refused scan leaves the tree unchanged");
-    assert!(t0.elapsed() < std::time::Duration::from_secs(5), "took {:?}", t0.elapsed());
+    assert!(
+        t0.elapsed() < std::time::Duration::from_secs(5),
+        "took {:?}",
+        t0.elapsed()
+    );
 }
 
 #[test]

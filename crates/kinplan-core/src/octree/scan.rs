@@ -308,9 +308,11 @@ impl Octree {
         let mut updates = 0usize;
         for (keys, delta, is_free) in [(&cells.free, miss, true), (&cells.occupied, hit, false)] {
             for key in keys.iter() {
-                if updates % UPDATES_PER_CHECK == 0 {
+                if updates.is_multiple_of(UPDATES_PER_CHECK) {
                     if self.num_nodes > params.max_nodes {
-                        return Err(OctreeError::TreeGrewTooLarge { limit: params.max_nodes });
+                        return Err(OctreeError::TreeGrewTooLarge {
+                            limit: params.max_nodes,
+                        });
                     }
                     if should_stop() {
                         stats.update_us = t1.elapsed().as_micros() as u64;
@@ -328,7 +330,9 @@ impl Octree {
             }
         }
         if self.num_nodes > params.max_nodes {
-            return Err(OctreeError::TreeGrewTooLarge { limit: params.max_nodes });
+            return Err(OctreeError::TreeGrewTooLarge {
+                limit: params.max_nodes,
+            });
         }
         stats.update_us = t1.elapsed().as_micros() as u64;
         stats.nodes = self.num_nodes;
@@ -339,14 +343,21 @@ impl Octree {
     /// Counts the cells each beam can cross (`‖Δkey‖₁ + 1`, at most the cut beam's
     /// `3·max_range/resolution + 4`; 0 for a point that is skipped), refuses the scan
     /// when the total passes `max_traced_cells`, and cuts the points into chunks.
-    fn plan_scan(&self, pts: &[[f32; 3]], origin: &[f32; 3], params: &ScanParams) -> Result<ScanPlan, OctreeError> {
+    fn plan_scan(
+        &self,
+        pts: &[[f32; 3]],
+        origin: &[f32; 3],
+        params: &ScanParams,
+    ) -> Result<ScanPlan, OctreeError> {
         let max_range = params.max_range;
         let cut_bound = if max_range > 0.0 {
             3 * (max_range * self.resolution_factor).min(1e15) as u64 + 4
         } else {
             u64::MAX
         };
-        let ko = self.key_of_f32(origin).ok_or(OctreeError::OutOfBounds { field: "origin" })?;
+        let ko = self
+            .key_of_f32(origin)
+            .ok_or(OctreeError::OutOfBounds { field: "origin" })?;
         let (mut lo, mut hi) = (ko, ko);
         let mut chunks = Vec::new();
         let (mut total, mut chunk_cells, mut chunk_start) = (0u64, 0u64, 0usize);
@@ -382,7 +393,11 @@ impl Octree {
             });
         }
         // a cut beam of a far point can leave the end points' box: widen it by the cut
-        if max_range > 0.0 && pts.iter().any(|p| p.iter().all(|v| v.is_finite()) && self.key_of_f32(p).is_none()) {
+        if max_range > 0.0
+            && pts
+                .iter()
+                .any(|p| p.iter().all(|v| v.is_finite()) && self.key_of_f32(p).is_none())
+        {
             let reach = (cut_bound / 3).min(65535) as u16;
             for a in 0..3 {
                 lo[a] = lo[a].min(ko[a].saturating_sub(reach));
@@ -493,7 +508,8 @@ impl Octree {
         while next < plan.chunks.len() {
             let mut end = next;
             let mut batch_cells = 0u64;
-            while end < plan.chunks.len() && (end == next || batch_cells + plan.chunks[end].1 <= BATCH_CELLS) {
+            while end < plan.chunks.len() && (end == next || batch_cells + plan.chunks[end].1 <= BATCH_CELLS)
+            {
                 batch_cells += plan.chunks[end].1;
                 end += 1;
             }

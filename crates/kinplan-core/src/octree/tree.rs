@@ -85,16 +85,21 @@ pub struct Octree {
     pub(crate) max_likelihood_pruned: bool,
 }
 
+/// Smallest cell size (m): a tenth of a millimetre.
+pub const MIN_RESOLUTION: f64 = 1e-4;
+/// Largest cell size (m): the cube then spans 65,536 km, and volumes stay finite.
+pub const MAX_RESOLUTION: f64 = 1e3;
+
 impl Octree {
-    /// An empty tree of cell size `resolution` (m, finite, > 0) with OctoMap's
-    /// default sensor model.
+    /// An empty tree of cell size `resolution` (m, within [`MIN_RESOLUTION`],
+    /// [`MAX_RESOLUTION`]) with OctoMap's default sensor model.
     pub fn new(resolution: f64) -> Result<Self, OctreeError> {
         Self::with_sensor_model(resolution, SensorModel::default())
     }
 
     /// An empty tree with the given sensor model.
     pub fn with_sensor_model(resolution: f64, sensor: SensorModel) -> Result<Self, OctreeError> {
-        if !(resolution.is_finite() && resolution > 0.0) {
+        if !(MIN_RESOLUTION..=MAX_RESOLUTION).contains(&resolution) {
             return Err(OctreeError::BadResolution(resolution));
         }
         sensor.validate()?;
