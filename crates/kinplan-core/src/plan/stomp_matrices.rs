@@ -110,7 +110,7 @@ impl StompMatrices {
         let mut column = DVector::zeros(free);
         let mut max_diagonal = 0.0_f64;
         for j in 0..free.div_ceil(2) {
-            if j % COLUMNS_PER_CHECK == 0 && should_stop() {
+            if j.is_multiple_of(COLUMNS_PER_CHECK) && should_stop() {
                 return Err(MatricesError::Stopped);
             }
             column.fill(0.0);

@@ -176,8 +176,10 @@ fn stomp_with_the_most_timesteps_answers_by_its_deadline() {
             plan(&chain, &w, &req, ctl).unwrap()
         });
         let took = t0.elapsed();
+        // a few milliseconds past the deadline on a quiet machine (timing and
+        // scoring the 10,000 waypoints); the margin is for a loaded CI host
         assert!(
-            took < Duration::from_millis(budget_ms + 40),
+            took < Duration::from_millis(budget_ms + 250),
             "{budget_ms} ms budget took {took:?}"
         );
         assert_eq!(r.status, PlanStatus::Timeout, "{budget_ms} ms budget");

@@ -167,8 +167,14 @@ impl Compute {
     }
 
     /// Admits a request or sheds it; the permit is held until the reply.
-    pub fn admit<T>(&self, request: &tonic::Request<T>) -> Result<(OwnedSemaphorePermit, Budget), Status> {
+    /// An admitted request's numbers are range-checked
+    /// ([`super::request_numbers`]) before any work.
+    pub fn admit<T: prost::Message>(
+        &self,
+        request: &tonic::Request<T>,
+    ) -> Result<(OwnedSemaphorePermit, Budget), Status> {
         let permit = self.admit_work()?;
+        super::request_numbers::check_request(request.get_ref())?;
         Ok((permit, Budget::new(self.deadline_of(request))))
     }
 

@@ -55,10 +55,13 @@ pub fn quaternion_in(field: &str, q: Option<&pb::Quaternion>) -> Result<UnitQuat
         finite(&format!("{field}.{name}"), value)?;
     }
     let raw = Quaternion::new(q.w, q.x, q.y, q.z);
-    let norm = raw.norm();
-    if norm == 0.0 {
+    if [q.w, q.x, q.y, q.z].iter().all(|c| *c == 0.0) {
         return Ok(UnitQuaternion::identity());
     }
+    // The norm scaled by the largest component: a tiny quaternion such as
+    // (0, 0, 0, 1e-200) has a tiny norm, not one that underflows to 0.
+    let largest = [q.w, q.x, q.y, q.z].iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+    let norm = largest * (raw / largest).norm();
     if (norm - 1.0).abs() > UNIT_TOLERANCE {
         return Err(invalid(
             field,
@@ -168,6 +171,20 @@ mod tests {
         };
         let err = quaternion_in("target.orientation", Some(&q)).unwrap_err();
         assert!(err.message().starts_with("target.orientation"));
+        // Regression: tiny quaternions were read as the identity (their norm
+        // underflowed to 0); only the all-zero one means "unset".
+        for (x, w) in [(0.0, 1e-200), (1e-300, 0.0), (0.0, 1e-7)] {
+            let q = pb::Quaternion { x, y: 0.0, z: 0.0, w };
+            let err = quaternion_in("box.orientation", Some(&q)).unwrap_err();
+            assert!(err.message().contains("norm 1"), "({x}, {w}): {}", err.message());
+        }
+        let unit = pb::Quaternion {
+            x: 0.6,
+            y: 0.0,
+            z: 0.0,
+            w: 0.8,
+        };
+        assert!(quaternion_in("q", Some(&unit)).is_ok());
         let err = finite_slice("seed", &[0.0, f64::NAN]).unwrap_err();
         assert!(err.message().starts_with("seed[1]"));
         let m = pb::Matrix {

@@ -23,6 +23,7 @@ mod models;
 mod planning;
 mod planning_convert;
 mod priority;
+mod request_numbers;
 mod robot;
 mod scene;
 mod scoring;

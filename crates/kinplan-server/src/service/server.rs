@@ -237,7 +237,7 @@ impl Shared {
     /// The first steps of every call about a robot: admission (or shedding with
     /// RESOURCE_EXHAUSTED), the request's budget, and the robot it names, from the
     /// cache or parsed on the CPU pool. Hold the permit until the reply.
-    pub async fn admit_robot<T>(
+    pub async fn admit_robot<T: prost::Message>(
         &self,
         request: &tonic::Request<T>,
         robot: Option<&pb::RobotRef>,

@@ -426,5 +426,8 @@ fn a_state_penetrating_a_mesh_and_a_sphere_has_a_clearance_in_either_order() {
         assert!(p.distance <= d + 1e-12);
         depths.push(d);
     }
-    assert!((depths[0] - depths[1]).abs() < 1e-9, "order changed the depth: {depths:?}");
+    assert!(
+        (depths[0] - depths[1]).abs() < 1e-9,
+        "order changed the depth: {depths:?}"
+    );
 }

@@ -32,6 +32,7 @@ pub(super) async fn stream_loop(
         let seq = msg.sequence;
         let at = |s: Status| with_sequence(s, seq);
         let _admitted = compute.admit_work().map_err(at)?;
+        crate::service::request_numbers::check_request(&msg).map_err(at)?;
         let mut model_id = Vec::new();
         let st = match session.as_mut() {
             None => {

@@ -13,9 +13,7 @@ pub fn octree_error(field: &str, e: OctreeError) -> Status {
         OctreeError::TooManyNodes { .. }
         | OctreeError::ScanTooLarge { .. }
         | OctreeError::ScanTooManyCells { .. }
-        | OctreeError::TreeGrewTooLarge { .. } => {
-            too_large(field, e.to_string())
-        }
+        | OctreeError::TreeGrewTooLarge { .. } => too_large(field, e.to_string()),
         _ => invalid(field, e.to_string()),
     }
 }
