@@ -1,4 +1,4 @@
-//! A bounded property test (issue 9): hostile but well-formed requests — NaN,
+//! A bounded property test: hostile but well-formed requests — NaN,
 //! ±inf, 1e308, 5e-324, huge counts, empty and oversized fields, forged
 //! tokens — at every RPC of one real in-process server. For each: no panic
 //! (the server keeps answering), no INTERNAL (so no non-finite number reached
@@ -10,8 +10,10 @@ use std::time::{Duration, Instant};
 
 use kinplan_server::service::ServerConfig;
 use kinplan_server::service::pb::{
-    self, kinematics_service_client::KinematicsServiceClient, mobile_service_client::MobileServiceClient,
-    robot_service_client::RobotServiceClient, scoring_service_client::ScoringServiceClient,
+    self, exploration_service_client::ExplorationServiceClient,
+    kinematics_service_client::KinematicsServiceClient, mobile_service_client::MobileServiceClient,
+    planning_service_client::PlanningServiceClient, robot_service_client::RobotServiceClient,
+    scoring_service_client::ScoringServiceClient,
 };
 use proptest::prelude::*;
 use tonic::Code;
@@ -412,6 +414,276 @@ async fn every_rpc(v: Values) -> Result<(), TestCaseError> {
         judge("Navigate", t, mobile.navigate(nav).await)?;
     }
     Ok(())
+}
+
+/// A value no physical field accepts: not finite, beyond ±1e6 or subnormal.
+fn absurd(v: f64) -> bool {
+    !v.is_finite() || v.abs() > 1e6 || (v != 0.0 && v.abs() < f64::MIN_POSITIVE)
+}
+
+/// [`judge`], and the answer must be an error when the request held an absurd
+/// value in a physical field.
+fn judge_refused<T>(
+    what: &str,
+    started: Instant,
+    must_refuse: bool,
+    answer: Result<T, tonic::Status>,
+) -> Result<(), TestCaseError> {
+    let refused = answer.is_err();
+    judge(what, started, answer)?;
+    prop_assert!(!must_refuse || refused, "{what}: OK for an absurd value");
+    Ok(())
+}
+
+/// Values for the planning and exploration requests: every field valid but one,
+/// `slot`, which takes the hostile value `f[slot]` (with `slot ≥ 24` every field
+/// is valid, so the valid paths run too).
+struct OneHostile<'a> {
+    f: &'a [f64],
+    slot: usize,
+}
+
+impl OneHostile<'_> {
+    /// Field `i`'s value: hostile when `i` is the chosen slot, else `valid`.
+    fn at(&self, i: usize, valid: f64) -> f64 {
+        if i == self.slot { self.f[i] } else { valid }
+    }
+
+    /// Whether field `i` is the hostile one and its value is absurd.
+    fn absurd_at(&self, i: usize) -> bool {
+        i == self.slot && absurd(self.f[i])
+    }
+
+    fn any_absurd(&self, fields: std::ops::Range<usize>) -> bool {
+        fields.into_iter().any(|i| self.absurd_at(i))
+    }
+}
+
+/// A scene (slots 0–9): a box with a hostile pose or size, and the tetrahedron and
+/// sphere that a UR5 at `[0, −1.5, 1.5, 0, 0, 0]` penetrates, in either order.
+fn scene(h: &OneHostile<'_>, swap: bool) -> pb::Scene {
+    let at = [-0.4223, -0.1914, 0.4184, 1.0, 0.0, 0.0, 0.0];
+    let object = |shape| pb::CollisionObject {
+        id: "o".into(),
+        pose: pose(at),
+        shape: Some(shape),
+        unknown_as_obstacle: false,
+    };
+    let tetra = pb::collision_object::Shape::Mesh(pb::TriangleMesh {
+        vertices: [[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]]
+            .iter()
+            .map(|p| vec3(*p).unwrap())
+            .collect(),
+        indices: vec![0, 1, 2, 0, 1, 3, 0, 2, 3, 1, 2, 3],
+    });
+    let sphere = pb::collision_object::Shape::Sphere(pb::Sphere { radius: 0.05 });
+    let valid = [1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.1, 0.1, 0.1];
+    let v: Vec<f64> = (0..10).map(|i| h.at(i, valid[i])).collect();
+    let hostile_box = pb::CollisionObject {
+        id: "box".into(),
+        pose: pose([v[0], v[1], v[2], v[3], v[4], v[5], v[6]]),
+        shape: Some(pb::collision_object::Shape::Box(pb::Box {
+            size: vec3([v[7], v[8], v[9]]),
+        })),
+        unknown_as_obstacle: false,
+    };
+    let mut objects = vec![object(tetra), object(sphere), hostile_box];
+    if swap {
+        objects.swap(0, 1);
+    }
+    pb::Scene { objects }
+}
+
+async fn planning_and_exploration(v: Values) -> Result<(), TestCaseError> {
+    let h = OneHostile {
+        f: &v.f,
+        slot: (v.n[7] % 32) as usize,
+    };
+    let swap = v.n[0].is_multiple_of(2);
+    let ur5 = [0.0, -1.5, 1.5, 0.0, 0.0, 0.0];
+    let free = [1.0, -1.2, 1.0, 0.0, 0.0, 0.0];
+    let mut planning = PlanningServiceClient::new(channel());
+    let mut exploration = ExplorationServiceClient::new(channel());
+    // a bad orientation of the box (slots 3–6) is absurd, or of no unit norm
+    let bad_scene = h.any_absurd(0..10)
+        || ((3..7).contains(&h.slot) && ((h.f[h.slot] - if h.slot == 3 { 1.0 } else { 0.0 }).abs() > 1e-6))
+        || ((7..10).contains(&h.slot) && h.f[h.slot] <= 0.0);
+
+    // CheckState: the penetrating pair in either order, one hostile value
+    let t = Instant::now();
+    let state: Vec<f64> = (0..6).map(|i| h.at(10 + i, ur5[i])).collect();
+    let check = pb::CheckStateRequest {
+        robot: named("ur5"),
+        states: vec![
+            pb::JointState {
+                positions: ur5.to_vec(),
+            },
+            pb::JointState { positions: state },
+        ],
+        scene: Some(scene(&h, swap)),
+        max_distance: Some(h.at(16, 0.5)),
+    };
+    let bad = bad_scene || h.any_absurd(10..17) || (h.slot == 16 && h.f[16] <= 0.0);
+    judge_refused("CheckState", t, bad, planning.check_state(check).await)?;
+
+    // Plan and PlanStream: every algorithm, one hostile start, goal or option
+    let options = pb::PlanOptions {
+        stomp: Some(pb::StompOptions {
+            timesteps: Some(v.n[2] % 12_000),
+            rollouts: Some(v.n[3] % 40),
+            max_iterations: Some(v.n[4] % 50),
+            cost_sensitivity: Some(h.at(17, 10.0)),
+            ..Default::default()
+        }),
+        rrt_connect: Some(pb::RrtConnectOptions {
+            range: Some(h.at(18, 0.3)),
+            max_samples: Some(v.n[6] % 5_000),
+            shortcut_attempts: Some(v.n[5] % 100),
+        }),
+        motion_resolution: Some(h.at(19, 0.05)),
+        time_budget: Some(h.at(20, 0.05)),
+        padded_motion: v.n[1].is_multiple_of(3),
+        ..Default::default()
+    };
+    let goal = if v.n[2].is_multiple_of(2) {
+        pb::plan_request::Goal::GoalJoints(pb::JointState {
+            positions: (0..6)
+                .map(|i| if i == 0 { h.at(21, free[0]) } else { free[i] })
+                .collect(),
+        })
+    } else {
+        let q = [h.at(22, 0.0), 1.0, 0.0, 0.0];
+        pb::plan_request::Goal::GoalPose(pose([0.4, 0.1, h.at(23, 0.4), q[0], q[1], q[2], q[3]]).unwrap())
+    };
+    let plan = pb::PlanRequest {
+        robot: named("ur5"),
+        start: free.iter().map(|q| -q).collect(),
+        goal: Some(goal),
+        scene: Some(pb::Scene {
+            objects: scene(&h, swap).objects[2..].to_vec(),
+        }),
+        algorithm: (v.n[4] % 4) as i32,
+        options: Some(options),
+        seed: v.n[5] as u64,
+    };
+    let bad = h.any_absurd(0..10) || h.any_absurd(17..24);
+    let t = Instant::now();
+    judge_refused("Plan", t, bad, planning.plan(plan.clone()).await)?;
+    let t = Instant::now();
+    let answer = match planning.plan_stream(plan).await {
+        Ok(frames) => drain(frames.into_inner()).await,
+        Err(e) => Err(e),
+    };
+    judge_refused("PlanStream", t, bad, answer)?;
+
+    // the octree RPCs: one hostile resolution, point, pose, box or camera value
+    let octree = Some(pb::Octree {
+        id: if v.n[6].is_multiple_of(5) {
+            "ColorOcTree"
+        } else {
+            "OcTree"
+        }
+        .into(),
+        resolution: h.at(0, 0.1),
+        binary: true,
+        data: if v.n[0].is_multiple_of(3) {
+            Vec::new()
+        } else {
+            vec![0x66, 0x66]
+        },
+    });
+    let bad_tree = h.absurd_at(0);
+    let bbox = Some(pb::BoundingBox {
+        min: vec3([h.at(1, -1.0), h.at(2, -1.0), h.at(3, -1.0)]),
+        max: vec3([h.at(4, 1.0), h.at(5, 1.0), h.at(6, 1.0)]),
+    });
+    let t = Instant::now();
+    let info = pb::OctreeInfoRequest {
+        octree: octree.clone(),
+        r#box: if v.n[1].is_multiple_of(2) { bbox } else { None },
+    };
+    let bad = bad_tree || (v.n[1].is_multiple_of(2) && h.any_absurd(1..7));
+    judge_refused("OctreeInfo", t, bad, exploration.octree_info(info).await)?;
+    let t = Instant::now();
+    let scan = pb::InsertScanRequest {
+        octree: if v.n[2].is_multiple_of(2) {
+            octree.clone()
+        } else {
+            None
+        },
+        resolution: h.at(7, 0.1),
+        sensor_pose: pose([h.at(8, 0.0), h.at(9, 0.0), h.at(10, 0.0), 1.0, 0.0, 0.0, 0.0]),
+        scan: Some(pb::insert_scan_request::Scan::Points(pb::PointCloud {
+            xyz: (11..17).map(|i| h.at(i, 1.0 + i as f64 / 10.0) as f32).collect(),
+        })),
+        max_range: Some(h.at(17, -1.0)),
+        discretize: v.n[4].is_multiple_of(2),
+        full: false,
+    };
+    let bad = h.any_absurd(8..11) || h.absurd_at(17) || (v.n[2].is_multiple_of(2) && bad_tree);
+    judge_refused("InsertScan", t, bad, exploration.insert_scan(scan).await)?;
+    let t = Instant::now();
+    let nbv = pb::NextBestViewRequest {
+        octree: octree.clone(),
+        camera: Some(pb::CameraModel {
+            horizontal_fov: Some(h.at(18, 1.2)),
+            width: Some(v.n[5] % 100),
+            height: Some(v.n[6] % 100),
+            ..Default::default()
+        }),
+        camera_pose: pose([h.at(19, 0.0), h.at(20, 0.0), h.at(21, 1.0), 1.0, 0.0, 0.0, 0.0]),
+        robot: if v.n[3].is_multiple_of(2) {
+            named("ur5")
+        } else {
+            None
+        },
+        options: Some(pb::NbvOptions {
+            region: bbox,
+            ..Default::default()
+        }),
+        ..Default::default()
+    };
+    let bad = bad_tree || h.any_absurd(1..7) || h.any_absurd(18..22);
+    judge_refused("NextBestView", t, bad, exploration.next_best_view(nbv).await)?;
+    let t = Instant::now();
+    let explore = pb::ExploreRequest {
+        robot: named("ur5"),
+        start: free.to_vec(),
+        scene: Some(pb::Scene {
+            objects: scene(&h, swap).objects[2..].to_vec(),
+        }),
+        region: bbox,
+        resolution: Some(h.at(22, 0.1)),
+        stop: Some(pb::ExploreStopRule {
+            max_iterations: Some(v.n[0] % 3),
+            ..Default::default()
+        }),
+        plan_time_budget: Some(h.at(23, 0.05)),
+        ..Default::default()
+    };
+    let bad = h.any_absurd(0..7) || h.any_absurd(22..24);
+    let answer = match exploration.explore(explore).await {
+        Ok(steps) => drain(steps.into_inner()).await,
+        Err(e) => Err(e),
+    };
+    judge_refused("Explore", t, bad, answer)
+}
+
+/// Reads a reply stream to its end: the first error, or OK.
+async fn drain<T>(mut stream: tonic::Streaming<T>) -> Result<(), tonic::Status> {
+    while stream.message().await?.is_some() {}
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+
+    /// The planning and exploration RPCs answer hostile values with a
+    /// considered status, in time, and never OK for an absurd physical value.
+    #[test]
+    fn hostile_values_at_every_planning_and_exploration_rpc(v in values()) {
+        shared().runtime.block_on(planning_and_exploration(v))?;
+    }
 }
 
 proptest! {
