@@ -52,8 +52,14 @@ impl CameraModel {
         if !(self.far.is_finite() && self.far > self.near) {
             return bad("far", self.far, "must be finite and > near");
         }
-        if self.width == 0 || self.height == 0 || self.width.saturating_mul(self.height) > 1 << 24 {
-            return bad("width", self.width as f64, "width · height must be in [1, 2^24]");
+        if self.width == 0 {
+            return bad("width", 0.0, "must be at least 1");
+        }
+        if self.height == 0 {
+            return bad("height", 0.0, "must be at least 1");
+        }
+        if self.width.saturating_mul(self.height) > 1 << 24 {
+            return bad("width", self.width as f64, "width · height must be at most 2^24");
         }
         Ok(())
     }
@@ -148,6 +154,22 @@ pub fn look_along(position: &Point3<f64>, dir: &Vector3<f64>) -> Option<Isometry
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Regression: a zero height was reported as the width.
+    #[test]
+    fn a_zero_size_names_its_own_field() {
+        for (width, height, field) in [(0, 424, "width"), (512, 0, "height"), (1 << 13, 1 << 12, "width")] {
+            let cam = CameraModel {
+                width,
+                height,
+                ..CameraModel::default()
+            };
+            match cam.validate() {
+                Err(NbvError::InvalidParam { field: f, .. }) => assert_eq!(f, field, "{width} x {height}"),
+                other => panic!("{width} x {height}: {other:?}"),
+            }
+        }
+    }
 
     #[test]
     fn frustum_planes_and_corners_agree() {

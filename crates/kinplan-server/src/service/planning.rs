@@ -239,16 +239,9 @@ impl PlanningService for PlanningApi {
             .run(&budget, move |b| -> Result<Vec<pb::StateCheck>, Status> {
                 let world = Arc::new(SceneGeometry::build(&scene).map_err(|e| collision_error("scene", e))?);
                 let checker = checker_for(&setup, world, CheckerParams::default())?;
-                let mut out = Vec::with_capacity(req.states.len());
-                for (i, s) in req.states.iter().enumerate() {
-                    if i % 64 == 0 && b.should_stop() {
-                        return Err(Status::deadline_exceeded(
-                            "the deadline passed while checking states",
-                        ));
-                    }
-                    out.push(check_one(&checker, &s.positions, max_distance)?);
-                }
-                Ok(out)
+                each_state(&req.states, &|| b.should_stop(), |q| {
+                    check_one(&checker, q, max_distance)
+                })
             })
             .await??;
         Ok(Response::new(pb::CheckStateResponse { states }))
@@ -256,6 +249,38 @@ impl PlanningService for PlanningApi {
 }
 
 /// Validity, clearance and witness points of one state.
+/// Answers every state with `check`, looking at the deadline every 64 states.
+/// A fault confined to one state (a panic in the geometry code) becomes that
+/// state's answer — `valid: false` with `error` set, logged — instead of failing
+/// the whole batch.
+fn each_state(
+    states: &[pb::JointState],
+    should_stop: &dyn Fn() -> bool,
+    check: impl Fn(&[f64]) -> Result<pb::StateCheck, Status>,
+) -> Result<Vec<pb::StateCheck>, Status> {
+    let mut out = Vec::with_capacity(states.len());
+    for (i, s) in states.iter().enumerate() {
+        if i % 64 == 0 && should_stop() {
+            return Err(Status::deadline_exceeded(
+                "the deadline passed while checking states",
+            ));
+        }
+        match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| check(&s.positions))) {
+            Ok(answer) => out.push(answer?),
+            Err(_) => {
+                tracing::error!(state = i, "checking one state panicked; answered as not valid");
+                out.push(pb::StateCheck {
+                    valid: false,
+                    error: "this state could not be checked (a server fault, logged); treat it as not valid"
+                        .into(),
+                    ..Default::default()
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
 fn check_one(checker: &SceneChecker, q: &[f64], max_distance: f64) -> Result<pb::StateCheck, Status> {
     let report = checker.report(q).map_err(collision_internal)?;
     let nearest = checker.proximity(q, max_distance).map_err(collision_internal)?;
@@ -276,5 +301,32 @@ fn check_one(checker: &SceneChecker, q: &[f64], max_distance: f64) -> Result<pb:
         robot_point,
         obstacle_point,
         closest_pair,
+        error: String::new(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fault_in_one_state_is_that_states_answer() {
+        let states: Vec<pb::JointState> = (0..3)
+            .map(|i| pb::JointState {
+                positions: vec![i as f64],
+            })
+            .collect();
+        let answers = each_state(&states, &|| false, |q| {
+            assert!(q[0] != 1.0, "a geometry fault on state 1");
+            Ok(pb::StateCheck {
+                valid: true,
+                ..Default::default()
+            })
+        })
+        .unwrap();
+        let valid: Vec<bool> = answers.iter().map(|a| a.valid).collect();
+        assert_eq!(valid, [true, false, true]);
+        assert!(answers[1].error.contains("could not be checked"));
+        assert!(answers[0].error.is_empty() && answers[2].error.is_empty());
+    }
 }
