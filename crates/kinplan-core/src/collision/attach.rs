@@ -1,7 +1,10 @@
-//! Bodies hanging off a chain: the links of a URDF tree that are not on the
-//! base → tip path but are carried by it through fixed joints, or through
-//! moving joints held at a locked value (a gripper's fingers during arm
-//! motion). Each becomes an [`AttachedBody`] of its nearest chain link.
+//! Bodies hanging off a chain: every link of a URDF tree that is not on the
+//! base → tip path — a tool or gripper beyond the tip, a camera bracket on a
+//! wrist, a pedestal above the base, another branch of the tree — carried by
+//! the chain through fixed joints, or through moving joints held at a locked
+//! value (a gripper's fingers during arm motion). Each becomes an
+//! [`AttachedBody`] of its nearest chain link, so the whole robot collides,
+//! not only the chain from base to tip.
 
 use std::collections::{HashMap, HashSet};
 
@@ -15,11 +18,14 @@ use crate::robot::{Chain, CollisionShape, Shape};
 const MAX_URDF_BYTES: usize = 4 << 20;
 
 /// The attached bodies of `chain` in the URDF `urdf` (the text the chain
-/// was parsed from). Off-chain moving joints take their value from
-/// `locked` (by joint name, rad or m), used as given even outside the
+/// was parsed from): the tree is walked from the chain's links through every
+/// joint not on the chain, down to children and up to parents (links above
+/// the base ride on the base link). Off-chain moving joints take their value
+/// from `locked` (by joint name, rad or m), used as given even outside the
 /// joint's limits (a recorded state is reproduced as it was), else 0
-/// clamped into the limits. Joint transform: `origin · motion(value)`, composed from
-/// the chain link down to the body.
+/// clamped into the limits. Joint transform: `J = origin · motion(value)`,
+/// composed from the chain link down to a child (`T · J`) or up to a parent
+/// (`T · J⁻¹`).
 pub fn attached_bodies(
     urdf: &str,
     chain: &Chain,
@@ -53,9 +59,18 @@ pub fn attached_bodies(
         .collect();
     let mut out = Vec::new();
     let mut seen: HashSet<String> = HashSet::new();
-    while let Some((parent, root, offset)) = frontier.pop() {
-        for joint in robot.joints.iter().filter(|j| j.parent.link == parent) {
-            let child = joint.child.link.as_str();
+    while let Some((from, root, offset)) = frontier.pop() {
+        // joints to a child of `from`, and the joint from its parent
+        let steps = robot.joints.iter().filter_map(|j| {
+            if j.parent.link == from {
+                Some((j, j.child.link.as_str(), false))
+            } else if j.child.link == from {
+                Some((j, j.parent.link.as_str(), true))
+            } else {
+                None
+            }
+        });
+        for (joint, child, upward) in steps {
             if on_chain.contains(child) || !seen.insert(child.to_string()) {
                 continue;
             }
@@ -98,9 +113,14 @@ pub fn attached_bodies(
                     });
                 }
             };
-            let pose_in_root = offset * origin * motion;
+            let pose_in_root = if upward {
+                offset * (origin * motion).inverse()
+            } else {
+                offset * origin * motion
+            };
+            let end = if upward { "parent" } else { "child" };
             let link = links.get(child).ok_or_else(|| CollisionError::UnknownName {
-                field: format!("{field}.child"),
+                field: format!("{field}.{end}"),
                 name: child.to_string(),
             })?;
             let shapes = link_shapes(link)?;

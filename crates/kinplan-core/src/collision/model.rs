@@ -135,6 +135,22 @@ impl RobotModel {
         Self::with_parts(chain, &[], &[])
     }
 
+    /// The whole robot of the URDF `urdf` that `chain` was parsed from: the
+    /// chain's bodies and every other link the chain carries
+    /// ([`attached_bodies`](super::attached_bodies): a gripper beyond the tip,
+    /// a pedestal above the base, other branches held at `locked` joint values
+    /// or 0 clamped into their limits), with the geometry of mesh files from
+    /// `meshes`.
+    pub fn of_urdf(
+        chain: Arc<Chain>,
+        urdf: &str,
+        locked: &[(&str, f64)],
+        meshes: &[InlineMesh],
+    ) -> Result<Self, CollisionError> {
+        let attached = super::attach::attached_bodies(urdf, &chain, locked)?;
+        Self::with_parts(chain, &attached, meshes)
+    }
+
     /// The collision model of `chain`, plus `attached` bodies and the
     /// geometry of mesh files named by links (`meshes`, matched by filename).
     pub fn with_parts(

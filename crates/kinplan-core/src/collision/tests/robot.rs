@@ -7,7 +7,7 @@ use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
 use super::super::*;
 use super::{box_mesh, checker, probe_urdf};
-use crate::robot::builtin_chain;
+use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
 fn panda_checker(acm: impl Fn(&RobotModel) -> AllowedCollisions) -> SceneChecker {
     let model = Arc::new(RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap());
@@ -430,4 +430,110 @@ fn a_state_penetrating_a_mesh_and_a_sphere_has_a_clearance_in_either_order() {
         (depths[0] - depths[1]).abs() < 1e-9,
         "order changed the depth: {depths:?}"
     );
+}
+
+/// A two-joint arm `base → upper → lower` (tip `lower`) whose URDF also holds
+/// a pedestal above the base (a fixed joint whose child is the base), a
+/// gripper fixed beyond the tip, and a finger on a prismatic joint of the
+/// gripper. Boxes: pedestal 0.4 m cube centred 0.3 m below the base origin;
+/// upper arm 0.5 m up z; lower arm 0.5 m up z again; gripper a 0.1 m cube
+/// centred 0.15 m beyond the lower arm's end; finger 0.02 m cube 0.1 m
+/// further, opened along x by its joint.
+fn arm_with_pedestal_and_gripper() -> String {
+    let boxed = |name: &str, size: &str, xyz: &str| {
+        format!(
+            r#"<link name="{name}"><collision><origin xyz="{xyz}"/><geometry><box size="{size}"/></geometry></collision></link>"#
+        )
+    };
+    format!(
+        r#"<robot name="arm">
+        <link name="world"/>
+        {pedestal}
+        <link name="base"/>
+        {upper}{lower}{gripper}{finger}
+        <joint name="world_pedestal" type="fixed"><parent link="world"/><child link="pedestal"/></joint>
+        <joint name="pedestal_base" type="fixed"><parent link="pedestal"/><child link="base"/><origin xyz="0 0 0.5"/></joint>
+        <joint name="j1" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+          <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+        <joint name="j2" type="revolute"><parent link="upper"/><child link="lower"/><origin xyz="0 0 0.5"/><axis xyz="0 1 0"/>
+          <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+        <joint name="flange" type="fixed"><parent link="lower"/><child link="gripper"/><origin xyz="0 0 0.5"/></joint>
+        <joint name="finger_joint" type="prismatic"><parent link="gripper"/><child link="finger"/><origin xyz="0 0 0.25"/>
+          <axis xyz="1 0 0"/><limit lower="0" upper="0.04" effort="1" velocity="1"/></joint>
+        </robot>"#,
+        pedestal = boxed("pedestal", "0.4 0.4 0.4", "0 0 0.2"),
+        upper = boxed("upper", "0.05 0.05 0.5", "0 0 0.25"),
+        lower = boxed("lower", "0.05 0.05 0.5", "0 0 0.25"),
+        gripper = boxed("gripper", "0.1 0.1 0.1", "0 0 0.15"),
+        finger = boxed("finger", "0.02 0.02 0.02", "0 0 0"),
+    )
+}
+
+fn whole_arm_checker(whole: bool, locked: &[(&str, f64)], obstacle: Obstacle) -> SceneChecker {
+    let urdf = arm_with_pedestal_and_gripper();
+    let spec = ChainSpec {
+        base_link: Some("base".into()),
+        tip_link: Some("lower".into()),
+    };
+    let chain = Arc::new(parse_chain(&urdf, &spec, UrdfLimits::default()).unwrap());
+    let model = if whole {
+        RobotModel::of_urdf(chain, &urdf, locked, &[]).unwrap()
+    } else {
+        RobotModel::new(chain).unwrap()
+    };
+    let model = Arc::new(model);
+    let acm = AllowedCollisions::adjacent(&model);
+    let world = Arc::new(
+        SceneGeometry::build(&Scene::new(vec![obstacle], &SceneLimits::default()).unwrap()).unwrap(),
+    );
+    SceneChecker::new(model, &acm, world, CheckerParams::default()).unwrap()
+}
+
+/// Regression: bodies beyond the tip link (a gripper) and above the base (a
+/// pedestal) were left out of the collision model, so states whose gripper
+/// met an obstacle were reported free. Every point placed here is worked out
+/// by hand from the URDF above (chain straight up at q = 0: the arm ends at
+/// z = 1.0 in the base frame, the gripper cube spans z 1.1–1.2, the finger sits at
+/// z = 1.25, the pedestal spans z −0.5 to −0.1).
+#[test]
+fn the_whole_robot_collides_the_gripper_beyond_the_tip_and_the_pedestal() {
+    let ball = |x: f64, y: f64, z: f64, r: f64| {
+        Obstacle::new(
+            "ball",
+            Isometry3::translation(x, y, z),
+            Geometry::Sphere { radius: r },
+        )
+    };
+    let q = [0.0, 0.0];
+    // on the gripper only (its face at x = 0.05; the arm's at x = 0.025)
+    let at_gripper = || ball(0.06, 0.0, 1.15, 0.02);
+    assert!(!whole_arm_checker(true, &[], at_gripper()).is_valid(&q));
+    assert!(
+        whole_arm_checker(false, &[], at_gripper()).is_valid(&q),
+        "chain-only model misses it"
+    );
+    let names: Vec<String> = whole_arm_checker(true, &[], at_gripper())
+        .report(&q)
+        .unwrap()
+        .collisions
+        .iter()
+        .map(|(l, _)| l.clone())
+        .collect();
+    assert_eq!(names, ["gripper"]);
+    // on the pedestal, below the base
+    let at_pedestal = || ball(0.25, 0.0, -0.3, 0.06);
+    assert!(!whole_arm_checker(true, &[], at_pedestal()).is_valid(&q));
+    assert!(whole_arm_checker(false, &[], at_pedestal()).is_valid(&q));
+    // the finger follows its locked joint: at 0.04 m it meets a ball at x = 0.05
+    let at_finger = || ball(0.05, 0.0, 1.25, 0.005);
+    assert!(
+        whole_arm_checker(true, &[], at_finger()).is_valid(&q),
+        "finger at 0: 50 − 10 − 5 mm clear"
+    );
+    assert!(!whole_arm_checker(true, &[("finger_joint", 0.04)], at_finger()).is_valid(&q));
+    // the gripper moves with the chain: turned 90° about y at j2, its cube spans x 0.6–0.7
+    let turned = [0.0, std::f64::consts::FRAC_PI_2];
+    let moved = || ball(0.65, 0.0, 0.5 + 0.06, 0.02);
+    assert!(!whole_arm_checker(true, &[], moved()).is_valid(&turned));
+    assert!(whole_arm_checker(true, &[], at_gripper()).is_valid(&turned));
 }
