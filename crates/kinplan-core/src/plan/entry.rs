@@ -121,7 +121,9 @@ pub struct PlanResult {
     /// acceleration limits of [`TimingParams`].
     pub time_from_start: Vec<f64>,
     pub dof: usize,
-    /// Every state and motion valid per the checker (re-checked here).
+    /// Every state and motion valid per the checker (re-checked here) and,
+    /// for CCSTOMP, every waypoint within the Cartesian tolerances: true
+    /// exactly when the status is `Succeeded`.
     pub valid: bool,
     /// Some waypoint lies beyond t_t or t_r of the straight Cartesian line.
     pub violates_tolerance: bool,
@@ -384,6 +386,9 @@ pub fn plan<C: StateChecker + ?Sized>(
         result.criteria = score(&input, &ScoreParams::default()).ok().map(|r| r.scores);
     }
     let ok = result.valid && !(req.algorithm == Algorithm::Ccstomp && result.violates_tolerance);
+    // `valid` is what a client may execute: for CCSTOMP a collision-free
+    // trajectory outside its tolerances is not (`violates_tolerance` says why).
+    result.valid = ok;
     result.status = match (ok, interrupted) {
         (true, _) => PlanStatus::Succeeded,
         (false, Some(Interrupt::Deadline)) => PlanStatus::Timeout,

@@ -668,3 +668,57 @@ fn a_refused_motion_is_replaced_through_a_nudged_waypoint_proved_free() {
         None
     );
 }
+
+/// Regression: a CCSTOMP trajectory that was collision-free but outside its
+/// tolerances came back as NO_VALID_TRAJECTORY with `valid` true. Over every
+/// status a plan can end with, `valid` holds exactly when it succeeded.
+#[test]
+fn valid_and_the_status_never_contradict_each_other() {
+    let mut seen = Vec::new();
+    let mut record = |r: PlanResult| {
+        assert_eq!(
+            r.valid,
+            r.status == PlanStatus::Succeeded,
+            "{:?} with valid = {}",
+            r.status,
+            r.valid
+        );
+        seen.push(r.status);
+    };
+    // succeeded, and collision-free but outside a 1 µm tube
+    let (chain, w, mut req, _) = ur5_ccstomp_request();
+    req.stomp.initial = InitialTrajectory::CartesianLine;
+    record(plan(&chain, &w, &req, PlanControl::default()).unwrap());
+    req.stomp.initial = InitialTrajectory::StraightLine;
+    req.stomp.max_iterations = 1;
+    req.cartesian.translation_tolerance = 1e-6;
+    req.cartesian.rotation_tolerance = 1e-6;
+    let r = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert!(r.violates_tolerance);
+    record(r);
+    // invalid start and goal, a deadline, a cancellation
+    let planar = planar3();
+    let world = PlanarWorld::planar3_blocked();
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.start = vec![0.0, 0.0, 0.0];
+    record(plan(&planar, &world, &req, PlanControl::default()).unwrap());
+    let mut req = blocked_request(Algorithm::RrtConnect);
+    req.goal = Goal::Joints(vec![0.0, 0.0, 0.0]);
+    record(plan(&planar, &world, &req, PlanControl::default()).unwrap());
+    let mut req = blocked_request(Algorithm::Stomp);
+    req.stomp.initial = InitialTrajectory::StraightLine;
+    let past = PlanControl {
+        deadline: Some(Instant::now()),
+        ..Default::default()
+    };
+    record(plan(&planar, &world, &req, past).unwrap());
+    let stop = || true;
+    let cancelled = PlanControl {
+        should_stop: &stop,
+        ..Default::default()
+    };
+    record(plan(&planar, &world, &req, cancelled).unwrap());
+    seen.sort_by_key(|s| format!("{s:?}"));
+    seen.dedup();
+    assert_eq!(seen.len(), 6, "{seen:?}");
+}
