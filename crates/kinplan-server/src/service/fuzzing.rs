@@ -1,35 +1,50 @@
-//! Entry points for coverage-guided fuzzers (`fuzz/`, cargo-fuzz): arbitrary
-//! bytes decoded as request messages and run through the service's own
-//! conversions to domain values, exactly as a call would be, minus the
-//! transport. Every outcome but a panic, a hang or unbounded memory is
+//! Entry points for coverage-guided fuzzers (`fuzz/`, cargo-fuzz): request
+//! messages (decoded from arbitrary bytes by the fuzz target) run through the
+//! service's own conversions to domain values, exactly as a call would be,
+//! minus the transport. Every outcome but a panic, a hang or unbounded memory is
 //! fine: bad input must come back as a `Status`.
-
-use prost::Message;
 
 use super::pb;
 use super::scene::scene_in;
 use kinplan_core::collision::SceneLimits;
 
-/// Decodes `data` as each request with a pure conversion and converts it.
-pub fn convert_requests(data: &[u8]) {
-    if let Ok(r) = pb::PlanRequest::decode(data) {
-        let _ = super::planning_convert::plan_input(&r);
-        let _ = scene_in("scene", r.scene.as_ref(), &SceneLimits::default());
+/// A `PlanRequest` through the planning and scene conversions.
+pub fn convert_plan(r: &pb::PlanRequest) {
+    let _ = super::planning_convert::plan_input(r);
+    let _ = scene_in("scene", r.scene.as_ref(), &SceneLimits::default());
+}
+
+/// An `ExploreRequest` through the exploration loop's conversion (for a UR5).
+pub fn convert_explore(r: &pb::ExploreRequest) {
+    if let Ok(chain) = kinplan_core::robot::builtin_chain("ur5") {
+        let _ = super::explore_convert::explore_params_in(r, &chain);
     }
-    if let Ok(r) = pb::ExploreRequest::decode(data)
-        && let Ok(chain) = kinplan_core::robot::builtin_chain("ur5")
-    {
-        let _ = super::explore_convert::explore_params_in(&r, &chain);
-    }
-    if let Ok(r) = pb::NextBestViewRequest::decode(data) {
-        let _ = super::exploration_convert::nbv_params_in(&r);
-        let _ = super::exploration_convert::camera_in(r.camera.as_ref());
-    }
+}
+
+/// A `NextBestViewRequest` through the next-best-view and camera conversions.
+pub fn convert_nbv(r: &pb::NextBestViewRequest) {
+    let _ = super::exploration_convert::nbv_params_in(r);
+    let _ = super::exploration_convert::camera_in(r.camera.as_ref());
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use prost::Message;
+
+    /// Decodes `data` as each request with a pure conversion and converts
+    /// it, as the `requests` fuzz target does.
+    fn convert_requests(data: &[u8]) {
+        if let Ok(r) = pb::PlanRequest::decode(data) {
+            convert_plan(&r);
+        }
+        if let Ok(r) = pb::ExploreRequest::decode(data) {
+            convert_explore(&r);
+        }
+        if let Ok(r) = pb::NextBestViewRequest::decode(data) {
+            convert_nbv(&r);
+        }
+    }
 
     #[test]
     fn hostile_bytes_and_real_requests_convert_without_panicking() {

@@ -2,7 +2,8 @@
 //! proto messages into domain values, runs the work and maps errors to
 //! `tonic::Status`. Only this layer (and `main.rs`) knows about tonic.
 
-pub mod pb;
+/// The generated contract (the `kinplan-proto` crate).
+pub use kinplan_proto as pb;
 
 mod auth;
 mod collision_models;
