@@ -5,7 +5,7 @@
 
 use kinplan_proto::prost::Message;
 use kinplan_proto::{ExploreRequest, NextBestViewRequest, PlanRequest};
-use kinplan_server::service::fuzzing;
+use kinplan_server::api::fuzzing;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -4,8 +4,8 @@
 
 use std::time::{Duration, Instant};
 
-use kinplan_server::service::ServerConfig;
-use kinplan_server::service::pb::{
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{
     self, kinematics_service_client::KinematicsServiceClient, robot_service_client::RobotServiceClient,
 };
 use tonic::Code;
@@ -173,7 +173,7 @@ async fn huge_grpc_timeout_means_no_deadline() {
     assert!(answer.result.is_some());
 }
 
-use kinplan_server::service::pb::{
+use kinplan_server::pb::{
     mobile_service_client::MobileServiceClient, scoring_service_client::ScoringServiceClient,
 };
 use std::sync::Arc;
@@ -702,7 +702,7 @@ async fn scoring_limits_are_checked_up_front() {
 /// listener closed is refused rather than left hanging.
 #[tokio::test]
 async fn a_drain_finishes_200_calls_in_flight_and_refuses_new_ones() {
-    use kinplan_server::service::pb::kinematics_service_client::KinematicsServiceClient;
+    use kinplan_server::pb::kinematics_service_client::KinematicsServiceClient;
     let mut server = crate::start(ServerConfig {
         drain_delay: Duration::from_millis(150),
         drain_timeout: Duration::from_secs(20),

@@ -1,8 +1,8 @@
 //! `kinplan loadtest` against a real server: every call is counted once, with
 //! its status, and the report adds up.
 
+use kinplan_server::ServerConfig;
 use kinplan_server::loadtest::{LoadtestArgs, Rpc, run_loadtest};
-use kinplan_server::service::ServerConfig;
 
 use crate::start;
 

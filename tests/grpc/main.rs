@@ -13,8 +13,8 @@ mod robot;
 mod scoring;
 mod security;
 
-use kinplan_server::service::pb::{self, robot_ref::Source};
-use kinplan_server::service::{ServerConfig, serve};
+use kinplan_server::pb::{self, robot_ref::Source};
+use kinplan_server::{ServerConfig, serve};
 use tonic::transport::Channel;
 
 pub struct TestServer {

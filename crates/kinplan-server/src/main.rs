@@ -9,7 +9,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use kinplan_server::loadtest::{
     HealthArgs, LoadtestArgs, MIN_WORKER_INTERVAL, check_health, run_loadtest, workers_for_rate,
 };
-use kinplan_server::service::{ServerConfig, TlsPem, Tokens, serve};
+use kinplan_server::{ServerConfig, TlsPem, Tokens, serve};
 
 /// mimalloc instead of the C library's allocator, for `serve` and `loadtest`
 /// alike: a call allocates and frees a few dozen small buffers (HTTP/2 frames,
@@ -260,7 +260,7 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
                 .with_http_listener(addr)
                 .set_buckets_for_metric(
                     metrics_exporter_prometheus::Matcher::Full("grpc_server_handling_seconds".into()),
-                    kinplan_server::service::HANDLING_BUCKETS,
+                    kinplan_server::HANDLING_BUCKETS,
                 )?
                 .install()?;
             tracing::info!(%addr, "metrics on http://{addr}/metrics");

@@ -14,10 +14,10 @@ use tonic::transport::{Channel, Endpoint};
 
 use super::report::{LatencyReport, Report};
 use super::workload::{Rpc, Workload, build_pool};
-use crate::service::code_name;
-use crate::service::pb::kinematics_service_client::KinematicsServiceClient;
-use crate::service::pb::robot_service_client::RobotServiceClient;
-use crate::service::pb::scoring_service_client::ScoringServiceClient;
+use crate::code_name;
+use crate::pb::kinematics_service_client::KinematicsServiceClient;
+use crate::pb::robot_service_client::RobotServiceClient;
+use crate::pb::scoring_service_client::ScoringServiceClient;
 
 /// Options of `kinplan loadtest`.
 #[derive(clap::Args, Debug, Clone)]

@@ -1,0 +1,411 @@
+//! `KinematicsService`: inverse kinematics ([`kinplan_core::ik`]) and the linear
+//! solvers behind it ([`kinplan_core::linalg`]), ALGORITHMS.md §1–2.
+//!
+//! Thin adapter: admit → resolve the robot → proto options, targets and
+//! matrices into domain values → solve on the CPU pool, with the request's
+//! deadline (less a reply reserve) as the IK time budget and
+//! [`Budget::should_stop`] as the cancellation check → reply. [`IkError`]s
+//! become INVALID_ARGUMENT naming the request field. Not converging is a
+//! status in the reply, never an error.
+
+use std::pin::Pin;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use nalgebra::{DVector, Isometry3, Point3};
+use rand::SeedableRng;
+use tokio_stream::Stream;
+use tokio_stream::wrappers::ReceiverStream;
+use tonic::{Request, Response, Status, Streaming};
+
+use crate::api::convert::{finite_slice, matrix_in, pose_in, pose_out, vec3_in};
+use crate::pb::{self, kinematics_service_server::KinematicsService};
+use crate::runtime::Shared;
+use crate::runtime::deadline::{deadline_after, grpc_timeout, soft_deadline, time_budget};
+use crate::runtime::{Budget, Compute, ModelStore, catch_unwind};
+use crate::status::ik::{IkAt, PathAt, ik_error};
+use crate::status::linalg::{SolveAt, linalg_error};
+use crate::status::{invalid, robot_error, too_large};
+use kinplan_core::ik::{
+    BatchSeeds, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
+    JointLimitMode, TrackParams, TrackResult, circle_path, line_path, solve_ik, solve_ik_batch, track_path,
+};
+use kinplan_core::linalg::{
+    LinearSolution, LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus,
+    solve_angle_relaxation_until, solve_pseudoinverse,
+};
+use kinplan_core::robot::Chain;
+
+mod convert;
+mod path;
+mod stream;
+#[cfg(test)]
+mod tests;
+
+use convert::*;
+use path::*;
+use stream::*;
+
+/// Most targets in one `SolveIkBatch`.
+pub const MAX_BATCH_TARGETS: usize = 10_000;
+/// Most poses of a `TrackPath` (explicit poses, or line/circle steps): the reply
+/// then stays under ~9 MB for a 7-joint arm (the default message limit is 16 MB).
+pub const MAX_PATH_POSES: usize = 50_000;
+/// Most solutions one target may ask for.
+pub const MAX_SOLUTIONS: u32 = 1_000;
+/// Most solutions a whole batch may ask for (targets × num_solutions).
+pub const MAX_BATCH_SOLUTIONS: usize = 100_000;
+/// Most entries of a `SolveLinearSystem` matrix.
+pub const MAX_MATRIX_ENTRIES: usize = 10_000;
+/// Most RLXA work (iteration cap × m × n) of one `SolveLinearSystem`; the
+/// solve also stops at the deadline (checked every 1024 iterations).
+pub const MAX_RLXA_WORK: u64 = 1_000_000_000;
+/// Most iterations of a `SolveLinearSystem` that records its residual history
+/// (8 bytes each in the reply, so at most 8 MB): bounded up front.
+pub const MAX_LINEAR_HISTORY: usize = 1_000_000;
+/// Largest magnitude of a matrix or right-hand-side entry: norms of up to
+/// `MAX_MATRIX_ENTRIES` squared entries stay finite.
+pub const MAX_LINEAR_ENTRY: f64 = 1e100;
+/// Most RLXA iterations inside one IK iteration (`options.rlxa_max_iterations`):
+/// the IK loop checks its deadline between iterations.
+pub const MAX_IK_RLXA_ITERATIONS: u32 = 100_000;
+/// Default random restarts of `SolveIk` and `SolveIkBatch`: the domain's
+/// (`IkParams::default().max_restarts`).
+const RESTARTS_SOLVE: Option<usize> = None;
+/// Default random restarts of `TrackPath` and `StreamIk`: none, to stay on the
+/// seed's branch.
+const RESTARTS_WARM: Option<usize> = Some(0);
+
+pub struct KinematicsApi {
+    shared: Shared,
+}
+
+impl KinematicsApi {
+    pub fn new(shared: Shared) -> Self {
+        Self { shared }
+    }
+}
+
+type ResponseStream = Pin<Box<dyn Stream<Item = Result<pb::StreamIkResponse, Status>> + Send>>;
+
+#[tonic::async_trait]
+impl KinematicsService for KinematicsApi {
+    async fn solve_ik(
+        &self,
+        request: Request<pb::SolveIkRequest>,
+    ) -> Result<Response<pb::SolveIkResponse>, Status> {
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
+        let req = request.into_inner();
+        let mut options = Options::from_proto(req.options.as_ref(), RESTARTS_SOLVE)?;
+        options.params.time_budget = time_budget(options.time_budget, soft_deadline(budget.deadline()));
+        let target = target_in("target", req.target.as_ref(), options.position_only)?;
+        let seed = (!req.seed.is_empty()).then_some(req.seed);
+        let chain = robot.chain.clone();
+        let result = self
+            .shared
+            .compute
+            .run(&budget, move |b| {
+                solve_ik(
+                    &chain,
+                    &target,
+                    seed.as_deref(),
+                    &options.params,
+                    options.rng_seed,
+                    &|| b.should_stop(),
+                )
+            })
+            .await?
+            .map_err(|e| ik_error(e, IkAt::Target))?;
+        let mut reply = result_out(result);
+        reply.model_id = robot.model_id;
+        Ok(Response::new(reply))
+    }
+
+    async fn solve_ik_batch(
+        &self,
+        request: Request<pb::SolveIkBatchRequest>,
+    ) -> Result<Response<pb::SolveIkBatchResponse>, Status> {
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
+        let req = request.into_inner();
+        if req.targets.is_empty() {
+            return Err(invalid("targets", "at least one target is required"));
+        }
+        if req.targets.len() > MAX_BATCH_TARGETS {
+            return Err(invalid(
+                "targets",
+                format!(
+                    "{} targets exceed the limit of {MAX_BATCH_TARGETS}",
+                    req.targets.len()
+                ),
+            ));
+        }
+        let mut options = Options::from_proto(req.options.as_ref(), RESTARTS_SOLVE)?;
+        if req.targets.len() * options.params.num_solutions > MAX_BATCH_SOLUTIONS {
+            return Err(invalid(
+                "options.num_solutions",
+                format!(
+                    "{} targets x {} solutions exceed the limit of {MAX_BATCH_SOLUTIONS} per batch",
+                    req.targets.len(),
+                    options.params.num_solutions
+                ),
+            ));
+        }
+        // the explicit budget is per target; the deadline bounds the batch (below)
+        options.params.time_budget = time_budget(options.time_budget, None);
+        let targets = req
+            .targets
+            .iter()
+            .enumerate()
+            .map(|(i, t)| target_in(&format!("targets[{i}]"), Some(t), options.position_only))
+            .collect::<Result<Vec<_>, _>>()?;
+        let dof = robot.chain.dof();
+        let per_target = match &req.seeds {
+            Some(m) => {
+                if m.rows as usize != req.targets.len() || m.cols as usize != dof {
+                    return Err(invalid(
+                        "seeds",
+                        format!(
+                            "is {}x{}, needs one row per target and one column per joint ({}x{dof})",
+                            m.rows,
+                            m.cols,
+                            req.targets.len()
+                        ),
+                    ));
+                }
+                if m.data.len() != req.targets.len() * dof {
+                    return Err(invalid(
+                        "seeds.data",
+                        format!("has {} values, needs {}", m.data.len(), req.targets.len() * dof),
+                    ));
+                }
+                for (i, row) in m.data.chunks_exact(dof).enumerate() {
+                    robot
+                        .chain
+                        .check_joints(row)
+                        .map_err(|e| robot_error(e, &format!("seeds[{i}]")))?;
+                }
+                Some(m.data.clone())
+            }
+            None => None,
+        };
+        let seed = (!req.seed.is_empty()).then_some(req.seed);
+        let chain = robot.chain.clone();
+        let soft = soft_deadline(budget.deadline());
+        let reply = self
+            .shared
+            .compute
+            .run(&budget, move |b| {
+                let start = Instant::now();
+                let stop = || b.should_stop() || soft.is_some_and(|d| Instant::now() >= d);
+                let seeds = match &per_target {
+                    Some(all) => BatchSeeds::PerTarget(all),
+                    None => BatchSeeds::shared(seed.as_deref()),
+                };
+                let results =
+                    solve_ik_batch(&chain, &targets, seeds, &options.params, options.rng_seed, &stop);
+                // a cancellation seen while the caller still waits is the deadline
+                let late = soft.is_some_and(|d| Instant::now() >= d);
+                let results = results
+                    .into_iter()
+                    .enumerate()
+                    .map(|(i, r)| {
+                        let mut r = r.map_err(|e| ik_error(e, IkAt::Batch(i)))?;
+                        if late {
+                            relabel_cancelled(&mut r);
+                        }
+                        Ok(result_out(r))
+                    })
+                    .collect::<Result<Vec<_>, Status>>()?;
+                Ok::<_, Status>(pb::SolveIkBatchResponse {
+                    succeeded: results.iter().filter(|r| r.success).count() as u32,
+                    results,
+                    elapsed_us: micros(start.elapsed()),
+                    model_id: Vec::new(),
+                })
+            })
+            .await??;
+        Ok(Response::new(pb::SolveIkBatchResponse {
+            model_id: robot.model_id,
+            ..reply
+        }))
+    }
+
+    async fn track_path(
+        &self,
+        request: Request<pb::TrackPathRequest>,
+    ) -> Result<Response<pb::TrackPathResponse>, Status> {
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
+        let req = request.into_inner();
+        let mut options = Options::from_proto(req.options.as_ref(), RESTARTS_WARM)?;
+        options.params.time_budget = time_budget(options.time_budget, soft_deadline(budget.deadline()));
+        let chain = robot.chain.clone();
+        let seed = if req.seed.is_empty() {
+            chain.mid_limits()
+        } else {
+            chain
+                .check_joints(&req.seed)
+                .map_err(|e| robot_error(e, "seed"))?;
+            req.seed
+        };
+        let (poses, path_field) = path_in(&req.poses, req.line.as_ref(), req.circle.as_ref(), &chain, &seed)?;
+        let targets: Vec<IkTarget> = poses
+            .iter()
+            .map(|p| target_of(p, options.position_only))
+            .collect();
+        let params = TrackParams {
+            ik: options.params,
+            stop_on_failure: req.stop_on_failure,
+        };
+        let result = self
+            .shared
+            .compute
+            .run(&budget, move |b| {
+                track_path(&chain, &targets, &seed, &params, options.rng_seed, &|| {
+                    b.should_stop()
+                })
+            })
+            .await?
+            .map_err(|e| ik_error(e, IkAt::Path(path_field)))?;
+        Ok(Response::new(track_out(result, &poses, robot.model_id)))
+    }
+
+    type StreamIkStream = ResponseStream;
+
+    async fn stream_ik(
+        &self,
+        request: Request<Streaming<pb::StreamIkRequest>>,
+    ) -> Result<Response<Self::StreamIkStream>, Status> {
+        // An open stream holds a stream slot, not an admission permit: each
+        // message's work is admitted on its own (idle streams block no one).
+        let permit = self.shared.compute.admit_stream()?;
+        // A controller's stream lives as long as the controller runs: only a
+        // deadline the client sets bounds it, not the server's default.
+        let deadline = grpc_timeout(request.metadata().as_ref()).and_then(deadline_after);
+        let inbound = request.into_inner();
+        let (tx, rx) = tokio::sync::mpsc::channel(4);
+        let models = self.shared.models.clone();
+        let compute = self.shared.compute.clone();
+        tokio::spawn(async move {
+            let _permit = permit;
+            let looped = catch_unwind(stream_loop(inbound, &tx, &models, &compute, deadline)).await;
+            let outcome = looped.unwrap_or_else(|_panic| {
+                tracing::error!("a StreamIk stream panicked; answering INTERNAL");
+                Err(Status::internal(
+                    "the server failed unexpectedly while handling this stream",
+                ))
+            });
+            if let Err(status) = outcome {
+                let _ = tx.send(Err(status)).await;
+            }
+        });
+        Ok(Response::new(Box::pin(ReceiverStream::new(rx))))
+    }
+
+    async fn solve_linear_system(
+        &self,
+        request: Request<pb::SolveLinearSystemRequest>,
+    ) -> Result<Response<pb::SolveLinearSystemResponse>, Status> {
+        let (_permit, budget) = self.shared.compute.admit(&request)?;
+        let req = request.into_inner();
+        let a = matrix_in("a", req.a.as_ref(), MAX_MATRIX_ENTRIES)?;
+        if req.b.len() != a.nrows() {
+            return Err(invalid(
+                "b",
+                format!("has {} entries, a has {} rows", req.b.len(), a.nrows()),
+            ));
+        }
+        finite_slice("b", &req.b)?;
+        if let Some(i) = a.iter().position(|v| v.abs() > MAX_LINEAR_ENTRY) {
+            return Err(invalid(
+                format!("a.data[{i}]"),
+                format!("magnitude above the limit of {MAX_LINEAR_ENTRY:e}"),
+            ));
+        }
+        if let Some(i) = req.b.iter().position(|v| v.abs() > MAX_LINEAR_ENTRY) {
+            return Err(invalid(
+                format!("b[{i}]"),
+                format!("magnitude above the limit of {MAX_LINEAR_ENTRY:e}"),
+            ));
+        }
+        let b = DVector::from_vec(req.b);
+        let solver = match linear_solver_in("method", req.method)? {
+            None => {
+                let params = PseudoinverseParams {
+                    relative_tolerance: req
+                        .singular_value_tolerance
+                        .unwrap_or(PseudoinverseParams::default().relative_tolerance),
+                };
+                params
+                    .validate()
+                    .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
+                LinearSolve::Svd(params)
+            }
+            Some(variant) => {
+                let d = RlxaParams::default();
+                let params = RlxaParams {
+                    max_iterations: if req.max_iterations == 0 {
+                        d.max_iterations
+                    } else {
+                        req.max_iterations as usize
+                    },
+                    tolerance: req.tolerance.unwrap_or(d.tolerance),
+                    relative_tolerance: req.relative_tolerance.unwrap_or(d.relative_tolerance),
+                    variant,
+                    record_history: req.record_history,
+                    ..d
+                };
+                params
+                    .validate()
+                    .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
+                if params.record_history && params.max_iterations > MAX_LINEAR_HISTORY {
+                    return Err(too_large(
+                        "max_iterations",
+                        format!(
+                            "{} iterations with record_history exceed the history limit of {MAX_LINEAR_HISTORY}",
+                            params.max_iterations
+                        ),
+                    ));
+                }
+                let work = (params.max_iterations as u64).saturating_mul(a.len() as u64);
+                if work > MAX_RLXA_WORK {
+                    return Err(invalid(
+                        "max_iterations",
+                        format!(
+                            "{} iterations on {} entries exceed the work limit of {MAX_RLXA_WORK} \
+                             (iterations x rows x cols)",
+                            params.max_iterations,
+                            a.len()
+                        ),
+                    ));
+                }
+                LinearSolve::Rlxa(params, req.rng_seed)
+            }
+        };
+        let (solution, elapsed) = self
+            .shared
+            .compute
+            .run(&budget, move |budget| {
+                let start = Instant::now();
+                let s = match solver {
+                    LinearSolve::Svd(p) => solve_pseudoinverse(&a, &b, &p),
+                    LinearSolve::Rlxa(p, seed) => {
+                        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+                        solve_angle_relaxation_until(&a, &b, &p, &mut rng, &|| budget.should_stop())
+                    }
+                };
+                s.map(|s| (s, start.elapsed()))
+            })
+            .await?
+            .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
+        Ok(Response::new(linear_out(solution, elapsed)))
+    }
+}
