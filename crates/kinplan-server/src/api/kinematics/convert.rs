@@ -4,6 +4,7 @@
 
 use super::*;
 
+/// The solver of a `SolveLinearSystem`, with its options (and the RLXA seed).
 pub(super) enum LinearSolve {
     Svd(PseudoinverseParams),
     Rlxa(RlxaParams, u64),
@@ -113,6 +114,67 @@ impl Options {
             time_budget,
         })
     }
+}
+
+/// The solver a `SolveLinearSystem` asks for, with its options (unset fields
+/// take the documented defaults), checked against the work limits for a
+/// matrix of `entries` entries.
+pub(super) fn linear_solve_in(
+    req: &pb::SolveLinearSystemRequest,
+    entries: usize,
+) -> Result<LinearSolve, Status> {
+    Ok(match linear_solver_in("method", req.method)? {
+        None => {
+            let params = PseudoinverseParams {
+                relative_tolerance: req
+                    .singular_value_tolerance
+                    .unwrap_or(PseudoinverseParams::default().relative_tolerance),
+            };
+            params
+                .validate()
+                .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
+            LinearSolve::Svd(params)
+        }
+        Some(variant) => {
+            let d = RlxaParams::default();
+            let params = RlxaParams {
+                max_iterations: if req.max_iterations == 0 {
+                    d.max_iterations
+                } else {
+                    req.max_iterations as usize
+                },
+                tolerance: req.tolerance.unwrap_or(d.tolerance),
+                relative_tolerance: req.relative_tolerance.unwrap_or(d.relative_tolerance),
+                variant,
+                record_history: req.record_history,
+                ..d
+            };
+            params
+                .validate()
+                .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
+            if params.record_history && params.max_iterations > MAX_LINEAR_HISTORY {
+                return Err(too_large(
+                    "max_iterations",
+                    format!(
+                        "{} iterations with record_history exceed the history limit of {MAX_LINEAR_HISTORY}",
+                        params.max_iterations
+                    ),
+                ));
+            }
+            let work = (params.max_iterations as u64).saturating_mul(entries as u64);
+            if work > MAX_RLXA_WORK {
+                return Err(invalid(
+                    "max_iterations",
+                    format!(
+                        "{} iterations on {} entries exceed the work limit of {MAX_RLXA_WORK} \
+                         (iterations x rows x cols)",
+                        params.max_iterations, entries
+                    ),
+                ));
+            }
+            LinearSolve::Rlxa(params, req.rng_seed)
+        }
+    })
 }
 
 /// `None` for the SVD pseudoinverse, the RLXA variant otherwise.

@@ -39,8 +39,6 @@ use kinplan_core::robot::Chain;
 mod convert;
 mod path;
 mod stream;
-#[cfg(test)]
-mod tests;
 
 use convert::*;
 use path::*;
@@ -336,60 +334,8 @@ impl KinematicsService for KinematicsApi {
                 format!("magnitude above the limit of {MAX_LINEAR_ENTRY:e}"),
             ));
         }
+        let solver = linear_solve_in(&req, a.len())?;
         let b = DVector::from_vec(req.b);
-        let solver = match linear_solver_in("method", req.method)? {
-            None => {
-                let params = PseudoinverseParams {
-                    relative_tolerance: req
-                        .singular_value_tolerance
-                        .unwrap_or(PseudoinverseParams::default().relative_tolerance),
-                };
-                params
-                    .validate()
-                    .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
-                LinearSolve::Svd(params)
-            }
-            Some(variant) => {
-                let d = RlxaParams::default();
-                let params = RlxaParams {
-                    max_iterations: if req.max_iterations == 0 {
-                        d.max_iterations
-                    } else {
-                        req.max_iterations as usize
-                    },
-                    tolerance: req.tolerance.unwrap_or(d.tolerance),
-                    relative_tolerance: req.relative_tolerance.unwrap_or(d.relative_tolerance),
-                    variant,
-                    record_history: req.record_history,
-                    ..d
-                };
-                params
-                    .validate()
-                    .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
-                if params.record_history && params.max_iterations > MAX_LINEAR_HISTORY {
-                    return Err(too_large(
-                        "max_iterations",
-                        format!(
-                            "{} iterations with record_history exceed the history limit of {MAX_LINEAR_HISTORY}",
-                            params.max_iterations
-                        ),
-                    ));
-                }
-                let work = (params.max_iterations as u64).saturating_mul(a.len() as u64);
-                if work > MAX_RLXA_WORK {
-                    return Err(invalid(
-                        "max_iterations",
-                        format!(
-                            "{} iterations on {} entries exceed the work limit of {MAX_RLXA_WORK} \
-                             (iterations x rows x cols)",
-                            params.max_iterations,
-                            a.len()
-                        ),
-                    ));
-                }
-                LinearSolve::Rlxa(params, req.rng_seed)
-            }
-        };
         let (solution, elapsed) = self
             .shared
             .compute
@@ -407,5 +353,83 @@ impl KinematicsService for KinematicsApi {
             .await?
             .map_err(|e| linalg_error(e, SolveAt::LinearSystem))?;
         Ok(Response::new(linear_out(solution, elapsed)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unset options take the defaults `proto/kinplan/v1/kinematics.proto`
+    /// documents beside each `IkOptions` field, written out here so that a change
+    /// of a default in the domain shows up as a contract change.
+    #[test]
+    fn unset_options_take_the_documented_defaults() {
+        let solve = Options::from_proto(None, RESTARTS_SOLVE).unwrap();
+        let p = solve.params;
+        assert_eq!(p.method, IkMethod::LevenbergMarquardt);
+        assert_eq!(p.linear_solver, LinearSolverKind::SvdPseudoinverse);
+        assert_eq!(p.position_tolerance, 1e-5);
+        assert_eq!(p.orientation_tolerance, 1e-5);
+        assert!(!solve.position_only);
+        assert_eq!(p.max_iterations, 100);
+        assert_eq!(p.damping, 1e-3);
+        assert_eq!(p.max_restarts, 200);
+        assert_eq!(p.num_solutions, 1);
+        assert_eq!(solve.rng_seed, 0);
+        assert_eq!(p.joint_limits, JointLimitMode::Clamp);
+        assert_eq!(solve.time_budget, None);
+        assert!(p.adaptive_damping);
+        assert_eq!(p.max_step, 1.0);
+        assert_eq!(p.distinct_tolerance, 1e-3);
+        assert_eq!(p.rlxa.max_iterations, 300);
+        assert!(!p.record_history);
+        // "0: default": the zero of a plain field means its default too.
+        let zeros = pb::IkOptions {
+            max_iterations: 0,
+            num_solutions: 0,
+            ..Default::default()
+        };
+        let p = Options::from_proto(Some(&zeros), RESTARTS_SOLVE).unwrap().params;
+        assert_eq!((p.max_iterations, p.num_solutions), (100, 1));
+        // TrackPath and StreamIk: no restarts unless asked for.
+        let warm = Options::from_proto(None, RESTARTS_WARM).unwrap().params;
+        assert_eq!(warm.max_restarts, 0);
+        let explicit = pb::IkOptions {
+            max_restarts: Some(7),
+            ..Default::default()
+        };
+        let p = Options::from_proto(Some(&explicit), RESTARTS_WARM)
+            .unwrap()
+            .params;
+        assert_eq!(p.max_restarts, 7);
+    }
+
+    /// Unset `SolveLinearSystemRequest` options take the documented defaults:
+    /// SVD with singular values below 1e-10 of the largest as zero; angle
+    /// relaxation with 20,000 iterations, tolerance 0.01, no relative tolerance,
+    /// seed 0, no history.
+    #[test]
+    fn unset_linear_system_options_take_the_documented_defaults() {
+        let svd = pb::SolveLinearSystemRequest::default();
+        match linear_solve_in(&svd, 4).unwrap() {
+            LinearSolve::Svd(p) => assert_eq!(p.relative_tolerance, 1e-10),
+            LinearSolve::Rlxa(..) => panic!("the default method is the SVD pseudoinverse"),
+        }
+        let rlxa = pb::SolveLinearSystemRequest {
+            method: pb::LinearSolver::AngleRelaxation as i32,
+            ..Default::default()
+        };
+        match linear_solve_in(&rlxa, 4).unwrap() {
+            LinearSolve::Rlxa(p, seed) => {
+                assert_eq!(p.max_iterations, 20_000);
+                assert_eq!(p.tolerance, 0.01);
+                assert_eq!(p.relative_tolerance, 0.0);
+                assert_eq!(p.variant, RlxaVariant::Faithful);
+                assert!(!p.record_history);
+                assert_eq!(seed, 0);
+            }
+            LinearSolve::Svd(_) => panic!("angle relaxation was asked for"),
+        }
     }
 }
