@@ -1,6 +1,6 @@
 //! Collision models per robot chain: the bodies of its URDF `<collision>`
 //! primitives and the allowed-collision matrix sampled as MoveIt's setup
-//! assistant does (10 000 states by default, a fraction of a second), built
+//! assistant does (10 000 states by default), built
 //! once per parsed chain and kept in a small bounded cache beside the model
 //! cache. Only an optimisation: a miss rebuilds, so every replica answers.
 
@@ -15,34 +15,21 @@ pub struct CollisionSetup {
     pub acm: AllowedCollisions,
 }
 
-/// Most body-pair tests one matrix may cost (samples × pairs). The sampling
-/// does not look at a request's deadline, so its cost is bounded here: a
-/// 7-body arm keeps its 10,000 samples (210,000 tests); a 96-body URDF gets
-/// 438 samples instead of 45.6 million tests.
-pub const MAX_ACM_PAIR_TESTS: usize = 2_000_000;
-
 impl CollisionSetup {
     /// Builds the model and samples the matrix: `acm_samples` states, fewer
-    /// when the model has so many body pairs that the tests would exceed
-    /// [`MAX_ACM_PAIR_TESTS`].
+    /// when the model has so many body pairs that the tests would exceed the
+    /// domain's bound ([`AcmParams::samples_within`]).
     pub fn build(chain: Arc<Chain>, acm_samples: usize) -> Result<Self, CollisionError> {
         let model = Arc::new(RobotModel::new(chain)?);
         let acm = AllowedCollisions::sampled(
             &model,
             &AcmParams {
-                samples: acm_samples_for(model.body_count(), acm_samples),
+                samples: AcmParams::samples_within(model.body_count(), acm_samples),
                 ..AcmParams::default()
             },
         )?;
         Ok(Self { model, acm })
     }
-}
-
-/// Samples for a model of `bodies` bodies: `wanted`, capped so that samples ×
-/// pairs stays within [`MAX_ACM_PAIR_TESTS`] (at least one sample).
-fn acm_samples_for(bodies: usize, wanted: usize) -> usize {
-    let pairs = (bodies * bodies.saturating_sub(1) / 2).max(1);
-    wanted.min(MAX_ACM_PAIR_TESTS / pairs).max(1)
 }
 
 /// Setups keyed by the identity of the chain they were built for. A setup
@@ -116,15 +103,6 @@ pub async fn collision_setup(
 mod tests {
     use super::*;
     use kinplan_core::robot::builtin_chain;
-
-    #[test]
-    fn large_models_sample_fewer_states_within_the_pair_test_bound() {
-        assert_eq!(acm_samples_for(7, 10_000), 10_000); // 21 pairs
-        assert_eq!(acm_samples_for(96, 10_000), 2_000_000 / 4_560); // 438
-        assert!(acm_samples_for(96, 10_000) * 4_560 <= MAX_ACM_PAIR_TESTS);
-        assert_eq!(acm_samples_for(0, 10_000), 10_000);
-        assert_eq!(acm_samples_for(100_000, 10_000), 1);
-    }
 
     #[test]
     fn a_setup_is_found_only_for_its_own_chain_and_the_capacity_holds() {

@@ -187,20 +187,6 @@ pub(super) fn linear_solver_in(field: &str, value: i32) -> Result<Option<RlxaVar
     }
 }
 
-/// Targets cut by the batch's deadline end TIME_BUDGET, not CANCELLED.
-pub(super) fn relabel_cancelled(r: &mut IkResult) {
-    let fix = |s: &mut IkStatus| {
-        if *s == IkStatus::Cancelled {
-            *s = IkStatus::TimeBudget;
-        }
-    };
-    fix(&mut r.stop_reason);
-    r.solutions.iter_mut().for_each(|s| fix(&mut s.status));
-    if let Some(b) = r.best_attempt.as_mut() {
-        fix(&mut b.status);
-    }
-}
-
 pub(super) fn target_of(pose: &Isometry3<f64>, position_only: bool) -> IkTarget {
     if position_only {
         IkTarget::Position(Point3::from(pose.translation.vector))

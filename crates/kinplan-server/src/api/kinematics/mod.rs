@@ -214,8 +214,9 @@ impl KinematicsService for KinematicsApi {
                     .enumerate()
                     .map(|(i, r)| {
                         let mut r = r.map_err(|e| ik_error(e, IkAt::Batch(i)))?;
+                        // Targets cut by the batch's deadline end TIME_BUDGET, not CANCELLED.
                         if late {
-                            relabel_cancelled(&mut r);
+                            r.cancelled_as_time_budget();
                         }
                         Ok(result_out(r))
                     })
