@@ -13,8 +13,8 @@ use kinplan_server::{ServerConfig, TlsPem, Tokens, serve};
 
 /// mimalloc instead of the C library's allocator, for `serve` and `loadtest`
 /// alike: a call allocates and frees a few dozen small buffers (HTTP/2 frames,
-/// headers, messages) across threads, where glibc's malloc/free showed as
-/// several percent of both processes' CPU (issue 12, `benches/RESULTS.md`).
+/// headers, messages) across threads, where glibc's malloc/free showed in
+/// both processes' CPU profiles (the figures are in `benches/RESULTS.md`).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

@@ -1,15 +1,15 @@
 //! The CPU pool's threads run at a lower scheduling priority than the async
 //! runtime's: when every core is busy computing, the threads that accept
 //! connections, shed excess calls with RESOURCE_EXHAUSTED and answer health
-//! checks still get a core at once instead of waiting for a time slice
-//! (several milliseconds under Linux's scheduler). Throughput is unchanged
+//! checks still get a core at once instead of waiting for a pool thread's time
+//! slice. Throughput is unchanged
 //! when the runtime is idle: a nice value only matters under contention.
 //!
 //! The same nice value also weighs the pool against other processes at nice
 //! 0 on the host: with nice 10 they get about 9× a pool thread's share, which
 //! lengthens computed calls' tails on a host shared with other work (not in a
 //! container, whose threads compete among themselves). `--cpu-nice 0` trades
-//! the prompt admission for that (measured in `benches/RESULTS.md`, issue 12).
+//! the prompt admission for that (both are measured in `benches/RESULTS.md`).
 
 /// Default nice value of the pool threads (0 is the default, 19 the lowest priority).
 pub const CPU_POOL_NICE: i32 = 10;

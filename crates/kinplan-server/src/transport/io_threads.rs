@@ -9,10 +9,10 @@
 //! was written by its own `writev` even when several calls of the connection
 //! finished together; on loopback each `writev` also pays the receiver's TCP
 //! processing. A single-threaded runtime queues the woken connection task behind
-//! the calls already queued, so the replies of one read are written together
-//! (`benches/RESULTS.md`, issue 12: server CPU per ForwardKinematics call
-//! 31 → 18 µs, one `writev` per read instead of one per call). The CPU pool is unchanged: work that is not tiny still runs
-//! there and never on these threads.
+//! the calls already queued, so the replies of one read are written together:
+//! one `writev` per read instead of one per call (the server CPU per call
+//! before and after is in `benches/RESULTS.md`). The CPU pool is unchanged:
+//! work that is not tiny still runs there and never on these threads.
 
 use std::future::Future;
 use std::pin::Pin;

@@ -27,8 +27,8 @@ use convert::{Options, Trajectory, criteria_out, score_reply};
 
 /// Requests whose estimated cost (waypoints × (1 + robot points per
 /// waypoint), all trajectories together) is below this are scored inline on
-/// the async runtime, others on the CPU pool: 500 waypoints of a 6-joint arm
-/// with its ~64 collision-vertex points is ~1 ms (see benches/RESULTS.md).
+/// the async runtime, others on the CPU pool: about 500 waypoints of a 6-joint
+/// arm with its 64 collision-vertex points (timings in `benches/RESULTS.md`).
 /// The estimate counts points, not waypoints alone, so a model with thousands
 /// of collision shapes never runs inline.
 const INLINE_COST: usize = 32_000;
