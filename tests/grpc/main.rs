@@ -6,7 +6,6 @@ mod explore;
 mod hardening;
 mod hostile;
 mod kinematics;
-mod loadtest;
 mod mobile;
 mod planning;
 mod robot;

@@ -12,15 +12,14 @@
 //!   threads, the guard layer, authentication, the in-process backend.
 //!
 //! `src/README.md` maps each capability to its handler, its conversion and
-//! its domain code. The `kinplan` binary (`main.rs`) runs the server. Only
+//! its domain code. The `kinplan` binary (`main.rs`, with `health.rs` for
+//! `kinplan health`) runs the server. Only
 //! this crate (with `kinplan-proto`) knows about tonic, prost and tokio.
 
 pub mod api;
 pub mod runtime;
 pub mod status;
 pub mod transport;
-
-pub mod loadtest;
 
 /// The generated contract (the `kinplan-proto` crate).
 pub use kinplan_proto as pb;

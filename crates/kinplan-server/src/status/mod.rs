@@ -17,6 +17,7 @@ pub mod plan;
 mod robot;
 pub mod score;
 
+pub use kinplan_proto::code_name;
 pub use robot::robot_error;
 
 /// INVALID_ARGUMENT naming `field`, with a BadRequest field violation.
@@ -56,32 +57,4 @@ fn field_status(code: Code, field: impl Into<String>, description: impl Into<Str
         message,
         ErrorDetails::with_bad_request_violation(field, description),
     )
-}
-
-/// The canonical upper-case name of a gRPC status code, as metrics label it.
-pub fn code_name(code: i32) -> &'static str {
-    const NAMES: [&str; 17] = [
-        "OK",
-        "CANCELLED",
-        "UNKNOWN",
-        "INVALID_ARGUMENT",
-        "DEADLINE_EXCEEDED",
-        "NOT_FOUND",
-        "ALREADY_EXISTS",
-        "PERMISSION_DENIED",
-        "RESOURCE_EXHAUSTED",
-        "FAILED_PRECONDITION",
-        "ABORTED",
-        "OUT_OF_RANGE",
-        "UNIMPLEMENTED",
-        "INTERNAL",
-        "UNAVAILABLE",
-        "DATA_LOSS",
-        "UNAUTHENTICATED",
-    ];
-    usize::try_from(code)
-        .ok()
-        .and_then(|i| NAMES.get(i))
-        .copied()
-        .unwrap_or("UNKNOWN")
 }

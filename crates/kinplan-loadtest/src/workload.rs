@@ -6,7 +6,7 @@ use nalgebra::Isometry3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::pb::{self, robot_ref::Source};
+use kinplan_proto::{self as pb, robot_ref::Source};
 
 /// The RPC a load test calls.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

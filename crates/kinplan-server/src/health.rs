@@ -53,3 +53,30 @@ pub async fn check_health(args: &HealthArgs) -> Result<&'static str, String> {
         _ => "UNKNOWN",
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kinplan_server::{ServerConfig, serve};
+
+    #[tokio::test]
+    async fn health_reports_serving_and_unknown_services() {
+        let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+        let addr = listener.local_addr().unwrap();
+        let (_stop, stopped) = tokio::sync::oneshot::channel::<()>();
+        tokio::spawn(serve(ServerConfig::default(), listener, async {
+            let _ = stopped.await;
+        }));
+        let mut args = HealthArgs {
+            target: addr.to_string(),
+            service: String::new(),
+            timeout: 2.0,
+        };
+        assert_eq!(check_health(&args).await.unwrap(), "SERVING");
+        args.service = "kinplan.v1.RobotService".into();
+        assert_eq!(check_health(&args).await.unwrap(), "SERVING");
+        args.service = "no.such.Service".into();
+        let err = check_health(&args).await.unwrap_err();
+        assert!(err.starts_with("NotFound"), "{err}");
+    }
+}

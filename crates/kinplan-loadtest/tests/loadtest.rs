@@ -1,10 +1,28 @@
-//! `kinplan loadtest` against a real server: every call is counted once, with
-//! its status, and the report adds up.
+//! `kinplan-loadtest` against a real server on a free loopback port: every
+//! call is counted once, with its status, and the report adds up.
 
-use kinplan_server::ServerConfig;
-use kinplan_server::loadtest::{LoadtestArgs, Rpc, run_loadtest};
+use kinplan_loadtest::{LoadtestArgs, Rpc, run_loadtest};
+use kinplan_server::{ServerConfig, serve};
 
-use crate::start;
+/// A server on a free loopback port, stopped when dropped.
+struct TestServer {
+    addr: std::net::SocketAddr,
+    _stop: tokio::sync::oneshot::Sender<()>,
+}
+
+async fn start(config: ServerConfig) -> TestServer {
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let addr = listener.local_addr().unwrap();
+    let (stop, stopped) = tokio::sync::oneshot::channel::<()>();
+    tokio::spawn(async move {
+        serve(config, listener, async {
+            let _ = stopped.await;
+        })
+        .await
+        .unwrap();
+    });
+    TestServer { addr, _stop: stop }
+}
 
 fn args(target: String, rpc: Rpc, total: u64) -> LoadtestArgs {
     LoadtestArgs {
@@ -69,21 +87,4 @@ async fn an_unreachable_server_is_a_clear_error() {
         .err()
         .unwrap();
     assert!(err.contains("is `kinplan serve` running?"), "{err}");
-}
-
-#[tokio::test]
-async fn health_reports_serving_and_unknown_services() {
-    use kinplan_server::loadtest::{HealthArgs, check_health};
-    let server = start(ServerConfig::default()).await;
-    let mut args = HealthArgs {
-        target: server.addr.to_string(),
-        service: String::new(),
-        timeout: 2.0,
-    };
-    assert_eq!(check_health(&args).await.unwrap(), "SERVING");
-    args.service = "kinplan.v1.RobotService".into();
-    assert_eq!(check_health(&args).await.unwrap(), "SERVING");
-    args.service = "no.such.Service".into();
-    let err = check_health(&args).await.unwrap_err();
-    assert!(err.starts_with("NotFound"), "{err}");
 }

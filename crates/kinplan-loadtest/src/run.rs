@@ -14,12 +14,12 @@ use tonic::transport::{Channel, Endpoint};
 
 use super::report::{LatencyReport, Report};
 use super::workload::{Rpc, Workload, build_pool};
-use crate::code_name;
-use crate::pb::kinematics_service_client::KinematicsServiceClient;
-use crate::pb::robot_service_client::RobotServiceClient;
-use crate::pb::scoring_service_client::ScoringServiceClient;
+use kinplan_proto::code_name;
+use kinplan_proto::kinematics_service_client::KinematicsServiceClient;
+use kinplan_proto::robot_service_client::RobotServiceClient;
+use kinplan_proto::scoring_service_client::ScoringServiceClient;
 
-/// Options of `kinplan loadtest`.
+/// Options of `kinplan-loadtest`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct LoadtestArgs {
     /// Server address: host:port, or a URI with http://.
