@@ -271,6 +271,19 @@ impl<F: Future> Future for CatchUnwind<F> {
 mod tests {
     use super::*;
 
+    /// Regression: the legal-looking maximum `grpc-timeout` overflowed
+    /// `Instant` arithmetic; it means no deadline, unless the server has a default.
+    #[test]
+    fn a_timeout_too_large_for_instant_is_no_deadline() {
+        let compute = Compute::new(1, 1, None);
+        let mut req = tonic::Request::new(());
+        req.metadata_mut()
+            .insert("grpc-timeout", "18446744073709551615S".parse().unwrap());
+        assert_eq!(compute.deadline_of(&req), None);
+        let compute = Compute::new(1, 1, Some(Duration::from_secs(1)));
+        assert!(compute.deadline_of(&req).is_some());
+    }
+
     #[cfg(target_os = "linux")]
     #[tokio::test]
     async fn pool_threads_run_at_the_nice_value_given() {
