@@ -18,12 +18,20 @@ pub fn deadline_after(timeout: Duration) -> Option<Instant> {
     Instant::now().checked_add(timeout - reserve)
 }
 
-/// The call's timeout: the shorter of `grpc-timeout` and the server's default.
-pub fn effective_timeout(header: Option<Duration>, default: Option<Duration>) -> Option<Duration> {
-    match (header, default) {
+/// The earlier (or shorter) of two optional limits, `None` meaning no
+/// limit: the one derivation behind every "this or that, whichever comes
+/// first" of the server (a call's timeout, a request's time budget against
+/// its deadline).
+pub fn earlier<T: Ord>(a: Option<T>, b: Option<T>) -> Option<T> {
+    match (a, b) {
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),
     }
+}
+
+/// The call's timeout: the shorter of `grpc-timeout` and the server's default.
+pub fn effective_timeout(header: Option<Duration>, default: Option<Duration>) -> Option<Duration> {
+    earlier(header, default)
 }
 
 /// Parses the `grpc-timeout` header: digits and a unit (H M S m u n),
@@ -60,13 +68,21 @@ pub fn reply_reserve(remaining: Duration) -> Duration {
         .min(remaining / 2)
 }
 
-/// The earlier of the explicit budget and the time left until `soft`.
+/// A request's time budget as a duration (for the domain's `time_budget`
+/// parameters): the shorter of its `explicit` budget and the time left until
+/// `soft` (a [`soft_deadline`]).
 pub fn time_budget(explicit: Option<Duration>, soft: Option<Instant>) -> Option<Duration> {
-    let from_deadline = soft.map(kinplan_core::ik::budget_until);
-    match (explicit, from_deadline) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    }
+    earlier(explicit, soft.map(kinplan_core::ik::budget_until))
+}
+
+/// A request's time budget as an instant (for work that checks a deadline):
+/// the earlier of `explicit` from now and the soft deadline of the call's
+/// `deadline`. An explicit budget too large for `Instant` is no limit.
+pub fn work_deadline(explicit: Option<Duration>, deadline: Option<Instant>) -> Option<Instant> {
+    earlier(
+        explicit.and_then(|b| Instant::now().checked_add(b)),
+        soft_deadline(deadline),
+    )
 }
 
 #[cfg(test)]
@@ -86,6 +102,35 @@ mod tests {
         md.insert("grpc-timeout", "18446744073709551615S".parse().unwrap());
         assert_eq!(grpc_timeout(&md), Some(Duration::from_secs(u64::MAX)));
         assert_eq!(deadline_after(Duration::from_secs(u64::MAX)), None);
+    }
+
+    #[test]
+    fn the_earlier_limit_applies_and_none_is_no_limit() {
+        assert_eq!(earlier(Some(3), Some(5)), Some(3));
+        assert_eq!(earlier(Some(5), Some(3)), Some(3));
+        assert_eq!(earlier(Some(5), None), Some(5));
+        assert_eq!(earlier(None, Some(3)), Some(3));
+        assert_eq!(earlier::<u32>(None, None), None);
+        let ms = Duration::from_millis;
+        assert_eq!(effective_timeout(Some(ms(10)), Some(ms(60_000))), Some(ms(10)));
+        assert_eq!(effective_timeout(None, Some(ms(60_000))), Some(ms(60_000)));
+    }
+
+    /// An explicit budget shorter than the deadline's applies from now; a
+    /// longer one (or one too large for `Instant`) gives way to the soft deadline.
+    #[test]
+    fn the_work_deadline_is_the_earlier_of_budget_and_soft_deadline() {
+        let ms = Duration::from_millis;
+        let deadline = Instant::now() + ms(60_000);
+        let soft = soft_deadline(Some(deadline)).unwrap();
+        let before = Instant::now();
+        let short = work_deadline(Some(ms(5)), Some(deadline)).unwrap();
+        assert!(short >= before + ms(5) && short < soft);
+        assert_eq!(work_deadline(Some(ms(120_000)), Some(deadline)), Some(soft));
+        assert_eq!(work_deadline(Some(Duration::MAX), Some(deadline)), Some(soft));
+        assert_eq!(work_deadline(Some(Duration::MAX), None), None);
+        assert_eq!(work_deadline(None, None), None);
+        assert!(work_deadline(Some(ms(5)), None).unwrap() >= before + ms(5));
     }
 
     #[test]

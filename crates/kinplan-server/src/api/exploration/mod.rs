@@ -8,7 +8,7 @@ use tonic::{Request, Response, Status};
 use crate::api::convert::{finite, pose_in};
 use crate::pb::{self, exploration_service_server::ExplorationService};
 use crate::runtime::Shared;
-use crate::runtime::deadline::soft_deadline;
+use crate::runtime::deadline::{soft_deadline, time_budget};
 use crate::status::invalid;
 use crate::status::nbv::nbv_error;
 use crate::status::octree::octree_error;
@@ -92,11 +92,7 @@ impl ExplorationService for ExplorationApi {
         let camera = camera_in(req.camera.as_ref())?;
         let camera_pose = pose_in("camera_pose", req.camera_pose.as_ref())?;
         let mut params = nbv_params_in(&req)?;
-        let soft = soft_deadline(budget.deadline()).map(kinplan_core::ik::budget_until);
-        params.time_budget = match (params.time_budget, soft) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        };
+        params.time_budget = time_budget(params.time_budget, soft_deadline(budget.deadline()));
         let reply = self
             .shared
             .compute

@@ -17,7 +17,7 @@ use crate::api::scene::scene_in;
 use crate::pb::{self, planning_service_server::PlanningService};
 use crate::runtime::Shared;
 use crate::runtime::collision_models::{CollisionSetup, collision_setup};
-use crate::runtime::deadline::soft_deadline;
+use crate::runtime::deadline::work_deadline;
 use crate::runtime::{Budget, models::Resolved};
 use crate::status::collision::{checker_error, collision_error, collision_internal};
 use crate::status::invalid;
@@ -50,14 +50,7 @@ impl PlanningApi {
         let input = plan_input(req)?;
         let scene = scene_in("scene", req.scene.as_ref(), &SceneLimits::default())?;
         let setup = collision_setup(&self.shared, &robot, &budget).await?;
-        let soft = soft_deadline(budget.deadline());
-        let deadline = match (
-            input.time_budget.and_then(|b| Instant::now().checked_add(b)),
-            soft,
-        ) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        };
+        let deadline = work_deadline(input.time_budget, budget.deadline());
         Ok(Prepared {
             _permit: permit,
             budget,

@@ -17,7 +17,7 @@ use crate::api::scene::scene_in;
 use crate::pb;
 use crate::runtime::Shared;
 use crate::runtime::collision_models::collision_setup;
-use crate::runtime::deadline::soft_deadline;
+use crate::runtime::deadline::work_deadline;
 use crate::status::collision::collision_error;
 use crate::status::explore::explore_error;
 use crate::status::invalid;
@@ -45,11 +45,7 @@ pub async fn explore_stream(
         return Err(invalid("scene", "is empty: the camera would see nothing"));
     }
     let setup = collision_setup(shared, &robot, &budget).await?;
-    let soft = soft_deadline(budget.deadline());
-    let deadline = match (time_budget.and_then(|b| Instant::now().checked_add(b)), soft) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    };
+    let deadline = work_deadline(time_budget, budget.deadline());
     let (tx, rx) = tokio::sync::mpsc::channel(16);
     let compute = shared.compute.clone();
     tokio::spawn(async move {
