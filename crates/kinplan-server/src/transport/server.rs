@@ -34,7 +34,7 @@ pub struct ServerConfig {
     /// CPU pool threads; 0 means one per core.
     pub cpu_threads: usize,
     /// Nice value of the CPU pool's threads (0–19; default 10, below the
-    /// I/O threads; see `service/priority.rs`).
+    /// I/O threads; see `runtime/priority.rs`).
     pub cpu_nice: i32,
     /// I/O threads, each with its own single-threaded async runtime serving
     /// the connections handed to it round robin; 0 means one per core.

@@ -1,7 +1,9 @@
 //! `ExplorationService`: NextBestView, InsertScan and OctreeInfo over the
 //! octree and nbv rooms. Octrees arrive as OctoMap node bytes inside the
 //! request (never a path) and are parsed on the CPU pool with a node limit;
-//! every long stage checks the request's deadline and cancellation.
+//! every long stage checks the request's deadline and cancellation. The
+//! service's other two calls, the Explore loop and its reference scenes, are
+//! handled in `explore_loop`.
 
 use tonic::{Request, Response, Status};
 
