@@ -3,7 +3,8 @@
 //! server traits (`*_service_server`) and [`FILE_DESCRIPTOR_SET`] for gRPC
 //! reflection. The server, the Rust client and the fuzz targets all use these
 //! types, so the contract is compiled once.
-#![allow(missing_docs, clippy::all, clippy::pedantic)]
+// The comments come from the .proto files, where `<limit>` is URDF, not HTML.
+#![allow(missing_docs, clippy::all, clippy::pedantic, rustdoc::invalid_html_tags)]
 
 tonic::include_proto!("kinplan.v1");
 

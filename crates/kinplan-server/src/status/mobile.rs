@@ -11,7 +11,7 @@ use kinplan_core::mobile::{
 };
 
 /// INVALID_ARGUMENT naming the request field that a [`MobileError`] is about; INTERNAL
-/// ([`token_failure`]) for a state the server could not encode.
+/// (`token_failure`) for a state the server could not encode.
 pub fn mobile_error(err: MobileError) -> Status {
     let field = match &err {
         MobileError::TokenEncoding { .. } => return token_failure(err),

@@ -4,7 +4,7 @@
 //! Thin adapter: admit → resolve the robot → proto options, targets and
 //! matrices into domain values → solve on the CPU pool, with the request's
 //! deadline (less a reply reserve) as the IK time budget and
-//! [`Budget::should_stop`] as the cancellation check → reply. [`IkError`]s
+//! [`Budget::should_stop`] as the cancellation check → reply. [`IkError`](kinplan_core::ik::IkError)s
 //! become INVALID_ARGUMENT naming the request field. Not converging is a
 //! status in the reply, never an error.
 
