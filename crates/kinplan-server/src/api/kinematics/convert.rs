@@ -1,8 +1,41 @@
 //! `KinematicsService` messages ↔ the ik and linalg rooms: IkOptions and
 //! targets in (method, solver, tolerances, restarts, the explicit time
-//! budget), domain answers out as replies.
+//! budget), TrackPath's poses (explicit, or a line or circle sampled into
+//! steps), domain answers out as replies.
 
-use super::*;
+use std::time::Duration;
+
+use nalgebra::{Isometry3, Point3};
+use tonic::Status;
+
+use crate::api::convert::{pose_in, pose_out, vec3_in};
+use crate::pb;
+use crate::status::ik::{IkAt, PathAt, ik_error};
+use crate::status::linalg::{SolveAt, linalg_error};
+use crate::status::{invalid, too_large};
+use kinplan_core::ik::{
+    IkMethod, IkParams, IkResult, IkSolution, IkStatus, IkTarget, JointLimitMode, TrackResult, circle_path,
+    line_path,
+};
+use kinplan_core::linalg::{
+    LinearSolution, LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus,
+};
+use kinplan_core::robot::Chain;
+
+/// Most poses of a `TrackPath` (explicit poses, or line/circle steps): the reply
+/// then stays under ~9 MB for a 7-joint arm (the default message limit is 16 MB).
+pub const MAX_PATH_POSES: usize = 50_000;
+/// Most solutions one target may ask for.
+pub const MAX_SOLUTIONS: u32 = 1_000;
+/// Most RLXA work (iteration cap × m × n) of one `SolveLinearSystem`; the
+/// solve also stops at the deadline (checked every 1024 iterations).
+pub const MAX_RLXA_WORK: u64 = 1_000_000_000;
+/// Most iterations of a `SolveLinearSystem` that records its residual history
+/// (8 bytes each in the reply, so at most 8 MB): bounded up front.
+pub const MAX_LINEAR_HISTORY: usize = 1_000_000;
+/// Most RLXA iterations inside one IK iteration (`options.rlxa_max_iterations`):
+/// the IK loop checks its deadline between iterations.
+pub const MAX_IK_RLXA_ITERATIONS: u32 = 100_000;
 
 /// The solver of a `SolveLinearSystem`, with its options (and the RLXA seed).
 pub(super) enum LinearSolve {
@@ -285,4 +318,66 @@ pub(super) fn linear_out(s: LinearSolution, elapsed: Duration) -> pb::SolveLinea
         residual_history: s.history,
         elapsed_us: micros(elapsed),
     }
+}
+
+/// The poses of a `TrackPath` and the field they came from.
+pub(super) fn path_in(
+    poses: &[pb::Pose],
+    line: Option<&pb::LinePath>,
+    circle: Option<&pb::CirclePath>,
+    chain: &Chain,
+    seed: &[f64],
+) -> Result<(Vec<Isometry3<f64>>, PathAt), Status> {
+    let given = usize::from(!poses.is_empty()) + usize::from(line.is_some()) + usize::from(circle.is_some());
+    if given != 1 {
+        return Err(invalid(
+            "poses",
+            format!("exactly one of poses, line and circle is required, got {given}"),
+        ));
+    }
+    let steps = |field: &str, steps: u32| {
+        if steps == 0 || steps as usize >= MAX_PATH_POSES {
+            Err(invalid(
+                field,
+                format!("must be between 1 and {}, got {steps}", MAX_PATH_POSES - 1),
+            ))
+        } else {
+            Ok(steps as usize)
+        }
+    };
+    let start = |field: &str, p: Option<&pb::Pose>| match p {
+        Some(p) => pose_in(field, Some(p)),
+        None => Ok(chain.fk(seed)),
+    };
+    if let Some(line) = line {
+        let s = start("line.start", line.start.as_ref())?;
+        let e = pose_in("line.end", line.end.as_ref())?;
+        let n = steps("line.steps", line.steps)?;
+        let path = line_path(&s, &e, n).map_err(|e| ik_error(e, IkAt::Path(PathAt::Line)))?;
+        return Ok((path, PathAt::Line));
+    }
+    if let Some(c) = circle {
+        let s = start("circle.start", c.start.as_ref())?;
+        if c.centre.is_none() {
+            return Err(invalid("circle.centre", "is required"));
+        }
+        let centre = Point3::from(vec3_in("circle.centre", c.centre.as_ref())?);
+        let normal = vec3_in("circle.normal", c.normal.as_ref())?;
+        let n = steps("circle.steps", c.steps)?;
+        let path = circle_path(&s, &centre, &normal, c.angle_step, n)
+            .map_err(|e| ik_error(e, IkAt::Path(PathAt::Circle)))?;
+        return Ok((path, PathAt::Circle));
+    }
+    if poses.len() > MAX_PATH_POSES {
+        return Err(invalid(
+            "poses",
+            format!("{} poses exceed the limit of {MAX_PATH_POSES}", poses.len()),
+        ));
+    }
+    let path = poses
+        .iter()
+        .enumerate()
+        .map(|(i, p)| pose_in(&format!("poses[{i}]"), Some(p)))
+        .collect::<Result<_, _>>()?;
+    Ok((path, PathAt::Poses))
 }

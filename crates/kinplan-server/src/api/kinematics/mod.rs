@@ -10,63 +10,44 @@
 
 use std::pin::Pin;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
-use nalgebra::{DVector, Isometry3, Point3};
+use nalgebra::DVector;
 use rand::SeedableRng;
 use tokio_stream::Stream;
 use tokio_stream::wrappers::ReceiverStream;
 use tonic::{Request, Response, Status, Streaming};
 
-use crate::api::convert::{finite_slice, matrix_in, pose_in, pose_out, vec3_in};
+use crate::api::convert::{finite_slice, matrix_in};
 use crate::pb::{self, kinematics_service_server::KinematicsService};
 use crate::runtime::Shared;
 use crate::runtime::deadline::{deadline_after, grpc_timeout, soft_deadline, time_budget};
 use crate::runtime::{Budget, Compute, ModelStore, catch_unwind};
-use crate::status::ik::{IkAt, PathAt, ik_error};
+use crate::status::ik::{IkAt, ik_error};
 use crate::status::linalg::{SolveAt, linalg_error};
-use crate::status::{invalid, robot_error, too_large};
+use crate::status::{invalid, robot_error};
 use kinplan_core::ik::{
-    BatchSeeds, IkMethod, IkParams, IkResult, IkSolution, IkSolver, IkStatus, IkTarget, IkWorkspace,
-    JointLimitMode, TrackParams, TrackResult, circle_path, line_path, solve_ik, solve_ik_batch, track_path,
+    BatchSeeds, IkSolver, IkTarget, IkWorkspace, TrackParams, solve_ik, solve_ik_batch, track_path,
 };
-use kinplan_core::linalg::{
-    LinearSolution, LinearSolverKind, PseudoinverseParams, RlxaParams, RlxaVariant, SolveStatus,
-    solve_angle_relaxation_until, solve_pseudoinverse,
-};
+use kinplan_core::linalg::{solve_angle_relaxation_until, solve_pseudoinverse};
 use kinplan_core::robot::Chain;
 
 mod convert;
-mod path;
 mod stream;
 
 use convert::*;
-use path::*;
+pub use convert::{MAX_IK_RLXA_ITERATIONS, MAX_LINEAR_HISTORY, MAX_PATH_POSES, MAX_RLXA_WORK, MAX_SOLUTIONS};
 use stream::*;
 
 /// Most targets in one `SolveIkBatch`.
 pub const MAX_BATCH_TARGETS: usize = 10_000;
-/// Most poses of a `TrackPath` (explicit poses, or line/circle steps): the reply
-/// then stays under ~9 MB for a 7-joint arm (the default message limit is 16 MB).
-pub const MAX_PATH_POSES: usize = 50_000;
-/// Most solutions one target may ask for.
-pub const MAX_SOLUTIONS: u32 = 1_000;
 /// Most solutions a whole batch may ask for (targets × num_solutions).
 pub const MAX_BATCH_SOLUTIONS: usize = 100_000;
 /// Most entries of a `SolveLinearSystem` matrix.
 pub const MAX_MATRIX_ENTRIES: usize = 10_000;
-/// Most RLXA work (iteration cap × m × n) of one `SolveLinearSystem`; the
-/// solve also stops at the deadline (checked every 1024 iterations).
-pub const MAX_RLXA_WORK: u64 = 1_000_000_000;
-/// Most iterations of a `SolveLinearSystem` that records its residual history
-/// (8 bytes each in the reply, so at most 8 MB): bounded up front.
-pub const MAX_LINEAR_HISTORY: usize = 1_000_000;
 /// Largest magnitude of a matrix or right-hand-side entry: norms of up to
 /// `MAX_MATRIX_ENTRIES` squared entries stay finite.
 pub const MAX_LINEAR_ENTRY: f64 = 1e100;
-/// Most RLXA iterations inside one IK iteration (`options.rlxa_max_iterations`):
-/// the IK loop checks its deadline between iterations.
-pub const MAX_IK_RLXA_ITERATIONS: u32 = 100_000;
 /// Default random restarts of `SolveIk` and `SolveIkBatch`: the domain's
 /// (`IkParams::default().max_restarts`).
 const RESTARTS_SOLVE: Option<usize> = None;
@@ -360,6 +341,8 @@ impl KinematicsService for KinematicsApi {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use kinplan_core::ik::{IkMethod, JointLimitMode};
+    use kinplan_core::linalg::{LinearSolverKind, RlxaVariant};
 
     /// Unset options take the defaults `proto/kinplan/v1/kinematics.proto`
     /// documents beside each `IkOptions` field, written out here so that a change

@@ -1,7 +1,26 @@
 //! `ScoringService` messages ↔ the score room: options and trajectories in
 //! (unset fields take the documented defaults), reports out.
 
-use super::*;
+use std::collections::HashMap;
+
+use tonic::Status;
+
+use crate::pb;
+use crate::status::invalid;
+use crate::status::score::TrajectoryAt;
+use kinplan_core::robot::Chain;
+use kinplan_core::score::{
+    self, CountedPeak, CycleTime, CycleTimeParams, JerkPeakParams, OwnedLimits, PointSet, ScoreParams,
+    ScoreReport, Scores, Series,
+};
+
+/// Smallest step between timestamps, s: smaller ones overflow the divided differences.
+pub const MIN_TIME_STEP: f64 = 1e-6;
+/// Largest timestamp magnitude, s.
+pub const MAX_TIME: f64 = 1e9;
+/// Smallest positive speed or acceleration limit: a 5e-324 limit made
+/// durations infinite.
+pub const MIN_RATE_LIMIT: f64 = 1e-6;
 
 /// Scoring options in domain form.
 pub(super) struct Options {

@@ -6,8 +6,6 @@
 //! reply; [`ScoreError`]s become INVALID_ARGUMENT naming the request field.
 //! Requests with many waypoints run on the CPU pool.
 
-use std::collections::HashMap;
-
 use tonic::{Request, Response, Status};
 
 use crate::pb::{self, scoring_service_server::ScoringService};
@@ -17,12 +15,13 @@ use crate::status::score::{TrajectoryAt, score_error};
 use crate::status::{invalid, too_large};
 use kinplan_core::robot::Chain;
 use kinplan_core::score::{
-    self, CountedPeak, CycleTime, CycleTimeParams, JerkPeakParams, LabelledSet, OwnedLimits, PointSet, Rows,
-    ScoreError, ScoreInput, ScoreParams, ScoreReport, Scores, Series, TrajectoryData,
+    self, LabelledSet, OwnedLimits, PointSet, Rows, ScoreError, ScoreInput, ScoreParams, ScoreReport,
+    TrajectoryData,
 };
 
 mod convert;
 
+pub use convert::{MAX_TIME, MIN_RATE_LIMIT, MIN_TIME_STEP};
 use convert::{Options, Trajectory, criteria_out, score_reply};
 
 /// Requests whose estimated cost (waypoints × (1 + robot points per
@@ -35,14 +34,6 @@ const INLINE_COST: usize = 32_000;
 /// Most robot points sampled over a whole request (points per waypoint ×
 /// waypoints): 24 bytes each, so at most ~96 MB, refused up front beyond.
 pub const MAX_ROBOT_POINT_SAMPLES: usize = 4_000_000;
-
-/// Smallest step between timestamps, s: smaller ones overflow the divided differences.
-pub const MIN_TIME_STEP: f64 = 1e-6;
-/// Largest timestamp magnitude, s.
-pub const MAX_TIME: f64 = 1e9;
-/// Smallest positive speed or acceleration limit: a 5e-324 limit made
-/// durations infinite.
-pub const MIN_RATE_LIMIT: f64 = 1e-6;
 
 /// Robot points per waypoint the request's options ask for.
 fn points_per_waypoint(o: Option<&pb::ScoreOptions>, chain: &Chain) -> usize {
