@@ -1,13 +1,9 @@
 //! Proto messages into domain values and back for `MobileService`: unset fields take the
-//! domain's defaults, sizes are bounded by the server's limits ([`super`]), and parameter sets
+//! domain's defaults, sizes are bounded by the server's limits (below), and parameter sets
 //! are validated as they are built.
 
 use tonic::Status;
 
-use super::{
-    MAX_OBSTACLES, MAX_PATH_NODES, MAX_POLYGON_VERTICES, MAX_RAYS_PER_BEAM, MAX_SENSORS,
-    MAX_STEERING_CANDIDATES, MAX_STEPS, MAX_WORLD_VERTICES,
-};
 use crate::pb;
 use crate::status::invalid;
 use crate::status::mobile::mobile_error;
@@ -17,6 +13,25 @@ use kinplan_core::mobile::{
     Saturation, SimParams, SimRun, StepReport, TricycleParams, TurnPreference, Twist, VdfEvent, VdfParams,
     WheelState, World,
 };
+
+/// Largest simulation accepted: `sim.max_time / sim.dt` steps.
+pub const MAX_STEPS: f64 = 100_000.0;
+/// Largest world accepted, obstacles.
+pub const MAX_OBSTACLES: usize = 10_000;
+/// Largest polygon accepted, vertices.
+pub const MAX_POLYGON_VERTICES: usize = 1_000;
+/// Most polygon vertices in one world: bounds the cost of one ray cast or
+/// distance query (the unit between cancellation checks).
+pub const MAX_WORLD_VERTICES: usize = 100_000;
+/// Longest path accepted, nodes.
+pub const MAX_PATH_NODES: usize = 10_000;
+/// Largest sensor ring accepted.
+pub const MAX_SENSORS: u32 = 360;
+/// Most rays per sensor beam accepted.
+pub const MAX_RAYS_PER_BEAM: u32 = 100;
+/// Most steering candidates a goal-seeking / shortest-path step evaluates (larger requests
+/// are clamped to it).
+pub const MAX_STEERING_CANDIDATES: u32 = 100_000;
 
 pub(super) fn pose_in(p: Option<&pb::Pose2D>) -> Pose {
     p.map_or(Pose::default(), |p| Pose::new(p.x, p.y, p.theta))

@@ -21,29 +21,16 @@ use kinplan_core::mobile::{
 
 mod convert;
 
+pub use convert::{
+    MAX_OBSTACLES, MAX_PATH_NODES, MAX_POLYGON_VERTICES, MAX_RAYS_PER_BEAM, MAX_SENSORS,
+    MAX_STEERING_CANDIDATES, MAX_STEPS, MAX_WORLD_VERTICES,
+};
+
 use convert::{
     astar_in, chassis_in, follow_in, path_in, point_in, pose_in, run_out, saturation_out, sensors_in, sim_in,
     step_out, twist_in, twist_out, vdf_in, wheels_in, wheels_out, world_in,
 };
 
-/// Largest simulation accepted: `sim.max_time / sim.dt` steps.
-pub const MAX_STEPS: f64 = 100_000.0;
-/// Largest world accepted, obstacles.
-pub const MAX_OBSTACLES: usize = 10_000;
-/// Largest polygon accepted, vertices.
-pub const MAX_POLYGON_VERTICES: usize = 1_000;
-/// Most polygon vertices in one world: bounds the cost of one ray cast or
-/// distance query (the unit between cancellation checks).
-pub const MAX_WORLD_VERTICES: usize = 100_000;
-/// Longest path accepted, nodes.
-pub const MAX_PATH_NODES: usize = 10_000;
-/// Largest sensor ring accepted.
-pub const MAX_SENSORS: u32 = 360;
-/// Most rays per sensor beam accepted.
-pub const MAX_RAYS_PER_BEAM: u32 = 100;
-/// Most steering candidates a goal-seeking / shortest-path step evaluates (larger requests
-/// are clamped to it).
-pub const MAX_STEERING_CANDIDATES: u32 = 100_000;
 /// Largest state token accepted, bytes.
 pub const MAX_TOKEN_BYTES: usize = 1 << 20;
 
