@@ -239,9 +239,10 @@ const ANSWER_SLACK: Duration = Duration::from_millis(250);
 impl Deadline {
     /// The answer arrived by the deadline (plus [`ANSWER_SLACK`]): a reply
     /// cut short by the budget, or the server's deadline answer — the guard's
-    /// DEADLINE_EXCEEDED, or tonic's own deadline timer (CANCELLED, "Timeout
-    /// expired") when the I/O thread was busy converting a large request as
-    /// the deadline passed — and nothing else.
+    /// DEADLINE_EXCEEDED, or tonic's own timer for the same `grpc-timeout`
+    /// (CANCELLED, "Timeout expired"), which fires first when the guard's
+    /// slightly earlier timer is polled late on a busy I/O thread — and
+    /// nothing else.
     fn in_time<T>(&self, answer: Result<tonic::Response<T>, tonic::Status>) {
         let took = self.sent.elapsed();
         let limit = Duration::from_millis(self.ms) + ANSWER_SLACK;
