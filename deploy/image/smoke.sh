@@ -9,6 +9,7 @@ cd "$(dirname "$0")/../.."
 tag=${1:-kinplan:latest}
 port=${KINPLAN_SMOKE_PORT:-50071}
 bin=target/release/kinplan
+loadtest=target/release/kinplan-loadtest
 name=kinplan-smoke-$$
 now() { date +%s.%N; }
 ms() { python3 -c "print(f'{($2 - $1) * 1000:.0f} ms')"; }
@@ -30,7 +31,8 @@ t1=$(now)
 echo "ready (health SERVING) $(ms "$t0" "$t1") after 'podman run'"
 
 echo "user: $(podman inspect "$name" --format '{{.Config.User}}'), read-only root: $(podman inspect "$name" --format '{{.HostConfig.ReadonlyRootfs}}')"
-"$bin" loadtest --target "127.0.0.1:$port" --rpc fk --total 500 --concurrency 4 --connections 1 --warmup 5 | sed 's/^/  /'
+[ -x "$loadtest" ] || cargo build --release --locked -p kinplan-loadtest
+"$loadtest" --target "127.0.0.1:$port" --rpc fk --total 500 --concurrency 4 --connections 1 --warmup 5 | sed 's/^/  /'
 curl -sf "http://127.0.0.1:$((port + 1))/metrics" | grep -c '^grpc_server_handled_total' | sed 's/^/  metric series grpc_server_handled_total: /' || echo "  (curl missing: metrics not checked)"
 
 # Drain: SIGTERM turns health NOT_SERVING for the drain delay (1 s), then the

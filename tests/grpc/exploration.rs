@@ -2,8 +2,8 @@
 //! tree (cells counted by hand), the tree's round trip through OctreeInfo,
 //! next-best views checked against the utility formula, and bad input.
 
-use kinplan_server::service::ServerConfig;
-use kinplan_server::service::pb::{
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{
     self, exploration_service_client::ExplorationServiceClient, insert_scan_request::Scan,
 };
 use tonic::Code;

@@ -4,8 +4,8 @@
 //! the previous ended, the final tree parses and holds the scanned wall),
 //! and bad input is named by field.
 
-use kinplan_server::service::ServerConfig;
-use kinplan_server::service::pb::{
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{
     self, collision_object::Shape, exploration_service_client::ExplorationServiceClient,
     explore_response::Event,
 };

@@ -8,8 +8,8 @@
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use kinplan_server::service::ServerConfig;
-use kinplan_server::service::pb::{
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{
     self, exploration_service_client::ExplorationServiceClient,
     kinematics_service_client::KinematicsServiceClient, mobile_service_client::MobileServiceClient,
     planning_service_client::PlanningServiceClient, robot_service_client::RobotServiceClient,

@@ -8,8 +8,8 @@
 use std::f64::consts::PI;
 use std::time::{Duration, Instant};
 
-use kinplan_server::service::ServerConfig;
-use kinplan_server::service::pb::{
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{
     self, kinematics_service_client::KinematicsServiceClient, robot_service_client::RobotServiceClient,
 };
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};

@@ -6,15 +6,14 @@ mod explore;
 mod hardening;
 mod hostile;
 mod kinematics;
-mod loadtest;
 mod mobile;
 mod planning;
 mod robot;
 mod scoring;
 mod security;
 
-use kinplan_server::service::pb::{self, robot_ref::Source};
-use kinplan_server::service::{ServerConfig, serve};
+use kinplan_server::pb::{self, robot_ref::Source};
+use kinplan_server::{ServerConfig, serve};
 use tonic::transport::Channel;
 
 pub struct TestServer {

@@ -5,8 +5,8 @@
 
 use std::f64::consts::{FRAC_PI_4, PI};
 
-use kinplan_server::service::ServerConfig;
-use kinplan_server::service::pb::{self, mobile_service_client::MobileServiceClient};
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{self, mobile_service_client::MobileServiceClient};
 use tonic::Code;
 use tonic::transport::Channel;
 use tonic_types::StatusExt;

@@ -5,8 +5,8 @@
 
 use std::time::{Duration, Instant};
 
-use kinplan_server::service::ServerConfig;
-use kinplan_server::service::pb::{
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{
     self, collision_object::Shape, plan_request::Goal, planning_service_client::PlanningServiceClient,
     robot_service_client::RobotServiceClient,
 };

@@ -2,8 +2,8 @@
 
 use std::time::Duration;
 
-use kinplan_server::service::ServerConfig;
-use kinplan_server::service::pb::{self, robot_ref::Source, robot_service_client::RobotServiceClient};
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{self, robot_ref::Source, robot_service_client::RobotServiceClient};
 use tonic::Code;
 use tonic_health::pb::{
     HealthCheckRequest, health_check_response::ServingStatus, health_client::HealthClient,

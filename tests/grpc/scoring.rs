@@ -5,8 +5,8 @@
 
 use std::f64::consts::PI;
 
-use kinplan_server::service::ServerConfig;
-use kinplan_server::service::pb::{self, scoring_service_client::ScoringServiceClient};
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{self, scoring_service_client::ScoringServiceClient};
 use tonic::Code;
 use tonic_health::pb::{
     HealthCheckRequest, health_check_response::ServingStatus, health_client::HealthClient,

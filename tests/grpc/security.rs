@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
-use kinplan_server::service::pb::{self, robot_service_client::RobotServiceClient};
-use kinplan_server::service::{ServerConfig, TlsPem, Tokens};
+use kinplan_server::pb::{self, robot_service_client::RobotServiceClient};
+use kinplan_server::{ServerConfig, TlsPem, Tokens};
 use tonic::Code;
 use tonic::metadata::MetadataValue;
 use tonic::transport::{Certificate, Channel, ClientTlsConfig, Identity};

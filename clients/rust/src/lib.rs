@@ -23,10 +23,14 @@ mod client;
 mod convert;
 mod error;
 mod ik;
-pub mod pb;
 mod plan;
 mod robot;
 mod stream;
+
+/// The generated messages and client stubs of `proto/kinplan/v1` (the
+/// `kinplan-proto` crate), for calls this crate does not wrap
+/// (`Client::channel` connects them).
+pub use kinplan_proto as pb;
 
 pub use client::{Client, DEFAULT_RETRIES, DEFAULT_TIMEOUT};
 pub use error::{Error, Result};

@@ -8,7 +8,7 @@ use std::time::Duration;
 use kinplan_client::{
     Algorithm, Client, Code, Goal, IkMethod, IkOptions, Obstacle, PlanSettings, PlanStatus, Shape,
 };
-use kinplan_server::service::{ServerConfig, serve};
+use kinplan_server::{ServerConfig, serve};
 use nalgebra::{DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
 
 const KR210: &str = "kuka_kr210_r2700_extra";

@@ -1,20 +1,21 @@
 //! `kinplan serve`: the gRPC server with built-in defaults; every setting is
-//! a flag and an environment variable. `kinplan loadtest` drives a running
-//! server at high rate and reports latency percentiles and throughput.
+//! a flag and an environment variable. `kinplan health` asks a server for its
+//! serving status. (The load test is its own binary, `kinplan-loadtest`.)
 
 use std::net::SocketAddr;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use kinplan_server::loadtest::{
-    HealthArgs, LoadtestArgs, MIN_WORKER_INTERVAL, check_health, run_loadtest, workers_for_rate,
-};
-use kinplan_server::service::{ServerConfig, TlsPem, Tokens, serve};
+use kinplan_server::{ServerConfig, TlsPem, Tokens, serve};
 
-/// mimalloc instead of the C library's allocator, for `serve` and `loadtest`
-/// alike: a call allocates and frees a few dozen small buffers (HTTP/2 frames,
-/// headers, messages) across threads, where glibc's malloc/free showed as
-/// several percent of both processes' CPU (issue 12, `benches/RESULTS.md`).
+mod health;
+
+use health::{HealthArgs, check_health};
+
+/// mimalloc instead of the C library's allocator: a call allocates and frees
+/// a few dozen small buffers (HTTP/2 frames, headers, messages) across
+/// threads, where glibc's malloc/free showed in the server's CPU profile
+/// (the figures are in `benches/RESULTS.md`).
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
@@ -25,12 +26,12 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once at startup: the size of the serve flags does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Run the gRPC server.
     Serve(ServeArgs),
-    /// Load-test a running server (latency percentiles, throughput, status codes).
-    Loadtest(LoadtestArgs),
     /// Ask a server for its health (exit 0 when SERVING).
     Health(HealthArgs),
 }
@@ -163,12 +164,6 @@ fn main() {
                 std::process::exit(1);
             }
         }
-        Command::Loadtest(args) => {
-            if let Err(err) = loadtest(&args) {
-                eprintln!("kinplan loadtest: {err}");
-                std::process::exit(1);
-            }
-        }
         Command::Health(args) => match client_runtime().and_then(|rt| rt.block_on(check_health(&args))) {
             Ok(status) => {
                 println!("{status}");
@@ -187,25 +182,6 @@ fn client_runtime() -> Result<tokio::runtime::Runtime, String> {
         .enable_all()
         .build()
         .map_err(|e| e.to_string())
-}
-
-fn loadtest(args: &LoadtestArgs) -> Result<(), String> {
-    if args.rate > 0.0 && args.concurrency < workers_for_rate(args.rate) {
-        eprintln!(
-            "kinplan loadtest: note: {} workers at {} calls/s send every {:.2} ms each, under {} ms; \
-             latencies include the client's timer delay (use --concurrency {} or more)",
-            args.concurrency,
-            args.rate,
-            args.concurrency as f64 / args.rate * 1e3,
-            MIN_WORKER_INTERVAL.as_millis(),
-            workers_for_rate(args.rate),
-        );
-    }
-    // Only coordinates: each connection runs on a thread of its own.
-    let runtime = client_runtime()?;
-    let report = runtime.block_on(run_loadtest(args))?;
-    print!("{}", report.summary());
-    Ok(())
 }
 
 fn init_logging(format: LogFormat) {
@@ -260,7 +236,7 @@ fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> 
                 .with_http_listener(addr)
                 .set_buckets_for_metric(
                     metrics_exporter_prometheus::Matcher::Full("grpc_server_handling_seconds".into()),
-                    kinplan_server::service::HANDLING_BUCKETS,
+                    kinplan_server::HANDLING_BUCKETS,
                 )?
                 .install()?;
             tracing::info!(%addr, "metrics on http://{addr}/metrics");

@@ -1,6 +1,6 @@
 //! `kinplan_native`: the kinplan services for Python without a network hop.
 //!
-//! - `Backend`: the services in this process (`kinplan_server::service::InProcess`):
+//! - `Backend`: the services in this process (`kinplan_server::InProcess`):
 //!   encoded protobuf request in, encoded response out, streams included. The
 //!   `kinplan` package wraps it as a gRPC channel, so `kinplan.Client.local()`
 //!   has the whole client API.
@@ -16,7 +16,7 @@ use std::thread::JoinHandle;
 use std::time::Duration;
 
 use bytes::Bytes;
-use kinplan_server::service::{InProcess, ResponseStream, ServerConfig, serve};
+use kinplan_server::{InProcess, ResponseStream, ServerConfig, serve};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;

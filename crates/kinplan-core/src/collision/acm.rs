@@ -63,7 +63,32 @@ impl Default for AcmParams {
     }
 }
 
+/// Most body-pair tests one sampled matrix may cost (samples × pairs). The
+/// sampling does not look at a deadline, so a caller that builds matrices
+/// for models it did not choose (the server, for any URDF a client sends)
+/// bounds the cost with [`AcmParams::samples_within`]: a 7-body arm keeps
+/// 10,000 samples (210,000 tests); a 96-body URDF gets 438 samples instead
+/// of 45.6 million tests.
+pub const MAX_ACM_PAIR_TESTS: usize = 2_000_000;
+
 impl AcmParams {
+    /// `wanted` samples for a model of `bodies` bodies, capped so that
+    /// samples × body pairs stays within [`MAX_ACM_PAIR_TESTS`] (at least one
+    /// sample).
+    ///
+    /// ```
+    /// use kinplan_core::collision::{AcmParams, MAX_ACM_PAIR_TESTS};
+    /// assert_eq!(AcmParams::samples_within(7, 10_000), 10_000); // 21 pairs
+    /// assert_eq!(AcmParams::samples_within(96, 10_000), 438); // 4,560 pairs
+    /// assert!(438 * 4_560 <= MAX_ACM_PAIR_TESTS);
+    /// assert_eq!(AcmParams::samples_within(0, 10_000), 10_000);
+    /// assert_eq!(AcmParams::samples_within(100_000, 10_000), 1);
+    /// ```
+    pub fn samples_within(bodies: usize, wanted: usize) -> usize {
+        let pairs = (bodies * bodies.saturating_sub(1) / 2).max(1);
+        wanted.min(MAX_ACM_PAIR_TESTS / pairs).max(1)
+    }
+
     pub fn validate(&self) -> Result<(), CollisionError> {
         if self.samples == 0 || self.samples > 10_000_000 {
             return Err(CollisionError::OutOfRange {

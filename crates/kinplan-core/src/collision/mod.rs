@@ -47,7 +47,7 @@ mod sweep;
 mod trig;
 mod world;
 
-pub use acm::{AcmParams, AllowReason, AllowedCollisions};
+pub use acm::{AcmParams, AllowReason, AllowedCollisions, MAX_ACM_PAIR_TESTS};
 pub use attach::attached_bodies;
 pub use checker::{MotionCheck, PadVerdict, StateChecker, interpolate_motion_valid};
 pub use error::CollisionError;

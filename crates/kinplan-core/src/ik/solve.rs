@@ -76,6 +76,37 @@ impl IkResult {
     pub fn best(&self) -> Option<&IkSolution> {
         self.solutions.first().or(self.best_attempt.as_ref())
     }
+
+    /// Relabels `Cancelled` as `TimeBudget` in the stop reason, every
+    /// solution and the best attempt: for a caller whose cancellation check
+    /// is a deadline (a batch of targets cut by the request's deadline),
+    /// running out of time is a budget stop, not a caller that went away.
+    ///
+    /// ```
+    /// use kinplan_core::ik::{IkResult, IkStatus};
+    /// let mut r = IkResult {
+    ///     solutions: vec![],
+    ///     best_attempt: None,
+    ///     stop_reason: IkStatus::Cancelled,
+    ///     attempts: 1,
+    ///     total_iterations: 3,
+    ///     elapsed_us: 10,
+    /// };
+    /// r.cancelled_as_time_budget();
+    /// assert_eq!(r.stop_reason, IkStatus::TimeBudget);
+    /// ```
+    pub fn cancelled_as_time_budget(&mut self) {
+        let relabel = |s: &mut IkStatus| {
+            if *s == IkStatus::Cancelled {
+                *s = IkStatus::TimeBudget;
+            }
+        };
+        relabel(&mut self.stop_reason);
+        self.solutions.iter_mut().for_each(|s| relabel(&mut s.status));
+        if let Some(b) = self.best_attempt.as_mut() {
+            relabel(&mut b.status);
+        }
+    }
 }
 
 /// Validates a request shared by every front.

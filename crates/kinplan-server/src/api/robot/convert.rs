@@ -1,0 +1,75 @@
+//! `RobotService` replies: a chain's description (joints, links, collision
+//! shapes) as `DescribeRobotResponse`.
+
+use crate::api::convert::{pose_out, vec3_out};
+use crate::pb;
+use kinplan_core::robot::{Chain, JointKind, Shape};
+
+/// A chain's description: joints, links with their collision shapes, the tip.
+pub(super) fn describe(chain: &Chain, model_id: Vec<u8>) -> pb::DescribeRobotResponse {
+    let joints = chain
+        .joints()
+        .iter()
+        .map(|j| pb::JointInfo {
+            name: j.name.clone(),
+            r#type: match j.kind {
+                JointKind::Revolute => pb::JointType::Revolute,
+                JointKind::Continuous => pb::JointType::Continuous,
+                JointKind::Prismatic => pb::JointType::Prismatic,
+            } as i32,
+            origin: Some(pose_out(&j.origin)),
+            axis: Some(vec3_out(&j.axis)),
+            lower: j.lower,
+            upper: j.upper,
+            max_velocity: j.max_velocity.unwrap_or(0.0),
+        })
+        .collect();
+    let links = chain
+        .links()
+        .iter()
+        .zip(chain.collision())
+        .map(|(link, collision)| pb::LinkInfo {
+            name: link.name.clone(),
+            parent_joint: link.after_joint.map_or(-1, |j| j as i32),
+            offset: Some(pose_out(&link.offset)),
+            collision: collision
+                .shapes
+                .iter()
+                .map(|s| pb::CollisionGeometry {
+                    origin: Some(pose_out(&s.origin)),
+                    shape: Some(shape_out(&s.shape)),
+                })
+                .collect(),
+        })
+        .collect();
+    pb::DescribeRobotResponse {
+        name: chain.name().into(),
+        model_id,
+        base_link: chain.base_link().into(),
+        tip_link: chain.tip_link().into(),
+        joints,
+        links,
+        tip_offset: Some(pose_out(chain.tip_offset())),
+        urdf: String::new(),
+    }
+}
+
+/// A collision primitive of a link.
+fn shape_out(shape: &Shape) -> pb::collision_geometry::Shape {
+    use pb::collision_geometry::Shape as S;
+    match shape {
+        Shape::Box { half_extents } => S::Box(pb::Box {
+            size: Some(vec3_out(&(half_extents * 2.0))),
+        }),
+        Shape::Sphere { radius } => S::Sphere(pb::Sphere { radius: *radius }),
+        Shape::Cylinder { radius, length } => S::Cylinder(pb::Cylinder {
+            radius: *radius,
+            length: *length,
+        }),
+        Shape::Capsule { radius, length } => S::Capsule(pb::Capsule {
+            radius: *radius,
+            length: *length,
+        }),
+        Shape::MeshReference { filename } => S::MeshReference(filename.clone()),
+    }
+}

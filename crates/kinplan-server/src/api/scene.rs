@@ -1,0 +1,161 @@
+//! `Scene` (common.proto) → the collision room's validated [`Scene`]: one
+//! obstacle per object, an octree object becoming its occupied (and, on
+//! request, unknown) cells grouped by cell size.
+
+use nalgebra::Point3;
+use tonic::Status;
+
+use crate::api::convert::{finite, pose_in, vec3_in};
+use crate::pb::{self, collision_object::Shape};
+use crate::status::invalid;
+use kinplan_core::collision::{self, Geometry, Obstacle, Scene, SceneLimits};
+use kinplan_core::octree::{Octree, OctreeLimits};
+
+/// Largest octree a scene object may carry, in nodes.
+const MAX_SCENE_OCTREE_NODES: usize = 2_000_000;
+
+/// The scene of a request (`field` is its path, e.g. "scene"); unset is empty.
+/// Shapes are checked here field by field; what only the whole scene can
+/// tell (element counts, degenerate triangles) is checked by [`Scene::new`],
+/// whose message names the object as `obstacles[i]` (= `objects[i]`).
+pub fn scene_in(field: &str, scene: Option<&pb::Scene>, limits: &SceneLimits) -> Result<Scene, Status> {
+    let Some(scene) = scene else {
+        return Ok(Scene::empty());
+    };
+    if scene.objects.len() > limits.max_obstacles {
+        return Err(invalid(
+            format!("{field}.objects"),
+            format!(
+                "{} objects exceed the limit of {}",
+                scene.objects.len(),
+                limits.max_obstacles
+            ),
+        ));
+    }
+    let mut obstacles = Vec::with_capacity(scene.objects.len());
+    for (i, object) in scene.objects.iter().enumerate() {
+        let path = format!("{field}.objects[{i}]");
+        let name = if object.id.is_empty() {
+            format!("object {i}")
+        } else {
+            object.id.chars().take(64).collect()
+        };
+        let pose = pose_in(
+            &format!("{path}.pose"),
+            object.pose.as_ref().or(Some(&pb::Pose::default())),
+        )?;
+        let Some(shape) = &object.shape else {
+            return Err(invalid(
+                path,
+                "one of box, sphere, cylinder, capsule, mesh or octree is required",
+            ));
+        };
+        match shape {
+            Shape::Octree(tree) => {
+                for geometry in octree_cells(
+                    &format!("{path}.octree"),
+                    tree,
+                    object.unknown_as_obstacle,
+                    limits,
+                )? {
+                    obstacles.push(Obstacle::new(name.clone(), pose, geometry));
+                }
+            }
+            other => obstacles.push(Obstacle::new(name, pose, primitive_in(&path, other)?)),
+        }
+    }
+    Scene::new(obstacles, limits).map_err(|e| invalid(field, e.to_string()))
+}
+
+fn positive(field: &str, value: f64) -> Result<f64, Status> {
+    let v = finite(field, value)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(field, format!("must be > 0, got {v}")))
+    }
+}
+
+fn primitive_in(path: &str, shape: &Shape) -> Result<Geometry, Status> {
+    Ok(match shape {
+        Shape::Box(b) => {
+            let size = vec3_in(&format!("{path}.box.size"), b.size.as_ref())?;
+            for (axis, v) in ["x", "y", "z"].iter().zip(size.iter()) {
+                positive(&format!("{path}.box.size.{axis}"), *v)?;
+            }
+            Geometry::Box {
+                half_extents: size / 2.0,
+            }
+        }
+        Shape::Sphere(s) => Geometry::Sphere {
+            radius: positive(&format!("{path}.sphere.radius"), s.radius)?,
+        },
+        Shape::Cylinder(c) => Geometry::Cylinder {
+            radius: positive(&format!("{path}.cylinder.radius"), c.radius)?,
+            length: positive(&format!("{path}.cylinder.length"), c.length)?,
+        },
+        Shape::Capsule(c) => Geometry::Capsule {
+            radius: positive(&format!("{path}.capsule.radius"), c.radius)?,
+            length: finite(&format!("{path}.capsule.length"), c.length)?.max(0.0),
+        },
+        Shape::Mesh(m) => {
+            if m.indices.len() % 3 != 0 {
+                return Err(invalid(
+                    format!("{path}.mesh.indices"),
+                    format!("{} indices is not a multiple of 3", m.indices.len()),
+                ));
+            }
+            let vertices = m
+                .vertices
+                .iter()
+                .enumerate()
+                .map(|(k, v)| vec3_in(&format!("{path}.mesh.vertices[{k}]"), Some(v)).map(Point3::from))
+                .collect::<Result<Vec<_>, _>>()?;
+            if let Some(k) = m.indices.iter().position(|&i| i as usize >= vertices.len()) {
+                return Err(invalid(
+                    format!("{path}.mesh.indices[{k}]"),
+                    format!(
+                        "{} is out of range: the mesh has {} vertices",
+                        m.indices[k],
+                        vertices.len()
+                    ),
+                ));
+            }
+            Geometry::Mesh {
+                vertices,
+                indices: m.indices.clone(),
+            }
+        }
+        Shape::Octree(_) => unreachable!("octrees are converted by octree_cells"),
+    })
+}
+
+/// The occupied leaves of an OctoMap tree (and, with `unknown`, the unknown
+/// cubes inside its known bounds) as cubes, one geometry per cube size.
+fn octree_cells(
+    path: &str,
+    tree: &pb::Octree,
+    unknown: bool,
+    limits: &SceneLimits,
+) -> Result<Vec<Geometry>, Status> {
+    let octree_limits = OctreeLimits {
+        max_nodes: MAX_SCENE_OCTREE_NODES,
+    };
+    let octree =
+        Octree::from_message_data(tree.binary, &tree.id, tree.resolution, &tree.data, &octree_limits)
+            .map_err(|e| invalid(path, e.to_string()))?;
+    let Some((min, max)) = octree.known_bounds() else {
+        return Ok(Vec::new());
+    };
+    collision::octree_cells(&octree, &min, &max, unknown, limits.max_total_elements)
+        .map_err(|e| invalid(path, e.to_string()))?
+        .ok_or_else(|| {
+            invalid(
+                path,
+                format!(
+                    "more than {} obstacle cells; send a coarser tree",
+                    limits.max_total_elements
+                ),
+            )
+        })
+}

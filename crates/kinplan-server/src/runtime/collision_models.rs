@@ -1,0 +1,127 @@
+//! Collision models per robot chain: the bodies of its URDF `<collision>`
+//! primitives and the allowed-collision matrix sampled as MoveIt's setup
+//! assistant does (10 000 states by default), built
+//! once per parsed chain and kept in a small bounded cache beside the model
+//! cache. Only an optimisation: a miss rebuilds, so every replica answers.
+
+use std::sync::{Arc, Mutex, Weak};
+
+use kinplan_core::collision::{AcmParams, AllowedCollisions, CollisionError, RobotModel};
+use kinplan_core::robot::Chain;
+
+/// A chain's collision bodies and the body pairs never checked.
+pub struct CollisionSetup {
+    pub model: Arc<RobotModel>,
+    pub acm: AllowedCollisions,
+}
+
+impl CollisionSetup {
+    /// Builds the model and samples the matrix: `acm_samples` states, fewer
+    /// when the model has so many body pairs that the tests would exceed the
+    /// domain's bound ([`AcmParams::samples_within`]).
+    pub fn build(chain: Arc<Chain>, acm_samples: usize) -> Result<Self, CollisionError> {
+        let model = Arc::new(RobotModel::new(chain)?);
+        let acm = AllowedCollisions::sampled(
+            &model,
+            &AcmParams {
+                samples: AcmParams::samples_within(model.body_count(), acm_samples),
+                ..AcmParams::default()
+            },
+        )?;
+        Ok(Self { model, acm })
+    }
+}
+
+/// Setups keyed by the identity of the chain they were built for. A setup
+/// holds its chain (the robot model owns it), so the chain's address cannot
+/// be reused by another chain while the entry lives; the capacity bounds the
+/// cache (oldest entry out first).
+pub struct CollisionModels {
+    entries: Mutex<Vec<(Weak<Chain>, Arc<CollisionSetup>)>>,
+    capacity: usize,
+    /// States sampled for each allowed-collision matrix.
+    pub acm_samples: usize,
+}
+
+impl CollisionModels {
+    pub fn new(capacity: usize, acm_samples: usize) -> Self {
+        Self {
+            entries: Mutex::new(Vec::new()),
+            capacity: capacity.max(1),
+            acm_samples,
+        }
+    }
+
+    /// The setup built for this very chain, if cached.
+    pub fn get(&self, chain: &Arc<Chain>) -> Option<Arc<CollisionSetup>> {
+        let entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+        entries
+            .iter()
+            .find(|(w, _)| w.upgrade().is_some_and(|c| Arc::ptr_eq(&c, chain)))
+            .map(|(_, s)| s.clone())
+    }
+
+    /// Keeps `setup` for `chain`, dropping the oldest entries beyond the capacity.
+    pub fn insert(&self, chain: &Arc<Chain>, setup: Arc<CollisionSetup>) {
+        let mut entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
+        if !entries
+            .iter()
+            .any(|(w, _)| w.upgrade().is_some_and(|c| Arc::ptr_eq(&c, chain)))
+        {
+            entries.push((Arc::downgrade(chain), setup));
+        }
+        while entries.len() > self.capacity {
+            entries.remove(0);
+        }
+    }
+}
+
+/// The chain's collision setup: cached, or built on the CPU pool (and cached
+/// even if this request's deadline passes meanwhile).
+pub async fn collision_setup(
+    shared: &crate::runtime::Shared,
+    robot: &crate::runtime::models::Resolved,
+    budget: &crate::runtime::Budget,
+) -> Result<Arc<CollisionSetup>, tonic::Status> {
+    let cache = shared.collision.clone();
+    if let Some(s) = cache.get(&robot.chain) {
+        return Ok(s);
+    }
+    let chain = robot.chain.clone();
+    shared
+        .compute
+        .run(budget, move |_| {
+            let setup = Arc::new(CollisionSetup::build(chain.clone(), cache.acm_samples)?);
+            cache.insert(&chain, setup.clone());
+            Ok(setup)
+        })
+        .await?
+        .map_err(|e: CollisionError| crate::status::collision::collision_error("robot", e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kinplan_core::robot::builtin_chain;
+
+    #[test]
+    fn a_setup_is_found_only_for_its_own_chain_and_the_capacity_holds() {
+        let cache = CollisionModels::new(2, 50);
+        let ur5 = builtin_chain("ur5").unwrap();
+        let setup = Arc::new(CollisionSetup::build(ur5.clone(), 50).unwrap());
+        cache.insert(&ur5, setup.clone());
+        assert!(Arc::ptr_eq(&cache.get(&ur5).unwrap(), &setup));
+        // An equal chain in another allocation is another model.
+        let copy = Arc::new((*ur5).clone());
+        assert!(cache.get(&copy).is_none());
+        cache.insert(&copy, Arc::new(CollisionSetup::build(copy.clone(), 50).unwrap()));
+        drop(copy);
+        // The dead entry is dropped on the next insert; capacity holds.
+        let panda = builtin_chain("franka_panda").unwrap();
+        cache.insert(
+            &panda,
+            Arc::new(CollisionSetup::build(panda.clone(), 50).unwrap()),
+        );
+        assert_eq!(cache.entries.lock().unwrap().len(), 2);
+    }
+}
