@@ -326,6 +326,8 @@ async fn a_short_budget_ends_in_time_with_timeout() {
             max_iterations: Some(1_000_000),
             iterations_after_valid: Some(1_000_000),
             straight_line_start: true,
+            // noise too small to leave the ball: no valid trajectory, ever
+            noise_stddev: vec![1e-4],
             ..Default::default()
         }),
         time_budget: Some(0.05),
