@@ -5,6 +5,9 @@
 //! own retry policy is on (UNAVAILABLE retried 3 times, 20/40/80 ms backoff,
 //! within the deadline), so a call that fails here failed after its retries:
 //! a lost request. Used by deploy/k8s/play.sh while a replica is killed.
+//! `--retry-transport-errors` also retries (up to 3 times, at once) a call
+//! that failed as UNKNOWN "transport error", which the client does not retry:
+//! tonic's status for a call whose connection broke under it.
 //!
 //! `cargo run --release -p kinplan-client --example balanced_load --
 //!  --targets 10.89.0.2:50051,10.89.0.3:50051 --out calls.txt`
@@ -28,6 +31,7 @@ struct Args {
     rate: f64,
     timeout: f64,
     out: String,
+    retry_transport_errors: bool,
 }
 
 fn parse() -> Result<Args, String> {
@@ -39,9 +43,14 @@ fn parse() -> Result<Args, String> {
         rate: 0.0,
         timeout: 5.0,
         out: "balanced_load_rust.txt".into(),
+        retry_transport_errors: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
+        if flag == "--retry-transport-errors" {
+            a.retry_transport_errors = true;
+            continue;
+        }
         let value = it.next().ok_or(format!("{flag} needs a value"))?;
         let bad = |e: &dyn std::fmt::Display| format!("{flag} {value}: {e}");
         match flag.as_str() {
@@ -71,12 +80,14 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     let start = Instant::now();
     let stop = start + Duration::from_secs_f64(args.duration);
     let sent = Arc::new(AtomicU64::new(0));
+    let transport_retries = Arc::new(AtomicU64::new(0));
     // each worker's schedule: one call every `interval` when paced
     let interval = (args.rate > 0.0).then(|| Duration::from_secs_f64(args.concurrency as f64 / args.rate));
     let mut workers = Vec::new();
     for w in 0..args.concurrency {
         let (robot, sent) = (robot.clone(), sent.clone());
         let (total, concurrency) = (args.total, args.concurrency);
+        let (retry_transport, transport_retries) = (args.retry_transport_errors, transport_retries.clone());
         workers.push(tokio::spawn(async move {
             let mut calls: Vec<(u64, u64, u8)> = Vec::new();
             let mut errors: BTreeMap<String, u64> = BTreeMap::new();
@@ -95,7 +106,19 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 i += 1;
                 let q = [0.1 + (i % 100) as f64 * 1e-3, -1.5, 1.4, 0.2, 0.3, 0.4];
-                let code = match robot.fk(&q).await {
+                let mut answer = robot.fk(&q).await;
+                // what the client does not retry: a call whose connection
+                // broke under it (the replica died) is UNKNOWN "transport error"
+                for _ in 0..3 {
+                    match &answer {
+                        Err(e) if retry_transport && is_transport_error(e) => {
+                            transport_retries.fetch_add(1, Ordering::Relaxed);
+                            answer = robot.fk(&q).await;
+                        }
+                        _ => break,
+                    }
+                }
+                let code = match answer {
                     Ok(_) => 0,
                     Err(e) => {
                         *errors.entry(e.to_string()).or_default() += 1;
@@ -131,10 +154,21 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (message, n) in &errors {
         println!("  {n} x {message}");
     }
+    if args.retry_transport_errors {
+        println!(
+            "  {} retries of UNKNOWN transport errors (--retry-transport-errors)",
+            transport_retries.load(Ordering::Relaxed)
+        );
+    }
     println!(
         "rust client: {} calls in {elapsed:.1} s, {} answered, {failed} failed after retries",
         calls.len(),
         calls.len() - failed
     );
     Ok(())
+}
+
+/// tonic's status for a call whose HTTP/2 connection failed under it.
+fn is_transport_error(e: &kinplan_client::Error) -> bool {
+    e.code() == kinplan_client::Code::Unknown && e.message() == "transport error"
 }
