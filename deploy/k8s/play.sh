@@ -10,8 +10,9 @@
 # Per round (one client each): load for DURATION s at RATE calls/s; at KILL_AT
 # s one replica's server process gets SIGKILL (a crash, no drain; KILL=pod
 # kills its whole pod); at RESTART_AT s its pod is started again (`podman pod
-# start`: the restart the kubelet does, which podman does not) and rejoins
-# once SERVING. A lost request is a call that failed after the client's own
+# start`: the restart the kubelet does, which podman does not here) and
+# rejoins once SERVING. KILL=term sends SIGTERM instead: the server drains
+# and exits 0, and podman restarts it itself (restartPolicy Always). A lost request is a call that failed after the client's own
 # retries.
 #
 # Networking stays off the host: every podman command runs in a network
@@ -27,7 +28,8 @@ DURATION=${DURATION:-20}    # s per round
 KILL_AT=${KILL_AT:-5}       # s into the round
 RESTART_AT=${RESTART_AT:-10}
 CONCURRENCY=${CONCURRENCY:-8}
-KILL=${KILL:-container}     # container: SIGKILL the server process; pod: the whole pod
+KILL=${KILL:-container}     # container: SIGKILL the server process; pod: SIGKILL the whole
+                            # pod; term: SIGTERM the server (its drain, as on a rollout)
 NETNS=${KINPLAN_PLAY_NETNS:-kinplan-play}
 SUBNET=${KINPLAN_PLAY_SUBNET:-10.89.7}   # /24 of the pods' network (inside the namespace)
 PY=${PYTHON:-target/py-venv/bin/python}
@@ -129,7 +131,9 @@ fk_count() { # ForwardKinematics calls a replica answered since it started (its 
 lost_total=0
 round() { # client victim
   local client=$1 victim=$2 calls=$work/calls-$1.txt events=$work/events-$1.txt
-  echo "== $client client over $targets: ${RATE}/s for ${DURATION} s; SIGKILL $victim ($KILL) at ${KILL_AT} s, restart at ${RESTART_AT} s"
+  local flags=""
+  [ "$client" = rust ] && [ -n "${RUST_RETRY_TRANSPORT:-}" ] && flags=" (+ --retry-transport-errors)"
+  echo "== $client client$flags over $targets: ${RATE}/s for ${DURATION} s; kill $victim ($KILL) at ${KILL_AT} s, $([ "$KILL" = term ] && echo "podman restarts it after its drain" || echo "restart at ${RESTART_AT} s")"
   declare -A before
   for p in "${pods[@]}"; do before[$p]=$(fk_count "$p"); done
   local driver
@@ -137,23 +141,50 @@ round() { # client victim
     driver=("$PY" deploy/k8s/balanced_load.py)
   else
     driver=(target/release/examples/balanced_load)
+    # the client does not retry a call whose connection broke (see balanced_load.rs)
+    [ -n "${RUST_RETRY_TRANSPORT:-}" ] && driver+=(--retry-transport-errors)
   fi
   in_ns "${driver[@]}" --targets "$targets" --concurrency "$CONCURRENCY" --rate "$RATE" \
     --duration "$DURATION" --total "${TOTAL:-1000000}" --out "$calls" &
   local load=$!
   sleep "$KILL_AT"
-  local victim_before
+  epoch_of() { # a time field of the victim's container, as epoch seconds
+    in_ns podman inspect "$victim-kinplan" --format "{{.State.$1.UnixNano}}" |
+      awk '{ printf "%d.%09d\n", $1 / 1e9, $1 % 1e9 }'
+  }
+  local victim_before started0
+  started0=$(epoch_of StartedAt)
   victim_before=$(fk_count "$victim")
   echo "kill_sent $(now)" > "$events"
   if [ "$KILL" = pod ]; then
     in_ns podman pod kill "$victim" >/dev/null
+  elif [ "$KILL" = term ]; then
+    in_ns podman kill --signal TERM "$victim-kinplan" >/dev/null
   else
     in_ns podman kill "$victim-kinplan" >/dev/null
   fi
-  echo "kill $(now)" >> "$events" # the process is gone by now
-  sleep "$(python3 -c "print(max(0.0, $RESTART_AT - $KILL_AT))")"
-  echo "restart $(now)" >> "$events"
-  in_ns podman pod start "$victim" 2> >(grep -v "static macs" >&2) >/dev/null
+  echo "kill $(now)" >> "$events" # the process is gone by now (SIGKILL)
+  if [ "$KILL" = term ]; then
+    # the server exits 0 after its drain, and podman's restartPolicy Always
+    # (the pod's, as the kubelet's) restarts it at once, in the same pod
+    for _ in $(seq 400); do
+      [ "$(epoch_of StartedAt)" != "$started0" ] && break
+      sleep 0.1
+    done
+    echo "exited $(epoch_of FinishedAt)" >> "$events"
+    echo "restart $(epoch_of StartedAt)" >> "$events"
+    echo "restarted_by podman" >> "$events"
+  else
+    # SIGKILL: podman restarts nothing (the pod's exit policy stops it); start
+    # the pod again at RESTART_AT, as the kubelet would restart the container
+    sleep "$(python3 -c "print(max(0.0, $RESTART_AT - $KILL_AT))")"
+    for _ in $(seq 100); do
+      [ "$(in_ns podman pod inspect "$victim" --format '{{.State}}')" = Exited ] && break
+      sleep 0.1
+    done
+    echo "restart $(now)" >> "$events"
+    in_ns podman pod start "$victim" 2> >(grep -v "static macs" >&2) >/dev/null
+  fi
   local new_ip
   new_ip=$(pod_ip "$victim")
   [ "$new_ip" = "${ip[$victim]}" ] || echo "note: $victim came back on $new_ip (was ${ip[$victim]}); the clients' address list does not follow"

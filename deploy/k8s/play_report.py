@@ -24,7 +24,10 @@ def main() -> int:
     with open(events_path) as f:
         for line in f:
             name, t = line.split()
+            if name == "restarted_by":
+                continue
             events[name] = (float(t) - epoch) * 1e6  # µs into the round
+    by_podman = "restarted_by podman" in open(events_path).read()
     # the kill happened between these two (podman's start-up, ~0.1 s)
     kill_sent, kill, restart = events["kill_sent"], events["kill"], events["restart"]
     ok = [c for c in calls if c[2] == 0]
@@ -59,9 +62,13 @@ def main() -> int:
     print(f"  after the kill: {len(slow_after)} calls slower than {slow / 1e3:.0f} ms, the last done "
           f"{recover:.3f} s after the kill; answered/s 1 s before {rate(kill - 1e6, kill):.0f}, "
           f"1 s after {rate(kill, kill + 1e6):.0f}")
+    if "exited" in events:
+        print(f"  the replica's server exited {(events['exited'] - kill_sent) / 1e6:.2f} s after SIGTERM was sent "
+              f"(its drain), restarted {(restart - events['exited']) / 1e6:.2f} s later")
     if "ready" in events:
         first = f", first call answered by it {(events['first_call'] - restart) / 1e6:.2f} s after" if "first_call" in events else ", no call reached it"
-        print(f"  restarted replica SERVING {(events['ready'] - restart) / 1e6:.2f} s after `podman pod start`{first}")
+        how = "podman restarted it (restartPolicy Always)" if by_podman else "`podman pod start`"
+        print(f"  restarted replica SERVING {(events['ready'] - restart) / 1e6:.2f} s after {how}{first}")
     return 1 if failed else 0
 
 
