@@ -42,6 +42,7 @@ command -v podman >/dev/null || skip "no podman (apt-get install -y podman runc 
 command -v runc >/dev/null || skip "no runc (crun fails on this host's hybrid cgroups; apt-get install -y runc)"
 command -v iptables >/dev/null || skip "no iptables (netavark needs it for the pods' bridge)"
 "$PY" -c 'import kinplan, yaml' 2>/dev/null || skip "$PY lacks the kinplan client or pyyaml (pip install ./clients/python pyyaml)"
+# (the Rust client's load: target/release/examples/balanced_load, built below)
 
 work=$(mktemp -d)
 # runc: crun 1.8 refuses this host's cgroup layout ("cgroups in hybrid mode
@@ -75,7 +76,10 @@ now() { date +%s.%N; }
 since() { python3 -c "import sys; print(f'{float(sys.argv[2]) - float(sys.argv[1]):.2f}')" "$1" "$2"; }
 
 echo "== image"
-[ -n "${SKIP_BUILD:-}" ] || bash deploy/image/build.sh
+if [ -z "${SKIP_BUILD:-}" ]; then
+  bash deploy/image/build.sh
+  cargo build --release --locked -p kinplan-client --example balanced_load
+fi
 podman image exists kinplan:latest || skip "no image kinplan:latest (deploy/image/build.sh)"
 # can a container run here at all?
 if ! err=$(in_ns podman run --rm --network none kinplan:latest --version 2>&1); then
