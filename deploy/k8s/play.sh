@@ -41,6 +41,7 @@ skip() { echo "SKIP: $*" >&2; exit 77; }
 command -v podman >/dev/null || skip "no podman (apt-get install -y podman runc iptables)"
 command -v runc >/dev/null || skip "no runc (crun fails on this host's hybrid cgroups; apt-get install -y runc)"
 command -v iptables >/dev/null || skip "no iptables (netavark needs it for the pods' bridge)"
+command -v curl >/dev/null || skip "no curl (reads the replicas' metrics)"
 "$PY" -c 'import kinplan, yaml' 2>/dev/null || skip "$PY lacks the kinplan client or pyyaml (pip install ./clients/python pyyaml)"
 # (the Rust client's load: target/release/examples/balanced_load, built below)
 
