@@ -12,17 +12,17 @@
 # kills its whole pod); at RESTART_AT s its pod is started again (`podman pod
 # start`: the restart the kubelet does, which podman does not here) and
 # rejoins once SERVING. KILL=term sends SIGTERM instead: the server drains
-# and exits 0, and podman restarts it itself (restartPolicy Always). A lost request is a call that failed after the client's own
-# retries.
+# and exits 0, and podman restarts it itself (restartPolicy Always). A lost
+# request is a call that failed after the client's own retries.
 #
 # Networking stays off the host: every podman command runs in a network
 # namespace made here (`ip netns add`; nsenter --net only, so podman's mounts
 # stay in the host's mount namespace), which holds podman's bridge, its
-# iptables rules and the pods; the clients run there too. podman's kube
-# network (podman-default-kube-network, 10.89.0.0/24) exists only inside it.
+# iptables rules and the pods; the clients run there too. The pods' network
+# (podman network `kinplan-play`, $SUBNET.0/24, removed at the end) has its
+# bridge only inside it.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-root=$PWD
 RATE=${RATE:-400}           # calls/s per client; 0: back to back (closed loop)
 DURATION=${DURATION:-20}    # s per round
 KILL_AT=${KILL_AT:-5}       # s into the round
