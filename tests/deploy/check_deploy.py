@@ -1,12 +1,14 @@
 """Offline checks of deploy/: the Kubernetes manifests validate against the
 Kubernetes schemas (kubernetes-validate, strict), their settings agree with
 each other and with the image, and the registry Dockerfile's final stage is
-the podman Containerfile.
+the podman Containerfile; the podman rendering (deploy/k8s/podman_render.py,
+run by deploy/k8s/play.sh) changes only what podman does not support.
 
     python tests/deploy/check_deploy.py      # needs kubernetes-validate, pyyaml
 """
 from __future__ import annotations
 
+import copy
 import re
 import sys
 from pathlib import Path
@@ -83,6 +85,29 @@ def main() -> int:
     check(
         float(env.get("KINPLAN_DRAIN_DELAY_SECS", 0)) < grace,
         "drain delay is not shorter than terminationGracePeriodSeconds",
+    )
+
+    # deploy/k8s/play.sh runs podman_render.py's rendering: it may only drop
+    # what podman does not run (Services, HPA, PDB, container ports, gRPC
+    # probes) and pin the pull policy; every other field is the manifest's.
+    sys.path.insert(0, str(ROOT / "deploy/k8s"))
+    import podman_render
+
+    try:
+        rendered = podman_render.render(copy.deepcopy(docs))
+    except SystemExit as err:
+        rendered = []
+        check(False, f"podman_render.py: {err}")
+    want = copy.deepcopy(deployment)
+    for wc in want["spec"]["template"]["spec"]["containers"]:
+        wc.pop("ports", None)
+        for probe in ("readinessProbe", "livenessProbe", "startupProbe"):
+            if "grpc" in wc.get(probe, {}):
+                del wc[probe]
+        wc.setdefault("imagePullPolicy", "Never")
+    check(
+        rendered == [want],
+        "podman_render.py changes more than ports, gRPC probes and the pull policy, or keeps another kind",
     )
 
     for f in failures:
