@@ -177,7 +177,7 @@ fn path_text(path: &[Step]) -> String {
 }
 
 /// Full name of the matrix message, whose data entries are also named by row
-/// and column.
+/// and column (`joint_positions[1][2]`) in the description.
 const MATRIX: &str = ".kinplan.v1.Matrix";
 
 fn varint(bytes: &[u8], at: &mut usize) -> Option<u64> {
@@ -251,7 +251,12 @@ fn walk(
         let refuse = |path: &mut Vec<Step>, field: &'static Field, index: Option<usize>, why: String| {
             let why = match index {
                 Some(k) if is_matrix && columns > 0 => {
-                    format!("{why} (row {}, column {})", k / columns, k % columns)
+                    format!(
+                        "{why} (that is {}[{}][{}])",
+                        path_text(path),
+                        k / columns,
+                        k % columns
+                    )
                 }
                 _ => why,
             };
@@ -406,7 +411,9 @@ mod tests {
         };
         let m = message(check_request(&req).unwrap_err());
         assert!(
-            m.starts_with("joint_positions.data[5]: must be a number, got NaN (row 1, column 2)"),
+            m.starts_with(
+                "joint_positions.data[5]: must be a number, got NaN (that is joint_positions[1][2])"
+            ),
             "{m}"
         );
     }
