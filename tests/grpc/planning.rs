@@ -626,3 +626,94 @@ async fn padded_motions_plan_around_the_sphere_and_an_unbounded_robot_is_refused
         "{status:?}"
     );
 }
+
+/// Regression: links off the chain — a gripper fixed beyond the tip, a
+/// pedestal above the base, a built-in hand's fingers — were not part of the
+/// collision model, so CheckState called states free whose gripper met an
+/// obstacle. A one-joint arm `base → arm` (tip `arm`, a 0.05 × 0.05 × 0.5 m
+/// box up z), a 0.1 m gripper cube centred 0.55 m up, a 0.4 m pedestal cube
+/// centred 0.3 m below the base: balls placed by hand on each.
+#[tokio::test]
+async fn the_whole_robot_collides_in_check_state() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let urdf = r#"<robot name="whole">
+      <link name="world"/>
+      <link name="pedestal"><collision><origin xyz="0 0 0.2"/><geometry><box size="0.4 0.4 0.4"/></geometry></collision></link>
+      <link name="base"/>
+      <link name="arm"><collision><origin xyz="0 0 0.25"/><geometry><box size="0.05 0.05 0.5"/></geometry></collision></link>
+      <link name="gripper"><collision><origin xyz="0 0 0.05"/><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+      <joint name="w" type="fixed"><parent link="world"/><child link="pedestal"/></joint>
+      <joint name="p" type="fixed"><parent link="pedestal"/><child link="base"/><origin xyz="0 0 0.5"/></joint>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+        <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+      <joint name="flange" type="fixed"><parent link="arm"/><child link="gripper"/><origin xyz="0 0 0.5"/></joint>
+    </robot>"#;
+    let robot = Some(pb::RobotRef {
+        source: Some(pb::robot_ref::Source::Urdf(urdf.into())),
+        base_link: "base".into(),
+        tip_link: "arm".into(),
+        ..Default::default()
+    });
+    let check = |ball: pb::CollisionObject| pb::CheckStateRequest {
+        robot: robot.clone(),
+        states: vec![pb::JointState { positions: vec![0.0] }],
+        scene: Some(pb::Scene { objects: vec![ball] }),
+        max_distance: None,
+    };
+    for (what, centre) in [("gripper", [0.07, 0.0, 0.55]), ("pedestal", [0.23, 0.0, -0.3])] {
+        let reply = planning
+            .check_state(check(sphere("ball", centre, 0.03)))
+            .await
+            .unwrap()
+            .into_inner();
+        let state = &reply.states[0];
+        assert!(!state.valid, "{what}: {state:?}");
+        assert_eq!(state.colliding, [format!("{what}:ball")], "{what}");
+    }
+    // clear of everything: 0.1 m beside the gripper
+    let reply = planning
+        .check_state(check(sphere("ball", [0.2, 0.0, 0.55], 0.03)))
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(reply.states[0].valid);
+
+    // the built-in Panda with its hand: the fingers (closed, off the chain) collide
+    let q = [0.0, 0.3, 0.0, -2.0, 0.0, 2.3, 0.785];
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let fk = robots
+        .forward_kinematics(pb::ForwardKinematicsRequest {
+            robot: named("franka_panda_hand"),
+            joint_positions: q.to_vec(),
+            include_links: true,
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    let tool = fk.tool_pose.unwrap().position.unwrap();
+    let reply = planning
+        .check_state(pb::CheckStateRequest {
+            robot: named("franka_panda_hand"),
+            states: vec![pb::JointState {
+                positions: q.to_vec(),
+            }],
+            scene: Some(pb::Scene {
+                objects: vec![sphere("ball", [tool.x, tool.y, tool.z], 0.005)],
+            }),
+            max_distance: None,
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    let hit: Vec<&str> = reply.states[0]
+        .colliding
+        .iter()
+        .map(|c| c.split(':').next().unwrap())
+        .collect();
+    assert!(
+        hit.iter().any(|l| l.contains("finger")),
+        "a ball between the closed fingertips touches a finger: {:?}",
+        reply.states[0].colliding
+    );
+}

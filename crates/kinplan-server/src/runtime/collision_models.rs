@@ -1,5 +1,7 @@
 //! Collision models per robot chain: the bodies of its URDF `<collision>`
-//! primitives and the allowed-collision matrix sampled as MoveIt's setup
+//! primitives — the whole robot: the chain and every link it carries (a
+//! gripper beyond the tip, a pedestal above the base, off-chain joints at 0
+//! clamped into their limits) — and the allowed-collision matrix sampled as MoveIt's setup
 //! assistant does (10 000 states by default), built
 //! once per parsed chain and kept in a small bounded cache beside the model
 //! cache. Only an optimisation: a miss rebuilds, so every replica answers.
@@ -16,11 +18,16 @@ pub struct CollisionSetup {
 }
 
 impl CollisionSetup {
-    /// Builds the model and samples the matrix: `acm_samples` states, fewer
-    /// when the model has so many body pairs that the tests would exceed the
-    /// domain's bound ([`AcmParams::samples_within`]).
-    pub fn build(chain: Arc<Chain>, acm_samples: usize) -> Result<Self, CollisionError> {
-        let model = Arc::new(RobotModel::new(chain)?);
+    /// Builds the model — of the whole robot in `urdf` (the text `chain` was
+    /// parsed from), or of the chain alone without one — and samples the
+    /// matrix: `acm_samples` states, fewer when the model has so many body
+    /// pairs that the tests would exceed the domain's bound
+    /// ([`AcmParams::samples_within`]).
+    pub fn build(chain: Arc<Chain>, urdf: Option<&str>, acm_samples: usize) -> Result<Self, CollisionError> {
+        let model = Arc::new(match urdf {
+            Some(text) => RobotModel::of_urdf(chain, text, &[], &[])?,
+            None => RobotModel::new(chain)?,
+        });
         let acm = AllowedCollisions::sampled(
             &model,
             &AcmParams {
@@ -88,10 +95,15 @@ pub async fn collision_setup(
         return Ok(s);
     }
     let chain = robot.chain.clone();
+    let urdf = robot.urdf.clone();
     shared
         .compute
         .run(budget, move |_| {
-            let setup = Arc::new(CollisionSetup::build(chain.clone(), cache.acm_samples)?);
+            let setup = Arc::new(CollisionSetup::build(
+                chain.clone(),
+                Some(&urdf),
+                cache.acm_samples,
+            )?);
             cache.insert(&chain, setup.clone());
             Ok(setup)
         })
@@ -108,19 +120,22 @@ mod tests {
     fn a_setup_is_found_only_for_its_own_chain_and_the_capacity_holds() {
         let cache = CollisionModels::new(2, 50);
         let ur5 = builtin_chain("ur5").unwrap();
-        let setup = Arc::new(CollisionSetup::build(ur5.clone(), 50).unwrap());
+        let setup = Arc::new(CollisionSetup::build(ur5.clone(), None, 50).unwrap());
         cache.insert(&ur5, setup.clone());
         assert!(Arc::ptr_eq(&cache.get(&ur5).unwrap(), &setup));
         // An equal chain in another allocation is another model.
         let copy = Arc::new((*ur5).clone());
         assert!(cache.get(&copy).is_none());
-        cache.insert(&copy, Arc::new(CollisionSetup::build(copy.clone(), 50).unwrap()));
+        cache.insert(
+            &copy,
+            Arc::new(CollisionSetup::build(copy.clone(), None, 50).unwrap()),
+        );
         drop(copy);
         // The dead entry is dropped on the next insert; capacity holds.
         let panda = builtin_chain("franka_panda").unwrap();
         cache.insert(
             &panda,
-            Arc::new(CollisionSetup::build(panda.clone(), 50).unwrap()),
+            Arc::new(CollisionSetup::build(panda.clone(), None, 50).unwrap()),
         );
         assert_eq!(cache.entries.lock().unwrap().len(), 2);
     }

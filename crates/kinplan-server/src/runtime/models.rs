@@ -20,6 +20,25 @@ use kinplan_core::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_cha
 pub struct Resolved {
     pub chain: Arc<Chain>,
     pub model_id: Vec<u8>,
+    /// The URDF the chain was parsed from: its other links (a gripper beyond
+    /// the tip, a pedestal) belong to the collision model too.
+    pub urdf: Arc<str>,
+}
+
+/// The URDF text of a built-in robot, shared (not copied per request).
+fn builtin_text(name: &str) -> Result<Arc<str>, Status> {
+    static TEXTS: std::sync::OnceLock<HashMap<&'static str, Arc<str>>> = std::sync::OnceLock::new();
+    let texts = TEXTS.get_or_init(|| {
+        kinplan_core::robot::BUILTIN_NAMES
+            .iter()
+            .filter_map(|n| Some((*n, Arc::<str>::from(kinplan_core::robot::builtin_urdf(n).ok()?))))
+            .collect()
+    });
+    kinplan_core::robot::builtin_urdf(name).map_err(|e| robot_error(e, ""))?;
+    texts
+        .get(name)
+        .cloned()
+        .ok_or_else(|| invalid("robot.name", "a built-in robot without its URDF"))
 }
 
 /// A small least-recently-used map, bounded in entries and in bytes (each
@@ -96,7 +115,8 @@ type ModelId = [u8; 32];
 /// Parsed models and the URDF texts behind them, both bounded.
 pub struct ModelStore {
     limits: UrdfLimits,
-    chains: Mutex<Lru<(ModelId, ChainSpec), Arc<Chain>>>,
+    /// Parsed chains with the text they came from (its other links collide too).
+    chains: Mutex<Lru<(ModelId, ChainSpec), (Arc<Chain>, Arc<str>)>>,
     texts: Mutex<Lru<ModelId, Arc<str>>>,
 }
 
@@ -138,14 +158,12 @@ impl ModelStore {
                     return Ok(Resolved {
                         chain,
                         model_id: Vec::new(),
+                        urdf: builtin_text(name)?,
                     });
                 }
                 // Another chain of a built-in: parsed once, then cached like any URDF.
-                let urdf = kinplan_core::robot::builtin_urdf(name).map_err(|e| robot_error(e, ""))?;
-                (
-                    Sha256::digest(urdf.as_bytes()).into(),
-                    Some(Arc::<str>::from(urdf)),
-                )
+                let urdf = builtin_text(name)?;
+                (Sha256::digest(urdf.as_bytes()).into(), Some(urdf))
             }
             Some(Source::Urdf(text)) => {
                 if text.len() > self.limits.max_bytes {
@@ -174,8 +192,12 @@ impl ModelStore {
             _ => id.to_vec(),
         };
         let key = (id, spec.clone());
-        if let Some(chain) = self.chains.lock().expect("cache lock").get(&key) {
-            return Ok(Resolved { chain, model_id });
+        if let Some((chain, urdf)) = self.chains.lock().expect("cache lock").get(&key) {
+            return Ok(Resolved {
+                chain,
+                model_id,
+                urdf,
+            });
         }
         let text = match text {
             Some(t) => t,
@@ -191,13 +213,18 @@ impl ModelStore {
         self.texts
             .lock()
             .expect("cache lock")
-            .insert(id, text, text_bytes);
-        let size = chain_bytes(&chain);
+            .insert(id, text.clone(), text_bytes);
+        // the text is counted again here: a chain entry keeps it alive
+        let size = chain_bytes(&chain) + text_bytes;
         self.chains
             .lock()
             .expect("cache lock")
-            .insert(key, chain.clone(), size);
-        Ok(Resolved { chain, model_id })
+            .insert(key, (chain.clone(), text.clone()), size);
+        Ok(Resolved {
+            chain,
+            model_id,
+            urdf: text,
+        })
     }
 
     async fn parse(
