@@ -25,6 +25,9 @@ pub struct Resolved {
     pub urdf: Arc<str>,
 }
 
+/// A parsed chain and the URDF text it came from.
+type ParsedChain = (Arc<Chain>, Arc<str>);
+
 /// The URDF text of a built-in robot, shared (not copied per request).
 fn builtin_text(name: &str) -> Result<Arc<str>, Status> {
     static TEXTS: std::sync::OnceLock<HashMap<&'static str, Arc<str>>> = std::sync::OnceLock::new();
@@ -116,7 +119,7 @@ type ModelId = [u8; 32];
 pub struct ModelStore {
     limits: UrdfLimits,
     /// Parsed chains with the text they came from (its other links collide too).
-    chains: Mutex<Lru<(ModelId, ChainSpec), (Arc<Chain>, Arc<str>)>>,
+    chains: Mutex<Lru<(ModelId, ChainSpec), ParsedChain>>,
     texts: Mutex<Lru<ModelId, Arc<str>>>,
 }
 
