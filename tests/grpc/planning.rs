@@ -653,7 +653,6 @@ async fn the_whole_robot_collides_in_check_state() {
         source: Some(pb::robot_ref::Source::Urdf(urdf.into())),
         base_link: "base".into(),
         tip_link: "arm".into(),
-        ..Default::default()
     });
     let check = |ball: pb::CollisionObject| pb::CheckStateRequest {
         robot: robot.clone(),
