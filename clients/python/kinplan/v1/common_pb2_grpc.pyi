@@ -5,6 +5,19 @@ Messages shared by every kinplan service.
 
 Units: metres, radians, seconds. Frames: a robot's base frame unless a field
 says otherwise. Quaternions have named fields x, y, z, w (w the scalar part).
+
+Numbers in requests: every double and float of a request is finite, within
++-1e6 and not subnormal (0 is fine) unless its field documents another
+range (point clouds and depth pixels take any value, non-finite and far ones
+being skipped; a linear system's matrix and right-hand side allow +-1e150;
+a few limits allow an infinity meaning "none"). A request that breaks this
+is INVALID_ARGUMENT naming the number's path, e.g. states[1].positions[2],
+before any work. Fields with a narrower documented range (a resolution, a
+radius) are checked against it too.
+
+Cost: every request's CPU time is bounded by its deadline (long loops look
+at it at least every few milliseconds) and its memory by its size and the
+limits each message documents.
 """
 
 from collections import abc as _abc

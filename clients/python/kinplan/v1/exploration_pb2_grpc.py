@@ -67,6 +67,8 @@ class ExplorationServiceServicer:
     def NextBestView(self, request, context):
         """Candidate views of the unknown space, filtered and ranked by utility
         f = w_d D + w_r R + w_i Ig (S0 §4), with per-stage counts and timings.
+        Memory: the input tree (at most 5,000,000 nodes) plus the candidates and
+        the region's frontier grid.
         """
         context.set_code(grpc.StatusCode.UNIMPLEMENTED)
         context.set_details('Method not implemented!')
@@ -74,7 +76,9 @@ class ExplorationServiceServicer:
 
     def InsertScan(self, request, context):
         """Integrates a point cloud (or a depth image) into an octree with
-        OctoMap's sensor model and returns the updated tree.
+        OctoMap's sensor model and returns the updated tree. Memory: the input
+        tree plus at most 5,000,000 nodes of growth and the keys of one batch of
+        beams (see InsertScanRequest for the order of the checks).
         """
         context.set_code(grpc.StatusCode.UNIMPLEMENTED)
         context.set_details('Method not implemented!')
@@ -82,7 +86,8 @@ class ExplorationServiceServicer:
 
     def OctreeInfo(self, request, context):
         """Resolution, node and leaf counts, bounds, and the free / occupied /
-        unknown volume inside a box.
+        unknown volume inside a box (each cell counting its part inside the box).
+        Memory: the input tree (at most 5,000,000 nodes).
         """
         context.set_code(grpc.StatusCode.UNIMPLEMENTED)
         context.set_details('Method not implemented!')
@@ -95,7 +100,8 @@ class ExplorationServiceServicer:
         the octree's occupied cells) -> execute -> scan -> insert, until the
         stop rule holds. One message per iteration, then a summary with the
         final octree. The scene is the ground truth the camera renders; the
-        planner never sees it.
+        planner never sees it. Memory: the scene, the growing tree (bounded like
+        InsertScan's) and one plan at a time.
         """
         context.set_code(grpc.StatusCode.UNIMPLEMENTED)
         context.set_details('Method not implemented!')

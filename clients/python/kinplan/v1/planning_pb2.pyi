@@ -257,7 +257,7 @@ class CheckStateRequest(_message.Message):
     def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., states: _Optional[_Iterable[_Union[JointState, _Mapping]]] = ..., scene: _Optional[_Union[_common_pb2.Scene, _Mapping]] = ..., max_distance: _Optional[float] = ...) -> None: ...
 
 class StateCheck(_message.Message):
-    __slots__ = ("valid", "within_limits", "clearance", "colliding", "robot_point", "obstacle_point", "closest_pair")
+    __slots__ = ("valid", "within_limits", "clearance", "colliding", "robot_point", "obstacle_point", "closest_pair", "error")
     VALID_FIELD_NUMBER: _ClassVar[int]
     WITHIN_LIMITS_FIELD_NUMBER: _ClassVar[int]
     CLEARANCE_FIELD_NUMBER: _ClassVar[int]
@@ -265,6 +265,7 @@ class StateCheck(_message.Message):
     ROBOT_POINT_FIELD_NUMBER: _ClassVar[int]
     OBSTACLE_POINT_FIELD_NUMBER: _ClassVar[int]
     CLOSEST_PAIR_FIELD_NUMBER: _ClassVar[int]
+    ERROR_FIELD_NUMBER: _ClassVar[int]
     valid: bool
     within_limits: bool
     clearance: float
@@ -272,7 +273,8 @@ class StateCheck(_message.Message):
     robot_point: _common_pb2.Vec3
     obstacle_point: _common_pb2.Vec3
     closest_pair: str
-    def __init__(self, valid: _Optional[bool] = ..., within_limits: _Optional[bool] = ..., clearance: _Optional[float] = ..., colliding: _Optional[_Iterable[str]] = ..., robot_point: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., obstacle_point: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., closest_pair: _Optional[str] = ...) -> None: ...
+    error: str
+    def __init__(self, valid: _Optional[bool] = ..., within_limits: _Optional[bool] = ..., clearance: _Optional[float] = ..., colliding: _Optional[_Iterable[str]] = ..., robot_point: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., obstacle_point: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., closest_pair: _Optional[str] = ..., error: _Optional[str] = ...) -> None: ...
 
 class CheckStateResponse(_message.Message):
     __slots__ = ("states",)

@@ -58,7 +58,10 @@ class PlanningServiceServicer:
         """A collision-free, timed joint trajectory from a start state to a goal
         (joint state or tool pose) in a scene. Planning failures (no valid
         trajectory, start or goal in collision, budget exhausted) are statuses
-        in the response; only malformed requests are errors.
+        in the response; only malformed requests are errors. Memory: the scene's
+        geometry plus STOMP's rollouts (timesteps x max_rollouts x joints, at most
+        4,000,000 values) or RRT-Connect's trees (at most 1,000,000 samples); STOMP's
+        matrices are banded, linear in the timesteps.
         """
         context.set_code(grpc.StatusCode.UNIMPLEMENTED)
         context.set_details('Method not implemented!')
@@ -75,7 +78,9 @@ class PlanningServiceServicer:
 
     def CheckState(self, request, context):
         """Validity and clearance of a batch of joint states in a scene, so a
-        client can check a plan without a collision library of its own.
+        client can check a plan without a collision library of its own. At most
+        100,000 states; memory linear in the states and the scene. A fault
+        confined to one state is that state's answer (StateCheck.error).
         """
         context.set_code(grpc.StatusCode.UNIMPLEMENTED)
         context.set_details('Method not implemented!')
