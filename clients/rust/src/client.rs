@@ -160,9 +160,7 @@ impl Client {
                 Ok(reply) => return Ok(reply.into_inner()),
                 Err(status) => status,
             };
-            let retry = status.code() == tonic::Code::Unavailable
-                && retries_left > 0
-                && Instant::now() + backoff < deadline;
+            let retry = retryable(&status) && retries_left > 0 && Instant::now() + backoff < deadline;
             if !retry {
                 return Err(Error::from(status));
             }
@@ -170,6 +168,18 @@ impl Client {
             retries_left -= 1;
             backoff *= 2;
         }
+    }
+}
+
+/// Whether a failed call may be sent again: UNAVAILABLE (no replica took it),
+/// or a transport failure under a call in flight (its connection broke: tonic
+/// answers UNKNOWN "transport error"). Every kinplan call is idempotent, so a
+/// retry cannot do the work twice in a way that matters.
+fn retryable(status: &tonic::Status) -> bool {
+    match status.code() {
+        tonic::Code::Unavailable => true,
+        tonic::Code::Unknown => status.message().starts_with("transport error"),
+        _ => false,
     }
 }
 
