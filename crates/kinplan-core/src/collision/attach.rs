@@ -182,8 +182,14 @@ fn link_shapes(link: &urdf_rs::Link) -> Result<Vec<CollisionShape>, CollisionErr
                 length: *length,
             },
             urdf_rs::Geometry::Sphere { radius } => Shape::Sphere { radius: *radius },
-            urdf_rs::Geometry::Mesh { filename, .. } => Shape::MeshReference {
+            urdf_rs::Geometry::Mesh { filename, scale } => Shape::MeshReference {
                 filename: filename.clone(),
+                scale: crate::robot::mesh_scale(scale.as_ref()).ok_or_else(|| {
+                    CollisionError::Degenerate {
+                        field: field.clone(),
+                        reason: format!("mesh `{filename}` has a scale that is not finite and non-zero"),
+                    }
+                })?,
             },
         };
         out.push(CollisionShape { origin, shape });

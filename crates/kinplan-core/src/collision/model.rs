@@ -420,7 +420,7 @@ fn body_shapes(
                 radius: *radius,
                 length: *length,
             },
-            Shape::MeshReference { filename } => {
+            Shape::MeshReference { filename, scale } => {
                 let mesh = meshes.iter().find(|m| &m.filename == filename).ok_or_else(|| {
                     CollisionError::MeshNotInline {
                         field: field.clone(),
@@ -428,7 +428,11 @@ fn body_shapes(
                     }
                 })?;
                 validate_mesh(&mesh.vertices, &mesh.indices, &field, &SceneLimits::default())?;
-                let points: Vec<_> = mesh.vertices.iter().map(|p| vec_to_parry(&p.coords)).collect();
+                let points: Vec<_> = mesh
+                    .vertices
+                    .iter()
+                    .map(|p| vec_to_parry(&p.coords.component_mul(scale)))
+                    .collect();
                 let hull = SharedShape::convex_hull(&points).ok_or_else(|| CollisionError::Degenerate {
                     field: field.clone(),
                     reason: format!("mesh `{filename}` has no 3-D convex hull"),

@@ -63,6 +63,8 @@ pub(super) fn box_mesh(h: Vector3<f64>) -> (Vec<Point3<f64>>, Vec<u32>) {
 /// Robot probe shapes: (name, URDF geometry, half width along x, inline meshes).
 fn probes() -> Vec<(&'static str, String, f64, Vec<InlineMesh>)> {
     let (vertices, indices) = box_mesh(Vector3::new(0.05, 0.04, 0.03));
+    // ten times larger in the file, scaled by the URDF to the same box
+    let (big, big_indices) = box_mesh(Vector3::new(0.5, 0.4, 0.3));
     vec![
         ("sphere", r#"<sphere radius="0.05"/>"#.into(), 0.05, vec![]),
         ("box", r#"<box size="0.1 0.3 0.2"/>"#.into(), 0.05, vec![]),
@@ -86,6 +88,16 @@ fn probes() -> Vec<(&'static str, String, f64, Vec<InlineMesh>)> {
                 filename: "package://probe/hull.stl".into(),
                 vertices,
                 indices,
+            }],
+        ),
+        (
+            "mesh scaled by the URDF",
+            r#"<mesh filename="package://probe/big.stl" scale="0.1 0.1 0.1"/>"#.into(),
+            0.05,
+            vec![InlineMesh {
+                filename: "package://probe/big.stl".into(),
+                vertices: big,
+                indices: big_indices,
             }],
         ),
     ]

@@ -24,9 +24,12 @@ pub enum Shape {
     Sphere {
         radius: f64,
     },
-    /// A mesh named by file: never read from disk, only reported.
+    /// A mesh named by file: never read from disk; its geometry comes with the
+    /// model (the client sends the file's bytes). `scale` multiplies the file's
+    /// coordinates per axis (URDF `<mesh scale>`, default 1 1 1).
     MeshReference {
         filename: String,
+        scale: Vector3<f64>,
     },
 }
 
@@ -43,4 +46,14 @@ pub struct CollisionShape {
 pub struct LinkCollision {
     pub link: String,
     pub shapes: Vec<CollisionShape>,
+}
+
+/// The scale of a URDF `<mesh scale="x y z">` (unset: 1 1 1), or `None` when a
+/// factor is not finite or is zero (a flattened or undefined mesh).
+pub fn mesh_scale(scale: Option<&urdf_rs::Vec3>) -> Option<Vector3<f64>> {
+    let s = match scale {
+        Some(v) => Vector3::new(v[0], v[1], v[2]),
+        None => Vector3::new(1.0, 1.0, 1.0),
+    };
+    s.iter().all(|f| f.is_finite() && *f != 0.0).then_some(s)
 }

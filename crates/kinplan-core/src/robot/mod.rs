@@ -11,7 +11,7 @@ mod urdf_export;
 pub use builtin::{ARM_NAMES, BUILTIN_NAMES, builtin_chain, builtin_urdf};
 pub use chain::{Chain, Joint, JointKind, LinkFrame};
 pub use error::RobotError;
-pub use geometry::{CollisionShape, LinkCollision, Shape};
+pub use geometry::{CollisionShape, LinkCollision, Shape, mesh_scale};
 pub use urdf::{ChainSpec, MAX_LIMIT, MAX_ORIGIN_METRES, MAX_XML_DEPTH, UrdfLimits, parse_chain};
 pub use urdf_export::expand_capsules;
 

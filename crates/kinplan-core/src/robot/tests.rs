@@ -309,7 +309,8 @@ fn mesh_files_are_reported_not_read() {
     assert_eq!(
         chain.collision()[0].shapes[0].shape,
         Shape::MeshReference {
-            filename: "/etc/passwd".into()
+            filename: "/etc/passwd".into(),
+            scale: nalgebra::Vector3::new(1.0, 1.0, 1.0),
         }
     );
 }

@@ -7,7 +7,7 @@ use std::collections::{HashMap, HashSet};
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
 
 use super::chain::LinkFrame;
-use super::{Chain, CollisionShape, Joint, JointKind, LinkCollision, RobotError, Shape};
+use super::{Chain, CollisionShape, Joint, JointKind, LinkCollision, RobotError, Shape, mesh_scale};
 
 /// Which part of a URDF tree to use. `None` picks the tree's single root as
 /// base, and its single end link as tip.
@@ -540,8 +540,14 @@ fn link_collision(link: &urdf_rs::Link) -> Result<LinkCollision, RobotError> {
                 positive(&[*radius])?;
                 Shape::Sphere { radius: *radius }
             }
-            urdf_rs::Geometry::Mesh { filename, .. } => Shape::MeshReference {
+            urdf_rs::Geometry::Mesh { filename, scale } => Shape::MeshReference {
                 filename: filename.clone(),
+                scale: mesh_scale(scale.as_ref()).ok_or_else(|| {
+                    RobotError::MalformedUrdf(format!(
+                        "link `{}`: mesh `{filename}` has a scale that is not finite and non-zero",
+                        link.name
+                    ))
+                })?,
             },
         };
         shapes.push(CollisionShape { origin, shape });

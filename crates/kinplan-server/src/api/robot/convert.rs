@@ -70,6 +70,6 @@ fn shape_out(shape: &Shape) -> pb::collision_geometry::Shape {
             radius: *radius,
             length: *length,
         }),
-        Shape::MeshReference { filename } => S::MeshReference(filename.clone()),
+        Shape::MeshReference { filename, .. } => S::MeshReference(filename.clone()),
     }
 }
