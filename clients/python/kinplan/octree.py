@@ -89,39 +89,32 @@ class Octree:
         if not self.binary:
             raise ValueError("only a binary tree's nodes are decoded")
         data = self.data
-        table = _child_table()
-        occ: List[Tuple[int, int, int, int]] = []
-        free: List[Tuple[int, int, int, int]] = []
-        order: List[bool] = []
+        inner_lo, inner_hi = _inner_children()
+        # one record per inner node (2 bytes, stream order): the node's lowest corner key and half edge; only
+        # the inner children are walked here, the leaves are read from the bytes with numpy below
+        nodes: List[Tuple[int, int, int, int]] = []
         stack = [(0, 0, 0, 0)] if data else []  # key of the node's lowest corner, depth
         i = 0
         while stack:
             kx, ky, kz, depth = stack.pop()
             half = 1 << (15 - depth)
-            children: List[Tuple[int, int, int, int]] = []
-            for base, byte in ((0, data[i]), (4, data[i + 1])):
-                o, f, n = table[byte]
-                for c in o:
-                    c += base
-                    occ.append((kx + half * (c & 1), ky + half * ((c >> 1) & 1), kz + half * (c >> 2), half))
-                    order.append(True)
-                for c in f:
-                    c += base
-                    free.append((kx + half * (c & 1), ky + half * ((c >> 1) & 1), kz + half * (c >> 2), half))
-                    order.append(False)
-                for c in n:
-                    c += base
-                    children.append((kx + half * (c & 1), ky + half * ((c >> 1) & 1), kz + half * (c >> 2),
-                                     depth + 1))
+            nodes.append((kx, ky, kz, half))
+            inner = inner_lo[data[i]] + inner_hi[data[i + 1]]
             i += 2
-            stack.extend(reversed(children))  # depth first, children in order 0..7
-        occupied = np.array(order, dtype=bool)
-        keys = np.empty((len(order), 4), dtype=np.int64)
-        if len(order):
-            keys[occupied] = np.array(occ, dtype=np.int64).reshape(-1, 4)
-            keys[~occupied] = np.array(free, dtype=np.int64).reshape(-1, 4)
-        mins = (keys[:, :3] - 32768) * self.resolution
-        return mins.astype(float), keys[:, 3] * self.resolution, occupied
+            if inner:  # depth first, children in order 0..7
+                stack.extend([(kx + half * (c & 1), ky + half * ((c >> 1) & 1), kz + half * (c >> 2), depth + 1)
+                              for c in reversed(inner)])
+        if not nodes:
+            return np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool)
+        rec = np.array(nodes, dtype=np.int64)
+        bits = np.frombuffer(data[:i], dtype="<u2").astype(np.int64)
+        kinds = (bits[:, None] >> (2 * np.arange(8))) & 3
+        r, c = np.nonzero((kinds == 1) | (kinds == 2))
+        offsets = np.array([[k & 1, (k >> 1) & 1, k >> 2] for k in range(8)], dtype=np.int64)
+        half = rec[r, 3]
+        keys = rec[r, :3] + half[:, None] * offsets[c]
+        mins = (keys - 32768) * self.resolution
+        return mins.astype(float), half * self.resolution, kinds[r, c] == 2
 
     def boxes(self, region: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
               max_cells: int = 1 << 23) -> Dict[str, Tuple[np.ndarray, np.ndarray]]:
@@ -167,7 +160,10 @@ class Octree:
             kmin = np.clip(kmin, 0, shape)
             kmax = np.clip(kmax, 0, shape)
             inside = np.all(kmax > kmin, axis=1)
-            for (x0, y0, z0), (x1, y1, z1) in zip(kmin[inside].tolist(), kmax[inside].tolist()):
+            single = inside & np.all(kmax - kmin == 1, axis=1)
+            known[tuple(kmin[single].T)] = True
+            big = inside & ~single
+            for (x0, y0, z0), (x1, y1, z1) in zip(kmin[big].tolist(), kmax[big].tolist()):
                 known[x0:x1, y0:y1, z0:z1] = True
         cells = np.argwhere(~known)
         a = (cells + k0) * res
@@ -189,18 +185,16 @@ class Octree:
         return f"Octree({kind}, resolution={self.resolution} m, {len(self.data)} bytes)"
 
 
-_CHILD_TABLE: List[Tuple[Tuple[int, ...], Tuple[int, ...], Tuple[int, ...]]] = []
+_INNER: List[Tuple[Tuple[int, ...], ...]] = []
 
 
-def _child_table() -> List[Tuple[Tuple[int, ...], Tuple[int, ...], Tuple[int, ...]]]:
-    """Per byte of a .bt node (4 children, 2 bits each): the children that
-    are occupied leaves (10), free leaves (01) and inner nodes (11)."""
-    if not _CHILD_TABLE:
-        for b in range(256):
-            kinds = [(b >> (2 * c)) & 3 for c in range(4)]
-            occupied, free, inner = (tuple(c for c in range(4) if kinds[c] == k) for k in (2, 1, 3))
-            _CHILD_TABLE.append((occupied, free, inner))
-    return _CHILD_TABLE
+def _inner_children() -> List[Tuple[Tuple[int, ...], ...]]:
+    """Per byte of a .bt node: its inner children (bits 11), for the low
+    byte (children 0-3) and for the high byte (children 4-7)."""
+    if not _INNER:
+        _INNER.append(tuple(tuple(c for c in range(4) if (b >> (2 * c)) & 3 == 3) for b in range(256)))
+        _INNER.append(tuple(tuple(c + 4 for c in range(4) if (b >> (2 * c)) & 3 == 3) for b in range(256)))
+    return _INNER
 
 
 def _count_binary_nodes(data: bytes) -> int:
