@@ -213,3 +213,60 @@ def test_an_exploration_recording_follows_the_run(c, tmp_path):
     np.testing.assert_allclose(views[-1][1], [s.view for s in steps if s.view is not None][-1], atol=1e-6)
     occupied = rows(data["/world/octree/occupied"], "Boxes3D:half_sizes", "iteration")
     assert occupied[-1][0] == summary.iterations and len(occupied[-1][1]) > 0
+
+
+MESHY = """<?xml version="1.0"?>
+<robot name="meshy">
+  <link name="base"><visual><geometry><box size="0.2 0.2 0.05"/></geometry></visual></link>
+  <link name="l1"><visual><geometry><mesh filename="link.stl"/></geometry></visual>
+    <collision><origin xyz="0 0 0.2"/><geometry><capsule radius="0.04" length="0.32"/></geometry></collision></link>
+  <link name="l2"><visual><geometry><mesh filename="link.stl"/></geometry></visual></link>
+  <link name="tool"/>
+  <link name="camera"><visual><geometry><box size="0.05 0.05 0.05"/></geometry></visual></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.05"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.4"/>
+    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="j3" type="fixed"><parent link="l2"/><child link="tool"/><origin xyz="0 0 0.4"/></joint>
+  <joint name="j4" type="fixed"><parent link="l1"/><child link="camera"/><origin xyz="0.1 0 0.2"/></joint>
+</robot>"""
+
+
+def write_stl_box(path, sx, sy, sz):
+    """A binary STL box standing on z = 0."""
+    import struct
+
+    v = [(x * sx / 2, y * sy / 2, (z + 1) * sz / 2) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1), (2, 3, 7), (2, 7, 6), (0, 2, 6),
+             (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    out = bytearray(80) + struct.pack("<I", len(faces))
+    for f in faces:
+        out += struct.pack("<3f", 0, 0, 0) + b"".join(struct.pack("<3f", *v[i]) for i in f) + b"\0\0"
+    path.write_bytes(bytes(out))
+
+
+def test_a_urdf_with_meshes_is_drawn_by_rerun_and_posed_by_kinplans_fk(c, tmp_path):
+    write_stl_box(tmp_path / "link.stl", 0.08, 0.08, 0.4)
+    urdf = tmp_path / "meshy.urdf"
+    urdf.write_text(MESHY)
+    robot = c.robot(urdf=MESHY, base_link="base", tip_link="tool")
+    q = np.linspace([0.0, 0.0], [1.5, 1.0], 12)
+    path = tmp_path / "urdf.rrd"
+    with viz.Recording("test", save=str(path)) as rec:
+        rec.robot(robot, urdf_file=str(urdf))
+        rec.plan(robot, kinplan.Plan(status="SUCCEEDED", message="", q=q, t=np.linspace(0, 2, 12), valid=True,
+                                     cost_history=np.zeros(0), deviation=np.zeros((0, 2)), violates_tolerance=False,
+                                     scores={}, colliding=[], goal=q[-1], iterations=0, duration=2.0, timings={}))
+    data = read(path)
+    meshes = sorted(e for e, b in data.items() if rows(b, "Asset3D:blob"))
+    # l1's and l2's visual mesh, read from link.stl by Rerun's loader, under the link entities
+    assert len(meshes) == 2 and meshes[0].startswith("/world/robot/l1/urdf/") and meshes[1].startswith("/world/robot/l2/")
+    for name in ("l1", "l2", "tool"):
+        got = transforms(data[f"/world/robot/{name}"], "plan_time")
+        assert len(got) == len(q)
+        for (t, T), qk in zip(got, q):
+            np.testing.assert_allclose(T, robot.fk(qk, links=True)[1][name], atol=1e-6)
+    # the link off the chain hangs from its parent link by its URDF joint, statically
+    (_, T), = transforms(data["/world/robot/l1/camera"], None)
+    np.testing.assert_allclose(T[:3, 3], [0.1, 0, 0.2], atol=1e-7)
+    assert rows(data["/world/robot/l1/camera/urdf/meshy/visual_geometries/camera/visual_0"], "Boxes3D:half_sizes")

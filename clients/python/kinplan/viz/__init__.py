@@ -48,7 +48,7 @@ COLORS: Dict[str, Tuple[int, int, int, int]] = {
     "unknown": (120, 120, 200, 70),
     "link": (170, 175, 185, 255),
     "collision": (230, 30, 30, 255),
-    "obstacle": (110, 110, 110, 160),
+    "obstacle": (110, 110, 110, 90),
     "tool_path": (30, 120, 230, 255),
     "tube": (250, 200, 40, 45),
     "region": (250, 200, 40, 255),
@@ -118,16 +118,23 @@ class Recording:
     - none: buffered in memory (``self.stream`` is the ``rerun.RecordingStream``
       for any other sink or your own logging).
 
-    Use as a context manager, or call :meth:`close` to flush the data."""
+    Use as a context manager, or call :meth:`close` to flush the data. With
+    ``blueprint`` (default), :meth:`close` sends a layout: the 3-D view of
+    ``world/`` (seen from ``eye`` = (position, target) when given, z up)
+    beside one plot per quantity logged under ``plots/``."""
 
     def __init__(self, name: str = "kinplan", *, save: Optional[str] = None, spawn: bool = False,
                  serve: bool = False, web_port: Optional[int] = None, grpc_port: Optional[int] = None,
-                 open_browser: bool = False, recording_id: Optional[str] = None):
+                 open_browser: bool = False, recording_id: Optional[str] = None, blueprint: bool = True,
+                 eye: Optional[Tuple[Sequence[float], Sequence[float]]] = None):
         self.stream: Any = rr.RecordingStream(name, recording_id=recording_id or str(uuid.uuid4()))
         self.url: Optional[str] = None
         self.service_seconds = 0.0
         self._robots: Dict[str, Dict[str, Any]] = {}
         self._views_logged: Dict[str, int] = {}
+        self._plots: List[str] = []
+        self.blueprint = blueprint
+        self.eye = eye
         if save is not None:
             self.stream.save(save)
         if spawn:
@@ -145,9 +152,31 @@ class Recording:
         self.close()
 
     def close(self) -> None:
-        """Flushes everything logged and closes the sinks (a saved file is complete)."""
+        """Sends the layout (with ``blueprint``), flushes everything logged
+        and closes the sinks (a saved file is complete)."""
+        if self.blueprint:
+            self.stream.send_blueprint(self.layout())
         self.stream.flush()
         self.stream.disconnect()
+
+    def layout(self) -> Any:
+        """The default blueprint: the 3-D view of ``world/`` beside a
+        column of plots, one per quantity logged under ``plots/``."""
+        rrb = importlib.import_module("rerun.blueprint")
+        eye = None
+        if self.eye is not None:
+            eye = rrb.EyeControls3D(position=self.eye[0], look_target=self.eye[1], eye_up=(0.0, 0.0, 1.0))
+        world = rrb.Spatial3DView(origin="/world", name="world", eye_controls=eye)
+        if not self._plots:
+            return rrb.Blueprint(world, collapse_panels=False)
+        plots = [rrb.TimeSeriesView(origin=f"/{p}", name=p.split("/", 1)[1]) for p in self._plots]
+        return rrb.Blueprint(rrb.Horizontal(world, rrb.Vertical(*plots), column_shares=[3, 1]))
+
+    def _plot(self, group: str) -> str:
+        """Registers a plot (an entity path under ``plots/``) for the layout."""
+        if group not in self._plots:
+            self._plots.append(group)
+        return group
 
     def _service(self, fn: Any, *args: Any, **kwargs: Any) -> Any:
         t0 = time.perf_counter()
@@ -159,12 +188,19 @@ class Recording:
     # ---- the robot ------------------------------------------------------------------------------------------------
 
     def robot(self, robot: Any, q: Optional[Any] = None, *, path: str = "world/robot",
-              color: Optional[Sequence[int]] = None) -> None:
+              color: Optional[Sequence[int]] = None, urdf_file: Optional[str] = None) -> None:
         """Draws ``robot``'s collision bodies (the capsules, spheres, boxes
         and cylinders of ``robot.describe()``: kinplan's own geometry; a mesh
         a URDF names is not read, and its link is drawn as its frame only)
         under ``path/<link>``; each link entity carries its pose. With
-        ``q``, poses it there (at the current time of the recording)."""
+        ``urdf_file`` (the robot's URDF on disk, its mesh files where it
+        names them), the URDF's visual and collision geometry instead, read
+        by Rerun's URDF loader and put under ``path/<link>/urdf``: posed the
+        same way, by kinplan's FK (a link off the chain hangs from its parent
+        link by its URDF joint at 0). With ``q``, poses it there (at the
+        current time of the recording)."""
+        if path not in self._robots and urdf_file is not None:
+            self._urdf_robot(robot, path, urdf_file)
         if path not in self._robots:
             d = self._service(robot.describe)
             shapes: Dict[str, List[Tuple[str, Any]]] = {}
@@ -182,6 +218,41 @@ class Recording:
             self._robots[path] = {"links": d.link_names, "shapes": shapes, "color": rgba, "colored": set()}
         if q is not None:
             self.pose(robot, q, path=path)
+
+    def _urdf_robot(self, robot: Any, path: str, urdf_file: str) -> None:
+        """The URDF's geometry by Rerun's loader, moved under the link
+        entities (``path/<link>/urdf/...``) that kinplan's FK poses; a link
+        off the chain hangs from its parent link by its URDF joint (at 0)."""
+        d = self._service(robot.describe)
+        tree = rr.urdf.UrdfTree.from_file_path(urdf_file)
+        entity = {name: f"{path}/{name}" for name in d.link_names}
+        pending = [j for j in tree.joints() if j.child_link not in entity]
+        while pending:  # the links off the chain, parents first
+            placed = [j for j in pending if j.parent_link in entity]
+            if not placed:
+                break  # links above the chain's base: not drawn
+            for j in placed:
+                entity[j.child_link] = f"{entity[j.parent_link]}/{j.child_link}"
+                R = _rpy_matrix(*j.origin_rpy)
+                self.stream.log(entity[j.child_link], rr.Transform3D(translation=j.origin_xyz,
+                                                                     quaternion=quaternions(R)), static=True)
+            pending = [j for j in pending if j not in placed]
+        chunks = list(tree.stream(include_joint_transforms=False))
+        frame_of: Dict[str, str] = {}
+        for ch in chunks:
+            names = ch.to_record_batch().schema.names
+            if "CoordinateFrame:frame" in names:
+                column = ch.to_record_batch().column(names.index("CoordinateFrame:frame"))
+                frame_of[ch.entity_path] = column[0][0].as_py()
+        moved = []
+        for ch in chunks:
+            link = frame_of.get(ch.entity_path)
+            if link in entity and "CoordinateFrame:frame" not in ch.to_record_batch().schema.names:
+                moved.append(ch.with_entity_path(f"/{entity[link]}/urdf{ch.entity_path}"))
+        rr.send_chunks(moved, recording=self.stream)
+        for name in d.link_names:
+            self.stream.log(f"{path}/{name}", rr.TransformAxes3D(0.05), static=True)
+        self._robots[path] = {"links": d.link_names, "shapes": {}, "color": COLORS["link"], "colored": set()}
 
     def pose(self, robot: Any, q: Any, *, path: str = "world/robot") -> Dict[str, np.ndarray]:
         """Poses the robot drawn at ``path`` at joints ``q`` (at the current
@@ -267,10 +338,12 @@ class Recording:
         ``world/<name>``. With a ``scene``, the scene is drawn and, with
         ``check``, every waypoint is checked (``robot.check``): links in
         collision turn red, the closest pair is a segment, the clearance a
-        plot. A plan with a Cartesian deviation (CCSTOMP) shows its tolerance
-        tube: the capsule of radius ``translation_tolerance`` (default 1 m,
-        CartesianOptions' default) around the straight tool line, and the
-        deviation against the tolerances as plots."""
+        plot. The tool's deviation from the straight Cartesian line
+        (``plan.deviation``) is plotted; given CCSTOMP's
+        ``translation_tolerance`` (m; CartesianOptions' default is 1) and
+        ``rotation_tolerance`` (rad; default 0.2), the tolerance tube is
+        drawn too (the capsule of that radius around the straight tool line)
+        and the tolerances go beside the deviations."""
         base = f"world/{name}"
         if scene is not None:
             self.scene(scene)
@@ -296,7 +369,7 @@ class Recording:
                                  columns=rr.Points3D.columns(positions=tool_wp[:, :3, 3]))
         if scene is not None and check:
             checks = self._service(robot.check, q, scene)
-            self.stream.send_columns(f"plots/{name}/clearance", indexes=idx,
+            self.stream.send_columns(self._plot(f"plots/{name}/clearance"), indexes=idx,
                                      columns=rr.Scalars.columns(scalars=checks.clearance))
             for k, t in enumerate(times):
                 self.stream.set_time(timeline, duration=float(t))
@@ -305,34 +378,36 @@ class Recording:
                 a, b = checks.robot_points[k], checks.obstacle_points[k]
                 if np.all(np.isfinite(a)) and np.all(np.isfinite(b)):
                     rgba = COLORS["collision"] if not checks.valid[k] else (240, 160, 0, 255)
-                    self.stream.log(f"{base}/closest_pair", rr.LineStrips3D([[a, b]], radii=0.004, colors=[rgba],
-                                                                           labels=[checks.closest_pair[k]]))
+                    self.stream.log(f"{base}/closest_pair", rr.LineStrips3D(
+                        [[a, b]], radii=0.004, colors=[rgba], labels=[checks.closest_pair[k]], show_labels=False))
                 else:
                     self.stream.log(f"{base}/closest_pair", rr.Clear(recursive=False))
             bad = ~checks.valid
             if bad.any():
                 self.stream.log(f"{base}/invalid_waypoints", rr.Points3D(tool_wp[bad, :3, 3], radii=0.015,
                                                                          colors=[COLORS["collision"]]), static=True)
-        if len(plan.deviation):
-            t_t = 1.0 if translation_tolerance is None else float(translation_tolerance)
-            t_r = 0.2 if rotation_tolerance is None else float(rotation_tolerance)
+        if len(plan.deviation) == len(q):
+            self._deviation(plan, name, idx, times, timeline, translation_tolerance, rotation_tolerance)
+        if translation_tolerance is not None:
             a, b = tool_wp[0, :3, 3], tool_wp[-1, :3, 3]
             axis = b - a
             length = float(np.linalg.norm(axis))
             R = _frame_with_z(axis / length if length > 0 else np.array([0.0, 0.0, 1.0]))
             self.stream.log(f"{base}/tolerance_tube", rr.Capsules3D(
-                lengths=[length], radii=[t_t], translations=[a], quaternions=[quaternions(R)],
-                colors=[COLORS["tube"]]), static=True)
-            dev = np.asarray(plan.deviation, dtype=float)
-            self.stream.send_columns(f"plots/{name}/deviation/translation", indexes=idx,
-                                     columns=rr.Scalars.columns(scalars=dev[:, 0]))
-            self.stream.send_columns(f"plots/{name}/deviation/rotation", indexes=idx,
-                                     columns=rr.Scalars.columns(scalars=dev[:, 1]))
-            ends = [rr.TimeColumn(timeline, duration=[times[0], times[-1]])]
-            self.stream.send_columns(f"plots/{name}/deviation/translation_tolerance", indexes=ends,
-                                     columns=rr.Scalars.columns(scalars=[t_t, t_t]))
-            self.stream.send_columns(f"plots/{name}/deviation/rotation_tolerance", indexes=ends,
-                                     columns=rr.Scalars.columns(scalars=[t_r, t_r]))
+                lengths=[length], radii=[float(translation_tolerance)], translations=[a],
+                quaternions=[quaternions(R)], colors=[COLORS["tube"]], fill_mode="solid"), static=True)
+
+    def _deviation(self, plan: Plan, name: str, idx: List[Any], times: np.ndarray, timeline: str,
+                   translation_tolerance: Optional[float], rotation_tolerance: Optional[float]) -> None:
+        """The deviation plots of :meth:`plan`, with the tolerances given."""
+        dev = np.asarray(plan.deviation, dtype=float)
+        ends = [rr.TimeColumn(timeline, duration=[times[0], times[-1]])]
+        for k, (kind, tol) in enumerate((("translation", translation_tolerance), ("rotation", rotation_tolerance))):
+            group = self._plot(f"plots/{name}/{kind}_deviation")
+            self.stream.send_columns(f"{group}/deviation", indexes=idx, columns=rr.Scalars.columns(scalars=dev[:, k]))
+            if tol is not None:
+                self.stream.send_columns(f"{group}/tolerance", indexes=ends,
+                                         columns=rr.Scalars.columns(scalars=[float(tol)] * 2))
 
     def plan_iterations(self, robot: Any, frames: Iterable[Union[np.ndarray, Plan]], *,
                         scene: Optional[Sequence[Obstacle]] = None, path: str = "world/robot",
@@ -367,7 +442,7 @@ class Recording:
         if final is not None:
             if len(final.cost_history):
                 self.stream.send_columns(
-                    f"plots/{name}/cost", indexes=[rr.TimeColumn(timeline, sequence=np.arange(len(final.cost_history)))],
+                    self._plot(f"plots/{name}/cost"), indexes=[rr.TimeColumn(timeline, sequence=np.arange(len(final.cost_history)))],
                     columns=rr.Scalars.columns(scalars=final.cost_history))
             self.plan(robot, final, scene=scene, path=path)
         return final
@@ -449,7 +524,7 @@ class Recording:
         if summary is not None:
             self.stream.set_time(timeline, sequence=0)
             self.stream.set_time(time_timeline, duration=0.0)
-            self.stream.log("plots/known_ratio", rr.Scalars(summary.initial_known_ratio))
+            self.stream.log(self._plot("plots/known_ratio"), rr.Scalars(summary.initial_known_ratio))
         clock = 0.0
         for s in run:
             k = s.iteration
@@ -482,7 +557,7 @@ class Recording:
                     [p for p, _ in s.failures], radii=0.03, colors=[COLORS["failed"]], labels=[r for _, r in s.failures]))
             else:
                 self.stream.log("world/explore/failed_views", rr.Clear(recursive=False))
-            self.stream.log("plots/known_ratio", rr.Scalars(s.known_ratio))
+            self.stream.log(self._plot("plots/known_ratio"), rr.Scalars(s.known_ratio))
             if trees is not None and k in trees:
                 self.octree(trees[k], region, path="world/octree", states=octree_states)
         if summary is not None:
@@ -524,6 +599,14 @@ def _densify(q: np.ndarray, step: float) -> np.ndarray:
         f = (np.arange(1, n + 1) / n)[:, None]
         rows.append(a + (b - a) * f)
     return np.vstack(rows)
+
+
+def _rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """URDF's fixed-axis roll, pitch, yaw: Rz(yaw) Ry(pitch) Rx(roll)."""
+    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
 
 
 def _frame_with_z(z: np.ndarray) -> np.ndarray:
