@@ -38,7 +38,7 @@ with kinplan.Client(address, timeout=300) as c:
     trees = kinplan.viz.replay_trees(c, items, every=every, **run)
     print(f"{len(trees)} intermediate trees replayed in {time.perf_counter() - t0:.1f} s")
     t0 = time.perf_counter()
-    with kinplan.viz.Recording("kinplan_explore_s0", save=out) as viz:
+    with kinplan.viz.Recording("kinplan_explore_s0", save=out, eye=((-1.0, -3.0, 3.0), (2.0, 0.0, 0.2))) as viz:
         viz.robot(irb, cell.start)
         viz.explore(items, irb, scene=cell, trees=trees)
     wall = time.perf_counter() - t0

@@ -39,7 +39,7 @@ with kinplan.Client(address, timeout=60) as c:
     print(stomp)
     print(ccstomp)
     t0 = time.perf_counter()
-    with kinplan.viz.Recording("kinplan_plan", save=out) as viz:
+    with kinplan.viz.Recording("kinplan_plan", save=out, eye=((1.4, -1.4, 0.9), (0.0, 0.0, 0.2))) as viz:
         viz.plan(ur5, stomp, scene=scene, name="stomp")
         # the CCSTOMP plan after the STOMP one, on the same timeline
         viz.plan(ur5, ccstomp, scene=scene, name="ccstomp", t0=float(stomp.t[-1]) + 1.0,

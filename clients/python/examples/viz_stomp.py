@@ -31,7 +31,7 @@ with kinplan.Client(address, timeout=60) as c:
     frames = list(ur5.plan_stream(start, goal, scene=scene, seed=1,
                                   stomp={"straight_line_start": True, "iterations_after_valid": 20}))
     t0 = time.perf_counter()
-    with kinplan.viz.Recording("kinplan_stomp", save=out) as viz:
+    with kinplan.viz.Recording("kinplan_stomp", save=out, eye=((1.4, -1.4, 0.9), (0.0, 0.0, 0.2))) as viz:
         plan = viz.plan_iterations(ur5, frames, scene=scene)
     wall = time.perf_counter() - t0
     print(plan)
