@@ -33,12 +33,12 @@ def read(path):
 
 
 def rows(batches, component, timeline=None):
-    """(time, value) of every row holding `component`, in time order (time
-    None for static rows; durations in seconds)."""
+    """(time, value) of every row holding `component` on `timeline`, in time
+    order (durations in seconds); `timeline` None: every row, time None."""
     out = []
     for b in batches:
         names = b.schema.names
-        if component not in names:
+        if component not in names or (timeline is not None and timeline not in names):
             continue
         values = b.column(names.index(component)).to_pylist()
         times = b.column(names.index(timeline)).to_pylist() if timeline in names else [None] * len(values)
@@ -270,3 +270,25 @@ def test_a_urdf_with_meshes_is_drawn_by_rerun_and_posed_by_kinplans_fk(c, tmp_pa
     (_, T), = transforms(data["/world/robot/l1/camera"], None)
     np.testing.assert_allclose(T[:3, 3], [0.1, 0, 0.2], atol=1e-7)
     assert rows(data["/world/robot/l1/camera/urdf/meshy/visual_geometries/camera/visual_0"], "Boxes3D:half_sizes")
+
+
+def test_stomp_iterations_are_on_their_own_timeline(c, tmp_path):
+    ur5 = c.robot("ur5")
+    scene = ball_scene(ur5)
+    frames = list(ur5.plan_stream(START, GOAL, scene=scene, seed=1,
+                                  stomp={"straight_line_start": True, "iterations_after_valid": 2}))
+    trajectories = frames[:-1]
+    assert isinstance(frames[-1], kinplan.Plan) and len(trajectories) >= 2
+    path = tmp_path / "stomp.rrd"
+    with viz.Recording("test", save=str(path)) as rec:
+        plan = rec.plan_iterations(ur5, frames, scene=scene)
+    assert plan is frames[-1]
+    data = read(path)
+    strips = rows(data["/world/stomp/tool_path"], "LineStrips3D:strips", "stomp_iteration")
+    assert [k for k, _ in strips] == list(range(len(trajectories)))
+    for (k, strip), q in zip(strips, trajectories):
+        np.testing.assert_allclose(strip[0], ur5.fk_batch(q)[:, :3, 3], atol=1e-6)
+    got = transforms(data["/world/robot/link_3"], "stomp_iteration")
+    for (k, T), q in zip(got, trajectories):
+        np.testing.assert_allclose(T, ur5.fk(q[len(q) // 2], links=True)[1]["link_3"], atol=1e-6)
+    assert len(rows(data["/plots/stomp/cost"], "Scalars:scalars", "stomp_iteration")) == len(plan.cost_history)

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import importlib
 import time
+import urllib.parse
 import uuid
 from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -142,7 +143,7 @@ class Recording:
         if serve:
             uri = self.stream.serve_grpc(grpc_port=grpc_port)
             rr.serve_web_viewer(web_port=web_port, open_browser=open_browser, connect_to=uri)
-            self.url = f"http://localhost:{web_port or 9090}/?url={uri}"
+            self.url = f"http://localhost:{web_port or 9090}/?url={urllib.parse.quote(uri, safe='')}"
         self.stream.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
 
     def __enter__(self) -> "Recording":
