@@ -13,6 +13,7 @@ import base64
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -68,19 +69,19 @@ def main() -> None:
     web, grpc, devtools = 9190, 9977, 9333
     viewer = subprocess.Popen([rerun_binary(), "--serve-web", "--web-viewer-port", str(web), "--port", str(grpc),
                                "--renderer", "webgl", "--hide-welcome-screen", rrd],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     browser = subprocess.Popen(["chromium-headless-shell", "--no-sandbox", "--use-angle=swiftshader",
                                 "--enable-unsafe-swiftshader", "--window-size=1600,1000",
                                 f"--remote-debugging-port={devtools}", "about:blank"],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     try:
         time.sleep(2)
         source = urllib.parse.quote(f"rerun+http://localhost:{grpc}/proxy", safe="")
         asyncio.run(capture(f"http://127.0.0.1:{web}/?url={source}&renderer=webgl", out, wait, devtools))
         print("wrote", out)
     finally:
-        for p in (browser, viewer):
-            p.terminate()
+        for p in (browser, viewer):  # each in a session of its own: the launcher's children go too
+            os.killpg(p.pid, signal.SIGTERM)
             p.wait()
 
 
