@@ -10,7 +10,7 @@ bytes; the server never opens a file.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -80,6 +80,99 @@ class Octree:
             stack.extend(reversed(children))  # depth first, children in order 0..7
         return np.array(out, dtype=float).reshape(-1, 3)
 
+    def leaves(self) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every leaf of a binary tree as a cube: its lowest corner (n x 3,
+        m, world frame), its edge (n, m; a pruned leaf at depth d is 2^(16-d)
+        cells a side) and whether it is occupied (n, bool; else free), in
+        the order of the node stream. ``occupied_cells()`` are the centres
+        of the occupied ones."""
+        if not self.binary:
+            raise ValueError("only a binary tree's nodes are decoded")
+        data = self.data
+        inner_lo, inner_hi = _inner_children()
+        # one record per inner node (2 bytes, stream order): the node's lowest corner key and half edge; only
+        # the inner children are walked here, the leaves are read from the bytes with numpy below
+        nodes: List[Tuple[int, int, int, int]] = []
+        stack = [(0, 0, 0, 0)] if data else []  # key of the node's lowest corner, depth
+        i = 0
+        while stack:
+            kx, ky, kz, depth = stack.pop()
+            half = 1 << (15 - depth)
+            nodes.append((kx, ky, kz, half))
+            inner = inner_lo[data[i]] + inner_hi[data[i + 1]]
+            i += 2
+            if inner:  # depth first, children in order 0..7
+                stack.extend([(kx + half * (c & 1), ky + half * ((c >> 1) & 1), kz + half * (c >> 2), depth + 1)
+                              for c in reversed(inner)])
+        if not nodes:
+            return np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool)
+        rec = np.array(nodes, dtype=np.int64)
+        bits = np.frombuffer(data[:i], dtype="<u2").astype(np.int64)
+        kinds = (bits[:, None] >> (2 * np.arange(8))) & 3
+        r, c = np.nonzero((kinds == 1) | (kinds == 2))
+        offsets = np.array([[k & 1, (k >> 1) & 1, k >> 2] for k in range(8)], dtype=np.int64)
+        half = rec[r, 3]
+        keys = rec[r, :3] + half[:, None] * offsets[c]
+        mins = (keys - 32768) * self.resolution
+        return mins.astype(float), half * self.resolution, kinds[r, c] == 2
+
+    def boxes(self, region: Optional[Tuple[Sequence[float], Sequence[float]]] = None,
+              max_cells: int = 1 << 23) -> Dict[str, Tuple[np.ndarray, np.ndarray]]:
+        """The space of ``region`` = (min xyz, max xyz) by state, as
+        axis-aligned boxes (min corners n x 3, max corners n x 3, m):
+        ``"occupied"`` and ``"free"`` leaves and ``"unknown"`` cells (the
+        finest cells no leaf covers), each clipped to the region, so that
+        their volumes add up to ``octree_info(tree, box=region)``'s. Without
+        a region: the whole leaves, and the unknown cells inside the bounds
+        of the known ones. Raises ValueError when the region holds more than
+        ``max_cells`` finest cells."""
+        mins, edges, occupied = self.leaves()
+        maxs = mins + edges[:, None]
+        res = self.resolution
+        if region is None:
+            if not len(mins):
+                empty = np.zeros((0, 3))
+                return {"occupied": (empty, empty), "free": (empty, empty), "unknown": (empty, empty)}
+            lo, hi = mins.min(axis=0), maxs.max(axis=0)
+        else:
+            lo, hi = (np.asarray(b, dtype=float).reshape(3) for b in region)
+            if np.any(hi < lo):
+                raise ValueError(f"region min {lo.tolist()} exceeds max {hi.tolist()}")
+        out: Dict[str, Tuple[np.ndarray, np.ndarray]] = {}
+        for name, pick in (("occupied", occupied), ("free", ~occupied)):
+            a, b = mins[pick], maxs[pick]
+            if region is not None:
+                a, b = np.maximum(a, lo), np.minimum(b, hi)
+                keep = np.all(b > a, axis=1)
+                a, b = a[keep], b[keep]
+            out[name] = (a, b)
+        # the finest cells of the region, minus those the leaves cover
+        k0 = np.floor(lo / res + 1e-9).astype(np.int64)
+        k1 = np.maximum(np.ceil(hi / res - 1e-9).astype(np.int64), k0)
+        shape = tuple(int(v) for v in k1 - k0)
+        if int(np.prod(shape, dtype=np.int64)) > max_cells:
+            raise ValueError(f"the region holds {int(np.prod(shape, dtype=np.int64))} cells of {res} m, more than "
+                             f"max_cells={max_cells}: give a smaller region")
+        known = np.zeros(shape, dtype=bool)
+        if known.size:
+            kmin = np.rint(mins / res).astype(np.int64) - k0
+            kmax = kmin + np.rint(edges / res).astype(np.int64)[:, None]
+            kmin = np.clip(kmin, 0, shape)
+            kmax = np.clip(kmax, 0, shape)
+            inside = np.all(kmax > kmin, axis=1)
+            single = inside & np.all(kmax - kmin == 1, axis=1)
+            known[tuple(kmin[single].T)] = True
+            big = inside & ~single
+            for (x0, y0, z0), (x1, y1, z1) in zip(kmin[big].tolist(), kmax[big].tolist()):
+                known[x0:x1, y0:y1, z0:z1] = True
+        cells = np.argwhere(~known)
+        a = (cells + k0) * res
+        b = a + res
+        a, b = np.maximum(a, lo), np.minimum(b, hi)
+        keep = np.all(b > a, axis=1)
+        out["unknown"] = (a[keep], b[keep])
+        return out
+
     def to_proto(self) -> common_pb2.Octree:
         return common_pb2.Octree(id=self.tree_id, resolution=self.resolution, binary=self.binary, data=self.data)
 
@@ -90,6 +183,18 @@ class Octree:
     def __repr__(self) -> str:
         kind = "binary" if self.binary else "full"
         return f"Octree({kind}, resolution={self.resolution} m, {len(self.data)} bytes)"
+
+
+_INNER: List[Tuple[Tuple[int, ...], ...]] = []
+
+
+def _inner_children() -> List[Tuple[Tuple[int, ...], ...]]:
+    """Per byte of a .bt node: its inner children (bits 11), for the low
+    byte (children 0-3) and for the high byte (children 4-7)."""
+    if not _INNER:
+        _INNER.append(tuple(tuple(c for c in range(4) if (b >> (2 * c)) & 3 == 3) for b in range(256)))
+        _INNER.append(tuple(tuple(c + 4 for c in range(4) if (b >> (2 * c)) & 3 == 3) for b in range(256)))
+    return _INNER
 
 
 def _count_binary_nodes(data: bytes) -> int:
