@@ -653,6 +653,7 @@ async fn the_whole_robot_collides_in_check_state() {
         source: Some(pb::robot_ref::Source::Urdf(urdf.into())),
         base_link: "base".into(),
         tip_link: "arm".into(),
+        meshes: Vec::new(),
     });
     let check = |ball: pb::CollisionObject| pb::CheckStateRequest {
         robot: robot.clone(),
@@ -715,4 +716,113 @@ async fn the_whole_robot_collides_in_check_state() {
         "a ball between the closed fingertips touches a finger: {:?}",
         reply.states[0].colliding
     );
+}
+
+/// A robot's own mesh files travel with its URDF: a one-joint arm whose link
+/// is a cube mesh (an OBJ of the unit cube centred on the origin, scaled by
+/// the URDF to 0.1 m and placed 0.25 m up the link) collides where the cube
+/// is, by the model id afterwards too; a missing or broken file is an error
+/// naming its URI.
+#[tokio::test]
+async fn mesh_files_travel_with_the_model() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let uri = "package://arm/meshes/link.obj";
+    let urdf = format!(
+        r#"<robot name="meshy"><link name="base"/>
+          <link name="arm"><collision><origin xyz="0 0 0.25"/><geometry><mesh filename="{uri}" scale="0.1 0.1 0.1"/></geometry></collision></link>
+          <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+            <limit lower="-3" upper="3" effort="1" velocity="1"/></joint></robot>"#
+    );
+    let mut cube = String::new();
+    for i in 0..8 {
+        let c = |bit: usize| if i & bit == 0 { -0.5 } else { 0.5 };
+        cube += &format!("v {} {} {}\n", c(1), c(2), c(4));
+    }
+    for f in [
+        [1, 3, 4, 2],
+        [5, 6, 8, 7],
+        [1, 2, 6, 5],
+        [3, 7, 8, 4],
+        [1, 5, 7, 3],
+        [2, 4, 8, 6],
+    ] {
+        cube += &format!("f {} {} {} {}\n", f[0], f[1], f[2], f[3]);
+    }
+    let with = |data: &[u8]| {
+        Some(pb::RobotRef {
+            source: Some(pb::robot_ref::Source::Urdf(urdf.clone())),
+            meshes: vec![pb::MeshFile {
+                uri: uri.into(),
+                data: data.to_vec(),
+            }],
+            ..Default::default()
+        })
+    };
+    let check = |robot, x: f64| pb::CheckStateRequest {
+        robot,
+        states: vec![pb::JointState { positions: vec![0.0] }],
+        scene: Some(pb::Scene {
+            objects: vec![sphere("ball", [x, 0.0, 0.25], 0.02)],
+        }),
+        max_distance: Some(1.0),
+    };
+    // the cube's face at x = 0.05: a ball at 0.06 touches it, one at 0.08 is 10 mm clear
+    let touching = planning
+        .check_state(check(with(cube.as_bytes()), 0.06))
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(!touching.states[0].valid, "{:?}", touching.states[0]);
+    let clear = planning
+        .check_state(check(with(cube.as_bytes()), 0.08))
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(clear.states[0].valid);
+    assert!(
+        (clear.states[0].clearance - 0.01).abs() < 1e-6,
+        "{}",
+        clear.states[0].clearance
+    );
+    // the model id names the URDF and its meshes
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let id = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: with(cube.as_bytes()),
+            ..Default::default()
+        })
+        .await
+        .unwrap()
+        .into_inner()
+        .model_id;
+    assert_eq!(id.len(), 32);
+    let by_id = Some(pb::RobotRef {
+        source: Some(pb::robot_ref::Source::ModelId(id)),
+        ..Default::default()
+    });
+    let again = planning
+        .check_state(check(by_id, 0.06))
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(!again.states[0].valid);
+    // missing and broken files name the URI
+    let missing = Some(pb::RobotRef {
+        source: Some(pb::robot_ref::Source::Urdf(urdf.clone())),
+        ..Default::default()
+    });
+    let err = planning.check_state(check(missing, 0.06)).await.unwrap_err();
+    assert_eq!(err.code(), Code::InvalidArgument);
+    assert!(
+        err.message().contains(uri) && err.message().contains("RobotRef.meshes"),
+        "{}",
+        err.message()
+    );
+    let err = planning
+        .check_state(check(with(b"v 0 0 nan\nf 1 1 1\n"), 0.06))
+        .await
+        .unwrap_err();
+    assert_eq!(err.code(), Code::InvalidArgument);
+    assert!(err.message().contains(uri), "{}", err.message());
 }

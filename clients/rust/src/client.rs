@@ -127,7 +127,23 @@ impl Client {
     /// A robot from URDF text sent by this client. The text is sent once; later
     /// calls name the content hash the server returns.
     pub fn robot_from_urdf(&self, urdf: impl Into<String>) -> Robot {
-        Robot::new(self.clone(), RobotSpec::urdf(urdf.into()))
+        Robot::new(self.clone(), RobotSpec::urdf(urdf.into(), Vec::new()))
+    }
+
+    /// A robot from URDF text and the collision mesh files it names, each
+    /// keyed by the URI exactly as the URDF writes it (`package://…`, a
+    /// relative path) with the file's bytes (STL or OBJ). The server never
+    /// opens a file: the bytes travel with the model, once, and are hashed
+    /// into its model id.
+    pub fn robot_from_urdf_with_meshes(
+        &self,
+        urdf: impl Into<String>,
+        meshes: impl IntoIterator<Item = (String, Vec<u8>)>,
+    ) -> Robot {
+        Robot::new(
+            self.clone(),
+            RobotSpec::urdf(urdf.into(), meshes.into_iter().collect()),
+        )
     }
 
     /// Names of the built-in robots.

@@ -25,7 +25,8 @@ pub(crate) struct RobotSpec {
 #[derive(Clone, Debug)]
 enum ModelSource {
     Builtin(String),
-    Urdf(Arc<str>),
+    /// URDF text and the mesh files it names, (URI as written, bytes).
+    Urdf(Arc<str>, Arc<[(String, Vec<u8>)]>),
 }
 
 impl RobotSpec {
@@ -37,9 +38,9 @@ impl RobotSpec {
         }
     }
 
-    pub(crate) fn urdf(text: String) -> RobotSpec {
+    pub(crate) fn urdf(text: String, meshes: Vec<(String, Vec<u8>)>) -> RobotSpec {
         RobotSpec {
-            source: ModelSource::Urdf(text.into()),
+            source: ModelSource::Urdf(text.into(), meshes.into()),
             base_link: String::new(),
             tip_link: String::new(),
         }
@@ -124,7 +125,7 @@ impl Robot {
     }
 
     pub(crate) fn remember(&self, id: &[u8]) {
-        if matches!(self.spec.source, ModelSource::Urdf(_))
+        if matches!(self.spec.source, ModelSource::Urdf(..))
             && !id.is_empty()
             && let Ok(mut cached) = self.model_id.lock()
         {
@@ -140,14 +141,21 @@ impl Robot {
 
     /// The reference to send: the name, the cached hash, or the URDF text.
     pub(crate) fn reference(&self, inline: bool) -> pb::RobotRef {
-        let source = match &self.spec.source {
-            ModelSource::Builtin(name) => Source::Name(name.clone()),
-            ModelSource::Urdf(text) => {
+        let (source, meshes) = match &self.spec.source {
+            ModelSource::Builtin(name) => (Source::Name(name.clone()), Vec::new()),
+            ModelSource::Urdf(text, files) => {
                 let id = self.cached_id();
                 if inline || id.is_empty() {
-                    Source::Urdf(text.to_string())
+                    let meshes = files
+                        .iter()
+                        .map(|(uri, data)| pb::MeshFile {
+                            uri: uri.clone(),
+                            data: data.clone(),
+                        })
+                        .collect();
+                    (Source::Urdf(text.to_string()), meshes)
                 } else {
-                    Source::ModelId(id)
+                    (Source::ModelId(id), Vec::new())
                 }
             }
         };
@@ -155,12 +163,13 @@ impl Robot {
             source: Some(source),
             base_link: self.spec.base_link.clone(),
             tip_link: self.spec.tip_link.clone(),
+            meshes,
         }
     }
 
     /// True when `reference(false)` would name a cached hash.
     pub(crate) fn sends_model_id(&self) -> bool {
-        matches!(self.spec.source, ModelSource::Urdf(_)) && !self.cached_id().is_empty()
+        matches!(self.spec.source, ModelSource::Urdf(..)) && !self.cached_id().is_empty()
     }
 
     /// A unary call about this robot, with the model-hash rule: `build` makes

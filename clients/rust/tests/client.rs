@@ -355,3 +355,48 @@ async fn unavailable_replicas_are_retried_and_unreachable_servers_say_so() {
     }
     assert!(balanced.list_robots().await.unwrap().iter().any(|n| n == KR210));
 }
+
+/// A robot's mesh files travel with its URDF: the two-link arm with a 0.1 m
+/// cube mesh (an OBJ, given by the URI the URDF writes) on its upper arm
+/// collides with a ball on the cube and not with one 10 mm off it.
+#[tokio::test]
+async fn a_urdf_with_its_mesh_files_collides_as_its_meshes() {
+    let s = server().await;
+    let client = Client::connect(&s.address).await.unwrap();
+    let uri = "package://two_link/meshes/upper.obj";
+    let urdf = TWO_LINK_URDF.replace(
+        r#"<link name="upper"/>"#,
+        &format!(
+            r#"<link name="upper"><collision><origin xyz="0.2 0 0"/><geometry><mesh filename="{uri}"/></geometry></collision></link>"#
+        ),
+    );
+    let mut cube = String::new();
+    for i in 0..8 {
+        let c = |bit: usize| if i & bit == 0 { -0.05 } else { 0.05 };
+        cube += &format!("v {} {} {}\n", c(1), c(2), c(4));
+    }
+    cube += "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+    let robot = client.robot_from_urdf_with_meshes(urdf, [(uri.to_string(), cube.into_bytes())]);
+    // the cube spans y ±0.05 around (0.2, 0, 0.5) at q = 0
+    let ball = |y: f64| {
+        vec![Obstacle::new(
+            "ball",
+            Isometry3::translation(0.2, y, 0.5),
+            Shape::Sphere { radius: 0.02 },
+        )]
+    };
+    let q = [DVector::from_vec(vec![0.0, 0.0])];
+    let touching = robot.check_states(&q, &ball(0.06)).await.unwrap();
+    assert!(!touching[0].valid, "{:?}", touching[0].colliding);
+    let clear = robot.check_states(&q, &ball(0.08)).await.unwrap();
+    assert!(
+        clear[0].valid && (clear[0].clearance - 0.01).abs() < 1e-6,
+        "{}",
+        clear[0].clearance
+    );
+    // once a reply carried the model id, it names the URDF and its meshes
+    robot.fk(&[0.0, 0.0]).await.unwrap();
+    assert!(robot.model_id().is_some());
+    let by_id = robot.check_states(&q, &ball(0.06)).await.unwrap();
+    assert!(!by_id[0].valid);
+}

@@ -34,7 +34,9 @@ pub enum CollisionError {
         count: usize,
         limit: usize,
     },
-    #[error("{field}: mesh file `{filename}` is not inline; give its vertices and indices")]
+    #[error(
+        "{field}: mesh file `{filename}` was not sent with the model; send its bytes keyed by that URI (RobotRef.meshes)"
+    )]
     MeshNotInline { field: String, filename: String },
     #[error("{field}: unknown name `{name}`")]
     UnknownName { field: String, name: String },

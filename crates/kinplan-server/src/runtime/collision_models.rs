@@ -8,7 +8,11 @@
 
 use std::sync::{Arc, Mutex, Weak};
 
-use kinplan_core::collision::{AcmParams, AllowedCollisions, CollisionError, RobotModel};
+use kinplan_core::collision::{
+    AcmParams, AllowedCollisions, CollisionError, MeshFileLimits, RobotModel, read_mesh_file,
+};
+
+use crate::runtime::models::ModelSource;
 use kinplan_core::robot::Chain;
 
 /// A chain's collision bodies and the body pairs never checked.
@@ -18,14 +22,27 @@ pub struct CollisionSetup {
 }
 
 impl CollisionSetup {
-    /// Builds the model — of the whole robot in `urdf` (the text `chain` was
-    /// parsed from), or of the chain alone without one — and samples the
+    /// Builds the model — of the whole robot in `source` (the URDF `chain` was
+    /// parsed from, with its mesh files), or of the chain alone without one —
+    /// and samples the
     /// matrix: `acm_samples` states, fewer when the model has so many body
     /// pairs that the tests would exceed the domain's bound
     /// ([`AcmParams::samples_within`]).
-    pub fn build(chain: Arc<Chain>, urdf: Option<&str>, acm_samples: usize) -> Result<Self, CollisionError> {
-        let model = Arc::new(match urdf {
-            Some(text) => RobotModel::of_urdf(chain, text, &[], &[])?,
+    pub fn build(
+        chain: Arc<Chain>,
+        source: Option<&ModelSource>,
+        acm_samples: usize,
+    ) -> Result<Self, CollisionError> {
+        let model = Arc::new(match source {
+            Some(source) => {
+                let limits = MeshFileLimits::default();
+                let meshes = source
+                    .meshes
+                    .iter()
+                    .map(|(uri, data)| read_mesh_file(uri, data, &limits))
+                    .collect::<Result<Vec<_>, _>>()?;
+                RobotModel::of_urdf(chain, &source.urdf, &[], &meshes)?
+            }
             None => RobotModel::new(chain)?,
         });
         let acm = AllowedCollisions::sampled(
@@ -95,13 +112,13 @@ pub async fn collision_setup(
         return Ok(s);
     }
     let chain = robot.chain.clone();
-    let urdf = robot.urdf.clone();
+    let source = robot.source.clone();
     shared
         .compute
         .run(budget, move |_| {
             let setup = Arc::new(CollisionSetup::build(
                 chain.clone(),
-                Some(&urdf),
+                Some(&source),
                 cache.acm_samples,
             )?);
             cache.insert(&chain, setup.clone());

@@ -20,13 +20,93 @@ use kinplan_core::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_cha
 pub struct Resolved {
     pub chain: Arc<Chain>,
     pub model_id: Vec<u8>,
-    /// The URDF the chain was parsed from: its other links (a gripper beyond
-    /// the tip, a pedestal) belong to the collision model too.
-    pub urdf: Arc<str>,
+    /// What the chain was parsed from: its other links (a gripper beyond the
+    /// tip, a pedestal) and its mesh files belong to the collision model too.
+    pub source: ModelSource,
 }
 
-/// A parsed chain and the URDF text it came from.
-type ParsedChain = (Arc<Chain>, Arc<str>);
+/// A model as the client sent it: the URDF text and the mesh files it names,
+/// as (URI, bytes) sorted by URI.
+#[derive(Clone)]
+pub struct ModelSource {
+    pub urdf: Arc<str>,
+    pub meshes: MeshFiles,
+}
+
+/// Mesh files as (URI, bytes), sorted by URI.
+pub type MeshFiles = Arc<[(String, Vec<u8>)]>;
+
+impl ModelSource {
+    fn of_urdf(urdf: Arc<str>) -> Self {
+        Self {
+            urdf,
+            meshes: Arc::from(Vec::new()),
+        }
+    }
+
+    /// Bytes held (the cache's accounting).
+    fn bytes(&self) -> usize {
+        self.urdf.len() + self.meshes.iter().map(|(u, d)| u.len() + d.len()).sum::<usize>()
+    }
+
+    /// The model id: SHA-256 of the URDF text alone when there are no mesh
+    /// files (as before meshes could be sent), else of
+    /// `"kinplan-model-v1\0" · len·urdf · Σ_files(len·uri · len·data)` with the
+    /// files sorted by URI and every length a little-endian u64.
+    fn id(&self) -> ModelId {
+        if self.meshes.is_empty() {
+            return Sha256::digest(self.urdf.as_bytes()).into();
+        }
+        let mut h = Sha256::new();
+        h.update(b"kinplan-model-v1\0");
+        let mut part = |bytes: &[u8]| {
+            h.update((bytes.len() as u64).to_le_bytes());
+            h.update(bytes);
+        };
+        part(self.urdf.as_bytes());
+        for (uri, data) in self.meshes.iter() {
+            part(uri.as_bytes());
+            part(data);
+        }
+        h.finalize().into()
+    }
+}
+
+/// Most mesh files one model may carry.
+pub const MAX_MESH_FILES: usize = 256;
+
+/// The mesh files of a request, sorted by URI: at most [`MAX_MESH_FILES`],
+/// each within the mesh reader's byte limit, no URI twice.
+fn meshes_in(files: &[pb::MeshFile]) -> Result<MeshFiles, Status> {
+    if files.len() > MAX_MESH_FILES {
+        return Err(invalid(
+            "robot.meshes",
+            format!("{} files exceed the limit of {MAX_MESH_FILES}", files.len()),
+        ));
+    }
+    let max = kinplan_core::collision::MeshFileLimits::default().max_bytes;
+    let mut out: Vec<(String, Vec<u8>)> = Vec::with_capacity(files.len());
+    for (i, f) in files.iter().enumerate() {
+        if f.uri.is_empty() {
+            return Err(invalid(format!("robot.meshes[{i}].uri"), "is required"));
+        }
+        if f.data.len() > max {
+            return Err(invalid(
+                format!("robot.meshes[{}]", f.uri),
+                format!("{} bytes exceed the limit of {max}", f.data.len()),
+            ));
+        }
+        out.push((f.uri.clone(), f.data.clone()));
+    }
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    if let Some(w) = out.windows(2).find(|w| w[0].0 == w[1].0) {
+        return Err(invalid(format!("robot.meshes[{}]", w[0].0), "is given twice"));
+    }
+    Ok(Arc::from(out))
+}
+
+/// A parsed chain and what it came from.
+type ParsedChain = (Arc<Chain>, ModelSource);
 
 /// The URDF text of a built-in robot, shared (not copied per request).
 fn builtin_text(name: &str) -> Result<Arc<str>, Status> {
@@ -120,7 +200,7 @@ pub struct ModelStore {
     limits: UrdfLimits,
     /// Parsed chains with the text they came from (its other links collide too).
     chains: Mutex<Lru<(ModelId, ChainSpec), ParsedChain>>,
-    texts: Mutex<Lru<ModelId, Arc<str>>>,
+    texts: Mutex<Lru<ModelId, ModelSource>>,
 }
 
 impl ModelStore {
@@ -153,6 +233,12 @@ impl ModelStore {
             base_link: Some(robot.base_link.clone()).filter(|s| !s.is_empty()),
             tip_link: Some(robot.tip_link.clone()).filter(|s| !s.is_empty()),
         };
+        if !robot.meshes.is_empty() && !matches!(robot.source, Some(Source::Urdf(_))) {
+            return Err(invalid(
+                "robot.meshes",
+                "mesh files come with an inline urdf (a model id already names them)",
+            ));
+        }
         let (id, text) = match &robot.source {
             None => return Err(invalid("robot", "one of name, urdf or model_id is required")),
             Some(Source::Name(name)) => {
@@ -161,12 +247,12 @@ impl ModelStore {
                     return Ok(Resolved {
                         chain,
                         model_id: Vec::new(),
-                        urdf: builtin_text(name)?,
+                        source: ModelSource::of_urdf(builtin_text(name)?),
                     });
                 }
                 // Another chain of a built-in: parsed once, then cached like any URDF.
-                let urdf = builtin_text(name)?;
-                (Sha256::digest(urdf.as_bytes()).into(), Some(urdf))
+                let source = ModelSource::of_urdf(builtin_text(name)?);
+                (source.id(), Some(source))
             }
             Some(Source::Urdf(text)) => {
                 if text.len() > self.limits.max_bytes {
@@ -179,8 +265,11 @@ impl ModelStore {
                         ),
                     ));
                 }
-                let id: ModelId = Sha256::digest(text.as_bytes()).into();
-                (id, Some(Arc::<str>::from(text.as_str())))
+                let source = ModelSource {
+                    urdf: Arc::from(text.as_str()),
+                    meshes: meshes_in(&robot.meshes)?,
+                };
+                (source.id(), Some(source))
             }
             Some(Source::ModelId(bytes)) => {
                 let id: ModelId = bytes.as_slice().try_into().map_err(|_| {
@@ -195,11 +284,11 @@ impl ModelStore {
             _ => id.to_vec(),
         };
         let key = (id, spec.clone());
-        if let Some((chain, urdf)) = self.chains.lock().expect("cache lock").get(&key) {
+        if let Some((chain, source)) = self.chains.lock().expect("cache lock").get(&key) {
             return Ok(Resolved {
                 chain,
                 model_id,
-                urdf,
+                source,
             });
         }
         let text = match text {
@@ -211,13 +300,13 @@ impl ModelStore {
                 )
             })?,
         };
-        let chain = self.parse(text.clone(), spec, compute, budget).await?;
-        let text_bytes = text.len();
+        let chain = self.parse(text.urdf.clone(), spec, compute, budget).await?;
+        let text_bytes = text.bytes();
         self.texts
             .lock()
             .expect("cache lock")
             .insert(id, text.clone(), text_bytes);
-        // the text is counted again here: a chain entry keeps it alive
+        // the source is counted again here: a chain entry keeps it alive
         let size = chain_bytes(&chain) + text_bytes;
         self.chains
             .lock()
@@ -226,7 +315,7 @@ impl ModelStore {
         Ok(Resolved {
             chain,
             model_id,
-            urdf: text,
+            source: text,
         })
     }
 
