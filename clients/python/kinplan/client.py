@@ -3,6 +3,7 @@ are not about one robot; ``client.robot(name)`` gives the :class:`Robot`
 handle of every call about one (:mod:`kinplan.robot`)."""
 from __future__ import annotations
 
+import os
 import time
 import warnings
 from typing import Any, Callable, Dict, Iterable, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
@@ -20,6 +21,7 @@ from ._services import mobile as _mobile
 from ._services import robot as _robot
 from ._services.robot import RobotRefs, check_robot_args
 from .description import JointLimits, RobotDescription
+from ._model_files import load_model
 from .errors import KinplanError, invalid_argument
 from .exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
 from .kinematics import LinearSolution
@@ -196,21 +198,34 @@ class Client:
         self,
         name: Optional[str] = None,
         *,
-        urdf: Optional[str] = None,
+        urdf: Optional[Union[str, "os.PathLike[str]"]] = None,
         base_link: str = "",
         tip_link: str = "",
         strict: bool = False,
+        package_dirs: Optional[Sequence[Union[str, "os.PathLike[str]"]]] = None,
+        meshes: Optional[Mapping[str, bytes]] = None,
     ) -> Robot:
-        """A built-in robot by `name`, or a model sent as `urdf` text: the
-        handle of every call about it (``fk``, ``ik``, ``plan``, ``check``,
-        ``score``, ...).
+        """A built-in robot by `name`, or a model sent as `urdf` (its text,
+        or the path of a URDF file): the handle of every call about it
+        (``fk``, ``ik``, ``plan``, ``check``, ``score``, ...).
+
+        The collision meshes a URDF names travel with it (the server opens
+        no file): given as `meshes` (``{uri: bytes}``, the URI as the URDF
+        writes it), or read from disk when the URDF is a file or
+        `package_dirs` are given — ``package://pkg/...`` under each package
+        dir, relative paths next to the URDF, as pinocchio resolves them. A
+        mesh that cannot be found raises :class:`FileNotFoundError` naming it
+        and every place looked. STL and OBJ are read by the server.
 
         Joint values outside the robot's limits (usually degrees given where
         radians are meant) raise a :class:`kinplan.JointLimitWarning` in
         ``fk``, ``fk_batch``, ``jacobian`` and ``score``; with
         `strict=True` they raise :class:`kinplan.InvalidArgument` instead."""
         check_robot_args(name, urdf)
-        return Robot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link, strict=strict)
+        text, files = (None, {}) if urdf is None else load_model(urdf, package_dirs, meshes)
+        robot = Robot(self, name=name, urdf=text, base_link=base_link, tip_link=tip_link, strict=strict)
+        robot.mesh_files = files
+        return robot
 
     def _robot_of(self, robot: Any) -> Robot:
         """A robot, or a built-in's name made into one."""

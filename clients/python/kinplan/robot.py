@@ -45,6 +45,7 @@ class Robot(RobotRefs):
         self.client = client
         self.name = name
         self.urdf_text = urdf
+        self.mesh_files: Dict[str, bytes] = {}
         self.base_link = base_link
         self.tip_link = tip_link
         self.strict = strict

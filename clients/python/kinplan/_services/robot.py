@@ -20,16 +20,11 @@ from . import Call
 FORWARD_KINEMATICS = "/kinplan.v1.RobotService/ForwardKinematics"
 
 
-def check_robot_args(name: Optional[str], urdf: Optional[str]) -> None:
-    """``Client.robot``'s checks: one of a name or a URDF text, and a URDF
-    that is not a file's path."""
+def check_robot_args(name: Optional[str], urdf: Optional[Any]) -> None:
+    """``Client.robot``'s checks: one of a name or a URDF (text or an
+    existing file's path: :func:`kinplan._model_files.load_model` reads it)."""
     if (name is None) == (urdf is None):
         raise invalid_argument("name", "give exactly one of name or urdf=")
-    if urdf is not None and "<" not in urdf and urdf.strip().lower().endswith((".urdf", ".xml")):
-        raise invalid_argument(
-            "urdf",
-            f"{urdf!r} looks like a file path; urdf= takes the document's text: urdf=open(path).read()",
-        )
 
 
 class RobotRefs:
@@ -39,6 +34,7 @@ class RobotRefs:
 
     name: Optional[str]
     urdf_text: Optional[str]
+    mesh_files: Dict[str, bytes]
     base_link: str
     tip_link: str
     model_id: bytes
@@ -72,6 +68,8 @@ class RobotRefs:
             ref.model_id = self.model_id
         else:
             ref.urdf = self.urdf_text or ""
+            for uri, data in sorted(self.mesh_files.items()):
+                ref.meshes.add(uri=uri, data=data)
         return ref
 
     def limits_key(self) -> Any:

@@ -19,6 +19,7 @@ the layer both clients share, so both give the same answers.
 from __future__ import annotations
 
 import asyncio
+import os
 import warnings
 from typing import Any, AsyncIterator, Callable, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -33,6 +34,7 @@ from .._services import exploration as _exploration
 from .._services import kinematics as _kinematics
 from .._services import robot as _robot
 from .._services.robot import check_robot_args
+from .._model_files import load_model
 from ..errors import KinplanError, invalid_argument
 from ..exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
 from ..kinematics import LinearSolution
@@ -173,11 +175,16 @@ class Client:
         out: List[Dict[str, Any]] = await self._run(_robot.list_robots(), timeout)
         return out
 
-    def robot(self, name: Optional[str] = None, *, urdf: Optional[str] = None, base_link: str = "",
-              tip_link: str = "", strict: bool = False) -> AsyncRobot:
+    def robot(self, name: Optional[str] = None, *, urdf: Optional[Union[str, "os.PathLike[str]"]] = None,
+              base_link: str = "", tip_link: str = "", strict: bool = False,
+              package_dirs: Optional[Sequence[Union[str, "os.PathLike[str]"]]] = None,
+              meshes: Optional[Mapping[str, bytes]] = None) -> AsyncRobot:
         """As :meth:`kinplan.Client.robot`."""
         check_robot_args(name, urdf)
-        return AsyncRobot(self, name=name, urdf=urdf, base_link=base_link, tip_link=tip_link, strict=strict)
+        text, files = (None, {}) if urdf is None else load_model(urdf, package_dirs, meshes)
+        robot = AsyncRobot(self, name=name, urdf=text, base_link=base_link, tip_link=tip_link, strict=strict)
+        robot.mesh_files = files
+        return robot
 
     def _robot_of(self, robot: Any) -> AsyncRobot:
         if robot is None:

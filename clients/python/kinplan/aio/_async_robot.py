@@ -4,7 +4,7 @@ are built and read by :mod:`kinplan._services`; each method only awaits its
 call."""
 from __future__ import annotations
 
-from typing import (TYPE_CHECKING, Any, AsyncIterator, Callable, Iterable, Literal, Mapping, Optional, Sequence,
+from typing import (TYPE_CHECKING, Any, AsyncIterator, Callable, Dict, Iterable, Literal, Mapping, Optional, Sequence,
                     Union)
 
 import grpc
@@ -39,6 +39,7 @@ class AsyncRobot(RobotRefs):
                  tip_link: str, strict: bool = False):
         self.client = client
         self.name, self.urdf_text = name, urdf
+        self.mesh_files: Dict[str, bytes] = {}
         self.base_link, self.tip_link = base_link, tip_link
         self.strict = strict
         self.model_id: bytes = b""

@@ -37,18 +37,28 @@ class Pose(_message.Message):
     def __init__(self, position: _Optional[_Union[Vec3, _Mapping]] = ..., orientation: _Optional[_Union[Quaternion, _Mapping]] = ...) -> None: ...
 
 class RobotRef(_message.Message):
-    __slots__ = ("name", "urdf", "model_id", "base_link", "tip_link")
+    __slots__ = ("name", "urdf", "model_id", "base_link", "tip_link", "meshes")
     NAME_FIELD_NUMBER: _ClassVar[int]
     URDF_FIELD_NUMBER: _ClassVar[int]
     MODEL_ID_FIELD_NUMBER: _ClassVar[int]
     BASE_LINK_FIELD_NUMBER: _ClassVar[int]
     TIP_LINK_FIELD_NUMBER: _ClassVar[int]
+    MESHES_FIELD_NUMBER: _ClassVar[int]
     name: str
     urdf: str
     model_id: bytes
     base_link: str
     tip_link: str
-    def __init__(self, name: _Optional[str] = ..., urdf: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ...) -> None: ...
+    meshes: _containers.RepeatedCompositeFieldContainer[MeshFile]
+    def __init__(self, name: _Optional[str] = ..., urdf: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., meshes: _Optional[_Iterable[_Union[MeshFile, _Mapping]]] = ...) -> None: ...
+
+class MeshFile(_message.Message):
+    __slots__ = ("uri", "data")
+    URI_FIELD_NUMBER: _ClassVar[int]
+    DATA_FIELD_NUMBER: _ClassVar[int]
+    uri: str
+    data: bytes
+    def __init__(self, uri: _Optional[str] = ..., data: _Optional[bytes] = ...) -> None: ...
 
 class JointPoint(_message.Message):
     __slots__ = ("positions", "time_from_start")
