@@ -671,6 +671,32 @@ async fn the_whole_robot_collides_in_check_state() {
         assert!(!state.valid, "{what}: {state:?}");
         assert_eq!(state.colliding, [format!("{what}:ball")], "{what}");
     }
+    // DescribeRobot lists every body and what carries it
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let described = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: robot.clone(),
+            include_collision_bodies: true,
+            ..Default::default()
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    let mut bodies: Vec<(String, String)> = described
+        .collision_bodies
+        .iter()
+        .map(|b| (b.name.clone(), b.carried_by.clone()))
+        .collect();
+    bodies.sort();
+    let pair = |a: &str, b: &str| (a.to_string(), b.to_string());
+    assert_eq!(
+        bodies,
+        [
+            pair("arm", "arm"),
+            pair("gripper", "arm"),
+            pair("pedestal", "base")
+        ]
+    );
     // clear of everything: 0.1 m beside the gripper
     let reply = planning
         .check_state(check(sphere("ball", [0.2, 0.0, 0.55], 0.03)))
@@ -681,7 +707,6 @@ async fn the_whole_robot_collides_in_check_state() {
 
     // the built-in Panda with its hand: the fingers (closed, off the chain) collide
     let q = [0.0, 0.3, 0.0, -2.0, 0.0, 2.3, 0.785];
-    let mut robots = RobotServiceClient::new(server.channel.clone());
     let fk = robots
         .forward_kinematics(pb::ForwardKinematicsRequest {
             robot: named("franka_panda_hand"),

@@ -415,6 +415,7 @@ async fn a_builtin_urdf_round_trips_as_standard_urdf() {
             robot: named("kuka_kr210_r2700_extra"),
             include_urdf: true,
             keep_capsules: false,
+            ..Default::default()
         })
         .await
         .unwrap()
@@ -442,6 +443,7 @@ async fn a_builtin_urdf_round_trips_as_standard_urdf() {
             robot: named("kuka_kr210_r2700_extra"),
             include_urdf: true,
             keep_capsules: true,
+            ..Default::default()
         })
         .await
         .unwrap()

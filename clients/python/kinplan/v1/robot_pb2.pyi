@@ -44,14 +44,16 @@ class ListRobotsResponse(_message.Message):
     def __init__(self, robots: _Optional[_Iterable[_Union[RobotSummary, _Mapping]]] = ...) -> None: ...
 
 class DescribeRobotRequest(_message.Message):
-    __slots__ = ("robot", "include_urdf", "keep_capsules")
+    __slots__ = ("robot", "include_urdf", "keep_capsules", "include_collision_bodies")
     ROBOT_FIELD_NUMBER: _ClassVar[int]
     INCLUDE_URDF_FIELD_NUMBER: _ClassVar[int]
     KEEP_CAPSULES_FIELD_NUMBER: _ClassVar[int]
+    INCLUDE_COLLISION_BODIES_FIELD_NUMBER: _ClassVar[int]
     robot: _common_pb2.RobotRef
     include_urdf: bool
     keep_capsules: bool
-    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., include_urdf: _Optional[bool] = ..., keep_capsules: _Optional[bool] = ...) -> None: ...
+    include_collision_bodies: bool
+    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., include_urdf: _Optional[bool] = ..., keep_capsules: _Optional[bool] = ..., include_collision_bodies: _Optional[bool] = ...) -> None: ...
 
 class JointInfo(_message.Message):
     __slots__ = ("name", "type", "origin", "axis", "lower", "upper", "max_velocity")
@@ -100,7 +102,7 @@ class LinkInfo(_message.Message):
     def __init__(self, name: _Optional[str] = ..., parent_joint: _Optional[int] = ..., offset: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., collision: _Optional[_Iterable[_Union[CollisionGeometry, _Mapping]]] = ...) -> None: ...
 
 class DescribeRobotResponse(_message.Message):
-    __slots__ = ("name", "model_id", "base_link", "tip_link", "joints", "links", "tip_offset", "urdf")
+    __slots__ = ("name", "model_id", "base_link", "tip_link", "joints", "links", "tip_offset", "urdf", "collision_bodies")
     NAME_FIELD_NUMBER: _ClassVar[int]
     MODEL_ID_FIELD_NUMBER: _ClassVar[int]
     BASE_LINK_FIELD_NUMBER: _ClassVar[int]
@@ -109,6 +111,7 @@ class DescribeRobotResponse(_message.Message):
     LINKS_FIELD_NUMBER: _ClassVar[int]
     TIP_OFFSET_FIELD_NUMBER: _ClassVar[int]
     URDF_FIELD_NUMBER: _ClassVar[int]
+    COLLISION_BODIES_FIELD_NUMBER: _ClassVar[int]
     name: str
     model_id: bytes
     base_link: str
@@ -117,7 +120,18 @@ class DescribeRobotResponse(_message.Message):
     links: _containers.RepeatedCompositeFieldContainer[LinkInfo]
     tip_offset: _common_pb2.Pose
     urdf: str
-    def __init__(self, name: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., joints: _Optional[_Iterable[_Union[JointInfo, _Mapping]]] = ..., links: _Optional[_Iterable[_Union[LinkInfo, _Mapping]]] = ..., tip_offset: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., urdf: _Optional[str] = ...) -> None: ...
+    collision_bodies: _containers.RepeatedCompositeFieldContainer[CollisionBodyInfo]
+    def __init__(self, name: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., joints: _Optional[_Iterable[_Union[JointInfo, _Mapping]]] = ..., links: _Optional[_Iterable[_Union[LinkInfo, _Mapping]]] = ..., tip_offset: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., urdf: _Optional[str] = ..., collision_bodies: _Optional[_Iterable[_Union[CollisionBodyInfo, _Mapping]]] = ...) -> None: ...
+
+class CollisionBodyInfo(_message.Message):
+    __slots__ = ("name", "carried_by", "shapes")
+    NAME_FIELD_NUMBER: _ClassVar[int]
+    CARRIED_BY_FIELD_NUMBER: _ClassVar[int]
+    SHAPES_FIELD_NUMBER: _ClassVar[int]
+    name: str
+    carried_by: str
+    shapes: int
+    def __init__(self, name: _Optional[str] = ..., carried_by: _Optional[str] = ..., shapes: _Optional[int] = ...) -> None: ...
 
 class ForwardKinematicsRequest(_message.Message):
     __slots__ = ("robot", "joint_positions", "include_links")

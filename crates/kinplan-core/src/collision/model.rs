@@ -247,6 +247,15 @@ impl RobotModel {
         self.bodies.len()
     }
 
+    /// Every body as (its name, the chain link carrying it, its shape count),
+    /// in the model's order.
+    pub fn bodies(&self) -> impl Iterator<Item = (&str, &str, usize)> {
+        let links = self.chain.links();
+        self.bodies
+            .iter()
+            .map(move |b| (b.name.as_str(), links[b.link].name.as_str(), b.shapes.len()))
+    }
+
     /// Body names (link names), in body order.
     pub fn body_names(&self) -> impl Iterator<Item = &str> {
         self.bodies.iter().map(|b| b.name.as_str())

@@ -8,6 +8,7 @@ use tonic::{Request, Response, Status};
 use crate::api::convert::{matrix_out, pose_out};
 use crate::pb::{self, robot_service_server::RobotService};
 use crate::runtime::Shared;
+use crate::runtime::collision_models::collision_setup;
 use crate::status::{invalid, robot_error, too_large};
 use kinplan_core::robot::{BUILTIN_NAMES, Chain, builtin_chain, builtin_urdf, expand_capsules};
 
@@ -52,12 +53,27 @@ impl RobotService for RobotApi {
         &self,
         request: Request<pb::DescribeRobotRequest>,
     ) -> Result<Response<pb::DescribeRobotResponse>, Status> {
-        let (_permit, _budget, robot) = self
+        let (_permit, budget, robot) = self
             .shared
             .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
         let req = request.get_ref();
+        let bodies = if req.include_collision_bodies {
+            let setup = collision_setup(&self.shared, &robot, &budget).await?;
+            setup
+                .model
+                .bodies()
+                .map(|(name, carrier, shapes)| pb::CollisionBodyInfo {
+                    name: name.to_string(),
+                    carried_by: carrier.to_string(),
+                    shapes: shapes.min(u32::MAX as usize) as u32,
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let mut reply = describe(&robot.chain, robot.model_id);
+        reply.collision_bodies = bodies;
         if req.include_urdf
             && let Some(pb::robot_ref::Source::Name(name)) =
                 req.robot.as_ref().and_then(|r| r.source.as_ref())
