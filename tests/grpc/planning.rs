@@ -653,7 +653,7 @@ async fn the_whole_robot_collides_in_check_state() {
         source: Some(pb::robot_ref::Source::Urdf(urdf.into())),
         base_link: "base".into(),
         tip_link: "arm".into(),
-        meshes: Vec::new(),
+        ..Default::default()
     });
     let check = |ball: pb::CollisionObject| pb::CheckStateRequest {
         robot: robot.clone(),
@@ -850,4 +850,112 @@ async fn mesh_files_travel_with_the_model() {
         .unwrap_err();
     assert_eq!(err.code(), Code::InvalidArgument);
     assert!(err.message().contains(uri), "{}", err.message());
+}
+
+/// MoveIt's SRDF comes with the URDF: its disable_collisions pairs are never
+/// checked, its group names the chain and its group states come back from
+/// DescribeRobot. A two-joint arm whose second link (0.6 m) reaches the base
+/// box when folded back (q2 = 3 rad: its end 0.1 + 0.5 − 0.6·cos(0.14) ≈ 0.0 m
+/// high, below the base's top at 0.1 m).
+#[tokio::test]
+async fn an_srdf_disables_pairs_names_the_chain_and_the_states() {
+    let server = start(config()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let urdf = r#"<robot name="folding">
+      <link name="base"><collision><origin xyz="0 0 0.05"/><geometry><box size="0.3 0.3 0.1"/></geometry></collision></link>
+      <link name="l1"><collision><origin xyz="0 0 0.25"/><geometry><box size="0.05 0.05 0.5"/></geometry></collision></link>
+      <link name="l2"><collision><origin xyz="0 0 0.3"/><geometry><box size="0.05 0.05 0.6"/></geometry></collision></link>
+      <link name="tool"/>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>
+        <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+      <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.5"/><axis xyz="0 1 0"/>
+        <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+      <joint name="t" type="fixed"><parent link="l2"/><child link="tool"/><origin xyz="0 0 0.6"/></joint>
+    </robot>"#;
+    let srdf = r#"<robot name="folding">
+      <group name="arm"><chain base_link="base" tip_link="tool"/></group>
+      <group name="upper"><chain base_link="base" tip_link="l1"/></group>
+      <group_state name="folded" group="arm"><joint name="j1" value="0"/><joint name="j2" value="3"/></group_state>
+      <disable_collisions link1="base" link2="l2" reason="Never"/>
+    </robot>"#;
+    let reference = |srdf: &str, group: &str| {
+        Some(pb::RobotRef {
+            source: Some(pb::robot_ref::Source::Urdf(urdf.into())),
+            srdf: srdf.into(),
+            group: group.into(),
+            ..Default::default()
+        })
+    };
+    let folded = |robot| pb::CheckStateRequest {
+        robot,
+        states: vec![pb::JointState {
+            positions: vec![0.0, 3.0],
+        }],
+        scene: None,
+        max_distance: None,
+    };
+    let without = planning
+        .check_state(folded(reference("", "")))
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(!without.states[0].valid, "{:?}", without.states[0]);
+    assert!(
+        without.states[0]
+            .colliding
+            .iter()
+            .any(|c| c.contains("base") && c.contains("l2"))
+    );
+    let with = planning
+        .check_state(folded(reference(srdf, "")))
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(with.states[0].valid, "{:?}", with.states[0]);
+    // the group names the chain; the states come back as written
+    let described = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: reference(srdf, "upper"),
+            ..Default::default()
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert_eq!(
+        (described.base_link.as_str(), described.tip_link.as_str()),
+        ("base", "l1")
+    );
+    assert_eq!(described.named_states.len(), 1);
+    let state = &described.named_states[0];
+    assert_eq!((state.name.as_str(), state.group.as_str()), ("folded", "arm"));
+    assert_eq!(state.joint_names, ["j1", "j2"]);
+    assert_eq!(state.positions, [0.0, 3.0]);
+    // the SRDF is part of the model: another id than the URDF's alone
+    let plain = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: reference("", ""),
+            ..Default::default()
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert_ne!(plain.model_id, described.model_id);
+    // bad input is named
+    let err = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: reference(srdf, "nope"),
+            ..Default::default()
+        })
+        .await
+        .unwrap_err();
+    assert!(err.message().starts_with("robot.group"), "{}", err.message());
+    let err = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: reference("<robot><group_state", ""),
+            ..Default::default()
+        })
+        .await
+        .unwrap_err();
+    assert_eq!(err.code(), Code::InvalidArgument, "{err:?}");
 }

@@ -164,6 +164,7 @@ impl Robot {
             base_link: self.spec.base_link.clone(),
             tip_link: self.spec.tip_link.clone(),
             meshes,
+            ..Default::default()
         }
     }
 

@@ -5,6 +5,8 @@
 pub enum RobotError {
     #[error("URDF could not be parsed: {0}")]
     MalformedUrdf(String),
+    #[error("SRDF could not be read: {0}")]
+    MalformedSrdf(String),
     #[error("URDF is {size} bytes, more than the limit of {limit} bytes")]
     UrdfTooLarge { size: usize, limit: usize },
     #[error("URDF has {count} {what}, more than the limit of {limit}")]

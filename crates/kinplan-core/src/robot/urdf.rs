@@ -99,7 +99,7 @@ pub fn parse_chain(text: &str, spec: &ChainSpec, limits: UrdfLimits) -> Result<C
 /// The scan follows XML's lexical rules (comments, CDATA, processing
 /// instructions, quoted attribute values); it only counts, the parser still
 /// decides what is well formed.
-fn prescan(text: &str, limits: &UrdfLimits) -> Result<(), RobotError> {
+pub(crate) fn prescan(text: &str, limits: &UrdfLimits) -> Result<(), RobotError> {
     let bytes = text.as_bytes();
     let mut depth = 0usize;
     let mut elements = 0usize;

@@ -9,8 +9,9 @@
 use std::sync::{Arc, Mutex, Weak};
 
 use kinplan_core::collision::{
-    AcmParams, AllowedCollisions, CollisionError, MeshFileLimits, RobotModel, read_mesh_file,
+    AcmParams, AllowReason, AllowedCollisions, CollisionError, MeshFileLimits, RobotModel, read_mesh_file,
 };
+use kinplan_core::robot::{UrdfLimits, parse_srdf};
 
 use crate::runtime::models::ModelSource;
 use kinplan_core::robot::Chain;
@@ -45,13 +46,33 @@ impl CollisionSetup {
             }
             None => RobotModel::new(chain)?,
         });
-        let acm = AllowedCollisions::sampled(
+        // MoveIt's disable_collisions pairs (by link name; pairs of links the
+        // model does not hold are left out)
+        let disabled = match source.and_then(|s| s.srdf.as_deref()) {
+            Some(text) => {
+                parse_srdf(text, &UrdfLimits::default())
+                    .map_err(|e| CollisionError::Parse {
+                        field: "srdf".into(),
+                        reason: e.to_string(),
+                    })?
+                    .disabled_collisions
+            }
+            None => Vec::new(),
+        };
+        let mut acm = AllowedCollisions::sampled(
             &model,
             &AcmParams {
                 samples: AcmParams::samples_within(model.body_count(), acm_samples),
                 ..AcmParams::default()
             },
         )?;
+        let index: std::collections::HashMap<&str, usize> =
+            model.body_names().enumerate().map(|(i, n)| (n, i)).collect();
+        for (a, b) in &disabled {
+            if let (Some(&i), Some(&j)) = (index.get(a.as_str()), index.get(b.as_str())) {
+                acm.allow(i, j, AllowReason::User);
+            }
+        }
         Ok(Self { model, acm })
     }
 }

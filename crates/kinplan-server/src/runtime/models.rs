@@ -12,7 +12,7 @@ use tonic::Status;
 use super::{Budget, Compute};
 use crate::pb::{self, robot_ref::Source};
 use crate::status::{invalid, not_found, robot_error};
-use kinplan_core::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
+use kinplan_core::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain, parse_srdf};
 
 /// A chain and the id a client can send instead of its URDF next time
 /// (empty for built-in robots).
@@ -31,6 +31,8 @@ pub struct Resolved {
 pub struct ModelSource {
     pub urdf: Arc<str>,
     pub meshes: MeshFiles,
+    /// MoveIt's SRDF for the URDF, when one was sent.
+    pub srdf: Option<Arc<str>>,
 }
 
 /// Mesh files as (URI, bytes), sorted by URI.
@@ -41,20 +43,24 @@ impl ModelSource {
         Self {
             urdf,
             meshes: Arc::from(Vec::new()),
+            srdf: None,
         }
     }
 
     /// Bytes held (the cache's accounting).
     fn bytes(&self) -> usize {
-        self.urdf.len() + self.meshes.iter().map(|(u, d)| u.len() + d.len()).sum::<usize>()
+        self.urdf.len()
+            + self.srdf.as_ref().map_or(0, |s| s.len())
+            + self.meshes.iter().map(|(u, d)| u.len() + d.len()).sum::<usize>()
     }
 
     /// The model id: SHA-256 of the URDF text alone when there are no mesh
-    /// files (as before meshes could be sent), else of
-    /// `"kinplan-model-v1\0" · len·urdf · Σ_files(len·uri · len·data)` with the
-    /// files sorted by URI and every length a little-endian u64.
+    /// files and no SRDF (as before they could be sent), else of
+    /// `"kinplan-model-v1\0" · len·urdf · len·srdf · Σ_files(len·uri · len·data)`
+    /// with the files sorted by URI, every length a little-endian u64 and an
+    /// absent SRDF empty.
     fn id(&self) -> ModelId {
-        if self.meshes.is_empty() {
+        if self.meshes.is_empty() && self.srdf.is_none() {
             return Sha256::digest(self.urdf.as_bytes()).into();
         }
         let mut h = Sha256::new();
@@ -64,6 +70,7 @@ impl ModelSource {
             h.update(bytes);
         };
         part(self.urdf.as_bytes());
+        part(self.srdf.as_deref().unwrap_or("").as_bytes());
         for (uri, data) in self.meshes.iter() {
             part(uri.as_bytes());
             part(data);
@@ -103,6 +110,28 @@ fn meshes_in(files: &[pb::MeshFile]) -> Result<MeshFiles, Status> {
         return Err(invalid(format!("robot.meshes[{}]", w[0].0), "is given twice"));
     }
     Ok(Arc::from(out))
+}
+
+/// The chain of the SRDF group `group`: its (first) `<chain>`.
+fn group_chain(source: &ModelSource, group: &str, limits: &UrdfLimits) -> Result<ChainSpec, Status> {
+    let Some(text) = &source.srdf else {
+        return Err(invalid(
+            "robot.group",
+            "names an SRDF group, and the model has no SRDF",
+        ));
+    };
+    let srdf = parse_srdf(text, limits).map_err(|e| robot_error(e, ""))?;
+    let found = srdf
+        .group(group)
+        .ok_or_else(|| invalid("robot.group", format!("the SRDF has no group `{group}`")))?;
+    let (base, tip) = found
+        .chains
+        .first()
+        .ok_or_else(|| invalid("robot.group", format!("group `{group}` has no <chain>")))?;
+    Ok(ChainSpec {
+        base_link: Some(base.clone()),
+        tip_link: Some(tip.clone()),
+    })
 }
 
 /// A parsed chain and what it came from.
@@ -229,20 +258,33 @@ impl ModelStore {
         let Some(robot) = robot else {
             return Err(invalid("robot", "is required"));
         };
-        let spec = ChainSpec {
+        let mut spec = ChainSpec {
             base_link: Some(robot.base_link.clone()).filter(|s| !s.is_empty()),
             tip_link: Some(robot.tip_link.clone()).filter(|s| !s.is_empty()),
         };
-        if !robot.meshes.is_empty() && !matches!(robot.source, Some(Source::Urdf(_))) {
+        let inline = matches!(robot.source, Some(Source::Urdf(_)));
+        if !robot.meshes.is_empty() && !inline {
             return Err(invalid(
                 "robot.meshes",
                 "mesh files come with an inline urdf (a model id already names them)",
             ));
         }
+        if !robot.srdf.is_empty() && !inline {
+            return Err(invalid(
+                "robot.srdf",
+                "an SRDF comes with an inline urdf (a model id already names it)",
+            ));
+        }
+        if !robot.group.is_empty() && spec != ChainSpec::default() {
+            return Err(invalid(
+                "robot.group",
+                "names the chain: leave base_link and tip_link empty",
+            ));
+        }
         let (id, text) = match &robot.source {
             None => return Err(invalid("robot", "one of name, urdf or model_id is required")),
             Some(Source::Name(name)) => {
-                if spec == ChainSpec::default() {
+                if spec == ChainSpec::default() && robot.group.is_empty() {
                     let chain = builtin_chain(name).map_err(|e| robot_error(e, ""))?;
                     return Ok(Resolved {
                         chain,
@@ -265,10 +307,25 @@ impl ModelStore {
                         ),
                     ));
                 }
+                if robot.srdf.len() > self.limits.max_bytes {
+                    return Err(invalid(
+                        "robot.srdf",
+                        format!(
+                            "{} bytes exceed the limit of {}",
+                            robot.srdf.len(),
+                            self.limits.max_bytes
+                        ),
+                    ));
+                }
                 let source = ModelSource {
                     urdf: Arc::from(text.as_str()),
                     meshes: meshes_in(&robot.meshes)?,
+                    srdf: Some(Arc::from(robot.srdf.as_str())).filter(|s: &Arc<str>| !s.is_empty()),
                 };
+                // refused when sent, not at the first call that reads it
+                if let Some(text) = &source.srdf {
+                    parse_srdf(text, &self.limits).map_err(|e| robot_error(e, ""))?;
+                }
                 (source.id(), Some(source))
             }
             Some(Source::ModelId(bytes)) => {
@@ -283,6 +340,22 @@ impl ModelStore {
             Some(Source::Name(_)) => Vec::new(),
             _ => id.to_vec(),
         };
+        let text = match text {
+            Some(t) => Some(t),
+            None if !robot.group.is_empty() => {
+                Some(self.texts.lock().expect("cache lock").get(&id).ok_or_else(|| {
+                    not_found(
+                        "robot.model_id",
+                        "this server does not hold that model; send the URDF again",
+                    )
+                })?)
+            }
+            None => None,
+        };
+        if !robot.group.is_empty() {
+            let source = text.as_ref().expect("fetched above");
+            spec = group_chain(source, &robot.group, &self.limits)?;
+        }
         let key = (id, spec.clone());
         if let Some((chain, source)) = self.chains.lock().expect("cache lock").get(&key) {
             return Ok(Resolved {

@@ -29,5 +29,6 @@ pub fn robot_error(err: RobotError, joints_field: &str) -> Status {
         | RobotError::UnsupportedJoint { .. }
         | RobotError::ZeroAxis { .. }
         | RobotError::InvertedLimits { .. } => invalid("robot.urdf", text),
+        RobotError::MalformedSrdf(_) => invalid("robot.srdf", text),
     }
 }

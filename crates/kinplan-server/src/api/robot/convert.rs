@@ -52,6 +52,7 @@ pub(super) fn describe(chain: &Chain, model_id: Vec<u8>) -> pb::DescribeRobotRes
         tip_offset: Some(pose_out(chain.tip_offset())),
         urdf: String::new(),
         collision_bodies: Vec::new(),
+        named_states: Vec::new(),
     }
 }
 

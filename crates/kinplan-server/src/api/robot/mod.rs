@@ -10,7 +10,9 @@ use crate::pb::{self, robot_service_server::RobotService};
 use crate::runtime::Shared;
 use crate::runtime::collision_models::collision_setup;
 use crate::status::{invalid, robot_error, too_large};
-use kinplan_core::robot::{BUILTIN_NAMES, Chain, builtin_chain, builtin_urdf, expand_capsules};
+use kinplan_core::robot::{
+    BUILTIN_NAMES, Chain, UrdfLimits, builtin_chain, builtin_urdf, expand_capsules, parse_srdf,
+};
 
 mod convert;
 
@@ -74,6 +76,19 @@ impl RobotService for RobotApi {
         };
         let mut reply = describe(&robot.chain, robot.model_id);
         reply.collision_bodies = bodies;
+        if let Some(text) = &robot.source.srdf {
+            let srdf = parse_srdf(text, &UrdfLimits::default()).map_err(|e| robot_error(e, ""))?;
+            reply.named_states = srdf
+                .group_states
+                .into_iter()
+                .map(|s| pb::NamedState {
+                    name: s.name,
+                    group: s.group,
+                    joint_names: s.joints.iter().map(|(n, _)| n.clone()).collect(),
+                    positions: s.joints.iter().map(|(_, v)| *v).collect(),
+                })
+                .collect();
+        }
         if req.include_urdf
             && let Some(pb::robot_ref::Source::Name(name)) =
                 req.robot.as_ref().and_then(|r| r.source.as_ref())
