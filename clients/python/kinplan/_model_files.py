@@ -22,6 +22,18 @@ def _looks_like_path(urdf: PathLike) -> bool:
     return isinstance(urdf, os.PathLike) or ("<" not in urdf and urdf.strip().lower().endswith((".urdf", ".xml")))
 
 
+def load_text(doc: Optional[PathLike], field: str) -> Optional[str]:
+    """A document given as text or as an existing file's path (``None`` stays ``None``)."""
+    if doc is None:
+        return None
+    if isinstance(doc, os.PathLike) or ("<" not in doc and doc.strip().lower().endswith((".srdf", ".xml", ".urdf"))):
+        path = pathlib.Path(doc)
+        if not path.is_file():
+            raise invalid_argument(field, f"{str(doc)!r} looks like a file path, but no such file exists here")
+        return path.read_text(encoding="utf-8")
+    return str(doc)
+
+
 def collision_mesh_uris(urdf_text: str) -> List[str]:
     """The ``<mesh filename>`` of every ``<collision>`` element, in order, once each."""
     try:

@@ -21,7 +21,7 @@ from ._services import mobile as _mobile
 from ._services import robot as _robot
 from ._services.robot import RobotRefs, check_robot_args
 from .description import JointLimits, RobotDescription
-from ._model_files import load_model
+from ._model_files import load_model, load_text
 from .errors import KinplanError, invalid_argument
 from .exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
 from .kinematics import LinearSolution
@@ -204,6 +204,8 @@ class Client:
         strict: bool = False,
         package_dirs: Optional[Sequence[Union[str, "os.PathLike[str]"]]] = None,
         meshes: Optional[Mapping[str, bytes]] = None,
+        srdf: Optional[Union[str, "os.PathLike[str]"]] = None,
+        group: str = "",
     ) -> Robot:
         """A built-in robot by `name`, or a model sent as `urdf` (its text,
         or the path of a URDF file): the handle of every call about it
@@ -217,6 +219,12 @@ class Client:
         mesh that cannot be found raises :class:`FileNotFoundError` naming it
         and every place looked. STL and OBJ are read by the server.
 
+        `srdf` (MoveIt's SRDF, text or path) comes with the model: its
+        ``disable_collisions`` pairs are never checked, `group` names one of
+        its groups as the chain (instead of `base_link`/`tip_link`), and
+        ``robot.describe().named_state("ready")`` gives a group state as a
+        joint vector in chain order.
+
         Joint values outside the robot's limits (usually degrees given where
         radians are meant) raise a :class:`kinplan.JointLimitWarning` in
         ``fk``, ``fk_batch``, ``jacobian`` and ``score``; with
@@ -224,7 +232,7 @@ class Client:
         check_robot_args(name, urdf)
         text, files = (None, {}) if urdf is None else load_model(urdf, package_dirs, meshes)
         robot = Robot(self, name=name, urdf=text, base_link=base_link, tip_link=tip_link, strict=strict)
-        robot.mesh_files = files
+        robot.mesh_files, robot.srdf_text, robot.group = files, load_text(srdf, "srdf"), group
         return robot
 
     def _robot_of(self, robot: Any) -> Robot:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import operator
 import warnings
 from dataclasses import dataclass, field
-from typing import Any, List
+from typing import Any, Dict, List
 
 import numpy as np
 
@@ -33,6 +33,25 @@ class RobotDescription:
     @property
     def dof(self) -> int:
         return len(self.joint_names)
+
+    @property
+    def named_states(self) -> Dict[str, Dict[str, float]]:
+        """The SRDF's group states: ``{name: {joint: value}}`` (empty without an SRDF)."""
+        if self.raw is None:
+            return {}
+        return {s.name: dict(zip(s.joint_names, s.positions)) for s in self.raw.named_states}
+
+    def named_state(self, name: str) -> np.ndarray:
+        """The SRDF group state `name` as a joint vector in chain order. A
+        chain joint the state does not set is an error naming it."""
+        states = self.named_states
+        if name not in states:
+            raise KeyError(f"no named state {name!r}; the SRDF has {sorted(states) or 'none'}")
+        values = states[name]
+        missing = [j for j in self.joint_names if j not in values]
+        if missing:
+            raise ValueError(f"named state {name!r} does not set the chain joints {missing}")
+        return np.array([values[j] for j in self.joint_names])
 
     @classmethod
     def from_proto(cls, r: robot_pb2.DescribeRobotResponse) -> "RobotDescription":

@@ -46,6 +46,8 @@ class Robot(RobotRefs):
         self.name = name
         self.urdf_text = urdf
         self.mesh_files: Dict[str, bytes] = {}
+        self.srdf_text: Optional[str] = None
+        self.group = ""
         self.base_link = base_link
         self.tip_link = tip_link
         self.strict = strict

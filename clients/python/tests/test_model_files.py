@@ -99,3 +99,40 @@ def test_only_collision_meshes_are_named():
     urdf = URDF.replace("<link name=\"base\"/>",
                         "<link name=\"base\"><visual><geometry><mesh filename=\"seen.dae\"/></geometry></visual></link>")
     assert collision_mesh_uris(urdf) == ["package://arm_pkg/meshes/link.stl", "../meshes/gripper.obj"]
+
+
+FOLDING = """<robot name="folding">
+  <link name="base"><collision><origin xyz="0 0 0.05"/><geometry><box size="0.3 0.3 0.1"/></geometry></collision></link>
+  <link name="l1"><collision><origin xyz="0 0 0.25"/><geometry><box size="0.05 0.05 0.5"/></geometry></collision></link>
+  <link name="l2"><collision><origin xyz="0 0 0.3"/><geometry><box size="0.05 0.05 0.6"/></geometry></collision></link>
+  <link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.1"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.5"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+  <joint name="t" type="fixed"><parent link="l2"/><child link="tool"/><origin xyz="0 0 0.6"/></joint>
+</robot>"""
+
+SRDF = """<robot name="folding">
+  <group name="arm"><chain base_link="base" tip_link="tool"/></group>
+  <group name="upper"><chain base_link="base" tip_link="l1"/></group>
+  <group_state name="folded" group="arm"><joint name="j1" value="0"/><joint name="j2" value="3"/></group_state>
+  <disable_collisions link1="base" link2="l2" reason="Never"/>
+</robot>"""
+
+
+def test_an_srdf_disables_pairs_names_groups_and_states(client, tmp_path):
+    (tmp_path / "folding.srdf").write_text(SRDF)
+    plain = client.robot(urdf=FOLDING)
+    robot = client.robot(urdf=FOLDING, srdf=tmp_path / "folding.srdf")
+    folded = robot.describe().named_state("folded")
+    np.testing.assert_array_equal(folded, [0.0, 3.0])
+    # folded back, the second link reaches into the base: a pair the SRDF disables
+    assert not plain.check([folded]).valid[0]
+    assert robot.check([folded]).valid[0]
+    upper = client.robot(urdf=FOLDING, srdf=SRDF, group="upper")
+    assert upper.describe().tip_link == "l1" and upper.describe().dof == 1
+    # a state for a longer chain gives this chain's joints; an unknown name lists the known ones
+    np.testing.assert_array_equal(upper.describe().named_state("folded"), [0.0])
+    with pytest.raises(KeyError, match="folded"):
+        upper.describe().named_state("ready")

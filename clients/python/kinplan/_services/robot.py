@@ -35,6 +35,8 @@ class RobotRefs:
     name: Optional[str]
     urdf_text: Optional[str]
     mesh_files: Dict[str, bytes]
+    srdf_text: Optional[str]
+    group: str
     base_link: str
     tip_link: str
     model_id: bytes
@@ -61,7 +63,7 @@ class RobotRefs:
         return length_delimited(_codec.ROBOT_REF, ref.SerializeToString())
 
     def _new_ref(self, inline: bool) -> common_pb2.RobotRef:
-        ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link)
+        ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link, group=self.group)
         if self.name is not None:
             ref.name = self.name
         elif self.model_id and not inline:
@@ -70,11 +72,13 @@ class RobotRefs:
             ref.urdf = self.urdf_text or ""
             for uri, data in sorted(self.mesh_files.items()):
                 ref.meshes.add(uri=uri, data=data)
+            ref.srdf = self.srdf_text or ""
         return ref
 
     def limits_key(self) -> Any:
         """What identifies this robot's chain in a client's cache."""
-        return (self.name, None if self.urdf_text is None else hash(self.urdf_text), self.base_link, self.tip_link)
+        return (self.name, None if self.urdf_text is None else hash(self.urdf_text), self.base_link, self.tip_link,
+                self.group)
 
     def _learn(self, reply: Any) -> None:
         """Keeps the model id a reply gives an inline model."""

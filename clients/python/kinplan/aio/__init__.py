@@ -34,7 +34,7 @@ from .._services import exploration as _exploration
 from .._services import kinematics as _kinematics
 from .._services import robot as _robot
 from .._services.robot import check_robot_args
-from .._model_files import load_model
+from .._model_files import load_model, load_text
 from ..errors import KinplanError, invalid_argument
 from ..exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
 from ..kinematics import LinearSolution
@@ -178,12 +178,13 @@ class Client:
     def robot(self, name: Optional[str] = None, *, urdf: Optional[Union[str, "os.PathLike[str]"]] = None,
               base_link: str = "", tip_link: str = "", strict: bool = False,
               package_dirs: Optional[Sequence[Union[str, "os.PathLike[str]"]]] = None,
-              meshes: Optional[Mapping[str, bytes]] = None) -> AsyncRobot:
+              meshes: Optional[Mapping[str, bytes]] = None,
+              srdf: Optional[Union[str, "os.PathLike[str]"]] = None, group: str = "") -> AsyncRobot:
         """As :meth:`kinplan.Client.robot`."""
         check_robot_args(name, urdf)
         text, files = (None, {}) if urdf is None else load_model(urdf, package_dirs, meshes)
         robot = AsyncRobot(self, name=name, urdf=text, base_link=base_link, tip_link=tip_link, strict=strict)
-        robot.mesh_files = files
+        robot.mesh_files, robot.srdf_text, robot.group = files, load_text(srdf, "srdf"), group
         return robot
 
     def _robot_of(self, robot: Any) -> AsyncRobot:

@@ -40,6 +40,8 @@ class AsyncRobot(RobotRefs):
         self.client = client
         self.name, self.urdf_text = name, urdf
         self.mesh_files: Dict[str, bytes] = {}
+        self.srdf_text: Optional[str] = None
+        self.group = ""
         self.base_link, self.tip_link = base_link, tip_link
         self.strict = strict
         self.model_id: bytes = b""

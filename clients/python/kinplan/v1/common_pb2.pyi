@@ -37,20 +37,24 @@ class Pose(_message.Message):
     def __init__(self, position: _Optional[_Union[Vec3, _Mapping]] = ..., orientation: _Optional[_Union[Quaternion, _Mapping]] = ...) -> None: ...
 
 class RobotRef(_message.Message):
-    __slots__ = ("name", "urdf", "model_id", "base_link", "tip_link", "meshes")
+    __slots__ = ("name", "urdf", "model_id", "base_link", "tip_link", "meshes", "srdf", "group")
     NAME_FIELD_NUMBER: _ClassVar[int]
     URDF_FIELD_NUMBER: _ClassVar[int]
     MODEL_ID_FIELD_NUMBER: _ClassVar[int]
     BASE_LINK_FIELD_NUMBER: _ClassVar[int]
     TIP_LINK_FIELD_NUMBER: _ClassVar[int]
     MESHES_FIELD_NUMBER: _ClassVar[int]
+    SRDF_FIELD_NUMBER: _ClassVar[int]
+    GROUP_FIELD_NUMBER: _ClassVar[int]
     name: str
     urdf: str
     model_id: bytes
     base_link: str
     tip_link: str
     meshes: _containers.RepeatedCompositeFieldContainer[MeshFile]
-    def __init__(self, name: _Optional[str] = ..., urdf: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., meshes: _Optional[_Iterable[_Union[MeshFile, _Mapping]]] = ...) -> None: ...
+    srdf: str
+    group: str
+    def __init__(self, name: _Optional[str] = ..., urdf: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., meshes: _Optional[_Iterable[_Union[MeshFile, _Mapping]]] = ..., srdf: _Optional[str] = ..., group: _Optional[str] = ...) -> None: ...
 
 class MeshFile(_message.Message):
     __slots__ = ("uri", "data")

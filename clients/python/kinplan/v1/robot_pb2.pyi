@@ -102,7 +102,7 @@ class LinkInfo(_message.Message):
     def __init__(self, name: _Optional[str] = ..., parent_joint: _Optional[int] = ..., offset: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., collision: _Optional[_Iterable[_Union[CollisionGeometry, _Mapping]]] = ...) -> None: ...
 
 class DescribeRobotResponse(_message.Message):
-    __slots__ = ("name", "model_id", "base_link", "tip_link", "joints", "links", "tip_offset", "urdf", "collision_bodies")
+    __slots__ = ("name", "model_id", "base_link", "tip_link", "joints", "links", "tip_offset", "urdf", "collision_bodies", "named_states")
     NAME_FIELD_NUMBER: _ClassVar[int]
     MODEL_ID_FIELD_NUMBER: _ClassVar[int]
     BASE_LINK_FIELD_NUMBER: _ClassVar[int]
@@ -112,6 +112,7 @@ class DescribeRobotResponse(_message.Message):
     TIP_OFFSET_FIELD_NUMBER: _ClassVar[int]
     URDF_FIELD_NUMBER: _ClassVar[int]
     COLLISION_BODIES_FIELD_NUMBER: _ClassVar[int]
+    NAMED_STATES_FIELD_NUMBER: _ClassVar[int]
     name: str
     model_id: bytes
     base_link: str
@@ -121,7 +122,20 @@ class DescribeRobotResponse(_message.Message):
     tip_offset: _common_pb2.Pose
     urdf: str
     collision_bodies: _containers.RepeatedCompositeFieldContainer[CollisionBodyInfo]
-    def __init__(self, name: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., joints: _Optional[_Iterable[_Union[JointInfo, _Mapping]]] = ..., links: _Optional[_Iterable[_Union[LinkInfo, _Mapping]]] = ..., tip_offset: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., urdf: _Optional[str] = ..., collision_bodies: _Optional[_Iterable[_Union[CollisionBodyInfo, _Mapping]]] = ...) -> None: ...
+    named_states: _containers.RepeatedCompositeFieldContainer[NamedState]
+    def __init__(self, name: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., joints: _Optional[_Iterable[_Union[JointInfo, _Mapping]]] = ..., links: _Optional[_Iterable[_Union[LinkInfo, _Mapping]]] = ..., tip_offset: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., urdf: _Optional[str] = ..., collision_bodies: _Optional[_Iterable[_Union[CollisionBodyInfo, _Mapping]]] = ..., named_states: _Optional[_Iterable[_Union[NamedState, _Mapping]]] = ...) -> None: ...
+
+class NamedState(_message.Message):
+    __slots__ = ("name", "group", "joint_names", "positions")
+    NAME_FIELD_NUMBER: _ClassVar[int]
+    GROUP_FIELD_NUMBER: _ClassVar[int]
+    JOINT_NAMES_FIELD_NUMBER: _ClassVar[int]
+    POSITIONS_FIELD_NUMBER: _ClassVar[int]
+    name: str
+    group: str
+    joint_names: _containers.RepeatedScalarFieldContainer[str]
+    positions: _containers.RepeatedScalarFieldContainer[float]
+    def __init__(self, name: _Optional[str] = ..., group: _Optional[str] = ..., joint_names: _Optional[_Iterable[str]] = ..., positions: _Optional[_Iterable[float]] = ...) -> None: ...
 
 class CollisionBodyInfo(_message.Message):
     __slots__ = ("name", "carried_by", "shapes")
