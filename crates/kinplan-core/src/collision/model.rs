@@ -12,7 +12,7 @@ use parry3d_f64::shape::SharedShape;
 use super::convert::{pose_to_parry, vec_to_parry};
 use super::fast::RobotFast;
 use super::fixed_frame::{FixedFrame, column, turned};
-use super::scene::{SceneLimits, validate_mesh};
+use super::scene::{SceneLimits, validate_mesh_points};
 use super::trig::sin_cos;
 use super::world::primitive_shape;
 use super::{CollisionError, Geometry};
@@ -214,7 +214,7 @@ impl RobotModel {
         }
         if bodies.len() > MAX_BODIES {
             return Err(CollisionError::TooManyBodies {
-                field: "robot".into(),
+                field: "links".into(),
                 count: bodies.len(),
                 limit: MAX_BODIES,
             });
@@ -436,7 +436,7 @@ fn body_shapes(
                         filename: filename.clone(),
                     }
                 })?;
-                validate_mesh(&mesh.vertices, &mesh.indices, &field, &SceneLimits::default())?;
+                validate_mesh_points(&mesh.vertices, &mesh.indices, &field, &SceneLimits::default())?;
                 let points: Vec<_> = mesh
                     .vertices
                     .iter()

@@ -240,6 +240,29 @@ pub(crate) fn validate_mesh(
     field: &str,
     limits: &SceneLimits,
 ) -> Result<usize, CollisionError> {
+    let triangles = validate_mesh_points(vertices, indices, field, limits)?;
+    for (t, tri) in indices.chunks_exact(3).enumerate() {
+        let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| vertices[i as usize]);
+        let area = 0.5 * (b - a).cross(&(c - a)).norm();
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || area <= 1e-12 {
+            return Err(CollisionError::Degenerate {
+                field: format!("{field}.indices[{}..{}]", 3 * t, 3 * t + 3),
+                reason: format!("triangle {t} has area {area:.3e} m²"),
+            });
+        }
+    }
+    Ok(triangles)
+}
+
+/// [`validate_mesh`] without the degenerate-triangle test: what a mesh used
+/// as its convex hull needs (a robot mesh file's zero-area slivers change no
+/// hull).
+pub(crate) fn validate_mesh_points(
+    vertices: &[Point3<f64>],
+    indices: &[u32],
+    field: &str,
+    limits: &SceneLimits,
+) -> Result<usize, CollisionError> {
     if vertices.is_empty() {
         return Err(CollisionError::Empty {
             field: format!("{field}.vertices"),
@@ -280,16 +303,6 @@ pub(crate) fn validate_mesh(
                 field: format!("{field}.indices[{k}]"),
                 index: i,
                 vertex_count: vertices.len(),
-            });
-        }
-    }
-    for (t, tri) in indices.chunks_exact(3).enumerate() {
-        let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| vertices[i as usize]);
-        let area = 0.5 * (b - a).cross(&(c - a)).norm();
-        if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || area <= 1e-12 {
-            return Err(CollisionError::Degenerate {
-                field: format!("{field}.indices[{}..{}]", 3 * t, 3 * t + 3),
-                reason: format!("triangle {t} has area {area:.3e} m²"),
             });
         }
     }

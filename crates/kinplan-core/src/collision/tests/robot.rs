@@ -537,3 +537,32 @@ fn the_whole_robot_collides_the_gripper_beyond_the_tip_and_the_pedestal() {
     assert!(!whole_arm_checker(true, &[], moved()).is_valid(&turned));
     assert!(whole_arm_checker(true, &[], at_gripper()).is_valid(&turned));
 }
+
+/// Regression: a robot mesh file with zero-area slivers (xArm 7's, as shipped)
+/// was refused, though a robot mesh collides as its convex hull, which
+/// slivers do not change; a scene mesh still refuses them.
+#[test]
+fn a_robot_mesh_with_zero_area_slivers_is_accepted() {
+    let (mut vertices, mut indices) = box_mesh(Vector3::new(0.05, 0.04, 0.03));
+    vertices.push(Point3::new(0.0, 0.0, 0.0));
+    let n = vertices.len() as u32;
+    indices.extend_from_slice(&[0, 1, n - 1]); // a proper triangle to the centre
+    indices.extend_from_slice(&[0, 0, 1]); // a repeated corner: zero area
+    let mesh = InlineMesh {
+        filename: "package://probe/slivers.stl".into(),
+        vertices: vertices.clone(),
+        indices: indices.clone(),
+    };
+    let urdf = probe_urdf(r#"<mesh filename="package://probe/slivers.stl"/>"#);
+    let c = checker(&urdf, &[mesh], vec![]);
+    assert_eq!(c.model().body_count(), 1);
+    let scene = Scene::new(
+        vec![Obstacle::new(
+            "slivers",
+            Isometry3::identity(),
+            Geometry::Mesh { vertices, indices },
+        )],
+        &SceneLimits::default(),
+    );
+    assert!(matches!(scene, Err(CollisionError::Degenerate { .. })));
+}
