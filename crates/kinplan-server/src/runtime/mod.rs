@@ -8,6 +8,7 @@ pub mod models;
 pub mod priority;
 pub mod request_numbers;
 mod shared;
+pub mod wire;
 
 pub use compute::{Budget, Compute, catch_unwind};
 pub use models::ModelStore;

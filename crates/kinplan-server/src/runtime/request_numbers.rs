@@ -18,7 +18,7 @@ use prost::Message;
 use prost_types::field_descriptor_proto::{Label, Type};
 use tonic::Status;
 
-use crate::pb;
+use super::wire::{descriptor_set, each_message, varint};
 use crate::status::invalid;
 
 /// Largest magnitude of a request number (metres, radians, seconds, …)
@@ -82,15 +82,8 @@ struct Field {
 fn schema() -> &'static HashMap<String, HashMap<u64, Field>> {
     static SCHEMA: OnceLock<HashMap<String, HashMap<u64, Field>>> = OnceLock::new();
     SCHEMA.get_or_init(|| {
-        let set = prost_types::FileDescriptorSet::decode(pb::FILE_DESCRIPTOR_SET)
-            .expect("the built-in descriptor set decodes");
         let mut messages = HashMap::new();
-        fn add(
-            prefix: &str,
-            m: &prost_types::DescriptorProto,
-            out: &mut HashMap<String, HashMap<u64, Field>>,
-        ) {
-            let name = format!("{prefix}.{}", m.name());
+        each_message(&descriptor_set(), &mut |name, m| {
             let range = |field: &str| {
                 WIDER_FIELDS
                     .iter()
@@ -124,17 +117,8 @@ fn schema() -> &'static HashMap<String, HashMap<u64, Field>> {
                     (f.number() as u64, field)
                 })
                 .collect();
-            for nested in &m.nested_type {
-                add(&name, nested, out);
-            }
-            out.insert(name, fields);
-        }
-        for file in &set.file {
-            let package = format!(".{}", file.package());
-            for m in &file.message_type {
-                add(&package, m, &mut messages);
-            }
-        }
+            messages.insert(name.to_string(), fields);
+        });
         messages
     })
 }
@@ -179,19 +163,6 @@ fn path_text(path: &[Step]) -> String {
 /// Full name of the matrix message, whose data entries are also named by row
 /// and column (`joint_positions[1][2]`) in the description.
 const MATRIX: &str = ".kinplan.v1.Matrix";
-
-fn varint(bytes: &[u8], at: &mut usize) -> Option<u64> {
-    let mut value = 0u64;
-    for shift in (0..64).step_by(7) {
-        let b = *bytes.get(*at)?;
-        *at += 1;
-        value |= u64::from(b & 0x7f) << shift;
-        if b & 0x80 == 0 {
-            return Some(value);
-        }
-    }
-    None
-}
 
 /// Why `v` is out of `range`, if it is.
 fn out_of_range(v: f64, float: bool, range: Range) -> Option<String> {
@@ -338,6 +309,7 @@ fn number_at(b: &[u8], float: bool) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::pb;
 
     fn message(status: Status) -> String {
         status.message().to_string()
@@ -345,7 +317,7 @@ mod tests {
 
     #[test]
     fn every_request_type_is_found_in_the_schema() {
-        let set = prost_types::FileDescriptorSet::decode(pb::FILE_DESCRIPTOR_SET).unwrap();
+        let set = descriptor_set();
         let inputs: Vec<String> = set
             .file
             .iter()

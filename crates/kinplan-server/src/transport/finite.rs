@@ -9,10 +9,9 @@
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
-use prost::Message;
 use prost_types::field_descriptor_proto::Type;
 
-use crate::pb;
+use crate::runtime::wire::{descriptor_set, each_message, varint};
 
 #[derive(Debug, Clone)]
 enum Kind {
@@ -38,16 +37,10 @@ const INFINITE_ALLOWED: &[(&str, &str)] = &[("JointInfo", "lower"), ("JointInfo"
 fn schema() -> &'static Schema {
     static SCHEMA: OnceLock<Schema> = OnceLock::new();
     SCHEMA.get_or_init(|| {
-        let set = prost_types::FileDescriptorSet::decode(pb::FILE_DESCRIPTOR_SET)
-            .expect("the built-in descriptor set decodes");
+        let set = descriptor_set();
         let mut messages = HashMap::new();
         let mut replies = HashMap::new();
-        fn add(
-            prefix: &str,
-            m: &prost_types::DescriptorProto,
-            out: &mut HashMap<String, HashMap<u64, Kind>>,
-        ) {
-            let name = format!("{prefix}.{}", m.name());
+        each_message(&set, &mut |name, m| {
             let fields = m
                 .field
                 .iter()
@@ -64,16 +57,9 @@ fn schema() -> &'static Schema {
                     (f.number() as u64, kind)
                 })
                 .collect();
-            for nested in &m.nested_type {
-                add(&name, nested, out);
-            }
-            out.insert(name, fields);
-        }
+            messages.insert(name.to_string(), fields);
+        });
         for file in &set.file {
-            let package = format!(".{}", file.package());
-            for m in &file.message_type {
-                add(&package, m, &mut messages);
-            }
             for service in &file.service {
                 for method in &service.method {
                     replies.insert(
@@ -101,19 +87,6 @@ pub struct NonFinite(pub Vec<u64>);
 pub fn check(type_name: &str, bytes: &[u8]) -> Result<(), NonFinite> {
     let mut path = Vec::new();
     walk(schema(), type_name, bytes, &mut path, 0)
-}
-
-fn varint(bytes: &[u8], at: &mut usize) -> Option<u64> {
-    let mut value = 0u64;
-    for shift in (0..64).step_by(7) {
-        let b = *bytes.get(*at)?;
-        *at += 1;
-        value |= u64::from(b & 0x7f) << shift;
-        if b & 0x80 == 0 {
-            return Some(value);
-        }
-    }
-    None
 }
 
 fn double_ok(kind: &Kind, v: f64) -> bool {
@@ -219,6 +192,8 @@ fn walk(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::pb;
+    use prost::Message;
 
     #[test]
     fn non_finite_numbers_are_found_at_any_depth() {
