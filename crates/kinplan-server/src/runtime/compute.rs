@@ -93,6 +93,11 @@ impl Drop for Running {
     }
 }
 
+/// The answer to a call shed because every admission slot is taken.
+pub fn shed_status() -> Status {
+    Status::resource_exhausted("server busy: every request slot is taken; retry with backoff")
+}
+
 impl Compute {
     /// `threads` workers (0: one per core) at nice [`super::priority::CPU_POOL_NICE`],
     /// at most `concurrency` requests in the server at once, `default_timeout`
@@ -162,11 +167,13 @@ impl Compute {
     pub fn admit_work(&self) -> Result<OwnedSemaphorePermit, Status> {
         self.admitted.clone().try_acquire_owned().map_err(|_| {
             metrics::counter!("kinplan_requests_shed_total").increment(1);
-            Status::resource_exhausted(format!(
-                "server busy: {} requests in flight; retry with backoff",
-                self.limit
-            ))
+            shed_status()
         })
+    }
+
+    /// True while every admission permit is taken: a new call would be shed.
+    pub fn saturated(&self) -> bool {
+        self.admitted.available_permits() == 0
     }
 
     /// Admits a request or sheds it; the permit is held until the reply.

@@ -130,7 +130,9 @@ pub async fn serve(
     listener: TcpListener,
     shutdown: impl Future<Output = ()> + Send + 'static,
 ) -> Result<(), BoxError> {
-    let (routes, services) = kinplan_routes(&kinplan_shared(&config), &config);
+    let shared = kinplan_shared(&config);
+    let (routes, services) = kinplan_routes(&shared, &config);
+    let compute = shared.compute.clone();
     let (health, health_service) = tonic_health::server::health_reporter();
     for name in services {
         health.set_service_status(name, ServingStatus::Serving).await;
@@ -181,7 +183,10 @@ pub async fn serve(
         builder = builder.tls_config(tls_config)?;
     }
     let router = builder
-        .layer(GuardLayer::new(cut_rx, config.request_timeout))
+        .layer(
+            GuardLayer::new(cut_rx, config.request_timeout)
+                .shedding_when(Arc::new(move || compute.saturated())),
+        )
         .layer(AuthLayer::new(config.auth_tokens.clone()))
         .add_routes(routes)
         .add_service(health_service)

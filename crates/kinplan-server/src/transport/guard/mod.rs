@@ -10,6 +10,7 @@
 use std::future::Future;
 use std::panic::AssertUnwindSafe;
 use std::pin::Pin;
+use std::sync::Arc;
 use std::task::{Context, Poll};
 use std::time::{Duration, Instant};
 
@@ -27,16 +28,33 @@ pub const HANDLING_BUCKETS: &[f64] = &[
     10.0,
 ];
 
+/// Whether the CPU pool admits no more work: a call that would be shed is
+/// answered RESOURCE_EXHAUSTED before its request is decoded.
+pub type Saturated = Arc<dyn Fn() -> bool + Send + Sync>;
+
 #[derive(Clone)]
 pub struct GuardLayer {
     /// Becomes true when shutdown's drain timeout has passed.
     cut: watch::Receiver<bool>,
     default_timeout: Option<Duration>,
+    saturated: Option<Saturated>,
 }
 
 impl GuardLayer {
     pub fn new(cut: watch::Receiver<bool>, default_timeout: Option<Duration>) -> Self {
-        Self { cut, default_timeout }
+        Self {
+            cut,
+            default_timeout,
+            saturated: None,
+        }
+    }
+
+    /// Sheds unary and server-streaming kinplan calls at the door while
+    /// `saturated()` holds (the handlers' own admission stays the rule; this
+    /// only answers a burst's extra calls without reading them).
+    pub fn shedding_when(mut self, saturated: Saturated) -> Self {
+        self.saturated = Some(saturated);
+        self
     }
 }
 
@@ -47,6 +65,7 @@ impl<S> tower::Layer<S> for GuardLayer {
             inner,
             cut: self.cut.clone(),
             default_timeout: self.default_timeout,
+            saturated: self.saturated.clone(),
         }
     }
 }
@@ -56,7 +75,12 @@ pub struct Guard<S> {
     inner: S,
     cut: watch::Receiver<bool>,
     default_timeout: Option<Duration>,
+    saturated: Option<Saturated>,
 }
+
+/// The calls admitted stream by stream (their messages are admitted one by
+/// one), which shedding at the door leaves alone.
+const ADMITTED_PER_MESSAGE: &[&str] = &["/kinplan.v1.KinematicsService/StreamIk"];
 
 type BoxFuture<T> = Pin<Box<dyn Future<Output = T> + Send>>;
 
@@ -154,6 +178,15 @@ where
         request.extensions_mut().insert(RequestDeadline(deadline));
         let cut = self.cut.clone();
         let reply_type = crate::transport::finite::reply_type(request.uri().path());
+        if reply_type.is_some()
+            && !ADMITTED_PER_MESSAGE.contains(&request.uri().path())
+            && self.saturated.as_ref().is_some_and(|busy| busy())
+        {
+            metrics::counter!("kinplan_requests_shed_total").increment(1);
+            let status = crate::runtime::compute::shed_status();
+            labels.record(code_name(status.code() as i32));
+            return Box::pin(std::future::ready(Ok(status.into_http())));
+        }
         let call = std::panic::catch_unwind(AssertUnwindSafe(|| self.inner.call(request)));
         Box::pin(async move {
             let future = match call {
@@ -230,6 +263,38 @@ mod tests {
         }));
         let response = svc.oneshot(http::Request::new(Body::empty())).await.unwrap();
         assert_eq!(status_of(&response), Some(tonic::Code::Internal as i32));
+    }
+
+    /// While the pool is saturated a kinplan call is shed at the door: the
+    /// handler never runs (nor is its request decoded); StreamIk, whose
+    /// messages are admitted one by one, and other services pass.
+    #[tokio::test]
+    async fn a_saturated_pool_sheds_at_the_door() {
+        let (_tx, layer) = layer();
+        let layer = layer.shedding_when(Arc::new(|| true));
+        let reached = Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let seen = reached.clone();
+        let svc = layer.layer(tower::service_fn(move |_req: http::Request<Body>| {
+            seen.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            std::future::ready(Ok::<_, std::convert::Infallible>(http::Response::new(
+                Body::empty(),
+            )))
+        }));
+        let call = |path: &str| {
+            let mut request = http::Request::new(Body::empty());
+            *request.uri_mut() = path.parse().unwrap();
+            svc.clone().oneshot(request)
+        };
+        let shed = call("/kinplan.v1.RobotService/ForwardKinematics").await.unwrap();
+        assert_eq!(status_of(&shed), Some(tonic::Code::ResourceExhausted as i32));
+        assert_eq!(reached.load(std::sync::atomic::Ordering::SeqCst), 0);
+        for passes in [
+            "/kinplan.v1.KinematicsService/StreamIk",
+            "/grpc.health.v1.Health/Check",
+        ] {
+            call(passes).await.unwrap();
+        }
+        assert_eq!(reached.load(std::sync::atomic::Ordering::SeqCst), 2);
     }
 
     struct PanickingBody;
