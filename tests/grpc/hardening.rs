@@ -1,4 +1,4 @@
-//! Hostile-client regressions (issue 9): each test is named after what broke —
+//! Hostile-client regressions: each test is named after what broke —
 //! a process abort, a panic, work outliving its deadline, idle streams holding
 //! admission, a shutdown that never ends, wrong codes.
 

@@ -1,5 +1,5 @@
 //! `KinematicsService`: inverse kinematics ([`kinplan_core::ik`]) and the linear
-//! solvers behind it ([`kinplan_core::linalg`]), ALGORITHMS.md §1–2.
+//! solvers behind it ([`kinplan_core::linalg`]); docs/inverse-kinematics.md and docs/linear-solvers.md.
 //!
 //! Thin adapter: admit → resolve the robot → proto options, targets and
 //! matrices into domain values → solve on the CPU pool, with the request's

@@ -1,5 +1,5 @@
 //! `MobileService`: chassis wheel kinematics, one controller step, and simulated path
-//! following and navigation (ALGORITHMS.md §6, [`kinplan_core::mobile`]).
+//! following and navigation (docs/mobile.md, [`kinplan_core::mobile`]).
 //!
 //! Thin adapter: admit → proto messages into domain values (unset fields: the domain's
 //! defaults; sizes bounded) → the domain function → reply. Simulations run on the CPU pool and

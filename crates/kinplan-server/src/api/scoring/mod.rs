@@ -1,5 +1,5 @@
 //! `ScoringService`: the S0 trajectory criteria, the S2 PTP cycle time and
-//! per-set statistics (ALGORITHMS.md §3) for joint trajectories.
+//! per-set statistics (docs/scoring.md) for joint trajectories.
 //!
 //! Thin adapter: admit → resolve the robot → proto options and trajectories
 //! into domain values → FK ([`score::sample_chain`]) and [`score::score`] →
