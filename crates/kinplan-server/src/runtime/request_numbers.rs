@@ -173,7 +173,7 @@ fn out_of_range(v: f64, float: bool, range: Range) -> Option<String> {
     };
     match range {
         Range::Any => None,
-        _ if v.is_nan() => Some("must be a number, got NaN".into()),
+        _ if v.is_nan() => Some("must be finite, got NaN".into()),
         Range::OrInfinite { positive } if v.is_infinite() && (v > 0.0) == positive => None,
         _ if v.is_infinite() => Some(format!("must be finite, got {v}")),
         Range::Finite(bound) if v.abs() > bound => Some(format!("must be within ±{bound:e}, got {v:e}")),
@@ -368,7 +368,9 @@ mod tests {
             max_distance: Some(f64::NAN),
             ..Default::default()
         };
-        assert!(message(check_request(&nan).unwrap_err()).starts_with("max_distance: must be a number"));
+        assert!(
+            message(check_request(&nan).unwrap_err()).starts_with("max_distance: must be finite, got NaN")
+        );
     }
 
     #[test]
@@ -383,9 +385,7 @@ mod tests {
         };
         let m = message(check_request(&req).unwrap_err());
         assert!(
-            m.starts_with(
-                "joint_positions.data[5]: must be a number, got NaN (that is joint_positions[1][2])"
-            ),
+            m.starts_with("joint_positions.data[5]: must be finite, got NaN (that is joint_positions[1][2])"),
             "{m}"
         );
     }
