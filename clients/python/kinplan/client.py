@@ -217,7 +217,7 @@ class Client:
         `package_dirs` are given — ``package://pkg/...`` under each package
         dir, relative paths next to the URDF, as pinocchio resolves them. A
         mesh that cannot be found raises :class:`FileNotFoundError` naming it
-        and every place looked. STL and OBJ are read by the server.
+        and every place looked. STL, OBJ and COLLADA are read by the server.
 
         `srdf` (MoveIt's SRDF, text or path) comes with the model: its
         ``disable_collisions`` pairs are never checked, `group` names one of

@@ -1,5 +1,6 @@
 //! Mesh files a robot's URDF names, read from the bytes a client sent with
-//! the model — never from disk: STL (binary and ASCII) and Wavefront OBJ.
+//! the model — never from disk: STL (binary and ASCII), Wavefront OBJ and
+//! COLLADA (`mesh_dae`).
 //! Each becomes an [`InlineMesh`] keyed by the URI the URDF writes, with
 //! shared vertices merged (STL repeats them per triangle) and every size
 //! bounded before it is allocated.
@@ -36,15 +37,16 @@ impl Default for MeshFileLimits {
 /// follows the extension: `.stl` (binary when its size is exactly
 /// `84 + 50·n` for the `n` its header gives, else ASCII `solid … facet …
 /// vertex x y z`), `.obj` (`v x y z`, `f i j k …` with 1-based or negative
-/// indices, `i/t/n` forms; polygons fanned into triangles). COLLADA (`.dae`)
-/// is refused with a message saying to send an STL or OBJ instead.
+/// indices, `i/t/n` forms; polygons fanned into triangles), `.dae` (the
+/// geometries a Z-up COLLADA scene instances, placed by their nodes and
+/// scaled by its unit).
 ///
 /// ```
 /// use kinplan_core::collision::{MeshFileLimits, read_mesh_file};
 /// let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n";
 /// let m = read_mesh_file("package://arm/tetra.obj", obj, &MeshFileLimits::default()).unwrap();
 /// assert_eq!((m.vertices.len(), m.indices.len()), (4, 12));
-/// assert!(read_mesh_file("hand.dae", b"<COLLADA/>", &MeshFileLimits::default()).is_err());
+/// assert!(read_mesh_file("hand.dae", b"<COLLADA/>", &MeshFileLimits::default()).is_err()); // no triangles
 /// ```
 pub fn read_mesh_file(
     uri: &str,
@@ -70,14 +72,20 @@ pub fn read_mesh_file(
     } else if path.ends_with(".obj") {
         read_obj(bytes, &mut mesh)?;
     } else if path.ends_with(".dae") {
-        return Err(CollisionError::Parse {
-            field: field(),
-            reason: "COLLADA (.dae) meshes are not read: send the collision mesh as STL or OBJ".into(),
-        });
+        let triangles = super::mesh_dae::read_collada(bytes, &field())?;
+        mesh.expect_triangles(triangles.len())?;
+        for t in triangles {
+            let corners = [
+                mesh.vertex(t[0].coords.into())?,
+                mesh.vertex(t[1].coords.into())?,
+                mesh.vertex(t[2].coords.into())?,
+            ];
+            mesh.triangle(corners)?;
+        }
     } else {
         return Err(CollisionError::Parse {
             field: field(),
-            reason: "unknown mesh format: the file name must end in .stl or .obj".into(),
+            reason: "unknown mesh format: the file name must end in .stl, .obj or .dae".into(),
         });
     }
     mesh.finish(uri)

@@ -14,6 +14,7 @@ pub use chain::{Chain, Joint, JointKind, LinkFrame};
 pub use error::RobotError;
 pub use geometry::{CollisionShape, LinkCollision, Shape, mesh_scale};
 pub use srdf::{EndEffector, Group, GroupState, Srdf, parse_srdf};
+pub(crate) use urdf::prescan;
 pub use urdf::{ChainSpec, MAX_LIMIT, MAX_ORIGIN_METRES, MAX_XML_DEPTH, UrdfLimits, parse_chain};
 pub use urdf_export::expand_capsules;
 
