@@ -22,3 +22,19 @@ def test_the_tour_notebook_runs_top_to_bottom(server_address, monkeypatch):
     # the last displayed value is the exploration summary
     shown = [o for o in outputs if o.get("output_type") == "execute_result"]
     assert "ExploreSummary" in shown[-1]["data"]["text/plain"]
+
+
+VIZ_NOTEBOOK = NOTEBOOK.parent / "viz_tour.ipynb"
+
+
+def test_the_viz_notebook_writes_a_recording(server_address, monkeypatch):
+    pytest.importorskip("rerun")
+    monkeypatch.setenv("KINPLAN_ADDRESS", server_address)
+    nb = nbformat.read(VIZ_NOTEBOOK, as_version=4)
+    client = nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
+                                     resources={"metadata": {"path": str(VIZ_NOTEBOOK.parent)}})
+    client.execute()
+    outputs = [o for cell in nb.cells if cell.cell_type == "code" for o in cell.get("outputs", [])]
+    assert not [o for o in outputs if o.get("output_type") == "error"]
+    shown = [o for o in outputs if o.get("output_type") == "execute_result"]
+    assert "viz_tour.rrd" in shown[-1]["data"]["text/plain"]
