@@ -741,6 +741,28 @@ async fn the_whole_robot_collides_in_check_state() {
         "a ball between the closed fingertips touches a finger: {:?}",
         reply.states[0].colliding
     );
+    // held open at their 40 mm limit, the fingers clear the 5 mm ball
+    let open = |value: f64| {
+        let mut robot = named("franka_panda_hand").unwrap();
+        robot.held_joints = [("panda_finger_joint1", value), ("panda_finger_joint2", value)]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect();
+        pb::CheckStateRequest {
+            robot: Some(robot),
+            states: vec![pb::JointState {
+                positions: q.to_vec(),
+            }],
+            scene: Some(pb::Scene {
+                objects: vec![sphere("ball", [tool.x, tool.y, tool.z], 0.005)],
+            }),
+            max_distance: None,
+        }
+    };
+    let opened = planning.check_state(open(0.04)).await.unwrap().into_inner();
+    assert!(opened.states[0].valid, "{:?}", opened.states[0]);
+    let closed = planning.check_state(open(0.0)).await.unwrap().into_inner();
+    assert!(!closed.states[0].valid);
 }
 
 /// A robot's own mesh files travel with its URDF: a one-joint arm whose link

@@ -206,6 +206,7 @@ class Client:
         meshes: Optional[Mapping[str, bytes]] = None,
         srdf: Optional[Union[str, "os.PathLike[str]"]] = None,
         group: str = "",
+        held_joints: Optional[Mapping[str, float]] = None,
     ) -> Robot:
         """A built-in robot by `name`, or a model sent as `urdf` (its text,
         or the path of a URDF file): the handle of every call about it
@@ -225,6 +226,10 @@ class Client:
         ``robot.describe().named_state("ready")`` gives a group state as a
         joint vector in chain order.
 
+        `held_joints` (``{joint: value}``, rad or m) holds joints off the
+        chain — a gripper's fingers, another arm — where the collision model
+        puts their links; unnamed ones sit at 0 clamped into their limits.
+
         Joint values outside the robot's limits (usually degrees given where
         radians are meant) raise a :class:`kinplan.JointLimitWarning` in
         ``fk``, ``fk_batch``, ``jacobian`` and ``score``; with
@@ -233,6 +238,7 @@ class Client:
         text, files = (None, {}) if urdf is None else load_model(urdf, package_dirs, meshes)
         robot = Robot(self, name=name, urdf=text, base_link=base_link, tip_link=tip_link, strict=strict)
         robot.mesh_files, robot.srdf_text, robot.group = files, load_text(srdf, "srdf"), group
+        robot.held_joints = {k: float(v) for k, v in (held_joints or {}).items()}
         return robot
 
     def _robot_of(self, robot: Any) -> Robot:

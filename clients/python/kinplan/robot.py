@@ -48,6 +48,7 @@ class Robot(RobotRefs):
         self.mesh_files: Dict[str, bytes] = {}
         self.srdf_text: Optional[str] = None
         self.group = ""
+        self.held_joints: Dict[str, float] = {}
         self.base_link = base_link
         self.tip_link = tip_link
         self.strict = strict

@@ -136,3 +136,13 @@ def test_an_srdf_disables_pairs_names_groups_and_states(client, tmp_path):
     np.testing.assert_array_equal(upper.describe().named_state("folded"), [0.0])
     with pytest.raises(KeyError, match="folded"):
         upper.describe().named_state("ready")
+
+
+def test_held_joints_put_the_fingers_where_asked(client):
+    q = [0.0, 0.3, 0.0, -2.0, 0.0, 2.3, 0.785]
+    tool = client.robot("franka_panda_hand").fk(q)[:3, 3]
+    ball = [kinplan.Sphere(0.005, tool)]
+    closed = client.robot("franka_panda_hand")
+    opened = client.robot("franka_panda_hand", held_joints={"panda_finger_joint1": 0.04, "panda_finger_joint2": 0.04})
+    assert not closed.check([q], ball).valid[0]
+    assert opened.check([q], ball).valid[0]

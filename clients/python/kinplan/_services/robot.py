@@ -37,6 +37,7 @@ class RobotRefs:
     mesh_files: Dict[str, bytes]
     srdf_text: Optional[str]
     group: str
+    held_joints: Dict[str, float]
     base_link: str
     tip_link: str
     model_id: bytes
@@ -64,6 +65,7 @@ class RobotRefs:
 
     def _new_ref(self, inline: bool) -> common_pb2.RobotRef:
         ref = common_pb2.RobotRef(base_link=self.base_link, tip_link=self.tip_link, group=self.group)
+        ref.held_joints.update(self.held_joints)
         if self.name is not None:
             ref.name = self.name
         elif self.model_id and not inline:

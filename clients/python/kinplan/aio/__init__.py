@@ -179,12 +179,14 @@ class Client:
               base_link: str = "", tip_link: str = "", strict: bool = False,
               package_dirs: Optional[Sequence[Union[str, "os.PathLike[str]"]]] = None,
               meshes: Optional[Mapping[str, bytes]] = None,
-              srdf: Optional[Union[str, "os.PathLike[str]"]] = None, group: str = "") -> AsyncRobot:
+              srdf: Optional[Union[str, "os.PathLike[str]"]] = None, group: str = "",
+              held_joints: Optional[Mapping[str, float]] = None) -> AsyncRobot:
         """As :meth:`kinplan.Client.robot`."""
         check_robot_args(name, urdf)
         text, files = (None, {}) if urdf is None else load_model(urdf, package_dirs, meshes)
         robot = AsyncRobot(self, name=name, urdf=text, base_link=base_link, tip_link=tip_link, strict=strict)
         robot.mesh_files, robot.srdf_text, robot.group = files, load_text(srdf, "srdf"), group
+        robot.held_joints = {k: float(v) for k, v in (held_joints or {}).items()}
         return robot
 
     def _robot_of(self, robot: Any) -> AsyncRobot:

@@ -42,6 +42,7 @@ class AsyncRobot(RobotRefs):
         self.mesh_files: Dict[str, bytes] = {}
         self.srdf_text: Optional[str] = None
         self.group = ""
+        self.held_joints: Dict[str, float] = {}
         self.base_link, self.tip_link = base_link, tip_link
         self.strict = strict
         self.model_id: bytes = b""

@@ -24,13 +24,15 @@ _sym_db = _symbol_database.Default()
 
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\x17kinplan/v1/common.proto\x12\nkinplan.v1\"\'\n\x04Vec3\x12\t\n\x01x\x18\x01 \x01(\x01\x12\t\n\x01y\x18\x02 \x01(\x01\x12\t\n\x01z\x18\x03 \x01(\x01\"8\n\nQuaternion\x12\t\n\x01x\x18\x01 \x01(\x01\x12\t\n\x01y\x18\x02 \x01(\x01\x12\t\n\x01z\x18\x03 \x01(\x01\x12\t\n\x01w\x18\x04 \x01(\x01\"W\n\x04Pose\x12\"\n\x08position\x18\x01 \x01(\x0b\x32\x10.kinplan.v1.Vec3\x12+\n\x0borientation\x18\x02 \x01(\x0b\x32\x16.kinplan.v1.Quaternion\"\xb0\x01\n\x08RobotRef\x12\x0e\n\x04name\x18\x01 \x01(\tH\x00\x12\x0e\n\x04urdf\x18\x02 \x01(\tH\x00\x12\x12\n\x08model_id\x18\x03 \x01(\x0cH\x00\x12\x11\n\tbase_link\x18\x04 \x01(\t\x12\x10\n\x08tip_link\x18\x05 \x01(\t\x12$\n\x06meshes\x18\x06 \x03(\x0b\x32\x14.kinplan.v1.MeshFile\x12\x0c\n\x04srdf\x18\x07 \x01(\t\x12\r\n\x05group\x18\x08 \x01(\tB\x08\n\x06source\"%\n\x08MeshFile\x12\x0b\n\x03uri\x18\x01 \x01(\t\x12\x0c\n\x04\x64\x61ta\x18\x02 \x01(\x0c\"8\n\nJointPoint\x12\x11\n\tpositions\x18\x01 \x03(\x01\x12\x17\n\x0ftime_from_start\x18\x02 \x01(\x01\"N\n\x0fJointTrajectory\x12\x13\n\x0bjoint_names\x18\x01 \x03(\t\x12&\n\x06points\x18\x02 \x03(\x0b\x32\x16.kinplan.v1.JointPoint\"2\n\x06Matrix\x12\x0c\n\x04rows\x18\x01 \x01(\r\x12\x0c\n\x04\x63ols\x18\x02 \x01(\r\x12\x0c\n\x04\x64\x61ta\x18\x03 \x03(\x01\"%\n\x03\x42ox\x12\x1e\n\x04size\x18\x01 \x01(\x0b\x32\x10.kinplan.v1.Vec3\"\x18\n\x06Sphere\x12\x0e\n\x06radius\x18\x01 \x01(\x01\"*\n\x08\x43ylinder\x12\x0e\n\x06radius\x18\x01 \x01(\x01\x12\x0e\n\x06length\x18\x02 \x01(\x01\")\n\x07\x43\x61psule\x12\x0e\n\x06radius\x18\x01 \x01(\x01\x12\x0e\n\x06length\x18\x02 \x01(\x01\"C\n\x0cTriangleMesh\x12\"\n\x08vertices\x18\x01 \x03(\x0b\x32\x10.kinplan.v1.Vec3\x12\x0f\n\x07indices\x18\x02 \x03(\r\"F\n\x06Octree\x12\n\n\x02id\x18\x01 \x01(\t\x12\x12\n\nresolution\x18\x02 \x01(\x01\x12\x0e\n\x06\x62inary\x18\x03 \x01(\x08\x12\x0c\n\x04\x64\x61ta\x18\x04 \x01(\x0c\"\xcb\x02\n\x0f\x43ollisionObject\x12\n\n\x02id\x18\x01 \x01(\t\x12\x1e\n\x04pose\x18\x02 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x1e\n\x03\x62ox\x18\x03 \x01(\x0b\x32\x0f.kinplan.v1.BoxH\x00\x12$\n\x06sphere\x18\x04 \x01(\x0b\x32\x12.kinplan.v1.SphereH\x00\x12(\n\x08\x63ylinder\x18\x05 \x01(\x0b\x32\x14.kinplan.v1.CylinderH\x00\x12&\n\x07\x63\x61psule\x18\x06 \x01(\x0b\x32\x13.kinplan.v1.CapsuleH\x00\x12(\n\x04mesh\x18\x07 \x01(\x0b\x32\x18.kinplan.v1.TriangleMeshH\x00\x12$\n\x06octree\x18\x08 \x01(\x0b\x32\x12.kinplan.v1.OctreeH\x00\x12\x1b\n\x13unknown_as_obstacle\x18\t \x01(\x08\x42\x07\n\x05shape\"5\n\x05Scene\x12,\n\x07objects\x18\x01 \x03(\x0b\x32\x1b.kinplan.v1.CollisionObjectb\x06proto3')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\x17kinplan/v1/common.proto\x12\nkinplan.v1\"\'\n\x04Vec3\x12\t\n\x01x\x18\x01 \x01(\x01\x12\t\n\x01y\x18\x02 \x01(\x01\x12\t\n\x01z\x18\x03 \x01(\x01\"8\n\nQuaternion\x12\t\n\x01x\x18\x01 \x01(\x01\x12\t\n\x01y\x18\x02 \x01(\x01\x12\t\n\x01z\x18\x03 \x01(\x01\x12\t\n\x01w\x18\x04 \x01(\x01\"W\n\x04Pose\x12\"\n\x08position\x18\x01 \x01(\x0b\x32\x10.kinplan.v1.Vec3\x12+\n\x0borientation\x18\x02 \x01(\x0b\x32\x16.kinplan.v1.Quaternion\"\x9e\x02\n\x08RobotRef\x12\x0e\n\x04name\x18\x01 \x01(\tH\x00\x12\x0e\n\x04urdf\x18\x02 \x01(\tH\x00\x12\x12\n\x08model_id\x18\x03 \x01(\x0cH\x00\x12\x11\n\tbase_link\x18\x04 \x01(\t\x12\x10\n\x08tip_link\x18\x05 \x01(\t\x12$\n\x06meshes\x18\x06 \x03(\x0b\x32\x14.kinplan.v1.MeshFile\x12\x0c\n\x04srdf\x18\x07 \x01(\t\x12\r\n\x05group\x18\x08 \x01(\t\x12\x39\n\x0bheld_joints\x18\t \x03(\x0b\x32$.kinplan.v1.RobotRef.HeldJointsEntry\x1a\x31\n\x0fHeldJointsEntry\x12\x0b\n\x03key\x18\x01 \x01(\t\x12\r\n\x05value\x18\x02 \x01(\x01:\x02\x38\x01\x42\x08\n\x06source\"%\n\x08MeshFile\x12\x0b\n\x03uri\x18\x01 \x01(\t\x12\x0c\n\x04\x64\x61ta\x18\x02 \x01(\x0c\"8\n\nJointPoint\x12\x11\n\tpositions\x18\x01 \x03(\x01\x12\x17\n\x0ftime_from_start\x18\x02 \x01(\x01\"N\n\x0fJointTrajectory\x12\x13\n\x0bjoint_names\x18\x01 \x03(\t\x12&\n\x06points\x18\x02 \x03(\x0b\x32\x16.kinplan.v1.JointPoint\"2\n\x06Matrix\x12\x0c\n\x04rows\x18\x01 \x01(\r\x12\x0c\n\x04\x63ols\x18\x02 \x01(\r\x12\x0c\n\x04\x64\x61ta\x18\x03 \x03(\x01\"%\n\x03\x42ox\x12\x1e\n\x04size\x18\x01 \x01(\x0b\x32\x10.kinplan.v1.Vec3\"\x18\n\x06Sphere\x12\x0e\n\x06radius\x18\x01 \x01(\x01\"*\n\x08\x43ylinder\x12\x0e\n\x06radius\x18\x01 \x01(\x01\x12\x0e\n\x06length\x18\x02 \x01(\x01\")\n\x07\x43\x61psule\x12\x0e\n\x06radius\x18\x01 \x01(\x01\x12\x0e\n\x06length\x18\x02 \x01(\x01\"C\n\x0cTriangleMesh\x12\"\n\x08vertices\x18\x01 \x03(\x0b\x32\x10.kinplan.v1.Vec3\x12\x0f\n\x07indices\x18\x02 \x03(\r\"F\n\x06Octree\x12\n\n\x02id\x18\x01 \x01(\t\x12\x12\n\nresolution\x18\x02 \x01(\x01\x12\x0e\n\x06\x62inary\x18\x03 \x01(\x08\x12\x0c\n\x04\x64\x61ta\x18\x04 \x01(\x0c\"\xcb\x02\n\x0f\x43ollisionObject\x12\n\n\x02id\x18\x01 \x01(\t\x12\x1e\n\x04pose\x18\x02 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x1e\n\x03\x62ox\x18\x03 \x01(\x0b\x32\x0f.kinplan.v1.BoxH\x00\x12$\n\x06sphere\x18\x04 \x01(\x0b\x32\x12.kinplan.v1.SphereH\x00\x12(\n\x08\x63ylinder\x18\x05 \x01(\x0b\x32\x14.kinplan.v1.CylinderH\x00\x12&\n\x07\x63\x61psule\x18\x06 \x01(\x0b\x32\x13.kinplan.v1.CapsuleH\x00\x12(\n\x04mesh\x18\x07 \x01(\x0b\x32\x18.kinplan.v1.TriangleMeshH\x00\x12$\n\x06octree\x18\x08 \x01(\x0b\x32\x12.kinplan.v1.OctreeH\x00\x12\x1b\n\x13unknown_as_obstacle\x18\t \x01(\x08\x42\x07\n\x05shape\"5\n\x05Scene\x12,\n\x07objects\x18\x01 \x03(\x0b\x32\x1b.kinplan.v1.CollisionObjectb\x06proto3')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'kinplan.v1.common_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
+  _globals['_ROBOTREF_HELDJOINTSENTRY']._loaded_options = None
+  _globals['_ROBOTREF_HELDJOINTSENTRY']._serialized_options = b'8\001'
   _globals['_VEC3']._serialized_start=39
   _globals['_VEC3']._serialized_end=78
   _globals['_QUATERNION']._serialized_start=80
@@ -38,29 +40,31 @@ if not _descriptor._USE_C_DESCRIPTORS:
   _globals['_POSE']._serialized_start=138
   _globals['_POSE']._serialized_end=225
   _globals['_ROBOTREF']._serialized_start=228
-  _globals['_ROBOTREF']._serialized_end=404
-  _globals['_MESHFILE']._serialized_start=406
-  _globals['_MESHFILE']._serialized_end=443
-  _globals['_JOINTPOINT']._serialized_start=445
-  _globals['_JOINTPOINT']._serialized_end=501
-  _globals['_JOINTTRAJECTORY']._serialized_start=503
-  _globals['_JOINTTRAJECTORY']._serialized_end=581
-  _globals['_MATRIX']._serialized_start=583
-  _globals['_MATRIX']._serialized_end=633
-  _globals['_BOX']._serialized_start=635
-  _globals['_BOX']._serialized_end=672
-  _globals['_SPHERE']._serialized_start=674
-  _globals['_SPHERE']._serialized_end=698
-  _globals['_CYLINDER']._serialized_start=700
-  _globals['_CYLINDER']._serialized_end=742
-  _globals['_CAPSULE']._serialized_start=744
-  _globals['_CAPSULE']._serialized_end=785
-  _globals['_TRIANGLEMESH']._serialized_start=787
-  _globals['_TRIANGLEMESH']._serialized_end=854
-  _globals['_OCTREE']._serialized_start=856
-  _globals['_OCTREE']._serialized_end=926
-  _globals['_COLLISIONOBJECT']._serialized_start=929
-  _globals['_COLLISIONOBJECT']._serialized_end=1260
-  _globals['_SCENE']._serialized_start=1262
-  _globals['_SCENE']._serialized_end=1315
+  _globals['_ROBOTREF']._serialized_end=514
+  _globals['_ROBOTREF_HELDJOINTSENTRY']._serialized_start=455
+  _globals['_ROBOTREF_HELDJOINTSENTRY']._serialized_end=504
+  _globals['_MESHFILE']._serialized_start=516
+  _globals['_MESHFILE']._serialized_end=553
+  _globals['_JOINTPOINT']._serialized_start=555
+  _globals['_JOINTPOINT']._serialized_end=611
+  _globals['_JOINTTRAJECTORY']._serialized_start=613
+  _globals['_JOINTTRAJECTORY']._serialized_end=691
+  _globals['_MATRIX']._serialized_start=693
+  _globals['_MATRIX']._serialized_end=743
+  _globals['_BOX']._serialized_start=745
+  _globals['_BOX']._serialized_end=782
+  _globals['_SPHERE']._serialized_start=784
+  _globals['_SPHERE']._serialized_end=808
+  _globals['_CYLINDER']._serialized_start=810
+  _globals['_CYLINDER']._serialized_end=852
+  _globals['_CAPSULE']._serialized_start=854
+  _globals['_CAPSULE']._serialized_end=895
+  _globals['_TRIANGLEMESH']._serialized_start=897
+  _globals['_TRIANGLEMESH']._serialized_end=964
+  _globals['_OCTREE']._serialized_start=966
+  _globals['_OCTREE']._serialized_end=1036
+  _globals['_COLLISIONOBJECT']._serialized_start=1039
+  _globals['_COLLISIONOBJECT']._serialized_end=1370
+  _globals['_SCENE']._serialized_start=1372
+  _globals['_SCENE']._serialized_end=1425
 # @@protoc_insertion_point(module_scope)

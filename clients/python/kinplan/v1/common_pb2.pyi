@@ -37,7 +37,14 @@ class Pose(_message.Message):
     def __init__(self, position: _Optional[_Union[Vec3, _Mapping]] = ..., orientation: _Optional[_Union[Quaternion, _Mapping]] = ...) -> None: ...
 
 class RobotRef(_message.Message):
-    __slots__ = ("name", "urdf", "model_id", "base_link", "tip_link", "meshes", "srdf", "group")
+    __slots__ = ("name", "urdf", "model_id", "base_link", "tip_link", "meshes", "srdf", "group", "held_joints")
+    class HeldJointsEntry(_message.Message):
+        __slots__ = ("key", "value")
+        KEY_FIELD_NUMBER: _ClassVar[int]
+        VALUE_FIELD_NUMBER: _ClassVar[int]
+        key: str
+        value: float
+        def __init__(self, key: _Optional[str] = ..., value: _Optional[float] = ...) -> None: ...
     NAME_FIELD_NUMBER: _ClassVar[int]
     URDF_FIELD_NUMBER: _ClassVar[int]
     MODEL_ID_FIELD_NUMBER: _ClassVar[int]
@@ -46,6 +53,7 @@ class RobotRef(_message.Message):
     MESHES_FIELD_NUMBER: _ClassVar[int]
     SRDF_FIELD_NUMBER: _ClassVar[int]
     GROUP_FIELD_NUMBER: _ClassVar[int]
+    HELD_JOINTS_FIELD_NUMBER: _ClassVar[int]
     name: str
     urdf: str
     model_id: bytes
@@ -54,7 +62,8 @@ class RobotRef(_message.Message):
     meshes: _containers.RepeatedCompositeFieldContainer[MeshFile]
     srdf: str
     group: str
-    def __init__(self, name: _Optional[str] = ..., urdf: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., meshes: _Optional[_Iterable[_Union[MeshFile, _Mapping]]] = ..., srdf: _Optional[str] = ..., group: _Optional[str] = ...) -> None: ...
+    held_joints: _containers.ScalarMap[str, float]
+    def __init__(self, name: _Optional[str] = ..., urdf: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., meshes: _Optional[_Iterable[_Union[MeshFile, _Mapping]]] = ..., srdf: _Optional[str] = ..., group: _Optional[str] = ..., held_joints: _Optional[_Mapping[str, float]] = ...) -> None: ...
 
 class MeshFile(_message.Message):
     __slots__ = ("uri", "data")

@@ -13,7 +13,7 @@ use kinplan_core::collision::{
 };
 use kinplan_core::robot::{UrdfLimits, parse_srdf};
 
-use crate::runtime::models::ModelSource;
+use crate::runtime::models::{HeldJoints, ModelSource};
 use kinplan_core::robot::Chain;
 
 /// A chain's collision bodies and the body pairs never checked.
@@ -31,9 +31,13 @@ impl CollisionSetup {
     /// ([`AcmParams::samples_within`]).
     pub fn build(
         chain: Arc<Chain>,
-        source: Option<&ModelSource>,
+        model: Option<(&ModelSource, &[(String, f64)])>,
         acm_samples: usize,
     ) -> Result<Self, CollisionError> {
+        let source = model.map(|(s, _)| s);
+        let held: Vec<(&str, f64)> = model
+            .map(|(_, h)| h.iter().map(|(n, v)| (n.as_str(), *v)).collect())
+            .unwrap_or_default();
         let model = Arc::new(match source {
             Some(source) => {
                 let limits = MeshFileLimits::default();
@@ -42,7 +46,7 @@ impl CollisionSetup {
                     .iter()
                     .map(|(uri, data)| read_mesh_file(uri, data, &limits))
                     .collect::<Result<Vec<_>, _>>()?;
-                RobotModel::of_urdf(chain, &source.urdf, &[], &meshes)?
+                RobotModel::of_urdf(chain, &source.urdf, &held, &meshes)?
             }
             None => RobotModel::new(chain)?,
         });
@@ -82,7 +86,7 @@ impl CollisionSetup {
 /// be reused by another chain while the entry lives; the capacity bounds the
 /// cache (oldest entry out first).
 pub struct CollisionModels {
-    entries: Mutex<Vec<(Weak<Chain>, Arc<CollisionSetup>)>>,
+    entries: Mutex<Vec<(Weak<Chain>, HeldJoints, Arc<CollisionSetup>)>>,
     capacity: usize,
     /// States sampled for each allowed-collision matrix.
     pub acm_samples: usize,
@@ -97,23 +101,23 @@ impl CollisionModels {
         }
     }
 
-    /// The setup built for this very chain, if cached.
-    pub fn get(&self, chain: &Arc<Chain>) -> Option<Arc<CollisionSetup>> {
+    /// The setup built for this very chain with these held joint values, if cached.
+    pub fn get(&self, chain: &Arc<Chain>, held: &[(String, f64)]) -> Option<Arc<CollisionSetup>> {
         let entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
         entries
             .iter()
-            .find(|(w, _)| w.upgrade().is_some_and(|c| Arc::ptr_eq(&c, chain)))
-            .map(|(_, s)| s.clone())
+            .find(|(w, h, _)| **h == *held && w.upgrade().is_some_and(|c| Arc::ptr_eq(&c, chain)))
+            .map(|(_, _, s)| s.clone())
     }
 
-    /// Keeps `setup` for `chain`, dropping the oldest entries beyond the capacity.
-    pub fn insert(&self, chain: &Arc<Chain>, setup: Arc<CollisionSetup>) {
+    /// Keeps `setup` for `chain` and `held`, dropping the oldest entries beyond the capacity.
+    pub fn insert(&self, chain: &Arc<Chain>, held: &HeldJoints, setup: Arc<CollisionSetup>) {
         let mut entries = self.entries.lock().unwrap_or_else(|e| e.into_inner());
         if !entries
             .iter()
-            .any(|(w, _)| w.upgrade().is_some_and(|c| Arc::ptr_eq(&c, chain)))
+            .any(|(w, h, _)| h == held && w.upgrade().is_some_and(|c| Arc::ptr_eq(&c, chain)))
         {
-            entries.push((Arc::downgrade(chain), setup));
+            entries.push((Arc::downgrade(chain), held.clone(), setup));
         }
         while entries.len() > self.capacity {
             entries.remove(0);
@@ -129,20 +133,21 @@ pub async fn collision_setup(
     budget: &crate::runtime::Budget,
 ) -> Result<Arc<CollisionSetup>, tonic::Status> {
     let cache = shared.collision.clone();
-    if let Some(s) = cache.get(&robot.chain) {
+    if let Some(s) = cache.get(&robot.chain, &robot.held) {
         return Ok(s);
     }
     let chain = robot.chain.clone();
     let source = robot.source.clone();
+    let held = robot.held.clone();
     shared
         .compute
         .run(budget, move |_| {
             let setup = Arc::new(CollisionSetup::build(
                 chain.clone(),
-                Some(&source),
+                Some((&source, &held[..])),
                 cache.acm_samples,
             )?);
-            cache.insert(&chain, setup.clone());
+            cache.insert(&chain, &held, setup.clone());
             Ok(setup)
         })
         .await?
@@ -155,17 +160,22 @@ mod tests {
     use kinplan_core::robot::builtin_chain;
 
     #[test]
-    fn a_setup_is_found_only_for_its_own_chain_and_the_capacity_holds() {
+    fn a_setup_is_found_only_for_its_own_chain_and_held_values_and_the_capacity_holds() {
         let cache = CollisionModels::new(2, 50);
+        let none: HeldJoints = Arc::from(Vec::new());
         let ur5 = builtin_chain("ur5").unwrap();
         let setup = Arc::new(CollisionSetup::build(ur5.clone(), None, 50).unwrap());
-        cache.insert(&ur5, setup.clone());
-        assert!(Arc::ptr_eq(&cache.get(&ur5).unwrap(), &setup));
+        cache.insert(&ur5, &none, setup.clone());
+        assert!(Arc::ptr_eq(&cache.get(&ur5, &none).unwrap(), &setup));
+        // other held values are another model
+        let held: HeldJoints = Arc::from(vec![("j".to_string(), 0.5)]);
+        assert!(cache.get(&ur5, &held).is_none());
         // An equal chain in another allocation is another model.
         let copy = Arc::new((*ur5).clone());
-        assert!(cache.get(&copy).is_none());
+        assert!(cache.get(&copy, &none).is_none());
         cache.insert(
             &copy,
+            &none,
             Arc::new(CollisionSetup::build(copy.clone(), None, 50).unwrap()),
         );
         drop(copy);
@@ -173,6 +183,7 @@ mod tests {
         let panda = builtin_chain("franka_panda").unwrap();
         cache.insert(
             &panda,
+            &none,
             Arc::new(CollisionSetup::build(panda.clone(), None, 50).unwrap()),
         );
         assert_eq!(cache.entries.lock().unwrap().len(), 2);

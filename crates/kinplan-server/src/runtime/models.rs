@@ -23,6 +23,19 @@ pub struct Resolved {
     /// What the chain was parsed from: its other links (a gripper beyond the
     /// tip, a pedestal) and its mesh files belong to the collision model too.
     pub source: ModelSource,
+    /// Values of joints off the chain, sorted by name (`RobotRef.held_joints`).
+    pub held: HeldJoints,
+}
+
+/// Joint values held off the chain, sorted by name.
+pub type HeldJoints = Arc<[(String, f64)]>;
+
+/// The held joint values of a request, sorted by name (finite: the request
+/// number check has seen them).
+fn held_in(robot: &pb::RobotRef) -> HeldJoints {
+    let mut held: Vec<(String, f64)> = robot.held_joints.iter().map(|(k, v)| (k.clone(), *v)).collect();
+    held.sort_by(|a, b| a.0.cmp(&b.0));
+    Arc::from(held)
 }
 
 /// A model as the client sent it: the URDF text and the mesh files it names,
@@ -290,6 +303,7 @@ impl ModelStore {
                         chain,
                         model_id: Vec::new(),
                         source: ModelSource::of_urdf(builtin_text(name)?),
+                        held: held_in(robot),
                     });
                 }
                 // Another chain of a built-in: parsed once, then cached like any URDF.
@@ -362,6 +376,7 @@ impl ModelStore {
                 chain,
                 model_id,
                 source,
+                held: held_in(robot),
             });
         }
         let text = match text {
@@ -389,6 +404,7 @@ impl ModelStore {
             chain,
             model_id,
             source: text,
+            held: held_in(robot),
         })
     }
 
