@@ -81,12 +81,16 @@ impl CollisionSetup {
     }
 }
 
+/// A cached setup: the chain it was built for (by identity), the held joint
+/// values, the setup.
+type CacheEntry = (Weak<Chain>, HeldJoints, Arc<CollisionSetup>);
+
 /// Setups keyed by the identity of the chain they were built for. A setup
 /// holds its chain (the robot model owns it), so the chain's address cannot
 /// be reused by another chain while the entry lives; the capacity bounds the
 /// cache (oldest entry out first).
 pub struct CollisionModels {
-    entries: Mutex<Vec<(Weak<Chain>, HeldJoints, Arc<CollisionSetup>)>>,
+    entries: Mutex<Vec<CacheEntry>>,
     capacity: usize,
     /// States sampled for each allowed-collision matrix.
     pub acm_samples: usize,
