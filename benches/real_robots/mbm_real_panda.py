@@ -11,13 +11,9 @@ Needs example-robot-data, pin, coal and pyyaml (pip) beside the client.
 Scenes whose start or goal a model finds in collision are counted apart
 (INVALID_START / INVALID_GOAL), not dropped.
 
-Not yet meaningful: the server holds every joint off the chain at 0 clamped
-into its limits — the Panda's fingers closed, for the real model and for the
-built-in `franka_panda_hand` alike — and a request cannot name other values
-yet, while these problems' goals are grasps with the fingers open around the
-object: with closed fingers every goal collides (2026-11-27: 14 of 14 goals
-INVALID_GOAL on both models). The runner is kept for when a RobotRef can
-carry the fingers' values.
+The problems' goals are grasps with the fingers open around an object, so
+both models hold the fingers open at their 40 mm limit (`held_joints`; the
+problems write 65 mm, past the URDF's limit), and so does the re-check.
 """
 import argparse
 import io
@@ -35,6 +31,7 @@ import yaml
 import kinplan
 
 ARM = [f"panda_joint{i}" for i in range(1, 8)]
+FINGERS = {"panda_finger_joint1": 0.04, "panda_finger_joint2": 0.04}
 
 
 def share_dir():
@@ -109,6 +106,9 @@ class CoalCheck:
         self.n_robot = len(self.geom.geometryObjects)
         self.data = self.model.createData()
         self.arm_q = [self.model.joints[self.model.getJointId(j)].idx_q for j in ARM]
+        self.q0 = pin.neutral(self.model)
+        for name, value in FINGERS.items():
+            self.q0[self.model.joints[self.model.getJointId(name)].idx_q] = value
 
     def path_collides(self, objects, path, step=0.01):
         geom = self.geom.copy()
@@ -119,7 +119,7 @@ class CoalCheck:
             for i in range(self.n_robot):
                 geom.addCollisionPair(pin.CollisionPair(i, oid))
         gdata = pin.GeometryData(geom)
-        q = pin.neutral(self.model)
+        q = self.q0.copy()
         for a, b in zip(path[:-1], path[1:]):
             n = max(1, math.ceil(np.max(np.abs(b - a)) / step))
             for s in np.linspace(0.0, 1.0, n + 1):
@@ -141,8 +141,9 @@ def main():
     coal_check = CoalCheck(urdf, share)
     server = None if args.target else kinplan.LocalServer().start()
     with kinplan.Client(args.target or server.address, timeout=60) as c:
-        real = c.robot(urdf=urdf, package_dirs=[share], base_link="panda_link0", tip_link="panda_hand")
-        capsules = c.robot("franka_panda_hand")
+        real = c.robot(urdf=urdf, package_dirs=[share], base_link="panda_link0", tip_link="panda_hand",
+                       held_joints=FINGERS)
+        capsules = c.robot("franka_panda_hand", held_joints=FINGERS)
         print("| set | problems | real: solved | real: start/goal in collision | real: median ms | real: paths colliding at 0.01 rad (coal, meshes) | capsules: solved | capsules: median ms |")
         print("|---|---|---|---|---|---|---|---|")
         for pset, probs in sets.items():
