@@ -43,10 +43,15 @@ struct Document {
     saw_scene: bool,
 }
 
-/// The triangles of a COLLADA file as (vertex positions in metres, index
-/// triples), after the checks of the module doc. `field` names the file in
-/// errors.
-pub(super) fn read_collada(bytes: &[u8], field: &str) -> Result<Vec<[Point3<f64>; 3]>, CollisionError> {
+/// The triangles of a COLLADA file (corners in metres), after the checks of
+/// the module doc; more than `max_triangles` in all (a geometry instanced by
+/// many nodes counts each time) is an error, found before they are held.
+/// `field` names the file in errors.
+pub(super) fn read_collada(
+    bytes: &[u8],
+    field: &str,
+    max_triangles: usize,
+) -> Result<Vec<[Point3<f64>; 3]>, CollisionError> {
     let bad = |reason: String| CollisionError::Parse {
         field: field.to_string(),
         reason,
@@ -75,7 +80,7 @@ pub(super) fn read_collada(bytes: &[u8], field: &str) -> Result<Vec<[Point3<f64>
         })?;
         let placed = Matrix4::new_scaling(doc.unit) * transform;
         for prim in primitives {
-            triangles_of(&doc, prim, &placed, &mut out).map_err(bad)?;
+            triangles_of(&doc, prim, &placed, max_triangles, &mut out).map_err(bad)?;
         }
     }
     Ok(out)
@@ -286,6 +291,7 @@ fn triangles_of(
     doc: &Document,
     prim: &Primitive,
     placed: &Matrix4<f64>,
+    max_triangles: usize,
     out: &mut Vec<[Point3<f64>; 3]>,
 ) -> Result<(), String> {
     let Some((_, vertices, offset)) = prim.inputs.iter().find(|(s, _, _)| s == "VERTEX") else {
@@ -316,6 +322,11 @@ fn triangles_of(
     };
     let mut fan = |corners: &[u32]| -> Result<(), String> {
         for k in 1..corners.len().saturating_sub(1) {
+            if out.len() >= max_triangles {
+                return Err(format!(
+                    "more than {max_triangles} triangles (the limit of a mesh)"
+                ));
+            }
             out.push([point(corners[0])?, point(corners[k])?, point(corners[k + 1])?]);
         }
         Ok(())
@@ -349,6 +360,7 @@ fn triangles_of(
 
 #[cfg(test)]
 mod tests {
+    use super::super::mesh_file::tests::{CUBE, FACES};
     use super::*;
 
     /// A COLLADA document in centimetres: one cube geometry (corners 0/1 on
@@ -356,25 +368,9 @@ mod tests {
     /// by a node translated 100 along x, and by a node (turned 90° about z by
     /// a `<rotate>`) holding a child scaled by 2 — and a quad `<polylist>`.
     fn document(extra_scene: &str, up: &str) -> String {
-        let corners: Vec<String> = (0..8)
-            .map(|i| format!("{} {} {}", i & 1, (i >> 1) & 1, (i >> 2) & 1))
-            .collect();
-        // 12 triangles, each index followed by a normal index 0
-        let tri = [
-            [0, 2, 1],
-            [1, 2, 3],
-            [4, 5, 6],
-            [5, 7, 6],
-            [0, 1, 4],
-            [1, 5, 4],
-            [2, 6, 3],
-            [3, 6, 7],
-            [0, 4, 2],
-            [2, 4, 6],
-            [1, 3, 5],
-            [3, 7, 5],
-        ];
-        let p: Vec<String> = tri.iter().flatten().map(|i| format!("{i} 0")).collect();
+        let corners: Vec<String> = CUBE.iter().map(|[x, y, z]| format!("{x} {y} {z}")).collect();
+        // the 12 triangles, each index followed by a normal index 0
+        let p: Vec<String> = FACES.iter().flatten().map(|i| format!("{i} 0")).collect();
         format!(
             r##"<?xml version="1.0"?>
 <COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
@@ -415,7 +411,7 @@ mod tests {
 
     #[test]
     fn instanced_geometry_is_placed_by_its_nodes_and_scaled_by_the_unit() {
-        let triangles = read_collada(document("", "Z_UP").as_bytes(), "m.dae").unwrap();
+        let triangles = read_collada(document("", "Z_UP").as_bytes(), "m.dae", 1000).unwrap();
         // 12 + 12 cube triangles, 2 from the fanned quad
         assert_eq!(triangles.len(), 26);
         let near = |a: &Point3<f64>, b: [f64; 3]| (a - Point3::from(b)).norm() < 1e-12;
@@ -440,7 +436,9 @@ mod tests {
     #[test]
     fn what_is_not_followed_or_not_z_up_is_refused_naming_the_file() {
         let refused = |doc: String, what: &str| {
-            let e = read_collada(doc.as_bytes(), "arm.dae").unwrap_err().to_string();
+            let e = read_collada(doc.as_bytes(), "arm.dae", 1000)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains("arm.dae") && e.contains(what), "{e}");
         };
         refused(document("", "Y_UP"), "Z_UP");
@@ -463,5 +461,8 @@ mod tests {
         );
         refused(deep, "nested");
         refused("<COLLADA><!DOCTYPE".into(), "");
+        // one geometry instanced by many nodes: the triangles are counted as they are placed
+        let many = "<node><instance_geometry url=\"#cube\"/></node>".repeat(200);
+        refused(document(&many, "Z_UP"), "more than 1000 triangles");
     }
 }

@@ -72,7 +72,7 @@ pub fn read_mesh_file(
     } else if path.ends_with(".obj") {
         read_obj(bytes, &mut mesh)?;
     } else if path.ends_with(".dae") {
-        let triangles = super::mesh_dae::read_collada(bytes, &field())?;
+        let triangles = super::mesh_dae::read_collada(bytes, &field(), limits.max_triangles)?;
         mesh.expect_triangles(triangles.len())?;
         for t in triangles {
             let corners = [
@@ -290,11 +290,11 @@ impl<'a> Builder<'a> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     /// The unit cube `[0, 1]³` as 12 triangles over its 8 corners.
-    const CUBE: [[f64; 3]; 8] = [
+    pub(in crate::collision) const CUBE: [[f64; 3]; 8] = [
         [0.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],
         [0.0, 1.0, 0.0],
@@ -304,7 +304,7 @@ mod tests {
         [0.0, 1.0, 1.0],
         [1.0, 1.0, 1.0],
     ];
-    const FACES: [[usize; 3]; 12] = [
+    pub(in crate::collision) const FACES: [[usize; 3]; 12] = [
         [0, 2, 1],
         [1, 2, 3],
         [4, 5, 6],
