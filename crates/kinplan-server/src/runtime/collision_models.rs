@@ -11,7 +11,6 @@ use std::sync::{Arc, Mutex, Weak};
 use kinplan_core::collision::{
     AcmParams, AllowReason, AllowedCollisions, CollisionError, MeshFileLimits, RobotModel, read_mesh_file,
 };
-use kinplan_core::robot::{UrdfLimits, parse_srdf};
 
 use crate::runtime::models::{HeldJoints, ModelSource};
 use kinplan_core::robot::Chain;
@@ -52,16 +51,9 @@ impl CollisionSetup {
         });
         // MoveIt's disable_collisions pairs (by link name; pairs of links the
         // model does not hold are left out)
-        let disabled = match source.and_then(|s| s.srdf.as_deref()) {
-            Some(text) => {
-                parse_srdf(text, &UrdfLimits::default())
-                    .map_err(|e| CollisionError::Parse {
-                        field: "srdf".into(),
-                        reason: e.to_string(),
-                    })?
-                    .disabled_collisions
-            }
-            None => Vec::new(),
+        let disabled: &[(String, String)] = match source.and_then(|s| s.srdf.as_deref()) {
+            Some(srdf) => &srdf.parsed.disabled_collisions,
+            None => &[],
         };
         let mut acm = AllowedCollisions::sampled(
             &model,
@@ -72,7 +64,7 @@ impl CollisionSetup {
         )?;
         let index: std::collections::HashMap<&str, usize> =
             model.body_names().enumerate().map(|(i, n)| (n, i)).collect();
-        for (a, b) in &disabled {
+        for (a, b) in disabled {
             if let (Some(&i), Some(&j)) = (index.get(a.as_str()), index.get(b.as_str())) {
                 acm.allow(i, j, AllowReason::User);
             }

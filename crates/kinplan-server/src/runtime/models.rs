@@ -12,7 +12,7 @@ use tonic::Status;
 use super::{Budget, Compute};
 use crate::pb::{self, robot_ref::Source};
 use crate::status::{invalid, not_found, robot_error};
-use kinplan_core::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain, parse_srdf};
+use kinplan_core::robot::{Chain, ChainSpec, Srdf, UrdfLimits, builtin_chain, parse_chain, parse_srdf};
 
 /// A chain and the id a client can send instead of its URDF next time
 /// (empty for built-in robots).
@@ -44,8 +44,15 @@ fn held_in(robot: &pb::RobotRef) -> HeldJoints {
 pub struct ModelSource {
     pub urdf: Arc<str>,
     pub meshes: MeshFiles,
-    /// MoveIt's SRDF for the URDF, when one was sent.
-    pub srdf: Option<Arc<str>>,
+    /// MoveIt's SRDF for the URDF, when one was sent: read once, when the
+    /// model arrives.
+    pub srdf: Option<Arc<SrdfSource>>,
+}
+
+/// An SRDF as sent (its text is part of the model id) and as read.
+pub struct SrdfSource {
+    pub text: String,
+    pub parsed: Srdf,
 }
 
 /// Mesh files as (URI, bytes), sorted by URI.
@@ -63,7 +70,7 @@ impl ModelSource {
     /// Bytes held (the cache's accounting).
     fn bytes(&self) -> usize {
         self.urdf.len()
-            + self.srdf.as_ref().map_or(0, |s| s.len())
+            + self.srdf.as_ref().map_or(0, |s| s.text.len())
             + self.meshes.iter().map(|(u, d)| u.len() + d.len()).sum::<usize>()
     }
 
@@ -83,7 +90,7 @@ impl ModelSource {
             h.update(bytes);
         };
         part(self.urdf.as_bytes());
-        part(self.srdf.as_deref().unwrap_or("").as_bytes());
+        part(self.srdf.as_ref().map_or("", |s| s.text.as_str()).as_bytes());
         for (uri, data) in self.meshes.iter() {
             part(uri.as_bytes());
             part(data);
@@ -126,15 +133,15 @@ fn meshes_in(files: &[pb::MeshFile]) -> Result<MeshFiles, Status> {
 }
 
 /// The chain of the SRDF group `group`: its (first) `<chain>`.
-fn group_chain(source: &ModelSource, group: &str, limits: &UrdfLimits) -> Result<ChainSpec, Status> {
-    let Some(text) = &source.srdf else {
+fn group_chain(source: &ModelSource, group: &str) -> Result<ChainSpec, Status> {
+    let Some(srdf) = &source.srdf else {
         return Err(invalid(
             "robot.group",
             "names an SRDF group, and the model has no SRDF",
         ));
     };
-    let srdf = parse_srdf(text, limits).map_err(|e| robot_error(e, ""))?;
     let found = srdf
+        .parsed
         .group(group)
         .ok_or_else(|| invalid("robot.group", format!("the SRDF has no group `{group}`")))?;
     let (base, tip) = found
@@ -334,12 +341,15 @@ impl ModelStore {
                 let source = ModelSource {
                     urdf: Arc::from(text.as_str()),
                     meshes: meshes_in(&robot.meshes)?,
-                    srdf: Some(Arc::from(robot.srdf.as_str())).filter(|s: &Arc<str>| !s.is_empty()),
+                    // read when sent: refused now, not at the first call that needs it
+                    srdf: match robot.srdf.as_str() {
+                        "" => None,
+                        text => Some(Arc::new(SrdfSource {
+                            text: text.to_string(),
+                            parsed: parse_srdf(text, &self.limits).map_err(|e| robot_error(e, ""))?,
+                        })),
+                    },
                 };
-                // refused when sent, not at the first call that reads it
-                if let Some(text) = &source.srdf {
-                    parse_srdf(text, &self.limits).map_err(|e| robot_error(e, ""))?;
-                }
                 (source.id(), Some(source))
             }
             Some(Source::ModelId(bytes)) => {
@@ -368,7 +378,7 @@ impl ModelStore {
         };
         if !robot.group.is_empty() {
             let source = text.as_ref().expect("fetched above");
-            spec = group_chain(source, &robot.group, &self.limits)?;
+            spec = group_chain(source, &robot.group)?;
         }
         let key = (id, spec.clone());
         if let Some((chain, source)) = self.chains.lock().expect("cache lock").get(&key) {

@@ -201,8 +201,9 @@ fn walk(
     if depth > 64 {
         return Ok(());
     }
-    // occurrences of each repeated field so far (their indices)
-    let mut seen: HashMap<u64, usize> = HashMap::new();
+    // occurrences of each repeated field so far (their indices): a few
+    // fields per message, so a small list, allocated only when one repeats
+    let mut seen: Vec<(u64, usize)> = Vec::new();
     let is_matrix = type_name == MATRIX;
     let mut columns = 0usize;
     let mut at = 0;
@@ -213,11 +214,18 @@ fn walk(
         let (number, wire) = (tag >> 3, tag & 7);
         let field: Option<&'static Field> = fields.get(&number);
         let mut next_index = |field: &Field| {
-            field.repeated.then(|| {
-                let k = seen.entry(number).or_insert(0);
-                *k += 1;
-                *k - 1
-            })
+            field
+                .repeated
+                .then(|| match seen.iter_mut().find(|(n, _)| *n == number) {
+                    Some((_, k)) => {
+                        *k += 1;
+                        *k - 1
+                    }
+                    None => {
+                        seen.push((number, 1));
+                        0
+                    }
+                })
         };
         let refuse = |path: &mut Vec<Step>, field: &'static Field, index: Option<usize>, why: String| {
             let why = match index {

@@ -10,9 +10,7 @@ use crate::pb::{self, robot_service_server::RobotService};
 use crate::runtime::Shared;
 use crate::runtime::collision_models::collision_setup;
 use crate::status::{invalid, robot_error, too_large};
-use kinplan_core::robot::{
-    BUILTIN_NAMES, Chain, UrdfLimits, builtin_chain, builtin_urdf, expand_capsules, parse_srdf,
-};
+use kinplan_core::robot::{BUILTIN_NAMES, Chain, builtin_chain, builtin_urdf, expand_capsules};
 
 mod convert;
 
@@ -76,14 +74,14 @@ impl RobotService for RobotApi {
         };
         let mut reply = describe(&robot.chain, robot.model_id);
         reply.collision_bodies = bodies;
-        if let Some(text) = &robot.source.srdf {
-            let srdf = parse_srdf(text, &UrdfLimits::default()).map_err(|e| robot_error(e, ""))?;
+        if let Some(srdf) = &robot.source.srdf {
             reply.named_states = srdf
+                .parsed
                 .group_states
-                .into_iter()
+                .iter()
                 .map(|s| pb::NamedState {
-                    name: s.name,
-                    group: s.group,
+                    name: s.name.clone(),
+                    group: s.group.clone(),
                     joint_names: s.joints.iter().map(|(n, _)| n.clone()).collect(),
                     positions: s.joints.iter().map(|(_, v)| *v).collect(),
                 })
