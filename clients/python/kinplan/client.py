@@ -26,7 +26,7 @@ from .errors import KinplanError, invalid_argument
 from .exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
 from .kinematics import LinearSolution
 from .mobile import MobileRun, Obstacle as MobileObstacle, StepResult, WheelKinematics
-from .octree import Octree, Views
+from .octree import Octree, OctreeSource, Views
 from .planning import Obstacle, Plan, StateChecks
 from .robot import Robot
 from .scoring import Comparison, Scores, Trajectory
@@ -294,15 +294,21 @@ class Client:
         ray_fraction: Optional[float] = None,
         max_results: int = 10,
         camera: Optional[Dict[str, Any]] = None,
+        region: Optional[Tuple[npt.ArrayLike, npt.ArrayLike]] = None,
         timeout: Optional[float] = None,
         **options: Any,
     ) -> Views:
         """Ranked next views of the unknown space in ``octree`` (an
-        :class:`Octree` or a ``.bt`` file's bytes). ``weights`` = (w_i, w_d,
-        w_r); ``gain`` one of "intersection", "rays", "occlusion_aware",
+        :class:`Octree`, a ``.bt``/``.ot`` file's bytes, a binary file object
+        or a path: see :meth:`Octree.read`). ``region`` = (min xyz, max xyz),
+        metres, world frame: where frontiers are sought. ``weights`` = (w_i,
+        w_d, w_r); ``gain`` one of "intersection", "rays", "occlusion_aware",
         "unobserved_voxels"; ``robot`` (optional, a robot or a built-in's name) adds the reach filter and IK
-        checks of the best candidates; further ``options`` are the fields of
-        ``NbvOptions`` (e.g. ``frontier_unknown_ratio=0.3``)."""
+        checks of the best candidates; further ``options`` are fields of
+        ``NbvOptions`` (e.g. ``frontier_unknown_ratio=0.3``; an unknown name is a
+        TypeError listing them)."""
+        if region is not None:
+            options["region"] = region
         call = _exploration.next_best_view(octree, camera_pose, camera_mount, candidate_poses, weights, gain,
                                            ray_fraction, max_results, camera, options, robot is not None)
         if robot is not None:
@@ -313,7 +319,7 @@ class Client:
 
     def insert_scan(
         self,
-        octree: Optional[Octree],
+        octree: Optional[OctreeSource],
         points: Any,
         origin: Any = None,
         *,
@@ -323,7 +329,8 @@ class Client:
         timeout: Optional[float] = None,
     ) -> Octree:
         """Inserts ``points`` (n x 3, world frame, metres) seen from ``origin``
-        (3-vector or 4x4 sensor pose) with OctoMap's sensor model; a new tree at
+        (3-vector or 4x4 sensor pose) with OctoMap's sensor model into
+        ``octree`` (any form :meth:`Octree.read` takes); a new tree at
         ``resolution`` when ``octree`` is None. Returns the updated tree."""
         out: Octree = self._run(_exploration.insert_scan(octree, points, origin, resolution, max_range, discretize),
                                 timeout)

@@ -9,8 +9,9 @@ bytes; the server never opens a file.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -41,17 +42,53 @@ class Octree:
         o = OctreeObstacle.from_bt_file_bytes(content)
         return cls(data=o.data, resolution=o.resolution, binary=True, tree_id=o.tree_id)
 
+    @classmethod
+    def from_file_bytes(cls, content: bytes) -> "Octree":
+        """A whole OctoMap file's bytes: ``.bt`` (binary) or ``.ot`` (full,
+        OcTree or ColorOcTree), told apart by the first header line."""
+        first = bytes(content[:64]).split(b"\n", 1)[0].strip()
+        if first == _BT_MAGIC:
+            return cls.from_bt(content)
+        if first == _OT_MAGIC:
+            tree_id, resolution, data = _split_header(content)
+            return cls(data=data, resolution=resolution, binary=False, tree_id=tree_id)
+        raise ValueError(
+            "not an OctoMap file: the first line must be "
+            f"{_BT_MAGIC.decode()!r} (.bt) or {_OT_MAGIC.decode()!r} (.ot)"
+        )
+
+    @classmethod
+    def read(cls, source: "OctreeSource", name: str = "octree") -> "Octree":
+        """An :class:`Octree` from any of the forms the client's calls take:
+        an ``Octree``; a ``.bt``/``.ot`` file's bytes; an open binary file
+        (anything with ``read()``); or a path, read here on the client (the
+        server never opens a file). ``name`` is the argument named in errors."""
+        if isinstance(source, Octree):
+            return source
+        if isinstance(source, (bytes, bytearray, memoryview)):
+            return cls.from_file_bytes(bytes(source))
+        if hasattr(source, "read"):
+            content = source.read()
+            if not isinstance(content, (bytes, bytearray)):
+                raise TypeError(f"{name}: the file must be opened in binary mode ('rb')")
+            return cls.from_file_bytes(bytes(content))
+        if isinstance(source, (str, os.PathLike)):
+            with open(source, "rb") as f:
+                return cls.from_file_bytes(f.read())
+        raise TypeError(
+            f"{name} must be an Octree, a .bt/.ot file's bytes, a binary file object or a path, "
+            f"got {type(source).__name__}"
+        )
+
     def to_bt(self) -> bytes:
         """The tree as a ``.bt`` file OctoMap reads (binary trees only)."""
         if not self.binary:
             raise ValueError("only a binary tree can be written as .bt")
-        header = (
-            f"# Octomap OcTree binary file\nid {self.tree_id}\nsize 0\nres {self.resolution}\ndata\n"
-        )
-        # OctoMap reads `size` but recounts the nodes; 0 would be refused by
-        # kinplan's own reader, so count the nodes (2 bytes each).
-        header = header.replace("size 0", f"size {_count_binary_nodes(self.data)}")
-        return header.encode() + self.data
+        # OctoMap checks `size` against the nodes it built while reading.
+        return (
+            f"{_BT_MAGIC.decode()}\nid {self.tree_id}\nsize {_count_binary_nodes(self.data)}\n"
+            f"res {self.resolution}\ndata\n"
+        ).encode() + self.data
 
     def occupied_cells(self) -> np.ndarray:
         """Centres (n x 3, m, world frame) of the occupied leaves of a binary
@@ -197,18 +234,49 @@ def _inner_children() -> List[Tuple[Tuple[int, ...], ...]]:
     return _INNER
 
 
+_BT_MAGIC = b"# Octomap OcTree binary file"
+_OT_MAGIC = b"# Octomap OcTree file"
+
+#: What the client's octree arguments take (see :meth:`Octree.read`).
+OctreeSource = Union["Octree", bytes, bytearray, memoryview, str, "os.PathLike[str]", Any]
+
+
+def _split_header(content: bytes) -> Tuple[str, float, bytes]:
+    """(id, resolution, node bytes) of an OctoMap file: text lines up to ``data``."""
+    tree_id, resolution, offset = "OcTree", None, 0
+    while True:
+        end = content.find(b"\n", offset)
+        if end < 0:
+            raise ValueError("the OctoMap header has no 'data' line")
+        line = content[offset:end].decode("ascii", "replace").strip()
+        offset = end + 1
+        if line.startswith("id "):
+            tree_id = line[3:].strip()
+        elif line.startswith("res "):
+            resolution = float(line[4:])
+        elif line == "data":
+            break
+    if resolution is None:
+        raise ValueError("the OctoMap header has no 'res' line")
+    return tree_id, resolution, content[offset:]
+
+
 def _count_binary_nodes(data: bytes) -> int:
-    """Nodes of a .bt node stream: each node is 2 bytes, children with
-    children (bits 11) follow depth first."""
-    count, pending, i = 0, 1, 0
+    """The nodes OctoMap builds from a .bt node stream (what its ``size``
+    header line must say): the root and every known child. Each inner node
+    is 2 bytes, 2 bits per child (00 unknown: no node; 01 free and 10
+    occupied leaves: a node; 11: a node whose own 2 bytes follow, depth
+    first)."""
+    count, pending, i = 1, 1, 0
     while pending:
         if i + 2 > len(data):
             raise ValueError("truncated binary octree")
         pending -= 1
-        count += 1
         bits = data[i] | (data[i + 1] << 8)
         i += 2
-        pending += sum(1 for c in range(8) if (bits >> (2 * c)) & 3 == 3)
+        children = [(bits >> (2 * c)) & 3 for c in range(8)]
+        count += sum(1 for b in children if b)
+        pending += sum(1 for b in children if b == 3)
     return count
 
 

@@ -56,3 +56,64 @@ def test_bad_scans_are_refused(client):
     with pytest.raises(kinplan.KinplanError) as e:
         client.insert_scan(None, wall(), resolution=-1.0)
     assert "resolution" in str(e.value)
+
+
+OCTOMAP_OT = __import__("pathlib").Path(__file__).resolve().parents[3] / "crates/kinplan-core/src/octree/fixtures/scans_octomap.ot"
+
+
+def test_the_bt_size_line_counts_the_nodes_octomap_builds():
+    # A root with 8 known leaves (0x66: children 10 01 10 01 in each byte): 9 nodes.
+    tree = kinplan.Octree(data=b"\x66\x66", resolution=0.1)
+    assert b"\nsize 9\n" in tree.to_bt()
+    # A root whose child 0 is inner (bits 11) with two occupied leaves: 1 + 1 + 2 nodes.
+    tree = kinplan.Octree(data=b"\x03\x00\x0a\x00", resolution=0.1)
+    assert b"\nsize 4\n" in tree.to_bt()
+
+
+def test_the_bt_size_line_agrees_with_the_server_count(client):
+    tree = client.insert_scan(None, wall(), origin=[0, 0, 0], resolution=0.1)
+    size = int(tree.to_bt().split(b"\nsize ")[1].split(b"\n")[0])
+    assert size == client.octree_info(tree)["nodes"]
+
+
+def test_every_octree_argument_form_is_taken(client, tmp_path):
+    import io
+
+    tree = client.insert_scan(None, wall(), origin=[0, 0, 0], resolution=0.1)
+    bt = tree.to_bt()
+    path = tmp_path / "wall.bt"
+    path.write_bytes(bt)
+    expected = client.octree_info(tree)["nodes"]
+    forms = (lambda: tree, lambda: bt, lambda: bytearray(bt), lambda: memoryview(bt), lambda: io.BytesIO(bt),
+             lambda: path, lambda: str(path))
+    for form in forms:
+        assert client.octree_info(form())["nodes"] == expected
+        grown = client.insert_scan(form(), wall() + [0.5, 0, 0], origin=[0, 0, 0])
+        assert client.octree_info(grown)["occupied_leaves"] == 72
+        assert len(client.next_best_view(form(), camera_pose=np.eye(4), max_results=2)) > 0
+    # An OctoMap-written .ot file (full nodes): its own header says how many nodes it holds.
+    ot = OCTOMAP_OT.read_bytes()
+    header_size = int(ot.split(b"\nsize ")[1].split(b"\n")[0])
+    assert client.octree_info(OCTOMAP_OT)["nodes"] == header_size
+    assert not kinplan.Octree.read(io.BytesIO(ot)).binary
+    with pytest.raises(TypeError, match="binary mode"):
+        client.octree_info(io.StringIO("# Octomap OcTree binary file\n"))
+    with pytest.raises(ValueError, match="not an OctoMap file"):
+        client.octree_info(b"hello")
+    with pytest.raises(TypeError, match="octree must be"):
+        client.insert_scan(42, wall())
+
+
+def test_nbv_takes_a_region_and_names_an_unknown_option(client):
+    tree = client.insert_scan(None, wall(), origin=np.eye(4), resolution=0.1)
+    everywhere = client.next_best_view(tree, camera_pose=np.eye(4), max_results=50)
+    # Frontier cells only in the half-space y > 0: every candidate's frontier lies there.
+    region = ([-5.0, 0.0, -5.0], [5.0, 5.0, 5.0])
+    half = client.next_best_view(tree, camera_pose=np.eye(4), max_results=50, region=region)
+    assert 0 < half.stages["frontier_cells"] < everywhere.stages["frontier_cells"]
+    frontiers = half.frontier[~np.isnan(half.frontier[:, 0])]
+    assert len(frontiers) and np.all(frontiers[:, 1] >= -1e-9)
+    with pytest.raises(TypeError, match="NbvOptions has no field 'pose'"):
+        client.next_best_view(tree, camera_pose=np.eye(4), pose=np.eye(4))
+    with pytest.raises(ValueError, match="region must be"):
+        client.next_best_view(tree, camera_pose=np.eye(4), region=[1, 2])

@@ -16,6 +16,34 @@ from ..v1 import common_pb2, exploration_pb2, planning_pb2
 from . import Call
 
 
+def nbv_options(options: Mapping[str, Any], argument: str = "options") -> exploration_pb2.NbvOptions:
+    """``NbvOptions`` of keyword values, each checked against the message's
+    fields (an unknown name is a TypeError listing the known ones);
+    ``region`` may be a (min xyz, max xyz) pair."""
+    known = exploration_pb2.NbvOptions.DESCRIPTOR.fields_by_name
+    values = dict(options)
+    for name in values:
+        if name not in known:
+            raise TypeError(f"{argument}: NbvOptions has no field {name!r}; the fields are {sorted(known)}")
+    region = values.pop("region", None)
+    opts = exploration_pb2.NbvOptions(**values)
+    if region is not None:
+        opts.region.CopyFrom(bounding_box(region, "region"))
+    return opts
+
+
+def bounding_box(box: Any, name: str) -> exploration_pb2.BoundingBox:
+    """A BoundingBox of (min xyz, max xyz), or one given as the message."""
+    if isinstance(box, exploration_pb2.BoundingBox):
+        return box
+    try:
+        lo, hi = (np.asarray(b, dtype=float).reshape(3) for b in box)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be (min xyz, max xyz), two 3-vectors in metres") from None
+    return exploration_pb2.BoundingBox(min=common_pb2.Vec3(x=lo[0], y=lo[1], z=lo[2]),
+                                       max=common_pb2.Vec3(x=hi[0], y=hi[1], z=hi[2]))
+
+
 def next_best_view(octree: Any, camera_pose: Any, camera_mount: Any, candidate_poses: Sequence[Any],
                    weights: Optional[Sequence[float]], gain: str, ray_fraction: Optional[float], max_results: int,
                    camera: Optional[Dict[str, Any]], options: Dict[str, Any], robot: bool) -> Call[Views]:
@@ -35,10 +63,12 @@ def _nbv_request_of(octree: Any, camera_pose: Any, camera_mount: Any, candidate_
                  weights: Optional[Sequence[float]], gain: str, ray_fraction: Optional[float], max_results: int,
                  camera: Optional[Dict[str, Any]], options: Dict[str, Any]) -> exploration_pb2.NextBestViewRequest:
     """The NextBestViewRequest of ``Client.next_best_view``'s arguments, without a robot."""
-    tree = octree if isinstance(octree, Octree) else Octree.from_bt(bytes(octree))
+    tree = Octree.read(octree)
     if gain not in GAINS:
         raise ValueError(f"gain must be one of {sorted(GAINS)}, got {gain!r}")
-    opts = exploration_pb2.NbvOptions(gain=GAINS[gain], max_results=int(max_results), **options)
+    opts = nbv_options(options)
+    opts.gain = GAINS[gain]
+    opts.max_results = int(max_results)
     if ray_fraction is not None:
         opts.ray_fraction = float(ray_fraction)
     if weights is not None:
@@ -95,9 +125,10 @@ def _views(reply: exploration_pb2.NextBestViewResponse) -> Views:
     )
 
 
-def insert_scan(octree: Optional[Octree], points: Any, origin: Any, resolution: float,
+def insert_scan(octree: Any, points: Any, origin: Any, resolution: float,
                 max_range: Optional[float], discretize: bool) -> Call[Octree]:
-    """InsertScan: ``points`` seen from ``origin`` into ``octree`` (a new tree when None)."""
+    """InsertScan: ``points`` seen from ``origin`` into ``octree`` (any
+    form :meth:`Octree.read` takes; a new tree when None)."""
     pts = np.asarray(points, dtype=np.float32)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points must be n x 3, got shape {pts.shape}")
@@ -108,7 +139,7 @@ def insert_scan(octree: Optional[Octree], points: Any, origin: Any, resolution: 
         discretize=discretize,
     )
     if octree is not None:
-        req.octree.CopyFrom(octree.to_proto())
+        req.octree.CopyFrom(Octree.read(octree).to_proto())
     if max_range is not None:
         req.max_range = float(max_range)
     return Call("exploration", "InsertScan", lambda r: Octree.from_proto(r.octree), request=req)
@@ -116,12 +147,9 @@ def insert_scan(octree: Optional[Octree], points: Any, origin: Any, resolution: 
 
 def octree_info(octree: Any, box: Any) -> Call[Dict[str, Any]]:
     """OctreeInfo: counts, bounds and volumes of a tree (inside ``box`` when given)."""
-    tree = octree if isinstance(octree, Octree) else Octree.from_bt(bytes(octree))
-    req = exploration_pb2.OctreeInfoRequest(octree=tree.to_proto())
+    req = exploration_pb2.OctreeInfoRequest(octree=Octree.read(octree).to_proto())
     if box is not None:
-        lo, hi = (np.asarray(b, dtype=float) for b in box)
-        req.box.min.CopyFrom(common_pb2.Vec3(x=lo[0], y=lo[1], z=lo[2]))
-        req.box.max.CopyFrom(common_pb2.Vec3(x=hi[0], y=hi[1], z=hi[2]))
+        req.box.CopyFrom(bounding_box(box, "box"))
     return Call("exploration", "OctreeInfo", _octree_info, request=req)
 
 
@@ -212,7 +240,7 @@ def explore(
     if planner not in ALGORITHMS:
         raise ValueError(f"planner must be one of {sorted(ALGORITHMS)}, got {planner!r}")
     lo, hi = (np.asarray(b, dtype=float).reshape(3) for b in region)
-    nbv_opts = exploration_pb2.NbvOptions(**dict(nbv or {}))
+    nbv_opts = nbv_options(nbv or {}, "nbv")
     if weights is not None:
         w_i, w_d, w_r = (float(v) for v in weights)
         nbv_opts.weights.CopyFrom(exploration_pb2.UtilityWeights(information_gain=w_i, distance=w_d, rotation=w_r))

@@ -38,7 +38,7 @@ from .._model_files import load_model, load_text
 from ..errors import KinplanError, invalid_argument
 from ..exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
 from ..kinematics import LinearSolution
-from ..octree import Octree, Views
+from ..octree import Octree, OctreeSource, Views
 from ..planning import Obstacle, Plan, StateChecks
 from ..scoring import Comparison, Scores, Trajectory
 from ._mobile import AsyncMobile
@@ -209,9 +209,12 @@ class Client:
                              camera_mount: Any = None, candidate_poses: Sequence[Any] = (),
                              weights: Optional[Sequence[float]] = None, gain: str = "intersection",
                              ray_fraction: Optional[float] = None, max_results: int = 10,
-                             camera: Optional[Dict[str, Any]] = None, timeout: Optional[float] = None,
-                             **options: Any) -> Views:
+                             camera: Optional[Dict[str, Any]] = None,
+                             region: Optional[Tuple[npt.ArrayLike, npt.ArrayLike]] = None,
+                             timeout: Optional[float] = None, **options: Any) -> Views:
         """As :meth:`kinplan.Client.next_best_view`."""
+        if region is not None:
+            options["region"] = region
         call = _exploration.next_best_view(octree, camera_pose, camera_mount, candidate_poses, weights, gain,
                                            ray_fraction, max_results, camera, options, robot is not None)
         if robot is not None:
@@ -220,7 +223,7 @@ class Client:
         views: Views = await self._run(call, timeout)
         return views
 
-    async def insert_scan(self, octree: Optional[Octree], points: Any, origin: Any = None, *,
+    async def insert_scan(self, octree: Optional[OctreeSource], points: Any, origin: Any = None, *,
                           resolution: float = 0.05, max_range: Optional[float] = None, discretize: bool = False,
                           timeout: Optional[float] = None) -> Octree:
         """As :meth:`kinplan.Client.insert_scan`."""
