@@ -14,8 +14,13 @@ pub struct RequestDeadline(pub Option<Instant>);
 /// DEADLINE_EXCEEDED beats tonic's own timer (which started first and answers
 /// CANCELLED). A timeout too large for `Instant` means no deadline.
 pub fn deadline_after(timeout: Duration) -> Option<Instant> {
-    let reserve = (timeout / 20).min(Duration::from_millis(2));
-    Instant::now().checked_add(timeout - reserve)
+    Instant::now().checked_add(timeout - answer_reserve(timeout))
+}
+
+/// How much earlier than a call's timeout this server answers it:
+/// `min(timeout / 20, 2 ms)`.
+pub fn answer_reserve(timeout: Duration) -> Duration {
+    (timeout / 20).min(Duration::from_millis(2))
 }
 
 /// The earlier (or shorter) of two optional limits, `None` meaning no

@@ -6,7 +6,6 @@ use std::future::Future;
 use std::panic::AssertUnwindSafe;
 use std::pin::Pin;
 use std::task::{Context, Poll};
-use std::time::Instant;
 
 use bytes::Bytes;
 use http_body::Frame;
@@ -113,7 +112,7 @@ impl Drop for GuardedBody {
     fn drop(&mut self) {
         // Dropped before its trailers: the client went away.
         if let Some(labels) = self.labels.take() {
-            labels.record("CANCELLED");
+            labels.record_abandoned();
         }
     }
 }
@@ -140,11 +139,10 @@ impl http_body::Body for GuardedBody {
                 std::panic::catch_unwind(AssertUnwindSafe(|| Pin::new(&mut this.inner).poll_frame(cx)));
             return match polled {
                 Err(panic) => {
-                    let labels = self.labels.clone().unwrap_or(CallLabels {
-                        service: "unknown".into(),
-                        method: "unknown".into(),
-                        started: Instant::now(),
-                    });
+                    let labels = self
+                        .labels
+                        .clone()
+                        .unwrap_or_else(|| CallLabels::for_path("/unknown/unknown"));
                     let status = panic_status(&labels, &*panic);
                     self.finish(status)
                 }

@@ -19,7 +19,9 @@ use tonic::Status;
 use tonic::body::Body;
 
 use crate::runtime::catch_unwind;
-use crate::runtime::deadline::{RequestDeadline, deadline_after, effective_timeout, grpc_timeout};
+use crate::runtime::deadline::{
+    RequestDeadline, answer_reserve, deadline_after, effective_timeout, grpc_timeout,
+};
 use crate::status::code_name;
 
 /// Histogram bucket bounds, seconds: 50 µs to 10 s.
@@ -84,12 +86,14 @@ const ADMITTED_PER_MESSAGE: &[&str] = &["/kinplan.v1.KinematicsService/StreamIk"
 
 type BoxFuture<T> = Pin<Box<dyn Future<Output = T> + Send>>;
 
-/// What a finished call is recorded under.
+/// What a finished call is recorded under, and the instant its client gives
+/// up (its timeout from when the call arrived; `None`: no timeout).
 #[derive(Clone)]
 pub(crate) struct CallLabels {
     service: String,
     method: String,
     started: Instant,
+    client_deadline: Option<Instant>,
 }
 
 impl CallLabels {
@@ -105,11 +109,47 @@ impl CallLabels {
             service,
             method,
             started: Instant::now(),
+            client_deadline: None,
         }
     }
 
-    /// Records the call as finished with `code` (a gRPC code name).
-    pub(crate) fn record(&self, code: &str) {
+    /// The same labels, for a call whose client gives up `timeout` after it arrived.
+    pub(crate) fn with_timeout(mut self, timeout: Option<Duration>) -> CallLabels {
+        self.client_deadline = timeout.and_then(|t| self.started.checked_add(t));
+        self
+    }
+
+    /// The code the client sees for an answer written now with `code`: once
+    /// the call's timeout has passed the client has already ended the call
+    /// with its own DEADLINE_EXCEEDED (its clock started before ours), so an
+    /// answer this late is recorded as that.
+    fn code_seen(&self, code: &'static str) -> &'static str {
+        match self.client_deadline {
+            Some(d) if Instant::now() >= d => "DEADLINE_EXCEEDED",
+            _ => code,
+        }
+    }
+
+    /// Records a call whose client went away before it was answered (the
+    /// stream was reset): DEADLINE_EXCEEDED when that happened at the
+    /// client's deadline (within the reserve [`deadline_after`] keeps, since
+    /// the client's clock started a little before ours), CANCELLED otherwise.
+    pub(crate) fn record_abandoned(&self) {
+        let timed_out = self.client_deadline.is_some_and(|d| {
+            let timeout = d.saturating_duration_since(self.started);
+            Instant::now() + answer_reserve(timeout) >= d
+        });
+        self.record(if timed_out {
+            "DEADLINE_EXCEEDED"
+        } else {
+            "CANCELLED"
+        });
+    }
+
+    /// Records the call as finished with `code` (a gRPC code name), as the
+    /// client sees it ([`Self::code_seen`]).
+    pub(crate) fn record(&self, code: &'static str) {
+        let code = self.code_seen(code);
         let labels = [
             ("grpc_service", self.service.clone()),
             ("grpc_method", self.method.clone()),
@@ -117,7 +157,7 @@ impl CallLabels {
         metrics::histogram!("grpc_server_handling_seconds", &labels)
             .record(self.started.elapsed().as_secs_f64());
         let mut with_code = labels.to_vec();
-        with_code.push(("grpc_code", code.to_string()));
+        with_code.push(("grpc_code", code.to_owned()));
         metrics::counter!("grpc_server_handled_total", &with_code).increment(1);
     }
 }
@@ -172,9 +212,10 @@ where
     }
 
     fn call(&mut self, mut request: http::Request<B>) -> Self::Future {
-        let labels = CallLabels::for_path(request.uri().path());
         let header = grpc_timeout(request.headers());
-        let deadline = effective_timeout(header, self.default_timeout).and_then(deadline_after);
+        let timeout = effective_timeout(header, self.default_timeout);
+        let labels = CallLabels::for_path(request.uri().path()).with_timeout(timeout);
+        let deadline = timeout.and_then(deadline_after);
         request.extensions_mut().insert(RequestDeadline(deadline));
         let cut = self.cut.clone();
         let reply_type = crate::transport::finite::reply_type(request.uri().path());
@@ -197,11 +238,15 @@ where
                     return Ok(status.into_http());
                 }
             };
+            // Until the handler answers: recorded as abandoned if the client
+            // resets the call first (this future is then dropped).
+            let waiting = Unanswered(Some(labels));
             let guarded = catch_unwind(future);
             let outcome = match deadline {
                 Some(d) => tokio::time::timeout_at(d.into(), guarded).await.ok(),
                 None => Some(guarded.await),
             };
+            let labels = waiting.answered();
             let response = match outcome {
                 None => Ok(deadline_status().into_http()),
                 Some(Err(panic)) => Ok(panic_status(&labels, &*panic).into_http()),
@@ -215,6 +260,25 @@ where
                 }
             }
         })
+    }
+}
+
+/// A call not yet answered; dropped so, it is recorded as abandoned.
+struct Unanswered(Option<CallLabels>);
+
+impl Unanswered {
+    fn answered(mut self) -> CallLabels {
+        self.0
+            .take()
+            .unwrap_or_else(|| CallLabels::for_path("/unknown/unknown"))
+    }
+}
+
+impl Drop for Unanswered {
+    fn drop(&mut self) {
+        if let Some(labels) = self.0.take() {
+            labels.record_abandoned();
+        }
     }
 }
 
@@ -451,6 +515,105 @@ mod tests {
         let collected = call_with(path, vec![framed(&reply)], 0).await;
         assert_eq!(collected.trailers().unwrap().get("grpc-status").unwrap(), "13");
         assert!(collected.to_bytes().is_empty());
+    }
+
+    /// A body that ends with OK trailers after `delay`.
+    struct LateOk(Pin<Box<tokio::time::Sleep>>);
+    impl http_body::Body for LateOk {
+        type Data = Bytes;
+        type Error = Status;
+        fn poll_frame(
+            mut self: Pin<&mut Self>,
+            cx: &mut Context<'_>,
+        ) -> Poll<Option<Result<Frame<Bytes>, Status>>> {
+            match self.0.as_mut().poll(cx) {
+                Poll::Ready(()) => Poll::Ready(Some(Ok(Frame::trailers(trailers(0))))),
+                Poll::Pending => Poll::Pending,
+            }
+        }
+    }
+
+    fn handled(text: &str, method: &str, code: &str) -> u64 {
+        text.lines()
+            .filter(|l| {
+                l.starts_with("grpc_server_handled_total")
+                    && l.contains(&format!("grpc_method=\"{method}\""))
+                    && l.contains(&format!("grpc_code=\"{code}\""))
+            })
+            .filter_map(|l| l.rsplit(' ').next()?.parse::<u64>().ok())
+            .sum()
+    }
+
+    /// Calls the client ends are recorded as the client saw them: a reply
+    /// stream it resets before the call's timeout is CANCELLED, after it
+    /// DEADLINE_EXCEEDED (its own timer ended the call); an answer written
+    /// after the timeout is DEADLINE_EXCEEDED too (the client stopped
+    /// waiting before it arrived), and a unary call reset before its answer
+    /// is counted, not lost.
+    #[test]
+    fn calls_the_client_ends_are_recorded_as_it_saw_them() {
+        let recorder = metrics_exporter_prometheus::PrometheusBuilder::new().build_recorder();
+        let handle = recorder.handle();
+        let runtime = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .unwrap();
+        let request = |method: &str, timeout: &str| {
+            let mut request = http::Request::builder()
+                .uri(format!("/kinplan.v1.KinematicsService/{method}"))
+                .body(Body::empty())
+                .unwrap();
+            request
+                .headers_mut()
+                .insert("grpc-timeout", timeout.parse().unwrap());
+            request
+        };
+        metrics::with_local_recorder(&recorder, || {
+            runtime.block_on(async {
+                let (_tx, layer) = layer();
+                let streaming = layer.layer(tower::service_fn(|_req: http::Request<Body>| async {
+                    Ok::<_, std::convert::Infallible>(http::Response::new(Body::new(Forever)))
+                }));
+                // Reset 10 ms into a 1 s call: the client cancelled.
+                let response = streaming
+                    .clone()
+                    .oneshot(request("StreamIk", "1S"))
+                    .await
+                    .unwrap();
+                let body = response.into_body();
+                tokio::time::sleep(Duration::from_millis(10)).await;
+                drop(body);
+                // Reset once a 30 ms timeout has passed: the client's deadline.
+                let response = streaming.oneshot(request("TrackPath", "30m")).await.unwrap();
+                let body = response.into_body();
+                tokio::time::sleep(Duration::from_millis(40)).await;
+                drop(body);
+                // OK written 40 ms into a 20 ms call: the client saw its deadline.
+                let late = layer.layer(tower::service_fn(|_req: http::Request<Body>| async {
+                    let body = LateOk(Box::pin(tokio::time::sleep(Duration::from_millis(40))));
+                    Ok::<_, std::convert::Infallible>(http::Response::new(Body::new(body)))
+                }));
+                let response = late.oneshot(request("SolveIk", "20m")).await.unwrap();
+                response.into_body().collect().await.unwrap();
+                // A unary call reset before its answer.
+                let slow = layer.layer(tower::service_fn(|_req: http::Request<Body>| async {
+                    tokio::time::sleep(Duration::from_secs(30)).await;
+                    Ok::<_, std::convert::Infallible>(http::Response::new(Body::empty()))
+                }));
+                let call = slow.oneshot(request("SolveIkBatch", "1S"));
+                assert!(
+                    tokio::time::timeout(Duration::from_millis(10), call)
+                        .await
+                        .is_err()
+                );
+            })
+        });
+        let text = handle.render();
+        assert_eq!(handled(&text, "StreamIk", "CANCELLED"), 1, "{text}");
+        assert_eq!(handled(&text, "TrackPath", "DEADLINE_EXCEEDED"), 1, "{text}");
+        assert_eq!(handled(&text, "SolveIk", "DEADLINE_EXCEEDED"), 1, "{text}");
+        assert_eq!(handled(&text, "SolveIk", "OK"), 0, "{text}");
+        assert_eq!(handled(&text, "SolveIkBatch", "CANCELLED"), 1, "{text}");
     }
 
     /// Metrics count the status the client sees: a stream's trailers, and a

@@ -1,0 +1,146 @@
+//! How fast a saturated server says "no": starts `<binary> serve` with two CPU
+//! threads and four request slots, holds all four with long IK calls, then
+//! sends 200 ListRobots calls at once (and 200 one after another) and reports
+//! each shed call's latency from the moment it was sent, with a Rust client
+//! (so the figure is the server's, not a slow client's).
+//!
+//! `cargo run --release -p kinplan-loadtest --example shed_burst -- target/release/kinplan`
+
+use std::time::{Duration, Instant};
+
+use kinplan_proto as pb;
+use pb::kinematics_service_client::KinematicsServiceClient;
+use pb::robot_service_client::RobotServiceClient;
+use tonic::transport::{Channel, Endpoint};
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let rank = ((p / 100.0) * (sorted.len() - 1) as f64).round() as usize;
+    sorted[rank.min(sorted.len() - 1)]
+}
+
+fn summary(what: &str, mut shed_ms: Vec<f64>, others: usize) {
+    shed_ms.sort_by(f64::total_cmp);
+    println!(
+        "{what}: {} shed, {others} other answers; shed latency p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
+        shed_ms.len(),
+        percentile(&shed_ms, 50.0),
+        percentile(&shed_ms, 99.0),
+        shed_ms.last().copied().unwrap_or(f64::NAN),
+    );
+}
+
+/// One ListRobots call: its latency in ms and whether it was shed.
+async fn list(mut robots: RobotServiceClient<Channel>) -> (f64, bool) {
+    let started = Instant::now();
+    let answer = robots.list_robots(pb::ListRobotsRequest {}).await;
+    let ms = started.elapsed().as_secs_f64() * 1e3;
+    let shed = matches!(&answer, Err(s) if s.code() == tonic::Code::ResourceExhausted);
+    (ms, shed)
+}
+
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .map(|a| a.port())
+        .expect("a free loopback port")
+}
+
+#[tokio::main(flavor = "multi_thread", worker_threads = 2)]
+async fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let binary = std::env::args()
+        .nth(1)
+        .ok_or("usage: shed_burst <path to the kinplan binary>")?;
+    let port = free_port();
+    let mut server = std::process::Command::new(&binary)
+        .args(["serve", "--listen", &format!("127.0.0.1:{port}")])
+        .args(["--cpu-threads", "2", "--concurrency-limit", "4"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()?;
+    let endpoint = Endpoint::from_shared(format!("http://127.0.0.1:{port}"))?.tcp_nodelay(true);
+    let mut channel = None;
+    for _ in 0..100 {
+        if let Ok(c) = endpoint.connect().await {
+            channel = Some(c);
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    let channel = channel.ok_or("the server did not start")?;
+    let robots = RobotServiceClient::new(channel.clone());
+    // Warm the connection and the code paths.
+    for _ in 0..50 {
+        let _ = list(robots.clone()).await;
+    }
+    // Four calls that run for seconds: a target 10 m away, unlimited restarts.
+    let far = pb::SolveIkRequest {
+        robot: Some(pb::RobotRef {
+            source: Some(pb::robot_ref::Source::Name("ur5".into())),
+            ..Default::default()
+        }),
+        target: Some(pb::Pose {
+            position: Some(pb::Vec3 {
+                x: 10.0,
+                y: 0.0,
+                z: 0.5,
+            }),
+            orientation: None,
+        }),
+        seed: vec![],
+        options: Some(pb::IkOptions {
+            max_restarts: Some(u32::MAX),
+            time_budget: Some(3.0),
+            ..Default::default()
+        }),
+    };
+    let busy: Vec<_> = (0..4)
+        .map(|_| {
+            let mut ik = KinematicsServiceClient::new(channel.clone());
+            let request = far.clone();
+            tokio::spawn(async move { ik.solve_ik(request).await })
+        })
+        .collect();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+
+    let burst = futures_join(robots.clone(), 200).await;
+    let shed: Vec<f64> = burst.iter().filter(|(_, s)| *s).map(|(ms, _)| *ms).collect();
+    summary(
+        "200 calls at once",
+        shed,
+        burst.iter().filter(|(_, s)| !*s).count(),
+    );
+
+    let mut sequential = Vec::new();
+    let mut others = 0;
+    for _ in 0..200 {
+        let (ms, shed) = list(robots.clone()).await;
+        if shed {
+            sequential.push(ms);
+        } else {
+            others += 1;
+        }
+    }
+    summary("200 calls one after another", sequential, others);
+
+    for call in busy {
+        let _ = call.await;
+    }
+    let _ = server.kill();
+    let _ = server.wait();
+    Ok(())
+}
+
+/// `n` ListRobots calls started together, each timed from its own start.
+async fn futures_join(robots: RobotServiceClient<Channel>, n: usize) -> Vec<(f64, bool)> {
+    let calls: Vec<_> = (0..n).map(|_| tokio::spawn(list(robots.clone()))).collect();
+    let mut out = Vec::with_capacity(n);
+    for call in calls {
+        if let Ok(result) = call.await {
+            out.push(result);
+        }
+    }
+    out
+}
