@@ -18,8 +18,10 @@ use super::world::primitive_shape;
 use super::{CollisionError, Geometry};
 use crate::robot::{Chain, CollisionShape, JointKind, Shape};
 
-/// Most collision bodies (links with geometry) a model may have.
-pub const MAX_BODIES: usize = 32;
+/// Most collision bodies (links with geometry) a model may have: one bit
+/// each in a `u64` of the padded check, whose top bit is its self pairs.
+pub const MAX_BODIES: usize = 63;
+const _: () = assert!(MAX_BODIES < 64);
 /// Most links a chain may have to get a collision model.
 pub const MAX_LINKS: usize = 96;
 

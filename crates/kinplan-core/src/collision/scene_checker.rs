@@ -563,7 +563,7 @@ fn scene_bodies(model: &RobotModel, world: &SceneGeometry, sweep: Option<&SweepB
 }
 
 /// The bit of a padded check's `proved` parts that stands for every self
-/// pair (bits 0–31 are the bodies, [`MAX_BODIES`] = 32).
+/// pair (the bits below [`MAX_BODIES`] are the bodies).
 const SELF_PAIRS: u64 = 1 << 63;
 
 /// What [`SceneChecker::hits_padded`] found.

@@ -566,3 +566,87 @@ fn a_robot_mesh_with_zero_area_slivers_is_accepted() {
     );
     assert!(matches!(scene, Err(CollisionError::Degenerate { .. })));
 }
+
+/// A two-link arm on a base that carries `teeth` fixed 2 cm cubes in a row
+/// along x (tooth i centred at x = 1 + 0.1 i, z = 0): 2 + `teeth` bodies.
+fn arm_with_teeth(teeth: usize) -> String {
+    let mut links = String::new();
+    let mut joints = String::new();
+    for i in 0..teeth {
+        links += &format!(
+            r#"<link name="tooth{i}"><collision><geometry><box size="0.02 0.02 0.02"/></geometry></collision></link>"#
+        );
+        joints += &format!(
+            r#"<joint name="t{i}" type="fixed"><parent link="base"/><child link="tooth{i}"/><origin xyz="{} 0 0"/></joint>"#,
+            1.0 + 0.1 * i as f64
+        );
+    }
+    format!(
+        r#"<robot name="rake"><link name="base"/>
+        <link name="upper"><collision><origin xyz="0 0 0.25"/><geometry><box size="0.05 0.05 0.5"/></geometry></collision></link>
+        <link name="lower"><collision><origin xyz="0 0 0.25"/><geometry><box size="0.05 0.05 0.5"/></geometry></collision></link>
+        <joint name="j1" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+          <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+        <joint name="j2" type="revolute"><parent link="upper"/><child link="lower"/><origin xyz="0 0 0.5"/><axis xyz="0 1 0"/>
+          <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+        {links}{joints}</robot>"#
+    )
+}
+
+/// A robot of up to [`MAX_BODIES`] bodies is modelled (Baxter and Talos have
+/// 37 and 52), its last body collides in state and motion checks, and one
+/// body more is refused with the count and the limit.
+#[test]
+fn a_robot_of_max_bodies_collides_with_its_last_body_and_one_more_is_refused() {
+    let spec = ChainSpec {
+        base_link: Some("base".into()),
+        tip_link: Some("lower".into()),
+    };
+    let model = |teeth: usize| {
+        let urdf = arm_with_teeth(teeth);
+        let chain = Arc::new(parse_chain(&urdf, &spec, UrdfLimits::default()).unwrap());
+        RobotModel::of_urdf(chain, &urdf, &[], &[])
+    };
+    let teeth = MAX_BODIES - 2;
+    let full = Arc::new(model(teeth).unwrap());
+    assert_eq!(full.body_names().count(), MAX_BODIES);
+    let last = 1.0 + 0.1 * (teeth - 1) as f64;
+    let checker_with_ball_at = |x: f64| {
+        let ball = Obstacle::new(
+            "ball",
+            Isometry3::translation(x, 0.0, 0.0),
+            Geometry::Sphere { radius: 0.02 },
+        );
+        let world = Arc::new(
+            SceneGeometry::build(&Scene::new(vec![ball], &SceneLimits::default()).unwrap()).unwrap(),
+        );
+        SceneChecker::new(
+            full.clone(),
+            &AllowedCollisions::adjacent(&full),
+            world,
+            CheckerParams::default(),
+        )
+        .unwrap()
+    };
+    let (a, b) = ([0.0, 0.0], [1.0, 0.5]);
+    // On the last tooth (its faces at x = last ± 0.01): every state collides.
+    let on_last = checker_with_ball_at(last + 0.02);
+    assert!(!on_last.is_valid(&a));
+    assert!(!on_last.motion_valid(&a, &b));
+    let report = on_last.report(&a).unwrap();
+    assert!(
+        report
+            .collisions
+            .iter()
+            .any(|(l, _)| l == &format!("tooth{}", teeth - 1)),
+        "{report:?}"
+    );
+    // 5 cm past it, beyond every body: free.
+    let past = checker_with_ball_at(last + 0.06);
+    assert!(past.is_valid(&a) && past.motion_valid(&a, &b));
+    let err = model(teeth + 1).unwrap_err();
+    assert!(
+        matches!(err, CollisionError::TooManyBodies { count, limit, .. } if count == MAX_BODIES + 1 && limit == MAX_BODIES),
+        "{err}"
+    );
+}
