@@ -119,17 +119,6 @@ impl CallLabels {
         self
     }
 
-    /// The code the client sees for an answer written now with `code`: once
-    /// the call's timeout has passed the client has already ended the call
-    /// with its own DEADLINE_EXCEEDED (its clock started before ours), so an
-    /// answer this late is recorded as that.
-    fn code_seen(&self, code: &'static str) -> &'static str {
-        match self.client_deadline {
-            Some(d) if Instant::now() >= d => "DEADLINE_EXCEEDED",
-            _ => code,
-        }
-    }
-
     /// Records a call whose client went away before it was answered (the
     /// stream was reset): DEADLINE_EXCEEDED when that happened at the
     /// client's deadline (within the reserve [`deadline_after`] keeps, since
@@ -146,16 +135,22 @@ impl CallLabels {
         });
     }
 
-    /// Records the call as finished with `code` (a gRPC code name), as the
-    /// client sees it ([`Self::code_seen`]).
+    /// Records the call as finished with `code` (a gRPC code name, the one
+    /// sent). An answer written once the call's timeout has passed is also
+    /// counted in `kinplan_answers_after_deadline_total`: its client has
+    /// given up or is about to (whether it still reads the answer depends
+    /// on how promptly its own timer fires).
     pub(crate) fn record(&self, code: &'static str) {
-        let code = self.code_seen(code);
+        let late = self.client_deadline.is_some_and(|d| Instant::now() >= d);
         let labels = [
             ("grpc_service", self.service.clone()),
             ("grpc_method", self.method.clone()),
         ];
         metrics::histogram!("grpc_server_handling_seconds", &labels)
             .record(self.started.elapsed().as_secs_f64());
+        if late {
+            metrics::counter!("kinplan_answers_after_deadline_total", &labels).increment(1);
+        }
         let mut with_code = labels.to_vec();
         with_code.push(("grpc_code", code.to_owned()));
         metrics::counter!("grpc_server_handled_total", &with_code).increment(1);
@@ -546,10 +541,9 @@ mod tests {
 
     /// Calls the client ends are recorded as the client saw them: a reply
     /// stream it resets before the call's timeout is CANCELLED, after it
-    /// DEADLINE_EXCEEDED (its own timer ended the call); an answer written
-    /// after the timeout is DEADLINE_EXCEEDED too (the client stopped
-    /// waiting before it arrived), and a unary call reset before its answer
-    /// is counted, not lost.
+    /// DEADLINE_EXCEEDED (its own timer ended the call); a unary call reset
+    /// before its answer is counted, not lost; an answer written after the
+    /// timeout keeps its code and is counted as late.
     #[test]
     fn calls_the_client_ends_are_recorded_as_it_saw_them() {
         let recorder = metrics_exporter_prometheus::PrometheusBuilder::new().build_recorder();
@@ -611,8 +605,14 @@ mod tests {
         let text = handle.render();
         assert_eq!(handled(&text, "StreamIk", "CANCELLED"), 1, "{text}");
         assert_eq!(handled(&text, "TrackPath", "DEADLINE_EXCEEDED"), 1, "{text}");
-        assert_eq!(handled(&text, "SolveIk", "DEADLINE_EXCEEDED"), 1, "{text}");
-        assert_eq!(handled(&text, "SolveIk", "OK"), 0, "{text}");
+        assert_eq!(handled(&text, "SolveIk", "OK"), 1, "{text}");
+        assert!(
+            text.lines()
+                .any(|l| l.starts_with("kinplan_answers_after_deadline_total")
+                    && l.contains("grpc_method=\"SolveIk\"")
+                    && l.ends_with(" 1")),
+            "{text}"
+        );
         assert_eq!(handled(&text, "SolveIkBatch", "CANCELLED"), 1, "{text}");
     }
 
