@@ -7,6 +7,7 @@
 //! users can depend on the algorithms alone.
 
 pub mod collision;
+pub mod deadline;
 pub mod explore;
 pub mod ik;
 pub mod linalg;
@@ -16,3 +17,5 @@ pub mod octree;
 pub mod plan;
 pub mod robot;
 pub mod score;
+
+pub use deadline::{Cancel, Deadline, Stop};
