@@ -19,8 +19,8 @@ fn deterministic_for_a_fixed_seed() {
             max_restarts: 60,
             ..IkParams::default()
         };
-        let a = solve_ik(&chain, &target, None, &p, 77, &never).unwrap();
-        let b = solve_ik(&chain, &target, None, &p, 77, &never).unwrap();
+        let a = solve_ik(&chain, &target, None, &p, 77, Deadline::none()).unwrap();
+        let b = solve_ik(&chain, &target, None, &p, 77, Deadline::none()).unwrap();
         let strip = |r: &IkResult| -> Vec<(Vec<f64>, usize, usize)> {
             r.solutions
                 .iter()
@@ -43,7 +43,7 @@ fn multiple_distinct_solutions_ranked_by_seed_distance() {
         max_restarts: 500,
         ..IkParams::default()
     };
-    let r = solve_ik(&chain, &target, Some(&q), &p, 11, &never).unwrap();
+    let r = solve_ik(&chain, &target, Some(&q), &p, 11, Deadline::none()).unwrap();
     assert_eq!(r.solutions.len(), 4);
     assert_eq!(r.stop_reason, IkStatus::Converged);
     assert_reaches(&chain, &target, &r, &p, "ur5 4 solutions");
@@ -79,7 +79,7 @@ fn tight_deadline_returns_promptly_with_time_budget() {
             ..IkParams::default()
         };
         let t0 = Instant::now();
-        let r = solve_ik(&chain, &target, None, &p, 1, &never).unwrap();
+        let r = solve_ik(&chain, &target, None, &p, 1, Deadline::none()).unwrap();
         let took = t0.elapsed();
         assert_eq!(r.stop_reason, IkStatus::TimeBudget, "{method:?}");
         assert!(!r.success());
@@ -100,7 +100,7 @@ fn cancellation_is_checked_every_iteration() {
         max_restarts: usize::MAX,
         ..IkParams::default()
     };
-    let r = solve_ik(&chain, &target, None, &p, 1, &stop).unwrap();
+    let r = solve_ik(&chain, &target, None, &p, 1, Deadline::none().with_cancel(&stop)).unwrap();
     assert_eq!(r.stop_reason, IkStatus::Cancelled);
     assert!(r.total_iterations <= 26);
 }
@@ -111,7 +111,7 @@ fn bad_inputs_are_errors() {
     let good = IkTarget::Pose(chain.fk(&[0.0; 6]));
     let p = IkParams::default();
     assert!(matches!(
-        solve_ik(&chain, &good, Some(&[0.0; 5]), &p, 0, &never),
+        solve_ik(&chain, &good, Some(&[0.0; 5]), &p, 0, Deadline::none()),
         Err(IkError::WrongSeedLength { expected: 6, got: 5 })
     ));
     assert!(matches!(
@@ -121,13 +121,13 @@ fn bad_inputs_are_errors() {
             Some(&[0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0]),
             &p,
             0,
-            &never
+            Deadline::none()
         ),
         Err(IkError::NonFiniteSeed { index: 1 })
     ));
     let nan = IkTarget::Position(Point3::new(f64::NAN, 0.0, 0.0));
     assert!(matches!(
-        solve_ik(&chain, &nan, None, &p, 0, &never),
+        solve_ik(&chain, &nan, None, &p, 0, Deadline::none()),
         Err(IkError::NonFiniteTarget { .. })
     ));
     let skew = Isometry3::from_parts(
@@ -135,7 +135,7 @@ fn bad_inputs_are_errors() {
         UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(2.0, 0.0, 0.0, 0.0)),
     );
     assert!(matches!(
-        solve_ik(&chain, &IkTarget::Pose(skew), None, &p, 0, &never),
+        solve_ik(&chain, &IkTarget::Pose(skew), None, &p, 0, Deadline::none()),
         Err(IkError::NonUnitQuaternion { .. })
     ));
     assert!(matches!(
@@ -181,7 +181,7 @@ fn bad_inputs_are_errors() {
             "time_budget",
         ),
     ] {
-        match solve_ik(&chain, &good, None, &bad, 0, &never) {
+        match solve_ik(&chain, &good, None, &bad, 0, Deadline::none()) {
             Err(IkError::InvalidParam { field: f, .. }) => assert_eq!(f.name(), field),
             other => panic!("{field}: expected InvalidParam, got {other:?}"),
         }
@@ -195,7 +195,7 @@ fn bad_inputs_are_errors() {
         ..p
     };
     assert!(matches!(
-        solve_ik(&chain, &good, None, &bad_rlxa, 0, &never),
+        solve_ik(&chain, &good, None, &bad_rlxa, 0, Deadline::none()),
         Err(IkError::Linalg(_))
     ));
 }
@@ -210,8 +210,8 @@ fn batch_matches_sequential() {
         .map(|_| IkTarget::Pose(chain.fk(&random_joints(&chain, &mut rng))))
         .collect();
     let p = IkParams::default();
-    let a = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, &never);
-    let b = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, &never);
+    let a = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, Deadline::none());
+    let b = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, Deadline::none());
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
         let (x, y) = (x.as_ref().unwrap(), y.as_ref().unwrap());
         assert_reaches(&chain, &targets[k], x, &p, "batch");
@@ -234,7 +234,14 @@ fn batch_per_target_seeds_keep_each_target_on_its_seeds_branch() {
         max_restarts: 0,
         ..IkParams::default()
     };
-    let r = solve_ik_batch(&chain, &targets, BatchSeeds::PerTarget(&seeds), &p, 1, &never);
+    let r = solve_ik_batch(
+        &chain,
+        &targets,
+        BatchSeeds::PerTarget(&seeds),
+        &p,
+        1,
+        Deadline::none(),
+    );
     for (k, res) in r.iter().enumerate() {
         let res = res.as_ref().unwrap();
         assert_reaches(&chain, &targets[k], res, &p, "per-target seed");
@@ -252,7 +259,7 @@ fn batch_per_target_seeds_keep_each_target_on_its_seeds_branch() {
         BatchSeeds::PerTarget(&seeds[..6]),
         &p,
         1,
-        &never,
+        Deadline::none(),
     );
     assert!(
         short
