@@ -265,6 +265,50 @@ fn next_best_view_ranks_filters_and_checks_reach() {
     assert!(next_best_view(&t, &bad, &cam, &current, None, Deadline::none()).is_err());
 }
 
+/// The reachability IK runs under the request's deadline: an IK that can never
+/// converge (one iteration per attempt, endless restarts, no budget of its own) is cut
+/// there, the request ends TIME_BUDGET, and the candidate keeps an unknown reachability
+/// (not a failure).
+#[test]
+fn an_ik_cut_by_the_deadline_leaves_reachability_unknown() {
+    let mut t = Octree::new(0.1).unwrap();
+    free_box(&mut t, [32758, 32758, 32768], [32782, 32778, 32782]);
+    let chain = crate::robot::builtin_chain("abb_irb4600_60_205").unwrap();
+    let cam = CameraModel {
+        width: 64,
+        height: 48,
+        ..CameraModel::default()
+    };
+    let current = look_along(&Point3::new(1.0, 0.0, 1.0), &Vector3::x()).unwrap();
+    let mut params = NbvParams {
+        extra_candidates: vec![
+            look_along(&Point3::new(1.2, 0.3, 1.1), &Vector3::new(1.0, 0.0, -0.3)).unwrap(),
+        ],
+        ik_check: 4,
+        max_results: 8,
+        count_failures: true,
+        ..NbvParams::default()
+    };
+    params.ik.max_iterations = 1;
+    params.ik.max_restarts = usize::MAX;
+    params.ik.time_budget = None;
+    let start = std::time::Instant::now();
+    // long enough for the stages before the IK in a debug build on a loaded machine
+    let deadline = Deadline::after(std::time::Duration::from_millis(1500));
+    let r = next_best_view(&t, &params, &cam, &current, Some(&chain), deadline).unwrap();
+    let took = start.elapsed();
+    assert_eq!(r.status, NbvStatus::TimeBudget);
+    assert!(took < std::time::Duration::from_secs(5), "{took:?}");
+    assert_eq!(r.stages.ik_checked, 1, "the first IK runs and is cut");
+    assert_eq!(r.stages.ik_failed, 0);
+    assert!(!r.candidates.is_empty());
+    assert!(
+        r.candidates
+            .iter()
+            .all(|c| c.reachable.is_none() && c.failures == 0)
+    );
+}
+
 #[test]
 fn huge_free_cubes_from_a_hostile_tree_stop_at_the_deadline() {
     use crate::octree::OctreeLimits;

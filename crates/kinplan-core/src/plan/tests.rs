@@ -462,6 +462,42 @@ fn a_pose_goal_is_solved_by_ik_and_reached() {
     );
 }
 
+/// The goal IK runs under the request's deadline: an unreachable pose with
+/// restarts enough for seconds is cut at the deadline and reported as a
+/// timeout (or a cancellation), not as an unreachable goal.
+#[test]
+fn the_goal_ik_stops_at_the_deadline_and_says_so() {
+    let chain = builtin_chain("ur5").unwrap();
+    let w = JointBoxes {
+        dof: 6,
+        limit: 2.0 * std::f64::consts::PI,
+        boxes: vec![],
+    };
+    let mut req = PlanRequest {
+        start: vec![0.0, -1.2, 1.4, -0.8, 1.1, 0.2],
+        goal: Goal::Pose(nalgebra::Isometry3::translation(5.0, 0.0, 0.0)),
+        algorithm: Algorithm::RrtConnect,
+        ..Default::default()
+    };
+    req.goal_ik.max_restarts = usize::MAX;
+    req.goal_ik.time_budget = None;
+    let t0 = Instant::now();
+    let ctl = PlanControl {
+        deadline: Deadline::at(t0 + Duration::from_millis(20)),
+        ..Default::default()
+    };
+    let r = plan(&chain, &w, &req, ctl).unwrap();
+    assert_eq!(r.status, PlanStatus::Timeout);
+    // generous slack for a loaded 2-core machine
+    assert!(t0.elapsed() < Duration::from_millis(500), "{:?}", t0.elapsed());
+    let stop = || true;
+    let ctl = PlanControl {
+        deadline: Deadline::none().with_cancel(&stop),
+        ..Default::default()
+    };
+    assert_eq!(plan(&chain, &w, &req, ctl).unwrap().status, PlanStatus::Cancelled);
+}
+
 #[test]
 fn resampling_keeps_every_vertex_and_the_count() {
     let path = [0.0, 0.0, 1.0, 0.0, 1.0, 3.0];

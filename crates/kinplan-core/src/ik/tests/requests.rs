@@ -90,6 +90,71 @@ fn tight_deadline_returns_promptly_with_time_budget() {
     }
 }
 
+/// The caller's deadline and `time_budget` both bound a solve; the earlier
+/// stops it (TIME_BUDGET either way), a raised cancellation answers CANCELLED.
+#[test]
+fn the_earlier_of_deadline_and_time_budget_stops_the_solve() {
+    let chain = builtin_chain("ur5").unwrap();
+    let target = IkTarget::Position(Point3::new(5.0, 0.0, 0.0));
+    let ms = Duration::from_millis;
+    for (deadline_ms, budget) in [(5, None), (5, Some(ms(60_000))), (60_000, Some(ms(5)))] {
+        let p = IkParams {
+            max_restarts: usize::MAX,
+            time_budget: budget,
+            ..IkParams::default()
+        };
+        let t0 = Instant::now();
+        let d = Deadline::at(t0 + ms(deadline_ms));
+        let r = solve_ik(&chain, &target, None, &p, 1, d).unwrap();
+        let took = t0.elapsed();
+        assert_eq!(
+            r.stop_reason,
+            IkStatus::TimeBudget,
+            "{deadline_ms} ms, {budget:?}"
+        );
+        assert!(took >= ms(5), "stopped before either limit: {took:?}");
+        // generous slack for a loaded 2-core machine
+        assert!(took < ms(150), "{deadline_ms} ms, {budget:?}: {took:?}");
+    }
+    let flag = std::sync::atomic::AtomicBool::new(true);
+    let p = IkParams {
+        max_restarts: usize::MAX,
+        time_budget: Some(ms(60_000)),
+        ..IkParams::default()
+    };
+    let r = solve_ik(
+        &chain,
+        &target,
+        None,
+        &p,
+        1,
+        Deadline::after(ms(60_000)).with_cancel(&flag),
+    )
+    .unwrap();
+    assert_eq!(r.stop_reason, IkStatus::Cancelled);
+    assert!(r.total_iterations <= 1);
+}
+
+/// A batch past its deadline answers every target TIME_BUDGET without an
+/// attempt; a cancelled one answers CANCELLED.
+#[test]
+fn a_batch_past_its_deadline_answers_time_budget_and_a_cancelled_one_cancelled() {
+    let chain = builtin_chain("ur5").unwrap();
+    let targets = vec![IkTarget::Position(Point3::new(0.3, 0.1, 0.4)); 8];
+    let p = IkParams::default();
+    let past = Deadline::at(Instant::now() - Duration::from_millis(1));
+    for r in solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 1, past) {
+        let r = r.unwrap();
+        assert_eq!((r.stop_reason, r.attempts), (IkStatus::TimeBudget, 0));
+    }
+    let gone = || true;
+    let cancelled = Deadline::none().with_cancel(&gone);
+    for r in solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 1, cancelled) {
+        let r = r.unwrap();
+        assert_eq!((r.stop_reason, r.attempts), (IkStatus::Cancelled, 0));
+    }
+}
+
 #[test]
 fn cancellation_is_checked_every_iteration() {
     let chain = builtin_chain("ur5").unwrap();
