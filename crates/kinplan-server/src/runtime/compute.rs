@@ -16,7 +16,7 @@ use tokio::sync::{OwnedSemaphorePermit, Semaphore, oneshot};
 use tonic::Status;
 
 pub use super::deadline::Budget;
-use super::deadline::{RequestDeadline, deadline_after, effective_timeout, grpc_timeout};
+use super::deadline::{RequestDeadline, call_deadline, grpc_timeout};
 
 /// Raises the cancellation flag if the request's future is dropped (caller
 /// gone, deadline) before the work's answer arrived; disarmed on completion so
@@ -172,7 +172,7 @@ impl Compute {
             return *deadline;
         }
         let header = grpc_timeout(request.metadata().as_ref());
-        effective_timeout(header, self.default_timeout).and_then(deadline_after)
+        call_deadline(header, self.default_timeout)
     }
 
     /// Runs `work` on the CPU pool. Answers DEADLINE_EXCEEDED when the

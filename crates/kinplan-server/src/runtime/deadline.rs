@@ -30,6 +30,15 @@ pub fn effective_timeout(header: Option<Duration>, default: Option<Duration>) ->
     earliest(header, default)
 }
 
+/// The instant a call starting now must be answered by: its
+/// [`effective_timeout`] from now, less [`deadline_after`]'s margin; `None`
+/// without a timeout (or one too large for `Instant`). The one derivation
+/// behind the guard layer, the in-process transport, admission outside a
+/// server and `StreamIk` (which takes no default).
+pub fn call_deadline(header: Option<Duration>, default: Option<Duration>) -> Option<Instant> {
+    effective_timeout(header, default).and_then(deadline_after)
+}
+
 /// What a request's work may spend: the call's deadline and a cancellation
 /// flag raised when the caller goes away (the request's future is dropped).
 /// The work sees them as one [`Deadline`] ([`Budget::deadline`]); a client's
@@ -143,6 +152,16 @@ mod tests {
         let ms = Duration::from_millis;
         assert_eq!(effective_timeout(Some(ms(10)), Some(ms(60_000))), Some(ms(10)));
         assert_eq!(effective_timeout(None, Some(ms(60_000))), Some(ms(60_000)));
+        assert_eq!(call_deadline(None, None), None);
+        assert_eq!(call_deadline(Some(Duration::MAX), None), None);
+        let before = Instant::now();
+        let d = call_deadline(Some(ms(10)), Some(ms(60_000))).unwrap();
+        // 10 ms less the margin of a twentieth (0.5 ms)
+        assert!(
+            d >= before + ms(9) && d <= Instant::now() + ms(10),
+            "{:?}",
+            d - before
+        );
     }
 
     /// The domain's deadline is the soft deadline with the caller's

@@ -22,7 +22,7 @@ use tonic::{Request, Response, Status, Streaming};
 use crate::api::convert::{finite_slice, matrix_in};
 use crate::pb::{self, kinematics_service_server::KinematicsService};
 use crate::runtime::Shared;
-use crate::runtime::deadline::{deadline_after, grpc_timeout};
+use crate::runtime::deadline::{call_deadline, grpc_timeout};
 use crate::runtime::{Budget, Compute, ModelStore, catch_unwind};
 use crate::status::ik::{IkAt, ik_error};
 use crate::status::linalg::{SolveAt, linalg_error};
@@ -261,7 +261,7 @@ impl KinematicsService for KinematicsApi {
         let permit = self.shared.compute.admit_stream()?;
         // A controller's stream lives as long as the controller runs: only a
         // deadline the client sets bounds it, not the server's default.
-        let deadline = grpc_timeout(request.metadata().as_ref()).and_then(deadline_after);
+        let deadline = call_deadline(grpc_timeout(request.metadata().as_ref()), None);
         let inbound = request.into_inner();
         let (tx, rx) = tokio::sync::mpsc::channel(4);
         let models = self.shared.models.clone();

@@ -19,7 +19,7 @@ use tonic::Status;
 use tonic::body::Body;
 
 use crate::runtime::catch_unwind;
-use crate::runtime::deadline::{RequestDeadline, deadline_after, effective_timeout, grpc_timeout};
+use crate::runtime::deadline::{RequestDeadline, call_deadline, grpc_timeout};
 use crate::status::code_name;
 
 /// Histogram bucket bounds, seconds: 50 µs to 10 s.
@@ -174,7 +174,7 @@ where
     fn call(&mut self, mut request: http::Request<B>) -> Self::Future {
         let labels = CallLabels::for_path(request.uri().path());
         let header = grpc_timeout(request.headers());
-        let deadline = effective_timeout(header, self.default_timeout).and_then(deadline_after);
+        let deadline = call_deadline(header, self.default_timeout);
         request.extensions_mut().insert(RequestDeadline(deadline));
         let cut = self.cut.clone();
         let reply_type = crate::transport::finite::reply_type(request.uri().path());
@@ -225,6 +225,7 @@ use body::observe;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::runtime::deadline::deadline_after;
     use bytes::Bytes;
     use http_body::Frame;
     use http_body_util::BodyExt;
