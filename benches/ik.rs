@@ -32,7 +32,13 @@ fn ik(c: &mut Criterion) {
                 k = (k + 1) % targets.len();
                 black_box(
                     solver
-                        .solve(&targets[k], None, &params, k as u64, &|| false)
+                        .solve(
+                            &targets[k],
+                            None,
+                            &params,
+                            k as u64,
+                            kinplan_core::Deadline::none(),
+                        )
                         .unwrap(),
                 )
             })

@@ -118,7 +118,7 @@ fn runs(c: &mut Criterion) {
         Point2::new(10.0, 0.0),
         &world,
         &params,
-        &|| false,
+        kinplan_core::Deadline::none(),
     )
     .unwrap();
     println!(
@@ -135,7 +135,7 @@ fn runs(c: &mut Criterion) {
                 Point2::new(10.0, 0.0),
                 &world,
                 &params,
-                &|| false,
+                kinplan_core::Deadline::none(),
             )
             .unwrap()
         })

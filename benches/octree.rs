@@ -32,13 +32,23 @@ fn bench(c: &mut Criterion) {
     c.bench_function("octree/insert_512x424_5cm", |b| {
         b.iter(|| {
             let mut t = Octree::new(0.05).unwrap();
-            t.insert_scan(&pts, &origin, &ScanParams::default(), &|| false)
-                .unwrap()
+            t.insert_scan(
+                &pts,
+                &origin,
+                &ScanParams::default(),
+                kinplan_core::Deadline::none(),
+            )
+            .unwrap()
         })
     });
     let mut t = Octree::new(0.05).unwrap();
-    t.insert_scan(&pts, &origin, &ScanParams::default(), &|| false)
-        .unwrap();
+    t.insert_scan(
+        &pts,
+        &origin,
+        &ScanParams::default(),
+        kinplan_core::Deadline::none(),
+    )
+    .unwrap();
     let p = RayParams::default();
     c.bench_function("octree/cast_ray_room", |b| {
         b.iter(|| {
@@ -59,14 +69,29 @@ fn bench(c: &mut Criterion) {
     let mut room = Octree::new(0.05).unwrap();
     for (o, yaw, pitch) in room_scene::scan_poses() {
         let pts = room_scene::beams(o, yaw, pitch, 512, 424, 70.6f64.to_radians(), 60f64.to_radians());
-        room.insert_scan(&pts, &o.map(|v| v as f32), &ScanParams::default(), &|| false)
-            .unwrap();
+        room.insert_scan(
+            &pts,
+            &o.map(|v| v as f32),
+            &ScanParams::default(),
+            kinplan_core::Deadline::none(),
+        )
+        .unwrap();
     }
     let chain = kinplan_core::robot::builtin_chain("abb_irb4600_60_205").unwrap();
     let current = look_along(&Point3::new(0.1, 0.2, 1.3), &Vector3::new(1.0, 0.3, 0.0)).unwrap();
     let params = NbvParams::default();
     c.bench_function("nbv/next_best_view_room_5cm", |b| {
-        b.iter(|| next_best_view(&room, &params, &cam, &current, Some(&chain), &|| false).unwrap())
+        b.iter(|| {
+            next_best_view(
+                &room,
+                &params,
+                &cam,
+                &current,
+                Some(&chain),
+                kinplan_core::Deadline::none(),
+            )
+            .unwrap()
+        })
     });
 }
 

@@ -87,11 +87,15 @@ fn main() {
         };
         let mut solver_ws = IkSolver::new(&chain);
         // warm the workspace once (first-use sizing is allowed to allocate)
-        let _ = solver_ws.solve(&targets[0], None, &params, 0, &|| false).unwrap();
+        let _ = solver_ws
+            .solve(&targets[0], None, &params, 0, kinplan_core::Deadline::none())
+            .unwrap();
         let before = ALLOCS.load(Ordering::Relaxed);
         let (mut iters, mut attempts) = (0, 0);
         for (i, t) in targets.iter().enumerate() {
-            let r = solver_ws.solve(t, None, &params, i as u64, &|| false).unwrap();
+            let r = solver_ws
+                .solve(t, None, &params, i as u64, kinplan_core::Deadline::none())
+                .unwrap();
             iters += r.total_iterations;
             attempts += r.attempts;
         }

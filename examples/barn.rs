@@ -335,7 +335,15 @@ fn main() {
         let t0 = Instant::now();
         let mut vdf = Tally::default();
         for w in &worlds {
-            let run = navigate(&chassis, start, goal, &w.world, &nav, &|| false).expect("valid input");
+            let run = navigate(
+                &chassis,
+                start,
+                goal,
+                &w.world,
+                &nav,
+                kinplan_core::Deadline::none(),
+            )
+            .expect("valid input");
             vdf.add(&run, w.reference, goal);
         }
         vdf.print(name, t0.elapsed().as_secs_f64());
@@ -358,7 +366,7 @@ fn main() {
             &GridAstarParams::default(),
             &follow,
             &sim,
-            &|| false,
+            kinplan_core::Deadline::none(),
         )
         .expect("valid input");
         pp.add(&run, w.reference, goal);

@@ -102,7 +102,7 @@ fn main() {
             };
             let (mut ok, mut col, mut np, mut to) = (0, 0, 0, 0);
             for w in &worlds {
-                match navigate(&chassis, start, goal, w, &nav, &|| false)
+                match navigate(&chassis, start, goal, w, &nav, kinplan_core::Deadline::none())
                     .expect("valid")
                     .outcome
                 {

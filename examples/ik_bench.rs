@@ -111,7 +111,7 @@ fn main() {
             for (i, t) in targets.iter().enumerate() {
                 let t0 = Instant::now();
                 let r = solver
-                    .solve(t, Some(&seed), &params, i as u64, &|| false)
+                    .solve(t, Some(&seed), &params, i as u64, kinplan_core::Deadline::none())
                     .unwrap();
                 times.push(t0.elapsed().as_secs_f64() * 1e6);
                 attempts += r.attempts;

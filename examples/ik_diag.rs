@@ -56,7 +56,7 @@ fn main() {
         let mut worst = 0;
         for (i, t) in targets.iter().enumerate() {
             let r = solver
-                .solve(t, Some(&seed), &params, i as u64, &|| false)
+                .solve(t, Some(&seed), &params, i as u64, kinplan_core::Deadline::none())
                 .unwrap();
             hist[(r.attempts - 1).min(7)] += 1;
             if std::env::var("SHOW").is_ok() && r.attempts >= 12 {

@@ -288,7 +288,7 @@ fn run_rrt<C: StateChecker>(
         g,
         params,
         seed,
-        Some(Instant::now() + DEADLINE),
+        kinplan_core::Deadline::after(DEADLINE),
     )
     .expect("valid inputs")
 }
@@ -420,7 +420,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                             ..PlanRequest::default()
                         };
                         let ctl = PlanControl {
-                            deadline: Some(Instant::now() + DEADLINE),
+                            deadline: kinplan_core::Deadline::after(DEADLINE),
                             ..PlanControl::default()
                         };
                         let t = Instant::now();

@@ -40,8 +40,13 @@ fn room_tree(res: f64) -> Octree {
     let mut t = Octree::new(res).unwrap();
     for (o, yaw, pitch) in room_scene::scan_poses() {
         let pts = room_scene::beams(o, yaw, pitch, 512, 424, 70.6f64.to_radians(), 60f64.to_radians());
-        t.insert_scan(&pts, &o.map(|v| v as f32), &ScanParams::default(), &|| false)
-            .unwrap();
+        t.insert_scan(
+            &pts,
+            &o.map(|v| v as f32),
+            &ScanParams::default(),
+            kinplan_core::Deadline::none(),
+        )
+        .unwrap();
     }
     t
 }
@@ -85,7 +90,14 @@ fn row(name: &str, t: &Octree, vs: &[Isometry3<f64>], cam: &CameraModel, no_rays
         let fractions: &[f64] = if no_rays { &[] } else { &[1.0, 0.5, 0.25, 0.1] };
         for (i, &f) in fractions.iter().enumerate() {
             let s = Instant::now();
-            let g = ray_gain(t, cam, pose, GainMethod::Rays { fraction: f }, &mut ws, &|| false);
+            let g = ray_gain(
+                t,
+                cam,
+                pose,
+                GainMethod::Rays { fraction: f },
+                &mut ws,
+                kinplan_core::Deadline::none(),
+            );
             times[i + 1] += s.elapsed().as_secs_f64();
             sums[i + 1] += g.cells;
             if i == 0 {
@@ -209,7 +221,15 @@ fn main() {
         }
         let s = Instant::now();
         let c0 = sched_ns();
-        let r = next_best_view(&t, &p, &cam, &current, Some(&chain), &|| false).unwrap();
+        let r = next_best_view(
+            &t,
+            &p,
+            &cam,
+            &current,
+            Some(&chain),
+            kinplan_core::Deadline::none(),
+        )
+        .unwrap();
         let total = s.elapsed().as_secs_f64() * 1e3;
         let cpu = match (c0, sched_ns()) {
             (Some(a), Some(b)) => format!(

@@ -105,7 +105,12 @@ fn main() {
         let mut t = Octree::new(0.05).unwrap();
         let s = Instant::now();
         let st = t
-            .insert_scan(&pts, &origin, &ScanParams::default(), &|| false)
+            .insert_scan(
+                &pts,
+                &origin,
+                &ScanParams::default(),
+                kinplan_core::Deadline::none(),
+            )
             .unwrap();
         ins.push(s.elapsed().as_secs_f64() * 1e3);
         last = Some((t, st));

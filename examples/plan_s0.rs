@@ -59,7 +59,15 @@ fn joints_for(chain: &Chain, c: &SceneChecker, pose: Isometry3<f64>) -> Vec<f64>
         max_restarts: 100,
         ..IkParams::default()
     };
-    let r = solve_ik(chain, &IkTarget::Pose(pose), None, &p, 1, &|| false).expect("ik");
+    let r = solve_ik(
+        chain,
+        &IkTarget::Pose(pose),
+        None,
+        &p,
+        1,
+        kinplan_core::Deadline::none(),
+    )
+    .expect("ik");
     r.solutions
         .iter()
         .find(|s| c.is_valid(&s.joints))

@@ -14,9 +14,7 @@ use nalgebra::{DMatrix, DVector, Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-fn never() -> bool {
-    false
-}
+const NEVER: kinplan_core::Deadline<'static> = kinplan_core::Deadline::none();
 
 /// Random orthogonal matrix (QR of a Gaussian-ish matrix).
 fn orthogonal(n: usize, rng: &mut ChaCha8Rng) -> DMatrix<f64> {
@@ -223,7 +221,7 @@ fn track_tables() {
                         },
                         ..TrackParams::default()
                     };
-                    let r = track_path(&chain, &targets, &q0, &tp, 1, &never).unwrap();
+                    let r = track_path(&chain, &targets, &q0, &tp, 1, NEVER).unwrap();
                     let mean =
                         r.steps.iter().map(|s| s.elapsed_us as f64).sum::<f64>() / r.steps.len() as f64;
                     let ok = r
@@ -273,7 +271,7 @@ fn track_tables() {
                     },
                     ..TrackParams::default()
                 };
-                let r = track_path(&chain, &targets, &q0, &tp, 1, &never).unwrap();
+                let r = track_path(&chain, &targets, &q0, &tp, 1, NEVER).unwrap();
                 let mean = r.steps.iter().map(|s| s.elapsed_us as f64).sum::<f64>() / r.steps.len() as f64;
                 let ok = r
                     .steps
@@ -324,7 +322,7 @@ fn heuristic_table() {
             let mut sweeps = 0;
             for t in &targets {
                 let t0 = Instant::now();
-                let r = solver.solve(t, Some(&seed), &p, 1, &never).unwrap();
+                let r = solver.solve(t, Some(&seed), &p, 1, NEVER).unwrap();
                 times.push(t0.elapsed().as_secs_f64() * 1e6);
                 if r.success() {
                     ok += 1;

@@ -144,7 +144,7 @@ pub fn interpolate_motion_valid<C: StateChecker + ?Sized>(
         return false;
     }
     if check.is_padded() {
-        return padded_motion_valid(checker, a, b, resolution, || false) == Some(true);
+        return padded_motion_valid(checker, a, b, resolution, crate::Deadline::none()) == Some(true);
     }
     let span = a
         .iter()

@@ -61,7 +61,7 @@ mod tests {
             &[[0.45, 0.05, 0.05]],
             &[0.05, 0.05, 0.05],
             &Default::default(),
-            &|| false,
+            crate::Deadline::none(),
         )
         .unwrap();
         let (a, b) = (Point3::new(0.0, 0.0, 0.0), Point3::new(0.5, 0.1, 0.1));

@@ -3,6 +3,7 @@
 use std::collections::VecDeque;
 
 use super::{PadVerdict, StateChecker};
+use crate::Deadline;
 
 /// Most joints the check handles (stack buffers): as many as a chain with a
 /// collision model can have.
@@ -44,7 +45,7 @@ const WINDOW: usize = 64;
 /// windows of 64 pieces in bisection order.
 ///
 /// The ends are not checked here (a straight motion between two states
-/// within the limits stays within them). `None` when `interrupted()` says so
+/// within the limits stays within them). `None` when `deadline` expires
 /// (asked every 32 checks); `Some(false)` when the checker cannot
 /// pad or the chain has more than `MAX_LINKS` joints.
 pub fn padded_motion_valid<C: StateChecker + ?Sized>(
@@ -52,9 +53,9 @@ pub fn padded_motion_valid<C: StateChecker + ?Sized>(
     a: &[f64],
     b: &[f64],
     resolution: f64,
-    interrupted: impl FnMut() -> bool,
+    deadline: Deadline<'_>,
 ) -> Option<bool> {
-    match padded_motion(checker, a, b, resolution, interrupted) {
+    match padded_motion(checker, a, b, resolution, deadline) {
         PaddedMotion::Free => Some(true),
         PaddedMotion::Refused { .. } => Some(false),
         PaddedMotion::Interrupted => None,
@@ -71,7 +72,7 @@ pub enum PaddedMotion {
     /// could not be proved within the limits of the check (0.5 for a
     /// malformed motion).
     Refused { at: f64 },
-    /// `interrupted()` said so.
+    /// The deadline expired.
     Interrupted,
 }
 
@@ -81,7 +82,7 @@ pub fn padded_motion<C: StateChecker + ?Sized>(
     a: &[f64],
     b: &[f64],
     resolution: f64,
-    mut interrupted: impl FnMut() -> bool,
+    deadline: Deadline<'_>,
 ) -> PaddedMotion {
     let refused = |at: f64| PaddedMotion::Refused { at };
     let n = a.len();
@@ -124,7 +125,7 @@ pub fn padded_motion<C: StateChecker + ?Sized>(
         while let Some((s, t, slot, mut proved)) = queue.pop_front() {
             checks += 1;
             let m = 0.5 * (s + t);
-            if checks.is_multiple_of(32) && interrupted() {
+            if checks.is_multiple_of(32) && deadline.expired() {
                 return PaddedMotion::Interrupted;
             }
             if spent[slot] == MAX_CHECKS_PER_PIECE {

@@ -6,6 +6,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+use crate::Deadline;
 use crate::collision::SceneGeometry;
 use crate::nbv::CameraModel;
 use crate::plan::noise::standard_normal as gaussian;
@@ -73,10 +74,10 @@ pub fn render_depth(
     sensor: &SensorParams,
     seed: u64,
 ) -> DepthImage {
-    render_depth_until(world, camera, pose, sensor, seed, &|| false).expect("never stopped")
+    render_depth_until(world, camera, pose, sensor, seed, Deadline::none()).expect("never stopped")
 }
 
-/// [`render_depth`] that polls `should_stop` before each row and returns
+/// [`render_depth`] that polls `deadline` before each row and returns
 /// `None` once it fires (an image of up to 2^24 rays takes seconds).
 pub fn render_depth_until(
     world: &SceneGeometry,
@@ -84,7 +85,7 @@ pub fn render_depth_until(
     pose: &Isometry3<f64>,
     sensor: &SensorParams,
     seed: u64,
-    should_stop: &(dyn Fn() -> bool + Sync),
+    deadline: Deadline<'_>,
 ) -> Option<DepthImage> {
     let (cols, rows) = grid(camera, sensor.pixel_stride);
     let origin = Point3::from(pose.translation.vector);
@@ -94,7 +95,7 @@ pub fn render_depth_until(
         .par_iter()
         .enumerate()
         .flat_map_iter(|(r, &v)| {
-            let skip = stopped.load(std::sync::atomic::Ordering::Relaxed) || should_stop();
+            let skip = stopped.load(std::sync::atomic::Ordering::Relaxed) || deadline.expired();
             if skip {
                 stopped.store(true, std::sync::atomic::Ordering::Relaxed);
             }

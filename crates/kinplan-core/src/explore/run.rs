@@ -18,6 +18,7 @@ use crate::octree::{Octree, ScanParams, ScanStatus};
 use crate::plan::{Goal, PlanControl, PlanStatus, plan};
 use crate::robot::Chain;
 use crate::score::{PointSet, Rows, ScoreInput, ScoreParams, Scores, TrajectoryData, sample_chain, score};
+use crate::{Deadline, Stop};
 
 /// The robot and the world it explores.
 pub struct ExploreWorld<'a> {
@@ -30,22 +31,13 @@ pub struct ExploreWorld<'a> {
     pub truth: &'a Arc<SceneGeometry>,
 }
 
-/// The caller's side channel: deadline, cancellation, and a callback per
-/// finished iteration (from the calling thread).
+/// The caller's side channel: the run's [`Deadline`] (instant and
+/// cancellation, checked between stages and inside NBV, sensing and
+/// planning) and a callback per finished iteration (from the calling thread).
+#[derive(Default)]
 pub struct ExploreControl<'a> {
-    pub deadline: Option<Instant>,
-    pub should_stop: &'a (dyn Fn() -> bool + Sync),
+    pub deadline: Deadline<'a>,
     pub on_step: Option<&'a mut dyn FnMut(&ExploreStep)>,
-}
-
-impl Default for ExploreControl<'_> {
-    fn default() -> Self {
-        ExploreControl {
-            deadline: None,
-            should_stop: &|| false,
-            on_step: None,
-        }
-    }
 }
 
 /// Why the loop ended.
@@ -61,7 +53,7 @@ pub enum ExploreStatus {
     NoCandidates,
     /// The deadline passed.
     Timeout,
-    /// `should_stop` fired.
+    /// The caller's cancellation was raised.
     Cancelled,
 }
 
@@ -184,16 +176,15 @@ struct Explorer<'a> {
     truth_checker: SceneChecker,
     tree: Octree,
     scans: usize,
-    deadline: Option<Instant>,
-    should_stop: &'a (dyn Fn() -> bool + Sync),
+    deadline: Deadline<'a>,
 }
 
 impl Explorer<'_> {
     fn interrupted(&self) -> Option<ExploreStatus> {
-        if self.deadline.is_some_and(|d| Instant::now() >= d) {
-            return Some(ExploreStatus::Timeout);
-        }
-        (self.should_stop)().then_some(ExploreStatus::Cancelled)
+        self.deadline.stop().map(|s| match s {
+            Stop::Deadline => ExploreStatus::Timeout,
+            Stop::Cancelled => ExploreStatus::Cancelled,
+        })
     }
 
     fn camera_pose(&self, q: &[f64]) -> Isometry3<f64> {
@@ -211,7 +202,7 @@ impl Explorer<'_> {
             &pose,
             &self.params.sensor,
             seed,
-            &|| self.interrupted().is_some(),
+            self.deadline,
         ) else {
             return Ok((us(t0), 0)); // stopped: nothing inserted
         };
@@ -227,7 +218,13 @@ impl Explorer<'_> {
         let origin = [o.x as f32, o.y as f32, o.z as f32];
         let stats = self
             .tree
-            .insert_scan(&points, &origin, &ScanParams::default(), self.should_stop)?;
+            // a view rendered in time is inserted whole: only a cancellation stops it
+            .insert_scan(
+                &points,
+                &origin,
+                &ScanParams::default(),
+                self.deadline.without_instant(),
+            )?;
         if stats.status == ScanStatus::Inserted {
             self.scans += 1;
         }
@@ -308,7 +305,7 @@ fn record_failure(record: &mut Vec<(Point3<f64>, u32)>, p: Point3<f64>, radius: 
 /// 3. Stop at `stop.known_ratio` of the observable cells (the region's cells
 ///    outside the true obstacles), at `stop.max_iterations`, after
 ///    `stop.max_consecutive_failures` iterations without a motion, when NBV
-///    has no candidate, at the deadline or on `should_stop`.
+///    has no candidate, or when `ctl.deadline` passes or is cancelled.
 ///
 /// Every random choice derives from `params.seed`: the same inputs give the
 /// same run.
@@ -356,7 +353,6 @@ pub fn explore(
         tree,
         scans: 0,
         deadline: ctl.deadline,
-        should_stop: ctl.should_stop,
     };
     let mut on_step = ctl.on_step;
     let mut q = start.to_vec();
@@ -404,7 +400,8 @@ pub fn explore(
             prior_failures: failure_record.clone(),
             max_results: params.candidates_per_iteration,
             ik_check: params.nbv.ik_check.max(params.candidates_per_iteration),
-            time_budget: ex.deadline.map(|d| d.saturating_duration_since(Instant::now())),
+            // bounded by the run's deadline (passed below), not a budget of its own
+            time_budget: None,
             seed: params.seed.wrapping_add(iterations as u64),
             ..params.nbv.clone()
         };
@@ -415,7 +412,7 @@ pub fn explore(
             &params.camera,
             &current,
             Some(chain),
-            ex.should_stop,
+            ex.deadline,
         )?;
         times.nbv_us = us(t0);
         if ranked.candidates.is_empty() {
@@ -541,15 +538,12 @@ fn plan_to(
         .seed
         .wrapping_mul(1_000_003)
         .wrapping_add((iteration * 131 + rank) as u64);
-    let budget_end = Instant::now() + params.plan_time_budget;
-    let deadline = Some(ex.deadline.map_or(budget_end, |d| d.min(budget_end)));
     let r = plan(
         chain,
         known,
         &req,
         PlanControl {
-            deadline,
-            should_stop: ex.should_stop,
+            deadline: ex.deadline.min_with_budget(Some(params.plan_time_budget)),
             progress: None,
         },
     )?;

@@ -4,6 +4,7 @@ use std::time::{Duration, Instant};
 use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::*;
+use crate::Deadline;
 use crate::collision::{
     AcmParams, AllowedCollisions, Geometry, Obstacle, RobotModel, Scene, SceneGeometry, SceneLimits,
 };
@@ -95,7 +96,17 @@ fn a_sphere_is_seen_at_the_distance_of_its_surface_and_out_of_range_is_no_return
     let moved = a.depth[15 * a.width + 20] as f64;
     assert!(moved != centre && (moved - centre).abs() < 0.06);
     // a render that is told to stop returns nothing
-    assert!(render_depth_until(&world, &cam, &pose, &sensor, 0, &|| true).is_none());
+    assert!(
+        render_depth_until(
+            &world,
+            &cam,
+            &pose,
+            &sensor,
+            0,
+            Deadline::none().with_cancel(&|| true)
+        )
+        .is_none()
+    );
 }
 
 struct Rig {
@@ -232,7 +243,7 @@ fn the_deadline_stops_the_loop_between_stages() {
     // well below the whole run's length in a release build, so
     // the deadline, not the end of the candidates, stops it
     let ctl = ExploreControl {
-        deadline: Some(t0 + Duration::from_millis(40)),
+        deadline: Deadline::at(t0 + Duration::from_millis(40)),
         ..ExploreControl::default()
     };
     let out = explore(&world, &scene.start, &p, ctl).unwrap();

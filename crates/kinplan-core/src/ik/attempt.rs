@@ -5,26 +5,24 @@
 use std::time::Instant;
 
 use super::{IkParams, IkStatus, IkTarget, PoseError};
+use crate::{Deadline, Stop};
 
-/// Deadline and cancellation, checked once per iteration.
+/// The request's start and its deadline (the caller's, already combined
+/// with `IkParams::time_budget`), checked once per iteration.
 pub(crate) struct Clock<'a> {
     pub start: Instant,
-    pub deadline: Option<Instant>,
-    pub should_stop: &'a (dyn Fn() -> bool + Sync),
+    pub deadline: Deadline<'a>,
 }
 
 impl Clock<'_> {
+    /// `TimeBudget` once the deadline has passed, `Cancelled` once the
+    /// caller's cancellation is raised.
     #[inline]
     pub fn interrupted(&self) -> Option<IkStatus> {
-        if let Some(d) = self.deadline
-            && Instant::now() >= d
-        {
-            return Some(IkStatus::TimeBudget);
-        }
-        if (self.should_stop)() {
-            return Some(IkStatus::Cancelled);
-        }
-        None
+        self.deadline.stop().map(|s| match s {
+            Stop::Deadline => IkStatus::TimeBudget,
+            Stop::Cancelled => IkStatus::Cancelled,
+        })
     }
     pub fn elapsed_us(&self) -> u64 {
         self.start.elapsed().as_micros().min(u64::MAX as u128) as u64

@@ -22,7 +22,7 @@ pub use fabrik::{PointChainReport, fabrik_points};
 pub use length_relaxation::{RelaxationGraph, length_relaxation_points, relax_length};
 pub use params::{IkMethod, IkParams, JointLimitMode};
 pub use point_chain::PointWorkspace;
-pub use solve::{IkResult, IkSolution, IkSolver, IkStatus, budget_until, solve_ik};
+pub use solve::{IkResult, IkSolution, IkSolver, IkStatus, solve_ik};
 pub use target::{IkTarget, PoseError, pose_error};
 pub use track::{
     BatchSeeds, PathStep, TrackParams, TrackResult, circle_path, line_path, solve_ik_batch, track_path,

@@ -100,7 +100,9 @@ pub struct IkParams {
     /// the last reset for the Jacobian methods, 0.99× for CCD (which uses 10× this count),
     /// FABRIK and length relaxation. Default 6.
     pub stall_iterations: usize,
-    /// Wall-clock budget for the whole request; `None` = no limit. Default none.
+    /// Wall-clock budget of one solve (s), counted from its start; `None` = no
+    /// limit. The solver stops at this budget or at the caller's
+    /// [`Deadline`](crate::Deadline), whichever comes first. Default none.
     pub time_budget: Option<Duration>,
     /// Record each solution's error at the start of every iteration of its attempt
     /// ([`IkSolution::history`](super::IkSolution::history)). Default off (nothing is

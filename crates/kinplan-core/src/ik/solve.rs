@@ -1,7 +1,7 @@
 //! The `solve_ik` front: validation, seeded random restarts, distinct solutions,
 //! time budget and cancellation around the per-attempt algorithms.
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -9,6 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use super::attempt::{Attempt, Clock};
 use super::workspace::IkWorkspace;
 use super::{IkError, IkMethod, IkParams, IkTarget};
+use crate::Deadline;
 use crate::robot::{Chain, JointKind};
 
 /// How an attempt (or the whole request) ended.
@@ -75,37 +76,6 @@ impl IkResult {
     /// First solution, or the flagged best attempt.
     pub fn best(&self) -> Option<&IkSolution> {
         self.solutions.first().or(self.best_attempt.as_ref())
-    }
-
-    /// Relabels `Cancelled` as `TimeBudget` in the stop reason, every
-    /// solution and the best attempt: for a caller whose cancellation check
-    /// is a deadline (a batch of targets cut by the request's deadline),
-    /// running out of time is a budget stop, not a caller that went away.
-    ///
-    /// ```
-    /// use kinplan_core::ik::{IkResult, IkStatus};
-    /// let mut r = IkResult {
-    ///     solutions: vec![],
-    ///     best_attempt: None,
-    ///     stop_reason: IkStatus::Cancelled,
-    ///     attempts: 1,
-    ///     total_iterations: 3,
-    ///     elapsed_us: 10,
-    /// };
-    /// r.cancelled_as_time_budget();
-    /// assert_eq!(r.stop_reason, IkStatus::TimeBudget);
-    /// ```
-    pub fn cancelled_as_time_budget(&mut self) {
-        let relabel = |s: &mut IkStatus| {
-            if *s == IkStatus::Cancelled {
-                *s = IkStatus::TimeBudget;
-            }
-        };
-        relabel(&mut self.stop_reason);
-        self.solutions.iter_mut().for_each(|s| relabel(&mut s.status));
-        if let Some(b) = self.best_attempt.as_mut() {
-            relabel(&mut b.status);
-        }
     }
 }
 
@@ -199,14 +169,12 @@ impl<'c> IkSolver<'c> {
         seed: Option<&[f64]>,
         params: &IkParams,
         rng_seed: u64,
-        should_stop: &(dyn Fn() -> bool + Sync),
+        deadline: Deadline<'_>,
     ) -> Result<IkResult, IkError> {
         validate_request(self.chain, target, seed, params)?;
-        let start = Instant::now();
         let clock = Clock {
-            start,
-            deadline: params.time_budget.map(|b| start + b),
-            should_stop,
+            start: Instant::now(),
+            deadline: deadline.min_with_budget(params.time_budget),
         };
         Ok(self.solve_validated(target, seed, params, rng_seed, &clock))
     }
@@ -327,16 +295,18 @@ pub(crate) fn run_attempt(
 /// start at joints drawn uniformly inside the limits from a ChaCha8 RNG seeded with
 /// `rng_seed`, so the same input gives the same answer. The search stops when
 /// `params.num_solutions` distinct converged solutions are found, the restarts are used
-/// up, `params.time_budget` has elapsed or `should_stop()` returns true (both checked
-/// every iteration). Solutions are ranked by Euclidean joint distance to the seed; when
+/// up, or `deadline` stops it: its instant or `params.time_budget` from the start,
+/// whichever comes first (`TimeBudget`), or its cancellation (`Cancelled`), both checked
+/// every iteration. Solutions are ranked by Euclidean joint distance to the seed; when
 /// none converged, [`IkResult::best_attempt`] holds the lowest-error attempt, flagged.
 ///
 /// ```
+/// use kinplan_core::Deadline;
 /// use kinplan_core::ik::{solve_ik, IkParams, IkTarget};
 /// let chain = kinplan_core::robot::builtin_chain("ur5").unwrap();
 /// let q = [0.3, -1.2, 1.4, -0.8, 1.1, 0.2];
 /// let target = IkTarget::Pose(chain.fk(&q));
-/// let r = solve_ik(&chain, &target, None, &IkParams::default(), 7, &|| false).unwrap();
+/// let r = solve_ik(&chain, &target, None, &IkParams::default(), 7, Deadline::none()).unwrap();
 /// assert!(r.success());
 /// let s = &r.solutions[0];
 /// assert!(s.position_error <= 1e-5 && s.orientation_error <= 1e-5);
@@ -349,14 +319,7 @@ pub fn solve_ik(
     seed: Option<&[f64]>,
     params: &IkParams,
     rng_seed: u64,
-    should_stop: &(dyn Fn() -> bool + Sync),
+    deadline: Deadline<'_>,
 ) -> Result<IkResult, IkError> {
-    IkSolver::new(chain).solve(target, seed, params, rng_seed, should_stop)
-}
-
-/// Convenience for callers holding a deadline instead of a budget.
-pub fn budget_until(deadline: Instant) -> Duration {
-    deadline
-        .saturating_duration_since(Instant::now())
-        .max(Duration::from_nanos(1))
+    IkSolver::new(chain).solve(target, seed, params, rng_seed, deadline)
 }

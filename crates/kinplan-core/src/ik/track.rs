@@ -9,6 +9,7 @@ use super::attempt::Clock;
 use super::solve::validate_request;
 use super::{IkError, IkParams, IkResult, IkSolver, IkStatus, IkTarget, PathParam};
 use crate::robot::Chain;
+use crate::{Deadline, Stop};
 
 /// Per-target RNG seed of a batch: a SplitMix64 step of `rng_seed + index`.
 fn batch_seed(rng_seed: u64, index: usize) -> u64 {
@@ -40,14 +41,14 @@ impl<'a> BatchSeeds<'a> {
 /// Solves every target independently and in parallel (rayon, one workspace per worker),
 /// each from its seed (see [`BatchSeeds`]) with its own deterministic RNG seed, so the
 /// answers do not depend on the thread count. `params.time_budget` applies to each
-/// target; `should_stop` to all.
+/// target; `deadline` to all.
 pub fn solve_ik_batch(
     chain: &Chain,
     targets: &[IkTarget],
     seeds: BatchSeeds<'_>,
     params: &IkParams,
     rng_seed: u64,
-    should_stop: &(dyn Fn() -> bool + Sync),
+    deadline: Deadline<'_>,
 ) -> Vec<Result<IkResult, IkError>> {
     let dof = chain.dof();
     if let BatchSeeds::PerTarget(all) = seeds
@@ -75,18 +76,22 @@ pub fn solve_ik_batch(
             || IkSolver::new(chain),
             |solver, (i, t)| {
                 // Once stopped, the remaining targets are answered at once
-                // (CANCELLED, no attempt) instead of each starting a solve.
-                if should_stop() {
+                // (TIME_BUDGET at the deadline, CANCELLED on cancellation, no
+                // attempt) instead of each starting a solve.
+                if let Some(stop) = deadline.stop() {
                     return Ok(IkResult {
                         solutions: Vec::new(),
                         best_attempt: None,
-                        stop_reason: IkStatus::Cancelled,
+                        stop_reason: match stop {
+                            Stop::Deadline => IkStatus::TimeBudget,
+                            Stop::Cancelled => IkStatus::Cancelled,
+                        },
                         attempts: 0,
                         total_iterations: 0,
                         elapsed_us: 0,
                     });
                 }
-                solver.solve(t, seed_of(i), params, batch_seed(rng_seed, i), should_stop)
+                solver.solve(t, seed_of(i), params, batch_seed(rng_seed, i), deadline)
             },
         )
         .collect()
@@ -155,10 +160,11 @@ pub struct TrackResult {
 
 /// Tracks a Cartesian path: step `k` is solved from the joints of step `k − 1` (the
 /// first from `seed`), with the same IK options each step (docs/inverse-kinematics.md#path-tracking,
-/// S2 §3.2 Tab. 5/6). `params.ik.time_budget` bounds the whole path; `should_stop` is checked
-/// every iteration.
+/// S2 §3.2 Tab. 5/6). `params.ik.time_budget` bounds the whole path, as does `deadline`
+/// (whichever comes first); both are checked every iteration.
 ///
 /// ```
+/// use kinplan_core::Deadline;
 /// use kinplan_core::ik::{circle_path, track_path, IkTarget, TrackParams};
 /// use nalgebra::{Point3, Vector3};
 /// let chain = kinplan_core::robot::builtin_chain("planar_4").unwrap();
@@ -167,7 +173,7 @@ pub struct TrackResult {
 /// let centre = Point3::from(start.translation.vector - Vector3::new(0.1, 0.0, 0.0));
 /// let path = circle_path(&start, &centre, &Vector3::z(), std::f64::consts::PI / 50.0, 100).unwrap();
 /// let targets: Vec<_> = path.iter().map(|p| IkTarget::Position(Point3::from(p.translation.vector))).collect();
-/// let r = track_path(&chain, &targets, &q0, &TrackParams::default(), 1, &|| false).unwrap();
+/// let r = track_path(&chain, &targets, &q0, &TrackParams::default(), 1, Deadline::none()).unwrap();
 /// assert!(r.all_converged && r.max_joint_step < 0.5);
 /// ```
 pub fn track_path(
@@ -176,7 +182,7 @@ pub fn track_path(
     seed: &[f64],
     params: &TrackParams,
     rng_seed: u64,
-    should_stop: &(dyn Fn() -> bool + Sync),
+    deadline: Deadline<'_>,
 ) -> Result<TrackResult, IkError> {
     params.validate()?;
     if targets.is_empty() {
@@ -188,8 +194,7 @@ pub fn track_path(
     let start = Instant::now();
     let clock = Clock {
         start,
-        deadline: params.ik.time_budget.map(|b| start + b),
-        should_stop,
+        deadline: deadline.min_with_budget(params.ik.time_budget),
     };
     let mut solver = IkSolver::new(chain);
     let mut prev = seed.to_vec();

@@ -6,6 +6,7 @@ use rand::Rng;
 
 use super::pseudoinverse::check_system;
 use super::{LinalgError, LinalgParam, LinearSolution, SolveStatus};
+use crate::Deadline;
 
 /// Faithful RLXA, or the safeguarded variant (reported separately).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
@@ -140,10 +141,10 @@ impl RlxaWorkspace {
         rng: &mut R,
         history: Option<&mut Vec<f64>>,
     ) -> Result<RlxaReport, LinalgError> {
-        self.solve_into_until(a, b, x, params, rng, history, &|| false)
+        self.solve_into_until(a, b, x, params, rng, history, Deadline::none())
     }
 
-    /// [`RlxaWorkspace::solve_into`], asking `should_stop` every
+    /// [`RlxaWorkspace::solve_into`], polling `deadline` every
     /// [`STOP_CHECK_WORK`] / (m·n) iterations; a stopped solve reports
     /// [`SolveStatus::IterationCap`] with the iterations done.
     #[allow(clippy::too_many_arguments)]
@@ -155,7 +156,7 @@ impl RlxaWorkspace {
         params: &RlxaParams,
         rng: &mut R,
         mut history: Option<&mut Vec<f64>>,
-        should_stop: &dyn Fn() -> bool,
+        deadline: Deadline<'_>,
     ) -> Result<RlxaReport, LinalgError> {
         params.validate()?;
         check_system(a, b)?;
@@ -196,7 +197,7 @@ impl RlxaWorkspace {
         let check_every = (STOP_CHECK_WORK / (m * n).max(1)).max(1);
         let mut it = 0;
         while it < params.max_iterations {
-            if it % check_every == check_every - 1 && should_stop() {
+            if it % check_every == check_every - 1 && deadline.expired() {
                 break;
             }
             if rn < threshold {
@@ -316,17 +317,17 @@ pub fn solve_angle_relaxation<R: Rng + ?Sized>(
     params: &RlxaParams,
     rng: &mut R,
 ) -> Result<LinearSolution, LinalgError> {
-    solve_angle_relaxation_until(a, b, params, rng, &|| false)
+    solve_angle_relaxation_until(a, b, params, rng, Deadline::none())
 }
 
 /// [`solve_angle_relaxation`], stopping early (status
-/// [`SolveStatus::IterationCap`]) once `should_stop` says so.
+/// [`SolveStatus::IterationCap`]) once `deadline` says so.
 pub fn solve_angle_relaxation_until<R: Rng + ?Sized>(
     a: &DMatrix<f64>,
     b: &DVector<f64>,
     params: &RlxaParams,
     rng: &mut R,
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
 ) -> Result<LinearSolution, LinalgError> {
     params.validate()?;
     check_system(a, b)?;
@@ -338,7 +339,7 @@ pub fn solve_angle_relaxation_until<R: Rng + ?Sized>(
     } else {
         None
     };
-    let rep = ws.solve_into_until(a, b, &mut x, params, rng, hist, should_stop)?;
+    let rep = ws.solve_into_until(a, b, &mut x, params, rng, hist, deadline)?;
     Ok(LinearSolution {
         x,
         residual_norm: rep.residual_norm,

@@ -13,6 +13,7 @@ use super::simulate::SimParams;
 use super::token::{decode_token, encode_token};
 use super::vector_distance::{NavMode, VdfEvent, VdfParams, VdfState, vdf_step};
 use super::world::World;
+use crate::Deadline;
 
 /// Settings of one step that have defaults.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -106,14 +107,14 @@ pub struct ControlStep {
 /// [`vdf_step`]. Path following: [`path_follow_step`] with period `options.dt`, the token's
 /// node indices checked against the path, parameters adapted to the chassis
 /// ([`PathFollowParams::for_chassis`]). The command is saturated by the chassis.
-/// `Ok(None)` when `should_stop` stopped the sensing.
+/// `Ok(None)` when `deadline` stopped the sensing.
 pub fn control_step(
     chassis: &Chassis,
     pose: Pose,
     token: &[u8],
     controller: &StepController,
     options: &StepOptions,
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
 ) -> Result<Option<ControlStep>, MobileError> {
     chassis.validate()?;
     let (command, reached, token, report) = match *controller {
@@ -127,7 +128,7 @@ pub fn control_step(
             let memory: VdfState = decode_token(token, &())?;
             let readings = match world {
                 Some(world) if readings.is_empty() => {
-                    match sense(world, pose, &sensors, options, should_stop)? {
+                    match sense(world, pose, &sensors, options, deadline)? {
                         Some(sensed) => sensed,
                         None => return Ok(None),
                     }
@@ -171,14 +172,14 @@ fn sense(
     pose: Pose,
     sensors: &RangeSensorParams,
     options: &StepOptions,
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
 ) -> Result<Option<Vec<f64>>, MobileError> {
     check_positive(MobileField::RobotRadius, options.robot_radius)?;
     pose.validate(MobileField::State)?;
     let mut ring = RangeSensors::new(*sensors, options.seed)?;
     let mut out = vec![0.0; sensors.count];
     Ok(ring
-        .sense_until(world, pose, options.robot_radius, &mut out, should_stop)
+        .sense_until(world, pose, options.robot_radius, &mut out, deadline)
         .then_some(out))
 }
 
@@ -220,7 +221,7 @@ mod tests {
             b"",
             &vd(&[], Some(&wall)),
             &opts,
-            &|| false,
+            Deadline::none(),
         )
         .unwrap()
         .unwrap();
@@ -236,7 +237,7 @@ mod tests {
             b"",
             &vd(&given, Some(&wall)),
             &opts,
-            &|| false,
+            Deadline::none(),
         )
         .unwrap()
         .unwrap();
@@ -249,7 +250,7 @@ mod tests {
                 b"",
                 &vd(&[], Some(&wall)),
                 &opts,
-                &|| true
+                Deadline::none().with_cancel(&|| true)
             )
             .unwrap(),
             None
@@ -265,7 +266,7 @@ mod tests {
                 b"",
                 &vd(&[], Some(&wall)),
                 &bad_radius,
-                &|| false
+                Deadline::none()
             ),
             Err(MobileError::NotPositive {
                 field: MobileField::RobotRadius,
@@ -285,13 +286,13 @@ mod tests {
         };
         let chassis = Chassis::default();
         let opts = StepOptions::default();
-        let first = control_step(&chassis, Pose::default(), b"", &follow, &opts, &|| false)
+        let first = control_step(&chassis, Pose::default(), b"", &follow, &opts, Deadline::none())
             .unwrap()
             .unwrap();
         // Node 0 lies inside the 0.3 m switching distance.
         assert_eq!(first.report, StepReport::FollowPath { target_node: 1 });
         let back = Pose::new(-1.0, 0.0, 0.0);
-        let kept = control_step(&chassis, back, &first.token, &follow, &opts, &|| false)
+        let kept = control_step(&chassis, back, &first.token, &follow, &opts, Deadline::none())
             .unwrap()
             .unwrap();
         assert_eq!(kept.report, StepReport::FollowPath { target_node: 1 });
@@ -300,19 +301,19 @@ mod tests {
             br#"{"target":0,"segment":9}"#,
         ] {
             assert!(matches!(
-                control_step(&chassis, back, forged, &follow, &opts, &|| false),
+                control_step(&chassis, back, forged, &follow, &opts, Deadline::none()),
                 Err(MobileError::BadToken { .. })
             ));
         }
         let vd_token = VdfState::default().to_token().unwrap();
         assert!(matches!(
-            control_step(&chassis, back, &vd_token, &follow, &opts, &|| false),
+            control_step(&chassis, back, &vd_token, &follow, &opts, Deadline::none()),
             Err(MobileError::BadToken { .. })
         ));
         // A negative period is the step's own field.
         let bad_dt = StepOptions { dt: -0.1, ..opts };
         assert!(matches!(
-            control_step(&chassis, back, b"", &follow, &bad_dt, &|| false),
+            control_step(&chassis, back, b"", &follow, &bad_dt, Deadline::none()),
             Err(MobileError::NotPositive {
                 field: MobileField::Dt,
                 ..
@@ -340,7 +341,7 @@ mod tests {
             &s.to_token().unwrap(),
             &vd(&blocked, None),
             &StepOptions::default(),
-            &|| false,
+            Deadline::none(),
         )
         .unwrap()
         .unwrap();

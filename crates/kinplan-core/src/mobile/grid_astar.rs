@@ -10,6 +10,7 @@ use super::error::{MobileError, check_positive, check_range};
 use super::field::{AstarField, MobileField};
 use super::pose::Point2;
 use super::world::World;
+use crate::Deadline;
 
 /// Grid A* parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -118,17 +119,17 @@ pub fn plan_grid_astar(
     goal: Point2,
     params: &GridAstarParams,
 ) -> Result<Option<Vec<Point2>>, MobileError> {
-    plan_grid_astar_until(world, start, goal, params, &|| false)
+    plan_grid_astar_until(world, start, goal, params, Deadline::none())
 }
 
-/// [`plan_grid_astar`], asking `should_stop` every grid cell while the grid is
+/// [`plan_grid_astar`], polling `deadline` every grid cell while the grid is
 /// built and every 1024 expansions while it is searched; `None` when stopped.
 pub fn plan_grid_astar_until(
     world: &World,
     start: Point2,
     goal: Point2,
     params: &GridAstarParams,
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
 ) -> Result<Option<Vec<Point2>>, MobileError> {
     params.validate()?;
     start.validate(MobileField::Start)?;
@@ -171,7 +172,7 @@ pub fn plan_grid_astar_until(
     for j in 0..ny {
         for i in 0..nx {
             // One distance query costs O(obstacle edges): ask after each.
-            if should_stop() {
+            if deadline.expired() {
                 return Ok(None);
             }
             g.blocked[j * nx + i] = world.distance(g.centre(i, j)).0 < params.inflation;
@@ -197,7 +198,7 @@ pub fn plan_grid_astar_until(
     let mut expanded = 0u32;
     while let Some(Open(f, c)) = heap.pop() {
         expanded = expanded.wrapping_add(1);
-        if expanded.is_multiple_of(1024) && should_stop() {
+        if expanded.is_multiple_of(1024) && deadline.expired() {
             return Ok(None);
         }
         if c == goal_idx {

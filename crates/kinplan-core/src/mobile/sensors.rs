@@ -10,6 +10,7 @@ use super::error::{MobileError, check_count, check_positive, check_range};
 use super::field::{MobileField, SensorField};
 use super::pose::{Point2, Pose};
 use super::world::World;
+use crate::Deadline;
 
 /// Sensor ring parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -96,10 +97,10 @@ impl RangeSensors {
     /// of radius `robot_radius` at `pose`: the minimum over the beam's rays of the ray length
     /// from the centre minus the radius, plus noise.
     pub fn sense(&mut self, world: &World, pose: Pose, robot_radius: f64, out: &mut [f64]) {
-        self.sense_until(world, pose, robot_radius, out, &|| false);
+        self.sense_until(world, pose, robot_radius, out, Deadline::none());
     }
 
-    /// [`RangeSensors::sense`], asking `should_stop` before each ray cast (a
+    /// [`RangeSensors::sense`], polling `deadline` before each ray cast (a
     /// ray costs O(obstacles within reach)); false when
     /// stopped early (then `out` is partly filled).
     pub fn sense_until(
@@ -108,7 +109,7 @@ impl RangeSensors {
         pose: Pose,
         robot_radius: f64,
         out: &mut [f64],
-        should_stop: &dyn Fn() -> bool,
+        deadline: Deadline<'_>,
     ) -> bool {
         let p = self.params;
         let o = Point2::new(pose.x, pose.y);
@@ -119,7 +120,7 @@ impl RangeSensors {
             let mut m = reach;
             for k in 0..p.rays_per_beam {
                 // A ray costs O(obstacles nearby): ask before each.
-                if should_stop() {
+                if deadline.expired() {
                     return false;
                 }
                 let off = if p.rays_per_beam == 1 {

@@ -7,6 +7,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
+use crate::Deadline;
 use crate::octree::{CellState, KnownCellCounts, OcKey, Octree, TREE_DEPTH};
 
 /// A tree at 0.1 m around the origin: aligned free cubes (pruned to one leaf each),
@@ -194,7 +195,7 @@ proptest! {
     fn frontier_cells_equal_a_scan_of_every_free_cell(seed in 0u64..1_000_000, ratio in 0.01f64..0.9) {
         let t = random_tree(seed);
         let (min, max) = (Point3::new(-1.2, -1.5, -1.0), Point3::new(1.4, 1.1, 1.3));
-        let got = frontier_cells(&t, &min, &max, ratio, &|| false).unwrap();
+        let got = frontier_cells(&t, &min, &max, ratio, Deadline::none()).unwrap();
         let (lo, hi) = (t.key_of(&min).unwrap(), t.key_of(&max).unwrap());
         let mut want = Vec::new();
         for z in lo[2]..=hi[2] {
@@ -221,7 +222,7 @@ proptest! {
         let got: Vec<(OcKey, f64)> = got.iter().map(|f| (f.key, f.unknown_ratio)).collect();
         prop_assert_eq!(&got, &want);
         // the lookup path (taken when the region's grid would be too large) agrees
-        let by_lookups = super::frontier::frontier_by_lookups(&t, &min, &max, ratio, &|| false).unwrap();
+        let by_lookups = super::frontier::frontier_by_lookups(&t, &min, &max, ratio, Deadline::none()).unwrap();
         let by_lookups: Vec<(OcKey, f64)> = by_lookups.iter().map(|f| (f.key, f.unknown_ratio)).collect();
         prop_assert_eq!(by_lookups, want);
     }
@@ -274,13 +275,17 @@ fn frontier_and_field_at_the_edge_of_the_key_space() {
     t.update_key(&[0, 0, 0], miss);
     let (min, max) = (t.key_center(&[0; 3], 16), t.key_center(&[3; 3], 16));
     for f in [
-        frontier_cells(&t, &min, &max, 0.25, &|| false).unwrap(),
-        super::frontier::frontier_by_lookups(&t, &min, &max, 0.25, &|| false).unwrap(),
+        frontier_cells(&t, &min, &max, 0.25, Deadline::none()).unwrap(),
+        super::frontier::frontier_by_lookups(&t, &min, &max, 0.25, Deadline::none()).unwrap(),
     ] {
         assert_eq!(f.len(), 1);
         assert_eq!((f[0].key, f[0].unknown_ratio), ([0; 3], 7.0 / 26.0));
     }
-    assert!(frontier_cells(&t, &min, &max, 0.3, &|| false).unwrap().is_empty());
+    assert!(
+        frontier_cells(&t, &min, &max, 0.3, Deadline::none())
+            .unwrap()
+            .is_empty()
+    );
     // seven unknown cells at +x, +y, +z, the face diagonals and the body diagonal:
     // F = (1/0.1)·(1 + 2·½ + ⅓)·(1,1,1) per axis = 23.33…·(1, 1, 1)
     let f = potential_field(&t, &[0; 3], 0.18).unwrap();

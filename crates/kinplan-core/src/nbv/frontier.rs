@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use super::camera::look_along;
 use super::grid::{Ball, MAX_CELLS, StateGrid};
+use crate::Deadline;
 use crate::octree::{CellState, OcKey, Octree, SearchCache, StateFilter, TREE_DEPTH};
 
 /// One frontier cell: a known-free depth-16 cell with enough unknown neighbours.
@@ -34,26 +35,26 @@ pub(crate) fn unknown_needed(min_unknown_ratio: f64) -> usize {
 ///
 /// When the box's keys with one cell of margin hold at most `grid::MAX_CELLS` (2^24) cells, the
 /// states are copied into a dense grid once and counted by 3×3×3 block sums
-/// (`StateGrid::frontier`, z planes in parallel, `should_stop` polled per plane);
+/// (`StateGrid::frontier`, z planes in parallel, `deadline` polled per plane);
 /// otherwise free cubes are scanned in parallel chunks with neighbour lookups in the
-/// tree (`should_stop` polled every 256 cells of a chunk). Either way the cells found
+/// tree (`deadline` polled every 256 cells of a chunk). Either way the cells found
 /// so far are returned when stopped.
 pub fn frontier_cells(
     tree: &Octree,
     min: &Point3<f64>,
     max: &Point3<f64>,
     min_unknown_ratio: f64,
-    should_stop: &(dyn Fn() -> bool + Sync),
+    deadline: Deadline<'_>,
 ) -> Result<Vec<Frontier>, crate::octree::OctreeError> {
     let (kmin, kmax) = (tree.key_of(min)?, tree.key_of(max)?);
     if (0..3).all(|i| kmin[i] <= kmax[i]) {
         let lo = kmin.map(|k| k as i64 - 1);
         let hi = kmax.map(|k| k as i64 + 1);
         if let Some(g) = StateGrid::new(tree, lo, hi, MAX_CELLS) {
-            return Ok(g.frontier(tree, &kmin, &kmax, unknown_needed(min_unknown_ratio), should_stop));
+            return Ok(g.frontier(tree, &kmin, &kmax, unknown_needed(min_unknown_ratio), deadline));
         }
     }
-    frontier_by_lookups(tree, min, max, min_unknown_ratio, should_stop)
+    frontier_by_lookups(tree, min, max, min_unknown_ratio, deadline)
 }
 
 /// [`frontier_cells`] by neighbour lookups in the tree: the surface cells of every free
@@ -64,7 +65,7 @@ pub(crate) fn frontier_by_lookups(
     min: &Point3<f64>,
     max: &Point3<f64>,
     min_unknown_ratio: f64,
-    should_stop: &(dyn Fn() -> bool + Sync),
+    deadline: Deadline<'_>,
 ) -> Result<Vec<Frontier>, crate::octree::OctreeError> {
     let mut cubes = Vec::new();
     let free = StateFilter {
@@ -180,7 +181,7 @@ pub(crate) fn frontier_by_lookups(
                     *polled += 1;
                     let k = [base[0] + dx as u16, base[1] + dy as u16, base[2] + dz as u16];
                     out.extend(test(k, &base, n, sure, cache));
-                    if polled.is_multiple_of(256) && should_stop() {
+                    if polled.is_multiple_of(256) && deadline.expired() {
                         stopped.store(true, Ordering::Relaxed);
                     }
                     stopped.load(Ordering::Relaxed)

@@ -5,6 +5,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::camera::{CameraModel, Frustum};
 use super::count::FrustumCounter;
+use crate::Deadline;
 use crate::octree::{CellState, OcKey, Octree, SearchCache};
 
 /// How the gain of a view is computed.
@@ -94,7 +95,7 @@ fn entropy(p: f64) -> f64 {
 
 /// Ray-cast gain of a view (see [`GainMethod`]): rays through the camera's pixel grid,
 /// a deterministic `fraction` of them (pixel i is used when `⌊(i+1)·f⌋ > ⌊i·f⌋`), each
-/// walked by a 3-D DDA from depth `near` to `far` (along +z). `should_stop` is polled
+/// walked by a 3-D DDA from depth `near` to `far` (along +z). `deadline` is polled
 /// every 64 rays; a stopped view returns what it found so far.
 pub fn ray_gain(
     tree: &Octree,
@@ -102,7 +103,7 @@ pub fn ray_gain(
     pose: &Isometry3<f64>,
     method: GainMethod,
     ws: &mut GainWorkspace,
-    should_stop: &(dyn Fn() -> bool + Sync),
+    deadline: Deadline<'_>,
 ) -> ViewGain {
     let fraction = method.fraction().unwrap_or(1.0).clamp(0.0, 1.0);
     let origin = Point3::from(pose.translation.vector);
@@ -116,7 +117,7 @@ pub fn ray_gain(
             continue;
         }
         used += 1;
-        if used.is_multiple_of(64) && should_stop() {
+        if used.is_multiple_of(64) && deadline.expired() {
             break;
         }
         let (u, v) = (i % camera.width, i / camera.width);

@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 
 use super::frontier::Frontier;
+use crate::Deadline;
 use crate::octree::{NodeRef, OcKey, Octree, TREE_DEPTH, child_key};
 
 /// No node covers the cell.
@@ -129,14 +130,14 @@ impl StateGrid {
     /// `S` the known (free, occupied or outside) cells of the 3×3×3 block, summed as
     /// three-cell row sums along x added over the nine rows. Same cells and ratios as
     /// [`frontier_cells`](super::frontier_cells)' neighbour lookups, in key order (z,
-    /// y, x). `should_stop` is polled per z plane; the planes done by then are returned.
+    /// y, x). `deadline` is polled per z plane; the planes done by then are returned.
     pub fn frontier(
         &self,
         tree: &Octree,
         kmin: &OcKey,
         kmax: &OcKey,
         need: usize,
-        should_stop: &(dyn Fn() -> bool + Sync),
+        deadline: Deadline<'_>,
     ) -> Vec<Frontier> {
         let [nx, ny, _] = self.dims;
         let plane = nx * ny;
@@ -162,7 +163,7 @@ impl StateGrid {
             .into_par_iter()
             .map(|z| {
                 let mut out = Vec::new();
-                if should_stop() {
+                if deadline.expired() {
                     return out;
                 }
                 let rz = z - z0;

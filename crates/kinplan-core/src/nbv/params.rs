@@ -94,7 +94,9 @@ pub struct NbvParams {
     pub prior_failures: Vec<(Point3<f64>, u32)>,
     /// Ranked candidates returned (count ≥ 1). Default 10.
     pub max_results: usize,
-    /// Time budget of the whole request; `None` = none. Default None.
+    /// Wall-clock budget of the whole request (s), from its start; `None` = none.
+    /// The request stops at this budget or at the caller's
+    /// [`Deadline`](crate::Deadline), whichever comes first. Default None.
     pub time_budget: Option<Duration>,
     /// Seed of the IK restarts. Default 0.
     pub seed: u64,

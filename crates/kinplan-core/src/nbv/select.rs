@@ -18,6 +18,7 @@ use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
 use crate::octree::{CellState, Octree};
 use crate::robot::Chain;
+use crate::{Deadline, Stop};
 
 /// How the request ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -26,7 +27,7 @@ pub enum NbvStatus {
     Complete,
     /// The time budget ran out; the result ranks what was evaluated by then.
     TimeBudget,
-    /// `should_stop` fired; likewise partial.
+    /// The caller's cancellation was raised; likewise partial.
     Cancelled,
 }
 
@@ -90,19 +91,17 @@ pub struct NbvResult {
     pub elapsed_us: u64,
 }
 
+/// The request's deadline (already combined with `NbvParams::time_budget`).
 struct Clock<'a> {
-    deadline: Option<Instant>,
-    should_stop: &'a (dyn Fn() -> bool + Sync),
+    deadline: Deadline<'a>,
 }
 
 impl Clock<'_> {
     fn interrupted(&self) -> Option<NbvStatus> {
-        if let Some(d) = self.deadline
-            && Instant::now() >= d
-        {
-            return Some(NbvStatus::TimeBudget);
-        }
-        (self.should_stop)().then_some(NbvStatus::Cancelled)
+        self.deadline.stop().map(|s| match s {
+            Stop::Deadline => NbvStatus::TimeBudget,
+            Stop::Cancelled => NbvStatus::Cancelled,
+        })
     }
 }
 
@@ -152,21 +151,22 @@ pub fn estimate_reach(chain: &Chain) -> f64 {
 ///    `base⁻¹ · pose · mount⁻¹`; unreachable ones are dropped (or, with
 ///    `count_failures`, kept with `f − failure_penalty · failures`).
 ///
-/// Deadline and `should_stop` are polled per candidate in every stage; on either the result ranks what was evaluated.
+/// `deadline` (its instant or `params.time_budget` from the start, whichever comes first, and its
+/// cancellation) is polled per candidate in every stage, the IK included; on either the result ranks
+/// what was evaluated (a candidate whose IK was cut is kept, its reachability unknown).
 pub fn next_best_view(
     tree: &Octree,
     params: &NbvParams,
     camera: &CameraModel,
     current_pose: &Isometry3<f64>,
     robot: Option<&Chain>,
-    should_stop: &(dyn Fn() -> bool + Sync),
+    deadline: Deadline<'_>,
 ) -> Result<NbvResult, NbvError> {
     params.validate()?;
     camera.validate()?;
     let start = Instant::now();
     let clock = Clock {
-        deadline: params.time_budget.map(|b| start + b),
-        should_stop,
+        deadline: deadline.min_with_budget(params.time_budget),
     };
     let mut st = StageStats::default();
     let mut status = NbvStatus::Complete;
@@ -181,8 +181,6 @@ pub fn next_best_view(
             )
         })
     });
-    // deadline or cancellation, for the loops that take a closure
-    let stop = || clock.interrupted().is_some();
 
     // 1. candidates: one dense state grid of the region plus the field's radius serves
     // the frontier test and every potential field when it fits (else tree lookups)
@@ -207,9 +205,9 @@ pub fn next_best_view(
                     &ka,
                     &kb,
                     unknown_needed(params.frontier_unknown_ratio),
-                    &stop,
+                    clock.deadline,
                 ),
-                None => frontier_cells(tree, a, b, params.frontier_unknown_ratio, &stop)?,
+                None => frontier_cells(tree, a, b, params.frontier_unknown_ratio, clock.deadline)?,
             }
         }
         _ => Vec::new(),
@@ -326,7 +324,7 @@ pub fn next_best_view(
                     (c, c / c_max, 0)
                 }
                 m => {
-                    let g = ray_gain(tree, camera, pose, m, ws, &stop);
+                    let g = ray_gain(tree, camera, pose, m, ws, clock.deadline);
                     (g.cells, g.ig, g.ray_steps)
                 }
             })
@@ -425,8 +423,16 @@ pub fn next_best_view(
                 None,
                 &params.ik,
                 params.seed.wrapping_add(i as u64),
-                should_stop,
+                clock.deadline,
             )?;
+            if r.solutions.is_empty()
+                && let Some(s) = clock.interrupted()
+            {
+                // cut by the deadline, not found unreachable
+                status = s;
+                out.push(c);
+                continue;
+            }
             if let Some(s) = r.solutions.first() {
                 c.reachable = Some(true);
                 c.joints = Some(s.joints.clone());

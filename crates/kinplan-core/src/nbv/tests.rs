@@ -3,6 +3,7 @@
 use nalgebra::{Point3, Vector3};
 
 use super::*;
+use crate::Deadline;
 use crate::octree::{CellState, OcKey, Octree};
 
 fn hm(t: &Octree) -> (f32, f32) {
@@ -123,7 +124,7 @@ fn walk_visits_the_cells_along_an_axis_and_rays_stop_at_occupied() {
         &pose,
         GainMethod::Rays { fraction: 1.0 },
         &mut ws,
-        &|| false,
+        Deadline::none(),
     );
     let f = frustum_unknown_count(&t, &Frustum::new(&cam, &pose)) as f64;
     // everything in front of the wall (x < 0.4) is unknown: the rays find no more than
@@ -137,7 +138,7 @@ fn walk_visits_the_cells_along_an_axis_and_rays_stop_at_occupied() {
         &pose,
         GainMethod::Rays { fraction: 0.1 },
         &mut ws,
-        &|| false,
+        Deadline::none(),
     );
     assert!(g10.cells <= g.cells && g10.cells > 0.0);
     let u = ray_gain(
@@ -146,7 +147,7 @@ fn walk_visits_the_cells_along_an_axis_and_rays_stop_at_occupied() {
         &pose,
         GainMethod::UnobservedVoxels { fraction: 1.0 },
         &mut ws,
-        &|| false,
+        Deadline::none(),
     );
     assert!(u.cells >= g.cells);
     let o = ray_gain(
@@ -155,7 +156,7 @@ fn walk_visits_the_cells_along_an_axis_and_rays_stop_at_occupied() {
         &pose,
         GainMethod::OcclusionAware { fraction: 1.0 },
         &mut ws,
-        &|| false,
+        Deadline::none(),
     );
     // unknown cells have entropy 1 bit and halve the visibility: Σ 2^−i per ray < 2
     assert!(o.cells > 0.0 && o.cells < 2.0 * 1200.0);
@@ -168,10 +169,10 @@ fn frontier_of_a_free_cube_is_its_surface() {
     // the 4³ block is pruned into one depth-14 cube
     assert_eq!(t.search_key(&[32769; 3], 16).map(|(_, d)| d), Some(14));
     let (a, b) = (Point3::new(-1.0, -1.0, -1.0), Point3::new(1.0, 1.0, 1.0));
-    let f = frontier_cells(&t, &a, &b, 0.25, &|| false).unwrap();
+    let f = frontier_cells(&t, &a, &b, 0.25, Deadline::none()).unwrap();
     assert_eq!(f.len(), 64 - 8);
     // edges and corners: 19/26 and 15/26 unknown; faces 9/26 < 0.5
-    let f = frontier_cells(&t, &a, &b, 0.5, &|| false).unwrap();
+    let f = frontier_cells(&t, &a, &b, 0.5, Deadline::none()).unwrap();
     assert_eq!(f.len(), 8 + 12 * 2);
 }
 
@@ -211,7 +212,7 @@ fn next_best_view_ranks_filters_and_checks_reach() {
         max_results: 8,
         ..NbvParams::default()
     };
-    let r = next_best_view(&t, &params, &cam, &current, Some(&chain), &|| false).unwrap();
+    let r = next_best_view(&t, &params, &cam, &current, Some(&chain), Deadline::none()).unwrap();
     assert_eq!(r.status, NbvStatus::Complete);
     let s = r.stages;
     assert!(s.frontier_cells > 0 && s.frontier_candidates > 0 && s.caller_candidates == 1);
@@ -246,14 +247,66 @@ fn next_best_view_ranks_filters_and_checks_reach() {
     }
     assert!(s.ik_checked > 0);
     // cancellation is a status, not an error
-    let r = next_best_view(&t, &params, &cam, &current, Some(&chain), &|| true).unwrap();
+    let r = next_best_view(
+        &t,
+        &params,
+        &cam,
+        &current,
+        Some(&chain),
+        Deadline::none().with_cancel(&|| true),
+    )
+    .unwrap();
     assert_eq!(r.status, NbvStatus::Cancelled);
     // bad parameters are errors
     let bad = NbvParams {
         gain: GainMethod::Rays { fraction: 0.0 },
         ..NbvParams::default()
     };
-    assert!(next_best_view(&t, &bad, &cam, &current, None, &|| false).is_err());
+    assert!(next_best_view(&t, &bad, &cam, &current, None, Deadline::none()).is_err());
+}
+
+/// The reachability IK runs under the request's deadline: an IK that can never
+/// converge (one iteration per attempt, endless restarts, no budget of its own) is cut
+/// there, the request ends TIME_BUDGET, and the candidate keeps an unknown reachability
+/// (not a failure).
+#[test]
+fn an_ik_cut_by_the_deadline_leaves_reachability_unknown() {
+    let mut t = Octree::new(0.1).unwrap();
+    free_box(&mut t, [32758, 32758, 32768], [32782, 32778, 32782]);
+    let chain = crate::robot::builtin_chain("abb_irb4600_60_205").unwrap();
+    let cam = CameraModel {
+        width: 64,
+        height: 48,
+        ..CameraModel::default()
+    };
+    let current = look_along(&Point3::new(1.0, 0.0, 1.0), &Vector3::x()).unwrap();
+    let mut params = NbvParams {
+        extra_candidates: vec![
+            look_along(&Point3::new(1.2, 0.3, 1.1), &Vector3::new(1.0, 0.0, -0.3)).unwrap(),
+        ],
+        ik_check: 4,
+        max_results: 8,
+        count_failures: true,
+        ..NbvParams::default()
+    };
+    params.ik.max_iterations = 1;
+    params.ik.max_restarts = usize::MAX;
+    params.ik.time_budget = None;
+    let start = std::time::Instant::now();
+    // long enough for the stages before the IK in a debug build on a loaded machine
+    let deadline = Deadline::after(std::time::Duration::from_millis(1500));
+    let r = next_best_view(&t, &params, &cam, &current, Some(&chain), deadline).unwrap();
+    let took = start.elapsed();
+    assert_eq!(r.status, NbvStatus::TimeBudget);
+    assert!(took < std::time::Duration::from_secs(5), "{took:?}");
+    assert_eq!(r.stages.ik_checked, 1, "the first IK runs and is cut");
+    assert_eq!(r.stages.ik_failed, 0);
+    assert!(!r.candidates.is_empty());
+    assert!(
+        r.candidates
+            .iter()
+            .all(|c| c.reachable.is_none() && c.failures == 0)
+    );
 }
 
 #[test]
@@ -269,7 +322,7 @@ fn huge_free_cubes_from_a_hostile_tree_stop_at_the_deadline() {
         ..NbvParams::default()
     };
     let start = std::time::Instant::now();
-    let r = next_best_view(&t, &params, &cam, &current, None, &|| false).unwrap();
+    let r = next_best_view(&t, &params, &cam, &current, None, Deadline::none()).unwrap();
     assert_eq!(r.status, NbvStatus::TimeBudget);
     assert!(
         start.elapsed() < std::time::Duration::from_secs(5),
@@ -282,7 +335,7 @@ fn huge_free_cubes_from_a_hostile_tree_stop_at_the_deadline() {
         &Point3::new(-1.0, -1.0, -1.0),
         &Point3::new(1.0, 1.0, 1.0),
         0.25,
-        &|| false,
+        Deadline::none(),
     )
     .unwrap();
     assert!(f.is_empty());

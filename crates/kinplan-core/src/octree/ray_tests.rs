@@ -6,6 +6,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
+use crate::Deadline;
 
 /// Parameter interval `[t0, t1]` of the segment `o + t·(e − o)`, t ∈ [0, 1], inside
 /// the depth-16 cell `k` (slab test in f64), or None.
@@ -162,7 +163,12 @@ fn insert_of_a_tiny_scan_by_hand() {
     // and to x = 0.25 (cell 32770), whose cell the first beam also crosses
     let pts = [[0.45f32, 0.05, 0.05], [0.44, 0.05, 0.05], [0.25, 0.05, 0.05]];
     let s = t
-        .insert_scan(&pts, &[0.05, 0.05, 0.05], &ScanParams::default(), &|| false)
+        .insert_scan(
+            &pts,
+            &[0.05, 0.05, 0.05],
+            &ScanParams::default(),
+            Deadline::none(),
+        )
         .unwrap();
     assert_eq!(s.status, ScanStatus::Inserted);
     assert_eq!((s.free_cells, s.occupied_cells), (3, 2));
@@ -180,19 +186,29 @@ fn insert_of_a_tiny_scan_by_hand() {
         ..ScanParams::default()
     };
     let s = t2
-        .insert_scan(&pts[..1], &[0.05, 0.05, 0.05], &p, &|| false)
+        .insert_scan(&pts[..1], &[0.05, 0.05, 0.05], &p, Deadline::none())
         .unwrap();
     assert_eq!((s.free_cells, s.occupied_cells), (2, 0));
     // cancellation leaves the tree unchanged
     let before = t.write_ot();
     let s = t
-        .insert_scan(&pts, &[0.05, 0.05, 0.05], &ScanParams::default(), &|| true)
+        .insert_scan(
+            &pts,
+            &[0.05, 0.05, 0.05],
+            &ScanParams::default(),
+            Deadline::none().with_cancel(&|| true),
+        )
         .unwrap();
     assert_eq!(s.status, ScanStatus::Cancelled);
     assert_eq!(t.write_ot(), before);
     assert!(
-        t.insert_scan(&pts, &[f32::NAN, 0.0, 0.0], &ScanParams::default(), &|| false)
-            .is_err()
+        t.insert_scan(
+            &pts,
+            &[f32::NAN, 0.0, 0.0],
+            &ScanParams::default(),
+            Deadline::none()
+        )
+        .is_err()
     );
 }
 
@@ -244,7 +260,7 @@ fn insert_scan_gives_octomaps_tree_byte_for_byte() {
             max_range,
             ..ScanParams::default()
         };
-        let s = t.insert_scan(&pts, &origin, &p, &|| false).unwrap();
+        let s = t.insert_scan(&pts, &origin, &p, Deadline::none()).unwrap();
         assert_eq!(s.status, ScanStatus::Inserted);
     }
     let ours = t.write_ot();
@@ -256,7 +272,7 @@ fn insert_scan_gives_octomaps_tree_byte_for_byte() {
             dense_limit_cells: 0,
             ..ScanParams::default()
         };
-        t2.insert_scan(&pts, &origin, &p, &|| false).unwrap();
+        t2.insert_scan(&pts, &origin, &p, Deadline::none()).unwrap();
     }
     assert!(t2.write_ot() == expected, "sorted path differs from OctoMap's");
     assert_eq!(ours.len(), expected.len());
@@ -291,7 +307,7 @@ fn a_scan_with_more_cells_than_the_node_limit_is_refused_while_traced() {
     };
     let t0 = std::time::Instant::now();
     let err = t
-        .insert_scan(&sphere_points(300, 300.0), &[0.0; 3], &p, &|| false)
+        .insert_scan(&sphere_points(300, 300.0), &[0.0; 3], &p, Deadline::none())
         .unwrap_err();
     assert!(
         matches!(err, OctreeError::ScanTooManyCells { limit: 5_000_000, .. }),
@@ -319,7 +335,12 @@ fn a_scan_whose_beams_cross_too_many_cells_is_refused_before_tracing() {
         false
     };
     let err = t
-        .insert_scan(&[[1.05, 0.05, 0.05]], &[0.05, 0.05, 0.05], &p, &stop)
+        .insert_scan(
+            &[[1.05, 0.05, 0.05]],
+            &[0.05, 0.05, 0.05],
+            &p,
+            Deadline::none().with_cancel(&stop),
+        )
         .unwrap_err();
     assert_eq!(err, OctreeError::ScanTooLarge { cells: 11, limit: 10 });
     assert_eq!(calls.into_inner(), 0, "refused before any beam was traced");
@@ -328,7 +349,7 @@ fn a_scan_whose_beams_cross_too_many_cells_is_refused_before_tracing() {
         ..ScanParams::default()
     };
     let s = t
-        .insert_scan(&[[1.05, 0.05, 0.05]], &[0.05, 0.05, 0.05], &ok, &|| false)
+        .insert_scan(&[[1.05, 0.05, 0.05]], &[0.05, 0.05, 0.05], &ok, Deadline::none())
         .unwrap();
     assert_eq!((s.free_cells, s.occupied_cells), (10, 1));
 }
@@ -343,7 +364,7 @@ fn the_update_stops_when_the_tree_passes_its_node_limit() {
         ..ScanParams::default()
     };
     let err = t
-        .insert_scan(&[[0.25, 0.05, 0.05]], &[0.05, 0.05, 0.05], &p, &|| false)
+        .insert_scan(&[[0.25, 0.05, 0.05]], &[0.05, 0.05, 0.05], &p, Deadline::none())
         .unwrap_err();
     assert_eq!(err, OctreeError::TreeGrewTooLarge { limit: 19 });
     // the same scan fits a limit of 20 nodes
@@ -353,7 +374,7 @@ fn the_update_stops_when_the_tree_passes_its_node_limit() {
         ..ScanParams::default()
     };
     let s = t
-        .insert_scan(&[[0.25, 0.05, 0.05]], &[0.05, 0.05, 0.05], &p, &|| false)
+        .insert_scan(&[[0.25, 0.05, 0.05]], &[0.05, 0.05, 0.05], &p, Deadline::none())
         .unwrap();
     assert_eq!(s.nodes, 20);
 }
@@ -371,7 +392,12 @@ fn a_long_scan_stops_within_a_chunk_of_its_stop_flag() {
         let calls = std::sync::atomic::AtomicUsize::new(0);
         let stop = || calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= 3;
         let s = t
-            .insert_scan(&sphere_points(2_000, 12.0), &[0.0; 3], &p, &stop)
+            .insert_scan(
+                &sphere_points(2_000, 12.0),
+                &[0.0; 3],
+                &p,
+                Deadline::none().with_cancel(&stop),
+            )
             .unwrap();
         assert_eq!(s.status, ScanStatus::Cancelled);
         assert!(t.is_empty(), "stopped while tracing: the tree is unchanged");

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use super::key::OcKey;
 use super::{Octree, OctreeError, OctreeLimits};
+use crate::Deadline;
 
 /// Options of [`Octree::insert_scan`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,7 +64,7 @@ impl ScanParams {
 pub enum ScanStatus {
     /// Every beam was integrated.
     Inserted,
-    /// `should_stop` returned true. Seen while the beams were traced, the tree is
+    /// `deadline` expired (passed or cancelled). Seen while the beams were traced, the tree is
     /// unchanged; seen while the cells were updated, the cells updated so far keep
     /// their update (each cell's update is whole): discard the tree when the scan
     /// must go in all or not at all.
@@ -234,13 +235,14 @@ impl Octree {
     /// limited so their bitsets stay within 256 MiB) or, beyond `dense_limit_cells`, into
     /// sorted Morton-code vectors merged batch by batch, refused once they hold more
     /// distinct cells than `max_nodes`; the update stops once the tree holds more than
-    /// `max_nodes` nodes. `should_stop` is polled per chunk and every 4,096 updates.
+    /// `max_nodes` nodes. `deadline` is polled per chunk and every 4,096 updates.
     ///
     /// ```
+    /// use kinplan_core::Deadline;
     /// use kinplan_core::octree::{CellState, Octree, ScanParams};
     /// let mut t = Octree::new(0.1).unwrap();
     /// // one beam along +x from the centre of cell 32768 to x = 0.45 (cell 32772)
-    /// let s = t.insert_scan(&[[0.45, 0.05, 0.05]], &[0.05, 0.05, 0.05], &ScanParams::default(), &|| false).unwrap();
+    /// let s = t.insert_scan(&[[0.45, 0.05, 0.05]], &[0.05, 0.05, 0.05], &ScanParams::default(), Deadline::none()).unwrap();
     /// assert_eq!((s.free_cells, s.occupied_cells), (4, 1));
     /// assert_eq!(t.state_of_key(&[32771, 32768, 32768]), CellState::Free);
     /// assert_eq!(t.state_of_key(&[32772, 32768, 32768]), CellState::Occupied);
@@ -251,7 +253,7 @@ impl Octree {
         points: &[[f32; 3]],
         origin: &[f32; 3],
         params: &ScanParams,
-        should_stop: &(dyn Fn() -> bool + Sync),
+        deadline: Deadline<'_>,
     ) -> Result<ScanStats, OctreeError> {
         params.validate()?;
         if origin.iter().any(|v| !v.is_finite()) {
@@ -294,9 +296,9 @@ impl Octree {
             .saturating_mul(plan.dims[1])
             .saturating_mul(plan.dims[2]);
         let traced = if cells <= params.dense_limit_cells {
-            self.trace_dense(pts, origin, params.max_range, &plan, should_stop)
+            self.trace_dense(pts, origin, params.max_range, &plan, deadline)
         } else {
-            self.trace_sorted(pts, origin, params, &plan, should_stop)?
+            self.trace_sorted(pts, origin, params, &plan, deadline)?
         };
         stats.trace_us = t0.elapsed().as_micros() as u64;
         let Some(cells) = traced else {
@@ -314,7 +316,7 @@ impl Octree {
                             limit: params.max_nodes,
                         });
                     }
-                    if should_stop() {
+                    if deadline.expired() {
                         stats.update_us = t1.elapsed().as_micros() as u64;
                         stats.nodes = self.num_nodes;
                         return Ok(stats);
@@ -410,14 +412,14 @@ impl Octree {
 
     /// Traces every beam into two bitsets over the key box (free, end points), one
     /// pair per worker, merges them by OR and clears free bits that are end points.
-    /// `None` when `should_stop` fired.
+    /// `None` when `deadline` fired.
     fn trace_dense(
         &self,
         pts: &[[f32; 3]],
         origin: &[f32; 3],
         max_range: f64,
         plan: &ScanPlan,
-        should_stop: &(dyn Fn() -> bool + Sync),
+        deadline: Deadline<'_>,
     ) -> Option<ScanCells> {
         let (lo, dims) = (plan.lo, plan.dims);
         let words = (dims[0] * dims[1] * dims[2]).div_ceil(64);
@@ -435,7 +437,7 @@ impl Octree {
             .map(|w| {
                 let (mut free, mut occ, mut skipped) = (vec![0u64; words], vec![0u64; words], 0usize);
                 for (range, _) in plan.chunks.iter().skip(w).step_by(workers) {
-                    if should_stop() {
+                    if deadline.expired() {
                         return None;
                     }
                     for p in &pts[range.clone()] {
@@ -493,14 +495,14 @@ impl Octree {
 
     /// Traces the beams batch by batch into sorted, deduplicated Morton-code vectors,
     /// merging each batch into the scan's sets; refuses the scan once the sets hold
-    /// more than `max_nodes` cells. `Ok(None)` when `should_stop` fired.
+    /// more than `max_nodes` cells. `Ok(None)` when `deadline` fired.
     fn trace_sorted(
         &self,
         pts: &[[f32; 3]],
         origin: &[f32; 3],
         params: &ScanParams,
         plan: &ScanPlan,
-        should_stop: &(dyn Fn() -> bool + Sync),
+        deadline: Deadline<'_>,
     ) -> Result<Option<ScanCells>, OctreeError> {
         let max_range = params.max_range;
         let (mut free, mut occ, mut skipped) = (Vec::<u64>::new(), Vec::<u64>::new(), 0usize);
@@ -516,7 +518,7 @@ impl Octree {
             let traced: Vec<Option<ChunkKeys>> = plan.chunks[next..end]
                 .par_iter()
                 .map(|(range, cells)| {
-                    if should_stop() {
+                    if deadline.expired() {
                         return None;
                     }
                     let mut ray = Vec::with_capacity(512);
@@ -604,11 +606,11 @@ impl Octree {
         intrinsics: &PinholeIntrinsics,
         camera_pose: &Isometry3<f64>,
         params: &ScanParams,
-        should_stop: &(dyn Fn() -> bool + Sync),
+        deadline: Deadline<'_>,
     ) -> Result<ScanStats, OctreeError> {
         let pts = depth_image_points(depth, width, height, intrinsics, camera_pose)?;
         let o = camera_pose.translation.vector;
-        self.insert_scan(&pts, &[o.x as f32, o.y as f32, o.z as f32], params, should_stop)
+        self.insert_scan(&pts, &[o.x as f32, o.y as f32, o.z as f32], params, deadline)
     }
 }
 

@@ -7,6 +7,7 @@ use rand::Rng;
 
 use super::CartesianParams;
 use super::noise::standard_normal;
+use crate::Deadline;
 use crate::ik::{IkParams, IkSolver, IkStatus, IkTarget};
 use crate::robot::Chain;
 
@@ -130,7 +131,7 @@ pub(crate) fn cartesian_noise<R: Rng>(
     params: &CartesianParams,
     ik: &IkParams,
     rng: &mut R,
-    should_stop: &(dyn Fn() -> bool + Sync),
+    deadline: Deadline<'_>,
     eps: &mut [f64],
 ) -> bool {
     let chain = solver.chain();
@@ -146,7 +147,7 @@ pub(crate) fn cartesian_noise<R: Rng>(
     let ik_seed: u64 = rng.random();
     let target = IkTarget::Pose(perturb_pose(&chain.fk(q), &r));
     eps.iter_mut().for_each(|e| *e = 0.0);
-    match solver.solve(&target, Some(q), ik, ik_seed, should_stop) {
+    match solver.solve(&target, Some(q), ik, ik_seed, deadline) {
         Ok(res) if res.stop_reason == IkStatus::Converged => {
             if let Some(s) = res.solutions.first() {
                 for ((e, a), b) in eps.iter_mut().zip(&s.joints).zip(q) {

@@ -2,34 +2,23 @@
 
 use std::time::Instant;
 
-/// Why a planner stopped early.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Interrupt {
-    Deadline,
-    Cancelled,
-}
+use crate::Deadline;
 
-/// The caller's deadline and cancellation closure.
+/// Why a planner stopped early.
+pub(crate) use crate::Stop as Interrupt;
+
+/// The caller's [`Deadline`] and the request's start.
 #[derive(Clone, Copy)]
 pub(crate) struct Clock<'a> {
     pub start: Instant,
-    pub deadline: Option<Instant>,
-    pub should_stop: &'a (dyn Fn() -> bool + Sync),
+    pub deadline: Deadline<'a>,
 }
 
 impl Clock<'_> {
     /// `Some` once the deadline has passed or the caller asked to stop.
     #[inline]
     pub fn interrupted(&self) -> Option<Interrupt> {
-        if let Some(d) = self.deadline
-            && Instant::now() >= d
-        {
-            return Some(Interrupt::Deadline);
-        }
-        if (self.should_stop)() {
-            return Some(Interrupt::Cancelled);
-        }
-        None
+        self.deadline.stop()
     }
 
     /// Microseconds since the request started.

@@ -105,7 +105,7 @@ pub(crate) fn interior_valid_as<C: StateChecker + ?Sized>(
     clock: &Clock<'_>,
 ) -> Option<bool> {
     if padded {
-        return padded_motion_valid(checker, a, b, resolution, || clock.interrupted().is_some());
+        return padded_motion_valid(checker, a, b, resolution, clock.deadline);
     }
     let span = a
         .iter()

@@ -14,6 +14,7 @@ use super::rrt_connect::{RrtStop, rrt_connect_path};
 use super::stomp::{IterationReport, StompStop, stomp_optimize};
 use super::timing::{TimingParams, time_parameterize};
 use super::{CartesianParams, RrtParams, StompParams};
+use crate::Deadline;
 use crate::collision::StateChecker;
 use crate::ik::{IkParams, IkTarget, solve_ik};
 use crate::robot::Chain;
@@ -95,7 +96,8 @@ pub enum PlanStatus {
     GoalUnreachable,
     /// The deadline passed first (the best trajectory so far is returned).
     Timeout,
-    /// `should_stop` returned true (the best trajectory so far is returned).
+    /// The caller's cancellation was raised (the best trajectory so far is
+    /// returned).
     Cancelled,
 }
 
@@ -142,23 +144,14 @@ pub struct PlanResult {
     pub timings: Timings,
 }
 
-/// The caller's side channel: deadline, cancellation and per-iteration
-/// progress (STOMP/CCSTOMP call it once per iteration, from the calling
-/// thread).
+/// The caller's side channel: the request's [`Deadline`] (instant and
+/// cancellation, checked by every planner loop, the goal IK included) and
+/// per-iteration progress (STOMP/CCSTOMP call it once per iteration, from
+/// the calling thread).
+#[derive(Default)]
 pub struct PlanControl<'a> {
-    pub deadline: Option<Instant>,
-    pub should_stop: &'a (dyn Fn() -> bool + Sync),
+    pub deadline: Deadline<'a>,
     pub progress: Option<&'a mut dyn FnMut(&IterationReport<'_>)>,
-}
-
-impl Default for PlanControl<'_> {
-    fn default() -> Self {
-        Self {
-            deadline: None,
-            should_stop: &|| false,
-            progress: None,
-        }
-    }
 }
 
 fn validate(chain: &Chain, checker_dof: usize, req: &PlanRequest) -> Result<(), PlanError> {
@@ -231,7 +224,6 @@ pub fn plan<C: StateChecker + ?Sized>(
     let clock = Clock {
         start: Instant::now(),
         deadline: ctl.deadline,
-        should_stop: ctl.should_stop,
     };
     let mut noop = |_: &IterationReport<'_>| {};
     let progress: &mut dyn FnMut(&IterationReport<'_>) = match ctl.progress {
@@ -280,17 +272,18 @@ pub fn plan<C: StateChecker + ?Sized>(
                 Some(start),
                 &req.goal_ik,
                 req.seed,
-                ctl.should_stop,
+                clock.deadline,
             )?;
             timings.goal_ik_us = t0.elapsed().as_micros() as u64;
             // solutions come nearest the seed (the start) first
             match ik.solutions.iter().find(|s| checker.is_valid(&s.joints)) {
                 Some(s) => s.joints.clone(),
                 None => {
-                    result.status = if ik.success() {
-                        PlanStatus::InvalidGoal
-                    } else {
-                        PlanStatus::GoalUnreachable
+                    result.status = match clock.interrupted() {
+                        Some(Interrupt::Deadline) => PlanStatus::Timeout,
+                        Some(Interrupt::Cancelled) => PlanStatus::Cancelled,
+                        None if ik.success() => PlanStatus::InvalidGoal,
+                        None => PlanStatus::GoalUnreachable,
                     };
                     return finish(result, timings);
                 }

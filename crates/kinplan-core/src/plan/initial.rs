@@ -44,7 +44,7 @@ fn cartesian_line_joints<C: StateChecker + ?Sized>(
         let prev = out[(i - 1) * dof..].to_vec();
         let target = IkTarget::Pose(line.pose_at_waypoint(i, n));
         let r = solver
-            .solve(&target, Some(&prev), &params, i as u64, clock.should_stop)
+            .solve(&target, Some(&prev), &params, i as u64, clock.deadline)
             .ok()?;
         if r.stop_reason != IkStatus::Converged {
             return None;

@@ -12,6 +12,7 @@ use super::costs::{interior_valid, interior_valid_as, resolution_of};
 use super::error::{PlanError, PlanField, check_vector};
 use super::noise::{standard_normal, stream};
 use super::rrt_tree::{Grown, grow};
+use crate::Deadline;
 use crate::collision::{PaddedMotion, StateChecker, padded_motion, padded_motion_valid};
 use crate::robot::{Chain, JointKind};
 
@@ -24,7 +25,7 @@ pub enum RrtStop {
     SampleBudget,
     /// The deadline passed.
     Deadline,
-    /// The caller's `should_stop` returned true.
+    /// The caller's cancellation was raised.
     Cancelled,
 }
 
@@ -76,7 +77,7 @@ pub fn rrt_connect<C: StateChecker + ?Sized>(
     goal: &[f64],
     params: &RrtParams,
     seed: u64,
-    deadline: Option<Instant>,
+    deadline: Deadline<'_>,
 ) -> Result<RrtOutcome, PlanError> {
     let dof = chain.dof();
     if dof == 0 {
@@ -94,7 +95,6 @@ pub fn rrt_connect<C: StateChecker + ?Sized>(
     let clock = Clock {
         start: Instant::now(),
         deadline,
-        should_stop: &|| false,
     };
     Ok(rrt_connect_path(
         chain, checker, start, goal, params, seed, &clock,
@@ -108,7 +108,7 @@ pub fn rrt_connect<C: StateChecker + ?Sized>(
 /// edge with the padded check ([`prove_lazily`]), so the returned path is as
 /// conservative as if every tree edge had been padded, while the many edges
 /// the search tries and drops are never padded. Shortcutting uses the
-/// checker's own check. Deadline and `should_stop` are checked every sample
+/// checker's own check. The deadline (and its cancellation) is checked every sample
 /// and every connect step. Parameters must be valid.
 pub(crate) fn rrt_connect_path<C: StateChecker + ?Sized>(
     chain: &Chain,
@@ -202,10 +202,9 @@ fn prove_lazily<C: StateChecker + ?Sized>(
     let Ok(found) = grown.path else {
         return grown;
     };
-    let interrupted = || clock.interrupted().is_some();
     let mut proved = start.to_vec();
     for (x, y) in found.chunks_exact(dof).zip(found.chunks_exact(dof).skip(1)) {
-        let at = match padded_motion(checker, x, y, resolution, interrupted) {
+        let at = match padded_motion(checker, x, y, resolution, clock.deadline) {
             PaddedMotion::Free => {
                 proved.extend_from_slice(y);
                 continue;
@@ -279,11 +278,10 @@ pub(super) fn nudged_waypoint<C: StateChecker + ?Sized>(
         return None;
     }
     let coarse = resolution * LAZY_COARSENING;
-    let interrupted = || clock.interrupted().is_some();
     let mut buf = vec![0.0; x.len()];
     let mut m = vec![0.0; x.len()];
     for k in 0..NUDGES {
-        if interrupted() {
+        if clock.interrupted().is_some() {
             return None;
         }
         let sigma = 0.05 * f64::powi(2.0, (k / 3) as i32);
@@ -298,8 +296,8 @@ pub(super) fn nudged_waypoint<C: StateChecker + ?Sized>(
         if checker.is_valid(&m)
             && guided(x, &m, &mut buf)
             && guided(&m, y, &mut buf)
-            && padded_motion_valid(checker, x, &m, resolution, interrupted) == Some(true)
-            && padded_motion_valid(checker, &m, y, resolution, interrupted) == Some(true)
+            && padded_motion_valid(checker, x, &m, resolution, clock.deadline) == Some(true)
+            && padded_motion_valid(checker, &m, y, resolution, clock.deadline) == Some(true)
         {
             return Some(m);
         }

@@ -23,7 +23,7 @@ pub enum StompStop {
     MaxIterations,
     /// The deadline passed.
     Deadline,
-    /// The caller's `should_stop` returned true.
+    /// The caller's cancellation was raised.
     Cancelled,
 }
 
@@ -105,7 +105,7 @@ pub(crate) fn stomp_optimize<C: StateChecker + ?Sized>(
     let dof = chain.dof();
     let n = params.timesteps;
     let free = n - 2;
-    let mats = match StompMatrices::new(free, &|| clock.interrupted().is_some()) {
+    let mats = match StompMatrices::new(free, clock.deadline) {
         Ok(m) => m,
         Err(MatricesError::Stopped | MatricesError::Empty) => {
             // Validated parameters have free ≥ 1: only an interruption lands here.
@@ -161,8 +161,6 @@ pub(crate) fn stomp_optimize<C: StateChecker + ?Sized>(
     let mut weights = vec![0.0; params.max_rollouts + 1];
     let mut delta = vec![DVector::<f64>::zeros(free); dof];
     let mut update = DVector::<f64>::zeros(free);
-    let should_stop = clock.should_stop;
-    let ik_stop = move || clock.interrupted().is_some() || should_stop();
 
     if !evaluated {
         stop = interrupt_stop(clock.interrupted().unwrap_or(Interrupt::Deadline));
@@ -202,7 +200,7 @@ pub(crate) fn stomp_optimize<C: StateChecker + ?Sized>(
                                 cp,
                                 ikp,
                                 &mut rng,
-                                &ik_stop,
+                                clock.deadline,
                                 &mut slot.eps[range],
                             );
                             slot.ik_stats.0 += 1;

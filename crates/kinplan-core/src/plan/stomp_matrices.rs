@@ -6,6 +6,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::Deadline;
+
 /// Central finite-difference acceleration stencil, times 12:
 /// `q̈(t) ≈ (−q(t−2) + 16q(t−1) − 30q(t) + 16q(t+1) − q(t+2)) / (12 dt²)`.
 pub const ACCELERATION_STENCIL: [f64; 5] = [-1.0, 16.0, -30.0, 16.0, -1.0];
@@ -92,9 +94,9 @@ pub struct StompMatrices {
 }
 
 impl StompMatrices {
-    /// The matrices for `free ≥ 1` waypoints; `should_stop` is polled while
+    /// The matrices for `free ≥ 1` waypoints; `deadline` is polled while
     /// the columns of R⁻¹ are scanned.
-    pub fn new(free: usize, should_stop: &dyn Fn() -> bool) -> Result<Self, MatricesError> {
+    pub fn new(free: usize, deadline: Deadline<'_>) -> Result<Self, MatricesError> {
         if free == 0 {
             return Err(MatricesError::Empty);
         }
@@ -110,7 +112,7 @@ impl StompMatrices {
         let mut column = DVector::zeros(free);
         let mut max_diagonal = 0.0_f64;
         for j in 0..free.div_ceil(2) {
-            if j.is_multiple_of(COLUMNS_PER_CHECK) && should_stop() {
+            if j.is_multiple_of(COLUMNS_PER_CHECK) && deadline.expired() {
                 return Err(MatricesError::Stopped);
             }
             column.fill(0.0);
@@ -241,10 +243,6 @@ mod tests {
         (factor, m)
     }
 
-    fn never() -> bool {
-        false
-    }
-
     #[test]
     fn a_rows_carry_the_stencil_and_are_truncated_at_the_ends() {
         let a = finite_difference_matrix(4, 0.5);
@@ -288,7 +286,7 @@ mod tests {
     #[test]
     fn the_banded_factor_reproduces_r() {
         for free in [1, 2, 5, 9, 40] {
-            let m = StompMatrices::new(free, &never).unwrap();
+            let m = StompMatrices::new(free, Deadline::none()).unwrap();
             let u = DMatrix::from_fn(free, free, |i, j| {
                 if j >= i && j - i <= BAND {
                     m.upper[i][j - i]
@@ -305,7 +303,7 @@ mod tests {
     fn noise_and_projection_equal_the_dense_matrices() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         for free in [1, 2, 3, 7, 38, 101] {
-            let m = StompMatrices::new(free, &never).unwrap();
+            let m = StompMatrices::new(free, Deadline::none()).unwrap();
             let (factor, dense_m) = dense_reference(free);
             for _ in 0..5 {
                 let z = DVector::from_fn(free, |_, _| super::super::noise::standard_normal(&mut rng));
@@ -326,7 +324,7 @@ mod tests {
     fn projected_unit_vectors_peak_at_one_over_n() {
         // M's columns are M e_j: each peaks at exactly 1/free.
         for free in [1, 3, 5, 38] {
-            let m = StompMatrices::new(free, &never).unwrap();
+            let m = StompMatrices::new(free, Deadline::none()).unwrap();
             let mut e = DVector::zeros(free);
             let mut col = DVector::zeros(free);
             for j in 0..free {
@@ -342,7 +340,7 @@ mod tests {
     #[test]
     fn the_sampled_noise_has_the_normalised_inverse_covariance() {
         let free = 5;
-        let m = StompMatrices::new(free, &never).unwrap();
+        let m = StompMatrices::new(free, Deadline::none()).unwrap();
         let r_inv = r_by_hand(free).cholesky().unwrap().inverse();
         let covariance = &r_inv / r_inv.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
         let sigma = 0.3;
@@ -370,7 +368,7 @@ mod tests {
         // 10,000 timesteps: a dense R⁻¹ would take 800 MB; the banded
         // matrices hold a few vectors.
         let free = 9_998;
-        let m = StompMatrices::new(free, &never).unwrap();
+        let m = StompMatrices::new(free, Deadline::none()).unwrap();
         assert_eq!(m.free(), free);
         let mut e = DVector::zeros(free);
         e[free / 2] = 1.0;
@@ -378,16 +376,16 @@ mod tests {
         m.project(&e, &mut col);
         assert!(col.iter().all(|v| v.is_finite()));
         // A raised stop flag ends the build at the next check.
-        let calls = std::cell::Cell::new(0);
-        let stop = || {
-            calls.set(calls.get() + 1);
-            calls.get() > 2
-        };
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        let stop = || calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed) >= 2;
         assert_eq!(
-            StompMatrices::new(free, &stop).unwrap_err(),
+            StompMatrices::new(free, Deadline::none().with_cancel(&stop)).unwrap_err(),
             MatricesError::Stopped
         );
-        assert_eq!(calls.get(), 3);
-        assert_eq!(StompMatrices::new(0, &never).unwrap_err(), MatricesError::Empty);
+        assert_eq!(calls.load(std::sync::atomic::Ordering::Relaxed), 3);
+        assert_eq!(
+            StompMatrices::new(0, Deadline::none()).unwrap_err(),
+            MatricesError::Empty
+        );
     }
 }

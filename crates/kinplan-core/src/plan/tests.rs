@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 
 use super::toy::{JointBoxes, PlanarWorld, fine_valid};
 use super::*;
+use crate::Deadline;
 use crate::collision::StateChecker;
 use crate::robot::{Chain, builtin_chain};
 
@@ -139,7 +140,7 @@ fn a_10_ms_budget_answers_within_about_10_ms() {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
         let r = pool.install(|| {
             let ctl = PlanControl {
-                deadline: Some(t0 + Duration::from_millis(10)),
+                deadline: Deadline::at(t0 + Duration::from_millis(10)),
                 ..Default::default()
             };
             plan(&chain, &w, &req, ctl).unwrap()
@@ -170,7 +171,7 @@ fn stomp_with_the_most_timesteps_answers_by_its_deadline() {
         let t0 = Instant::now();
         let r = pool.install(|| {
             let ctl = PlanControl {
-                deadline: Some(t0 + Duration::from_millis(budget_ms)),
+                deadline: Deadline::at(t0 + Duration::from_millis(budget_ms)),
                 ..Default::default()
             };
             plan(&chain, &w, &req, ctl).unwrap()
@@ -195,7 +196,7 @@ fn cancellation_is_a_status() {
     let mut req = blocked_request(Algorithm::Stomp);
     req.stomp.initial = InitialTrajectory::StraightLine;
     let ctl = PlanControl {
-        should_stop: &stop,
+        deadline: Deadline::none().with_cancel(&stop),
         ..Default::default()
     };
     let r = plan(&chain, &w, &req, ctl).unwrap();
@@ -461,6 +462,42 @@ fn a_pose_goal_is_solved_by_ik_and_reached() {
     );
 }
 
+/// The goal IK runs under the request's deadline: an unreachable pose with
+/// restarts enough for seconds is cut at the deadline and reported as a
+/// timeout (or a cancellation), not as an unreachable goal.
+#[test]
+fn the_goal_ik_stops_at_the_deadline_and_says_so() {
+    let chain = builtin_chain("ur5").unwrap();
+    let w = JointBoxes {
+        dof: 6,
+        limit: 2.0 * std::f64::consts::PI,
+        boxes: vec![],
+    };
+    let mut req = PlanRequest {
+        start: vec![0.0, -1.2, 1.4, -0.8, 1.1, 0.2],
+        goal: Goal::Pose(nalgebra::Isometry3::translation(5.0, 0.0, 0.0)),
+        algorithm: Algorithm::RrtConnect,
+        ..Default::default()
+    };
+    req.goal_ik.max_restarts = usize::MAX;
+    req.goal_ik.time_budget = None;
+    let t0 = Instant::now();
+    let ctl = PlanControl {
+        deadline: Deadline::at(t0 + Duration::from_millis(20)),
+        ..Default::default()
+    };
+    let r = plan(&chain, &w, &req, ctl).unwrap();
+    assert_eq!(r.status, PlanStatus::Timeout);
+    // generous slack for a loaded 2-core machine
+    assert!(t0.elapsed() < Duration::from_millis(500), "{:?}", t0.elapsed());
+    let stop = || true;
+    let ctl = PlanControl {
+        deadline: Deadline::none().with_cancel(&stop),
+        ..Default::default()
+    };
+    assert_eq!(plan(&chain, &w, &req, ctl).unwrap().status, PlanStatus::Cancelled);
+}
+
 #[test]
 fn resampling_keeps_every_vertex_and_the_count() {
     let path = [0.0, 0.0, 1.0, 0.0, 1.0, 3.0];
@@ -626,8 +663,7 @@ fn a_refused_motion_is_replaced_through_a_nudged_waypoint_proved_free() {
     };
     let clock = super::clock::Clock {
         start: Instant::now(),
-        deadline: None,
-        should_stop: &|| false,
+        deadline: Deadline::none(),
     };
     for seed in 0..5 {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
@@ -660,7 +696,7 @@ fn a_refused_motion_is_replaced_through_a_nudged_waypoint_proved_free() {
         },
     ));
     let stopped = super::clock::Clock {
-        should_stop: &|| true,
+        deadline: Deadline::none().with_cancel(&|| true),
         ..clock
     };
     assert_eq!(
@@ -708,13 +744,13 @@ fn valid_and_the_status_never_contradict_each_other() {
     let mut req = blocked_request(Algorithm::Stomp);
     req.stomp.initial = InitialTrajectory::StraightLine;
     let past = PlanControl {
-        deadline: Some(Instant::now()),
+        deadline: Deadline::at(Instant::now()),
         ..Default::default()
     };
     record(plan(&planar, &world, &req, past).unwrap());
     let stop = || true;
     let cancelled = PlanControl {
-        should_stop: &stop,
+        deadline: Deadline::none().with_cancel(&stop),
         ..Default::default()
     };
     record(plan(&planar, &world, &req, cancelled).unwrap());

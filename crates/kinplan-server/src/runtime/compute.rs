@@ -1,7 +1,8 @@
 //! Admission control and the CPU pool. Every request takes an admission
 //! permit (or is shed with RESOURCE_EXHAUSTED); long computations run on a
 //! dedicated rayon pool, never on the async runtime, and see the request's
-//! deadline and cancellation through a [`Budget`].
+//! deadline and cancellation through a [`Budget`] (its
+//! [`Budget::deadline`] is what the domain polls).
 
 use std::future::Future;
 use std::panic::AssertUnwindSafe;
@@ -14,33 +15,8 @@ use std::time::{Duration, Instant};
 use tokio::sync::{OwnedSemaphorePermit, Semaphore, oneshot};
 use tonic::Status;
 
-use super::deadline::{RequestDeadline, deadline_after, effective_timeout, grpc_timeout};
-
-/// What a running computation may spend: a deadline and a cancellation flag
-/// raised when the caller goes away.
-#[derive(Debug, Clone)]
-pub struct Budget {
-    deadline: Option<Instant>,
-    cancelled: Arc<AtomicBool>,
-}
-
-impl Budget {
-    pub fn new(deadline: Option<Instant>) -> Self {
-        Self {
-            deadline,
-            cancelled: Arc::new(AtomicBool::new(false)),
-        }
-    }
-
-    pub fn deadline(&self) -> Option<Instant> {
-        self.deadline
-    }
-
-    /// True once the deadline has passed or the caller has gone.
-    pub fn should_stop(&self) -> bool {
-        self.cancelled.load(Ordering::Relaxed) || self.deadline.is_some_and(|d| Instant::now() >= d)
-    }
-}
+pub use super::deadline::Budget;
+use super::deadline::{RequestDeadline, call_deadline, grpc_timeout};
 
 /// Raises the cancellation flag if the request's future is dropped (caller
 /// gone, deadline) before the work's answer arrived; disarmed on completion so
@@ -196,18 +172,18 @@ impl Compute {
             return *deadline;
         }
         let header = grpc_timeout(request.metadata().as_ref());
-        effective_timeout(header, self.default_timeout).and_then(deadline_after)
+        call_deadline(header, self.default_timeout)
     }
 
     /// Runs `work` on the CPU pool. Answers DEADLINE_EXCEEDED when the
-    /// deadline passes first (the work sees `should_stop()` and ends early)
+    /// deadline passes first (the work polls [`Budget::deadline`] and ends early)
     /// and INTERNAL if the work panics.
     pub async fn run<T, F>(&self, budget: &Budget, work: F) -> Result<T, Status>
     where
         T: Send + 'static,
         F: FnOnce(&Budget) -> T + Send + 'static,
     {
-        if budget.should_stop() {
+        if budget.expired() {
             return Err(deadline_exceeded());
         }
         if self.inline {
@@ -222,21 +198,21 @@ impl Compute {
             });
         }
         let mut cancel_on_drop = CancelOnDrop {
-            flag: budget.cancelled.clone(),
+            flag: budget.cancel_flag().clone(),
             armed: true,
         };
         let (tx, rx) = oneshot::channel();
         let inner = budget.clone();
         let running = self.running.clone();
         self.pool.spawn(move || {
-            if inner.should_stop() {
+            if inner.expired() {
                 return;
             }
             let _running = Running::start(&running);
             let out = std::panic::catch_unwind(AssertUnwindSafe(|| work(&inner)));
             let _ = tx.send(out);
         });
-        let received = match budget.deadline {
+        let received = match budget.call_deadline() {
             Some(deadline) => tokio::time::timeout_at(deadline.into(), rx)
                 .await
                 .map_err(|_| deadline_exceeded())?,
@@ -334,7 +310,7 @@ mod tests {
         let started = Instant::now();
         let result = compute
             .run(&budget, |b| {
-                while !b.should_stop() {
+                while !b.deadline().expired() {
                     std::hint::spin_loop();
                 }
                 1
@@ -346,7 +322,7 @@ mod tests {
         // A finished run leaves the budget usable for the next one.
         let reused = Budget::new(None);
         assert_eq!(compute.run(&reused, |_| 1).await.unwrap(), 1);
-        assert!(!reused.should_stop());
+        assert!(!reused.expired());
         assert_eq!(compute.run(&reused, |_| 2).await.unwrap(), 2);
         let panicking = compute
             .run(&Budget::new(None), |_| -> i32 { panic!("boom") })

@@ -1,9 +1,16 @@
 //! Deadlines: the `grpc-timeout` header, the server's default, the instant a
-//! call must be answered by, and the earlier "soft" deadline that leaves time
-//! for the reply. Shared by the transport (the guard layer sets a call's
-//! deadline) and the handlers (admission and the domain's time budgets).
+//! call must be answered by, the earlier "soft" deadline that leaves time
+//! for the reply, and the one derivation of the [`Deadline`] the domain
+//! sees ([`Budget::deadline`]: the soft deadline and the cancellation raised
+//! when the caller goes away). Shared by the transport (the guard layer sets
+//! a call's deadline) and the handlers (admission and the domain's work).
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+
+use kinplan_core::Deadline;
+use kinplan_core::deadline::earliest;
 
 /// The instant a call must be answered by (`None`: no deadline), set by the
 /// guard from `grpc-timeout` and the server's default, read by admission.
@@ -23,20 +30,73 @@ pub fn answer_reserve(timeout: Duration) -> Duration {
     (timeout / 20).min(Duration::from_millis(2))
 }
 
-/// The earlier (or shorter) of two optional limits, `None` meaning no
-/// limit: the one derivation behind every "this or that, whichever comes
-/// first" of the server (a call's timeout, a request's time budget against
-/// its deadline).
-pub fn earlier<T: Ord>(a: Option<T>, b: Option<T>) -> Option<T> {
-    match (a, b) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    }
-}
-
 /// The call's timeout: the shorter of `grpc-timeout` and the server's default.
 pub fn effective_timeout(header: Option<Duration>, default: Option<Duration>) -> Option<Duration> {
-    earlier(header, default)
+    earliest(header, default)
+}
+
+/// The instant a call starting now must be answered by: its
+/// [`effective_timeout`] from now, less [`deadline_after`]'s margin; `None`
+/// without a timeout (or one too large for `Instant`). The one derivation
+/// behind the guard layer, the in-process transport, admission outside a
+/// server and `StreamIk` (which takes no default).
+pub fn call_deadline(header: Option<Duration>, default: Option<Duration>) -> Option<Instant> {
+    effective_timeout(header, default).and_then(deadline_after)
+}
+
+/// What a request's work may spend: the call's deadline and a cancellation
+/// flag raised when the caller goes away (the request's future is dropped).
+/// The work sees them as one [`Deadline`] ([`Budget::deadline`]); a client's
+/// own budget (`options.time_budget`) is folded in with
+/// [`Deadline::min_with_budget`].
+#[derive(Debug, Clone)]
+pub struct Budget {
+    /// When the call must be answered (`None`: never).
+    call: Option<Instant>,
+    /// `call` less the reply reserve ([`soft_deadline`]), taken when the
+    /// budget was made.
+    soft: Option<Instant>,
+    cancelled: Arc<AtomicBool>,
+}
+
+impl Budget {
+    /// The budget of a call to be answered by `call`.
+    pub fn new(call: Option<Instant>) -> Self {
+        Self {
+            call,
+            soft: soft_deadline(call),
+            cancelled: Arc::new(AtomicBool::new(false)),
+        }
+    }
+
+    /// When the call must be answered (the pool's timer answers
+    /// DEADLINE_EXCEEDED then).
+    pub fn call_deadline(&self) -> Option<Instant> {
+        self.call
+    }
+
+    /// The request's deadline as the domain sees it: the soft deadline (the
+    /// call's, less a reply reserve, so that an answer cut short still
+    /// arrives) and the caller's cancellation.
+    pub fn deadline(&self) -> Deadline<'_> {
+        Deadline::at_opt(self.soft).with_cancel(&*self.cancelled)
+    }
+
+    /// True once the caller has gone.
+    pub fn cancelled(&self) -> bool {
+        self.cancelled.load(Ordering::Relaxed)
+    }
+
+    /// True once the call's deadline has passed or the caller has gone:
+    /// work not yet started is not started.
+    pub fn expired(&self) -> bool {
+        self.cancelled() || self.call.is_some_and(|d| Instant::now() >= d)
+    }
+
+    /// The flag raised when the caller goes away.
+    pub(crate) fn cancel_flag(&self) -> &Arc<AtomicBool> {
+        &self.cancelled
+    }
 }
 
 /// Parses the `grpc-timeout` header: digits and a unit (H M S m u n),
@@ -73,23 +133,6 @@ pub fn reply_reserve(remaining: Duration) -> Duration {
         .min(remaining / 2)
 }
 
-/// A request's time budget as a duration (for the domain's `time_budget`
-/// parameters): the shorter of its `explicit` budget and the time left until
-/// `soft` (a [`soft_deadline`]).
-pub fn time_budget(explicit: Option<Duration>, soft: Option<Instant>) -> Option<Duration> {
-    earlier(explicit, soft.map(kinplan_core::ik::budget_until))
-}
-
-/// A request's time budget as an instant (for work that checks a deadline):
-/// the earlier of `explicit` from now and the soft deadline of the call's
-/// `deadline`. An explicit budget too large for `Instant` is no limit.
-pub fn work_deadline(explicit: Option<Duration>, deadline: Option<Instant>) -> Option<Instant> {
-    earlier(
-        explicit.and_then(|b| Instant::now().checked_add(b)),
-        soft_deadline(deadline),
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -110,32 +153,63 @@ mod tests {
     }
 
     #[test]
-    fn the_earlier_limit_applies_and_none_is_no_limit() {
-        assert_eq!(earlier(Some(3), Some(5)), Some(3));
-        assert_eq!(earlier(Some(5), Some(3)), Some(3));
-        assert_eq!(earlier(Some(5), None), Some(5));
-        assert_eq!(earlier(None, Some(3)), Some(3));
-        assert_eq!(earlier::<u32>(None, None), None);
+    fn the_shorter_timeout_applies_and_none_is_no_limit() {
         let ms = Duration::from_millis;
         assert_eq!(effective_timeout(Some(ms(10)), Some(ms(60_000))), Some(ms(10)));
         assert_eq!(effective_timeout(None, Some(ms(60_000))), Some(ms(60_000)));
+        assert_eq!(call_deadline(None, None), None);
+        assert_eq!(call_deadline(Some(Duration::MAX), None), None);
+        let before = Instant::now();
+        let d = call_deadline(Some(ms(10)), Some(ms(60_000))).unwrap();
+        // 10 ms less the margin of a twentieth (0.5 ms)
+        assert!(
+            d >= before + ms(9) && d <= Instant::now() + ms(10),
+            "{:?}",
+            d - before
+        );
     }
 
-    /// An explicit budget shorter than the deadline's applies from now; a
-    /// longer one (or one too large for `Instant`) gives way to the soft deadline.
+    /// The domain's deadline is the soft deadline with the caller's
+    /// cancellation; an explicit budget shorter than it applies from now, a
+    /// longer one (or one too large for `Instant`) gives way to it.
     #[test]
     fn the_work_deadline_is_the_earlier_of_budget_and_soft_deadline() {
         let ms = Duration::from_millis;
-        let deadline = Instant::now() + ms(60_000);
-        let soft = soft_deadline(Some(deadline)).unwrap();
+        let call = Instant::now() + ms(60_000);
+        let budget = Budget::new(Some(call));
+        let soft = budget.deadline().instant().unwrap();
+        // a 60 s call keeps the 100 ms reserve ceiling
+        assert_eq!(call - soft, ms(100));
+        assert_eq!(budget.call_deadline(), Some(call));
         let before = Instant::now();
-        let short = work_deadline(Some(ms(5)), Some(deadline)).unwrap();
+        let short = budget.deadline().min_with_budget(Some(ms(5))).instant().unwrap();
         assert!(short >= before + ms(5) && short < soft);
-        assert_eq!(work_deadline(Some(ms(120_000)), Some(deadline)), Some(soft));
-        assert_eq!(work_deadline(Some(Duration::MAX), Some(deadline)), Some(soft));
-        assert_eq!(work_deadline(Some(Duration::MAX), None), None);
-        assert_eq!(work_deadline(None, None), None);
-        assert!(work_deadline(Some(ms(5)), None).unwrap() >= before + ms(5));
+        let long = budget.deadline().min_with_budget(Some(ms(120_000)));
+        assert_eq!(long.instant(), Some(soft));
+        let huge = budget.deadline().min_with_budget(Some(Duration::MAX));
+        assert_eq!(huge.instant(), Some(soft));
+        let none = Budget::new(None);
+        assert_eq!(
+            none.deadline().min_with_budget(Some(Duration::MAX)).instant(),
+            None
+        );
+        assert_eq!(none.deadline().instant(), None);
+        assert!(none.deadline().min_with_budget(Some(ms(5))).instant().unwrap() >= before + ms(5));
+    }
+
+    /// The caller going away stops the work through every deadline derived
+    /// from the budget, clones included; the call's deadline ends it too.
+    #[test]
+    fn cancellation_reaches_the_domain_deadline() {
+        let budget = Budget::new(Some(Instant::now() + Duration::from_secs(60)));
+        let clone = budget.clone();
+        assert!(!budget.expired() && !budget.deadline().expired());
+        budget.cancel_flag().store(true, Ordering::Relaxed);
+        assert!(clone.cancelled() && clone.expired());
+        assert_eq!(clone.deadline().stop(), Some(kinplan_core::Stop::Cancelled));
+        let past = Budget::new(Some(Instant::now() - Duration::from_millis(1)));
+        assert!(past.expired() && !past.cancelled());
+        assert_eq!(past.deadline().stop(), Some(kinplan_core::Stop::Deadline));
     }
 
     #[test]
@@ -146,19 +220,6 @@ mod tests {
         assert!(reserve >= Duration::from_micros(1100) && reserve <= Duration::from_micros(1200));
         let soft = soft_deadline(Some(now + Duration::from_secs(60))).unwrap();
         assert_eq!((now + Duration::from_secs(60)) - soft, Duration::from_millis(100));
-        assert_eq!(
-            time_budget(Some(Duration::from_millis(3)), None),
-            Some(Duration::from_millis(3))
-        );
-        assert!(
-            time_budget(
-                Some(Duration::from_secs(3)),
-                Some(now + Duration::from_millis(10))
-            )
-            .unwrap()
-                <= Duration::from_millis(10)
-        );
-        assert_eq!(time_budget(None, None), None);
     }
 
     /// The reserve on exact durations (no clock involved): a tenth of the time

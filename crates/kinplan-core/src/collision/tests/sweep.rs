@@ -289,7 +289,7 @@ fn an_unlimited_prismatic_joint_after_a_revolute_one_cannot_be_padded() {
     assert!(plain.is_valid(&[0.0, 0.5]));
     assert_eq!(plain.padded_valid(&[0.0, 0.5], &[0.01, 0.01]), None);
     assert_eq!(
-        padded_motion_valid(&plain, &[0.0, 0.5], &[0.1, 0.6], 0.05, || false),
+        padded_motion_valid(&plain, &[0.0, 0.5], &[0.1, 0.6], 0.05, crate::Deadline::none()),
         Some(false)
     );
     assert!(plain.motion_valid(&[0.0, 0.5], &[0.1, 0.6]));
@@ -548,7 +548,7 @@ fn a_motion_through_an_obstacle_is_refused_before_grazing_pieces_are_halved() {
     assert!(checker.is_valid(&a) && checker.is_valid(&b));
     let counting = CountingPads::new(&checker, true);
     assert_eq!(
-        padded_motion_valid(&counting, &a, &b, 0.05, || false),
+        padded_motion_valid(&counting, &a, &b, 0.05, crate::Deadline::none()),
         Some(false)
     );
     // breadth first: the 16 midpoints are checked before any piece is
@@ -579,13 +579,31 @@ fn rrt_connect_under_padded_motions_replaces_a_grazing_edge() {
     assert!(plain.motion_valid(&a, &b) && !fine_motion_valid(&plain, &a, &b, 1e-4));
     let chain = padded.model().chain().clone();
     for seed in 0..4 {
-        let out = rrt_connect(&chain, &plain, &a, &b, &RrtParams::default(), seed, None).unwrap();
+        let out = rrt_connect(
+            &chain,
+            &plain,
+            &a,
+            &b,
+            &RrtParams::default(),
+            seed,
+            crate::Deadline::none(),
+        )
+        .unwrap();
         assert_eq!(
             out.path.len(),
             6,
             "the interpolated search takes the straight motion"
         );
-        let out = rrt_connect(&chain, &padded, &a, &b, &RrtParams::default(), seed, None).unwrap();
+        let out = rrt_connect(
+            &chain,
+            &padded,
+            &a,
+            &b,
+            &RrtParams::default(),
+            seed,
+            crate::Deadline::none(),
+        )
+        .unwrap();
         assert_eq!(out.stop, RrtStop::Connected);
         assert!(out.path.len() > 6, "seed {seed}: a detour");
         assert_eq!(
@@ -676,8 +694,8 @@ fn halves_that_skip_the_parts_proved_over_their_piece_accept_more_and_stay_sound
         if !(plain.is_valid(&a) && plain.is_valid(&b)) {
             continue;
         }
-        let spared = padded_motion_valid(&counting, &a, &b, 0.05, || false).unwrap();
-        let full = padded_motion_valid(&unspared, &a, &b, 0.05, || false).unwrap();
+        let spared = padded_motion_valid(&counting, &a, &b, 0.05, crate::Deadline::none()).unwrap();
+        let full = padded_motion_valid(&unspared, &a, &b, 0.05, crate::Deadline::none()).unwrap();
         assert!(spared || !full, "{a:?} → {b:?}: accepted by full checks only");
         if spared {
             accepted += 1;
@@ -786,19 +804,25 @@ fn a_refused_motion_says_where_it_was_refused() {
         },
     );
     let checker = checker_with(model_of(SWING), vec![wall], true);
-    match padded_motion(&checker, &[0.0], &[1.6], 0.05, || false) {
+    match padded_motion(&checker, &[0.0], &[1.6], 0.05, crate::Deadline::none()) {
         PaddedMotion::Refused { at } => {
             assert!((at * 1.6 - 1.2).abs() <= 0.1, "refused at θ = {}", at * 1.6)
         }
         other => panic!("{other:?}"),
     }
     assert_eq!(
-        padded_motion(&checker, &[-1.0], &[-2.5], 0.05, || false),
+        padded_motion(&checker, &[-1.0], &[-2.5], 0.05, crate::Deadline::none()),
         PaddedMotion::Free
     );
     // a free motion of at least 32 pieces: asked at the 32nd check
     assert_eq!(
-        padded_motion(&checker, &[-3.0], &[1.0], 0.05, || true),
+        padded_motion(
+            &checker,
+            &[-3.0],
+            &[1.0],
+            0.05,
+            crate::Deadline::none().with_cancel(&|| true)
+        ),
         PaddedMotion::Interrupted
     );
 }

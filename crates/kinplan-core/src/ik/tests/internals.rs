@@ -61,7 +61,7 @@ fn error_history_on_request() {
         ..IkParams::default()
     };
     let seed = chain.mid_limits();
-    let r = solve_ik(&chain, &target, Some(&seed), &params, 4, &never).unwrap();
+    let r = solve_ik(&chain, &target, Some(&seed), &params, 4, Deadline::none()).unwrap();
     let s = &r.solutions[0];
     assert_eq!(s.history.len(), s.iterations + 1);
     let at_seed = chain.fk(&seed);
@@ -76,7 +76,15 @@ fn error_history_on_request() {
         let (a, b) = (w[0].0.powi(2) + w[0].1.powi(2), w[1].0.powi(2) + w[1].1.powi(2));
         assert!(b <= a * (1.0 + 1e-12), "error rose: {w:?}");
     }
-    let quiet = solve_ik(&chain, &target, Some(&seed), &IkParams::default(), 4, &never).unwrap();
+    let quiet = solve_ik(
+        &chain,
+        &target,
+        Some(&seed),
+        &IkParams::default(),
+        4,
+        Deadline::none(),
+    )
+    .unwrap();
     assert!(quiet.solutions[0].history.is_empty());
     assert_eq!(quiet.solutions[0].joints, s.joints);
 }
@@ -93,9 +101,9 @@ fn reused_workspace_gives_the_fresh_answer() {
     let mut workspace = IkWorkspace::new(&ur5); // wrong chain: must be replaced
     for i in 0..20 {
         let target = IkTarget::Pose(panda.fk(&random_joints(&panda, &mut rng)));
-        let fresh = solve_ik(&panda, &target, None, &params, i, &never).unwrap();
+        let fresh = solve_ik(&panda, &target, None, &params, i, Deadline::none()).unwrap();
         let mut solver = IkSolver::with_workspace(&panda, workspace);
-        let reused = solver.solve(&target, None, &params, i, &never).unwrap();
+        let reused = solver.solve(&target, None, &params, i, Deadline::none()).unwrap();
         workspace = solver.into_workspace();
         assert_eq!(fresh.solutions.len(), reused.solutions.len(), "target {i}");
         for (a, b) in fresh.solutions.iter().zip(&reused.solutions) {
@@ -124,7 +132,7 @@ fn newton_svd_converges_like_the_jacobian_inverse_on_a_six_axis_arm() {
             .iter()
             .enumerate()
             .map(|(i, t)| {
-                let r = solve_ik(&chain, t, None, &p, i as u64, &never).unwrap();
+                let r = solve_ik(&chain, t, None, &p, i as u64, Deadline::none()).unwrap();
                 assert!(r.success(), "{method:?} target {i}");
                 r.attempts
             })

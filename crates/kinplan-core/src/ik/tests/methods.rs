@@ -15,7 +15,7 @@ proptest! {
             let target = IkTarget::Pose(chain.fk(&random_joints(&chain, &mut rng)));
             for method in [IkMethod::LevenbergMarquardt, IkMethod::JacobianInverse, IkMethod::Newton] {
                 let p = jacobian_params(method, LinearSolverKind::SvdPseudoinverse);
-                let r = solve_ik(&chain, &target, None, &p, solver_seed(seed), &never).unwrap();
+                let r = solve_ik(&chain, &target, None, &p, solver_seed(seed), Deadline::none()).unwrap();
                 if method == IkMethod::Newton && !r.success() {
                     // Newton (S2 eq. 29/30) has no damping and may stall on the 7-joint
                     // Panda even with restarts (seed 17532964656178293055): it must then
@@ -54,7 +54,7 @@ proptest! {
                 // arm): give them sweeps rather than restarts.
                 let max_iterations = if method.is_jacobian_method() { 100 } else { 5_000 };
                 let p = IkParams { method, max_restarts: 300, max_iterations, ..IkParams::default() };
-                let r = solve_ik(&chain, &target, None, &p, solver_seed(seed), &never).unwrap();
+                let r = solve_ik(&chain, &target, None, &p, solver_seed(seed), Deadline::none()).unwrap();
                 assert_reaches(&chain, &target, &r, &p, &format!("{arm} {method:?}"));
             }
         }
@@ -70,7 +70,7 @@ fn pose_roundtrip_rlxa() {
         let target = IkTarget::Pose(chain.fk(&random_joints(&chain, &mut rng)));
         for method in [IkMethod::JacobianInverse, IkMethod::LevenbergMarquardt] {
             let p = jacobian_params(method, LinearSolverKind::AngleRelaxation);
-            let r = solve_ik(&chain, &target, None, &p, 5, &never).unwrap();
+            let r = solve_ik(&chain, &target, None, &p, 5, Deadline::none()).unwrap();
             assert_reaches(&chain, &target, &r, &p, &format!("{arm} {method:?}+RLXA"));
         }
     }
@@ -89,7 +89,7 @@ fn newton_rlxa_returns_a_flagged_answer() {
         ..jacobian_params(IkMethod::Newton, LinearSolverKind::AngleRelaxation)
     };
     let seed = chain.mid_limits();
-    let r = solve_ik(&chain, &target, Some(&seed), &p, 1, &never).unwrap();
+    let r = solve_ik(&chain, &target, Some(&seed), &p, 1, Deadline::none()).unwrap();
     // No attempt converges: the answer is the flagged best attempt, after every
     // attempt (the seeded one and 3 restarts) ran out.
     assert!(!r.success());
@@ -135,7 +135,7 @@ fn newton_rlxa_returns_a_flagged_answer() {
             max_restarts: restarts,
             ..p
         };
-        let r = solve_ik(&chain, &target, Some(&seed), &p, 1, &never).unwrap();
+        let r = solve_ik(&chain, &target, Some(&seed), &p, 1, Deadline::none()).unwrap();
         r.best().unwrap().position_error
     };
     let prefix: Vec<f64> = (0..=3).map(best_of).collect();
@@ -163,7 +163,7 @@ fn heuristics_converge_on_planar_chains() {
                 position_tolerance: 1e-5,
                 ..IkParams::default()
             };
-            let r = solve_ik(&chain, &target, Some(&vec![0.0; n]), &p, 3, &never).unwrap();
+            let r = solve_ik(&chain, &target, Some(&vec![0.0; n]), &p, 3, Deadline::none()).unwrap();
             assert_reaches(&chain, &target, &r, &p, &format!("planar_{n} {method:?}"));
         }
     }
@@ -182,7 +182,7 @@ fn ccd_reaches_a_nearby_pose() {
         max_restarts: 20,
         ..IkParams::default()
     };
-    let r = solve_ik(&chain, &target, Some(&seed), &p, 3, &never).unwrap();
+    let r = solve_ik(&chain, &target, Some(&seed), &p, 3, Deadline::none()).unwrap();
     assert_reaches(&chain, &target, &r, &p, "ur5 CCD pose");
 }
 
@@ -203,7 +203,7 @@ fn length_relaxation_3d_reaches_positions() {
                 max_restarts: 20,
                 ..IkParams::default()
             };
-            let r = solve_ik(&chain, &target, None, &p, 3, &never).unwrap();
+            let r = solve_ik(&chain, &target, None, &p, 3, Deadline::none()).unwrap();
             assert_reaches(&chain, &target, &r, &p, &format!("{arm} 3-D length relaxation"));
         }
     }
@@ -235,7 +235,7 @@ fn prismatic_joints() {
             max_iterations: 2000,
             ..IkParams::default()
         };
-        let r = solve_ik(&chain, &target, None, &p, 1, &never).unwrap();
+        let r = solve_ik(&chain, &target, None, &p, 1, Deadline::none()).unwrap();
         assert_reaches(&chain, &target, &r, &p, &format!("prismatic {method:?}"));
     }
     for method in [IkMethod::Fabrik, IkMethod::LengthRelaxation] {
@@ -243,7 +243,7 @@ fn prismatic_joints() {
             method,
             ..IkParams::default()
         };
-        match solve_ik(&chain, &target, None, &p, 1, &never) {
+        match solve_ik(&chain, &target, None, &p, 1, Deadline::none()) {
             Err(IkError::MethodCannotServe { reason, .. }) => assert!(reason.contains("j2")),
             other => panic!("expected MethodCannotServe, got {other:?}"),
         }
@@ -260,7 +260,7 @@ fn orientation_target_refused_by_point_heuristics() {
             ..IkParams::default()
         };
         assert!(matches!(
-            solve_ik(&chain, &target, None, &p, 1, &never),
+            solve_ik(&chain, &target, None, &p, 1, Deadline::none()),
             Err(IkError::MethodCannotServe { method: m, .. }) if m == method
         ));
     }

@@ -11,14 +11,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::*;
+use crate::Deadline;
 use crate::linalg::LinearSolverKind;
 use crate::robot::{BUILTIN_NAMES, Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
 const ARMS: [&str; 6] = crate::robot::ARM_NAMES;
-
-fn never() -> bool {
-    false
-}
 
 fn random_joints(chain: &Chain, rng: &mut ChaCha8Rng) -> Vec<f64> {
     chain.limits().map(|(lo, hi)| rng.random_range(lo..=hi)).collect()

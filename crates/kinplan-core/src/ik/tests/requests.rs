@@ -19,8 +19,8 @@ fn deterministic_for_a_fixed_seed() {
             max_restarts: 60,
             ..IkParams::default()
         };
-        let a = solve_ik(&chain, &target, None, &p, 77, &never).unwrap();
-        let b = solve_ik(&chain, &target, None, &p, 77, &never).unwrap();
+        let a = solve_ik(&chain, &target, None, &p, 77, Deadline::none()).unwrap();
+        let b = solve_ik(&chain, &target, None, &p, 77, Deadline::none()).unwrap();
         let strip = |r: &IkResult| -> Vec<(Vec<f64>, usize, usize)> {
             r.solutions
                 .iter()
@@ -43,7 +43,7 @@ fn multiple_distinct_solutions_ranked_by_seed_distance() {
         max_restarts: 500,
         ..IkParams::default()
     };
-    let r = solve_ik(&chain, &target, Some(&q), &p, 11, &never).unwrap();
+    let r = solve_ik(&chain, &target, Some(&q), &p, 11, Deadline::none()).unwrap();
     assert_eq!(r.solutions.len(), 4);
     assert_eq!(r.stop_reason, IkStatus::Converged);
     assert_reaches(&chain, &target, &r, &p, "ur5 4 solutions");
@@ -79,7 +79,7 @@ fn tight_deadline_returns_promptly_with_time_budget() {
             ..IkParams::default()
         };
         let t0 = Instant::now();
-        let r = solve_ik(&chain, &target, None, &p, 1, &never).unwrap();
+        let r = solve_ik(&chain, &target, None, &p, 1, Deadline::none()).unwrap();
         let took = t0.elapsed();
         assert_eq!(r.stop_reason, IkStatus::TimeBudget, "{method:?}");
         assert!(!r.success());
@@ -87,6 +87,71 @@ fn tight_deadline_returns_promptly_with_time_budget() {
         assert!(best.position_error > 3.0);
         // 3 ms budget; generous slack for a loaded 2-core machine
         assert!(took < Duration::from_millis(150), "{method:?} took {took:?}");
+    }
+}
+
+/// The caller's deadline and `time_budget` both bound a solve; the earlier
+/// stops it (TIME_BUDGET either way), a raised cancellation answers CANCELLED.
+#[test]
+fn the_earlier_of_deadline_and_time_budget_stops_the_solve() {
+    let chain = builtin_chain("ur5").unwrap();
+    let target = IkTarget::Position(Point3::new(5.0, 0.0, 0.0));
+    let ms = Duration::from_millis;
+    for (deadline_ms, budget) in [(5, None), (5, Some(ms(60_000))), (60_000, Some(ms(5)))] {
+        let p = IkParams {
+            max_restarts: usize::MAX,
+            time_budget: budget,
+            ..IkParams::default()
+        };
+        let t0 = Instant::now();
+        let d = Deadline::at(t0 + ms(deadline_ms));
+        let r = solve_ik(&chain, &target, None, &p, 1, d).unwrap();
+        let took = t0.elapsed();
+        assert_eq!(
+            r.stop_reason,
+            IkStatus::TimeBudget,
+            "{deadline_ms} ms, {budget:?}"
+        );
+        assert!(took >= ms(5), "stopped before either limit: {took:?}");
+        // generous slack for a loaded 2-core machine
+        assert!(took < ms(150), "{deadline_ms} ms, {budget:?}: {took:?}");
+    }
+    let flag = std::sync::atomic::AtomicBool::new(true);
+    let p = IkParams {
+        max_restarts: usize::MAX,
+        time_budget: Some(ms(60_000)),
+        ..IkParams::default()
+    };
+    let r = solve_ik(
+        &chain,
+        &target,
+        None,
+        &p,
+        1,
+        Deadline::after(ms(60_000)).with_cancel(&flag),
+    )
+    .unwrap();
+    assert_eq!(r.stop_reason, IkStatus::Cancelled);
+    assert!(r.total_iterations <= 1);
+}
+
+/// A batch past its deadline answers every target TIME_BUDGET without an
+/// attempt; a cancelled one answers CANCELLED.
+#[test]
+fn a_batch_past_its_deadline_answers_time_budget_and_a_cancelled_one_cancelled() {
+    let chain = builtin_chain("ur5").unwrap();
+    let targets = vec![IkTarget::Position(Point3::new(0.3, 0.1, 0.4)); 8];
+    let p = IkParams::default();
+    let past = Deadline::at(Instant::now() - Duration::from_millis(1));
+    for r in solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 1, past) {
+        let r = r.unwrap();
+        assert_eq!((r.stop_reason, r.attempts), (IkStatus::TimeBudget, 0));
+    }
+    let gone = || true;
+    let cancelled = Deadline::none().with_cancel(&gone);
+    for r in solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 1, cancelled) {
+        let r = r.unwrap();
+        assert_eq!((r.stop_reason, r.attempts), (IkStatus::Cancelled, 0));
     }
 }
 
@@ -100,7 +165,7 @@ fn cancellation_is_checked_every_iteration() {
         max_restarts: usize::MAX,
         ..IkParams::default()
     };
-    let r = solve_ik(&chain, &target, None, &p, 1, &stop).unwrap();
+    let r = solve_ik(&chain, &target, None, &p, 1, Deadline::none().with_cancel(&stop)).unwrap();
     assert_eq!(r.stop_reason, IkStatus::Cancelled);
     assert!(r.total_iterations <= 26);
 }
@@ -111,7 +176,7 @@ fn bad_inputs_are_errors() {
     let good = IkTarget::Pose(chain.fk(&[0.0; 6]));
     let p = IkParams::default();
     assert!(matches!(
-        solve_ik(&chain, &good, Some(&[0.0; 5]), &p, 0, &never),
+        solve_ik(&chain, &good, Some(&[0.0; 5]), &p, 0, Deadline::none()),
         Err(IkError::WrongSeedLength { expected: 6, got: 5 })
     ));
     assert!(matches!(
@@ -121,13 +186,13 @@ fn bad_inputs_are_errors() {
             Some(&[0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0]),
             &p,
             0,
-            &never
+            Deadline::none()
         ),
         Err(IkError::NonFiniteSeed { index: 1 })
     ));
     let nan = IkTarget::Position(Point3::new(f64::NAN, 0.0, 0.0));
     assert!(matches!(
-        solve_ik(&chain, &nan, None, &p, 0, &never),
+        solve_ik(&chain, &nan, None, &p, 0, Deadline::none()),
         Err(IkError::NonFiniteTarget { .. })
     ));
     let skew = Isometry3::from_parts(
@@ -135,7 +200,7 @@ fn bad_inputs_are_errors() {
         UnitQuaternion::new_unchecked(nalgebra::Quaternion::new(2.0, 0.0, 0.0, 0.0)),
     );
     assert!(matches!(
-        solve_ik(&chain, &IkTarget::Pose(skew), None, &p, 0, &never),
+        solve_ik(&chain, &IkTarget::Pose(skew), None, &p, 0, Deadline::none()),
         Err(IkError::NonUnitQuaternion { .. })
     ));
     assert!(matches!(
@@ -181,7 +246,7 @@ fn bad_inputs_are_errors() {
             "time_budget",
         ),
     ] {
-        match solve_ik(&chain, &good, None, &bad, 0, &never) {
+        match solve_ik(&chain, &good, None, &bad, 0, Deadline::none()) {
             Err(IkError::InvalidParam { field: f, .. }) => assert_eq!(f.name(), field),
             other => panic!("{field}: expected InvalidParam, got {other:?}"),
         }
@@ -195,7 +260,7 @@ fn bad_inputs_are_errors() {
         ..p
     };
     assert!(matches!(
-        solve_ik(&chain, &good, None, &bad_rlxa, 0, &never),
+        solve_ik(&chain, &good, None, &bad_rlxa, 0, Deadline::none()),
         Err(IkError::Linalg(_))
     ));
 }
@@ -210,8 +275,8 @@ fn batch_matches_sequential() {
         .map(|_| IkTarget::Pose(chain.fk(&random_joints(&chain, &mut rng))))
         .collect();
     let p = IkParams::default();
-    let a = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, &never);
-    let b = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, &never);
+    let a = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, Deadline::none());
+    let b = solve_ik_batch(&chain, &targets, BatchSeeds::None, &p, 5, Deadline::none());
     for (k, (x, y)) in a.iter().zip(&b).enumerate() {
         let (x, y) = (x.as_ref().unwrap(), y.as_ref().unwrap());
         assert_reaches(&chain, &targets[k], x, &p, "batch");
@@ -234,7 +299,14 @@ fn batch_per_target_seeds_keep_each_target_on_its_seeds_branch() {
         max_restarts: 0,
         ..IkParams::default()
     };
-    let r = solve_ik_batch(&chain, &targets, BatchSeeds::PerTarget(&seeds), &p, 1, &never);
+    let r = solve_ik_batch(
+        &chain,
+        &targets,
+        BatchSeeds::PerTarget(&seeds),
+        &p,
+        1,
+        Deadline::none(),
+    );
     for (k, res) in r.iter().enumerate() {
         let res = res.as_ref().unwrap();
         assert_reaches(&chain, &targets[k], res, &p, "per-target seed");
@@ -252,7 +324,7 @@ fn batch_per_target_seeds_keep_each_target_on_its_seeds_branch() {
         BatchSeeds::PerTarget(&seeds[..6]),
         &p,
         1,
-        &never,
+        Deadline::none(),
     );
     assert!(
         short

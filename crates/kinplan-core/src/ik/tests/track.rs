@@ -28,7 +28,7 @@ fn track_circle_on_planar_chain() {
                 },
                 ..TrackParams::default()
             };
-            let r = track_path(&chain, &targets, &q0, &tp, 1, &never).unwrap();
+            let r = track_path(&chain, &targets, &q0, &tp, 1, Deadline::none()).unwrap();
             assert!(r.all_converged, "planar_{n} {solver:?}");
             assert_eq!(r.steps.len(), 101);
             assert!(
@@ -59,7 +59,15 @@ fn track_kr210_circle_and_line() {
     assert!((line[50].translation.vector - end.translation.vector).norm() < 1e-12);
     for path in [circle, line] {
         let targets: Vec<IkTarget> = path.iter().map(|t| IkTarget::Pose(*t)).collect();
-        let r = track_path(&chain, &targets, &q0, &TrackParams::default(), 1, &never).unwrap();
+        let r = track_path(
+            &chain,
+            &targets,
+            &q0,
+            &TrackParams::default(),
+            1,
+            Deadline::none(),
+        )
+        .unwrap();
         assert!(r.all_converged);
         assert!(r.max_joint_step < 0.1, "jump {}", r.max_joint_step);
     }
@@ -69,7 +77,14 @@ fn track_kr210_circle_and_line() {
 fn bad_paths_are_errors() {
     let chain = builtin_chain("planar_3").unwrap();
     assert!(matches!(
-        track_path(&chain, &[], &[0.0; 3], &TrackParams::default(), 0, &never),
+        track_path(
+            &chain,
+            &[],
+            &[0.0; 3],
+            &TrackParams::default(),
+            0,
+            Deadline::none()
+        ),
         Err(IkError::EmptyPath)
     ));
     let s = Isometry3::identity();

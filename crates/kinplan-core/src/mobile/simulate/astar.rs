@@ -1,6 +1,7 @@
 //! Global navigation: grid A* on the known world, then path following.
 
 use super::{Outcome, SimParams, SimRun, follow_path, start_check};
+use crate::Deadline;
 use crate::mobile::chassis::Chassis;
 use crate::mobile::error::MobileError;
 use crate::mobile::field::MobileField;
@@ -28,19 +29,19 @@ pub fn navigate_astar(
     astar: &GridAstarParams,
     follow: &PathFollowParams,
     sim: &SimParams,
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
 ) -> Result<SimRun, MobileError> {
     start.validate(MobileField::Start)?;
     sim.validate()?;
     start_check(Some(world), start, sim.robot_radius)?;
-    let Some(points) = plan_grid_astar_until(world, start.point(), goal, astar, should_stop)? else {
+    let Some(points) = plan_grid_astar_until(world, start.point(), goal, astar, deadline)? else {
         return Ok(SimRun {
-            outcome: if should_stop() {
+            outcome: if deadline.expired() {
                 Outcome::Cancelled
             } else {
                 Outcome::NoPath
             },
-            no_path_reason: (!should_stop()).then_some(NoPathReason::NoGridPath),
+            no_path_reason: (!deadline.expired()).then_some(NoPathReason::NoGridPath),
             states: vec![start],
             ..SimRun::default()
         });
@@ -53,7 +54,7 @@ pub fn navigate_astar(
             ..SimRun::default()
         });
     }
-    follow_path(chassis, start, &path, Some(world), follow, sim, should_stop)
+    follow_path(chassis, start, &path, Some(world), follow, sim, deadline)
 }
 
 #[cfg(test)]
@@ -88,7 +89,7 @@ mod tests {
             &astar,
             &follow,
             &sim,
-            &|| false,
+            Deadline::none(),
         )
         .unwrap();
         assert_eq!(run.outcome, Outcome::NoPath);
@@ -102,7 +103,7 @@ mod tests {
             &astar,
             &follow,
             &sim,
-            &|| false,
+            Deadline::none(),
         )
         .unwrap();
         assert_eq!(run.outcome, Outcome::Reached);

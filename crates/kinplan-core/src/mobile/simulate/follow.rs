@@ -2,6 +2,7 @@
 //! chassis until the last node is reached, time runs out, it collides or it is stopped.
 
 use super::{Outcome, SimParams, SimRun, start_check, step_into};
+use crate::Deadline;
 use crate::mobile::chassis::Chassis;
 use crate::mobile::error::MobileError;
 use crate::mobile::field::MobileField;
@@ -13,14 +14,15 @@ use crate::mobile::world::World;
 
 /// Simulates [`path_follow_step`](crate::mobile::path_follow_step) on `chassis` from `start` along
 /// `path` (optionally among obstacles, with collision detection) until the last node is
-/// reached, the time runs out, a collision happens or `should_stop()` returns true (checked
+/// reached, the time runs out, a collision happens or `deadline` expires (checked
 /// every step).
 ///
 /// ```
+/// use kinplan_core::Deadline;
 /// use kinplan_core::mobile::{follow_path, Chassis, Outcome, PathFollowParams, PathNode, Pose, SimParams};
 /// let path = [PathNode { x: 1.0, y: 1.0, heading: Some(0.0) }];
 /// let sim = SimParams { dt: 0.02, max_time: 120.0, ..SimParams::default() };
-/// let run = follow_path(&Chassis::omr_iii(), Pose::default(), &path, None, &PathFollowParams::default(), &sim, &|| false).unwrap();
+/// let run = follow_path(&Chassis::omr_iii(), Pose::default(), &path, None, &PathFollowParams::default(), &sim, Deadline::none()).unwrap();
 /// assert_eq!(run.outcome, Outcome::Reached);
 /// ```
 pub fn follow_path(
@@ -30,7 +32,7 @@ pub fn follow_path(
     world: Option<&World>,
     follow: &PathFollowParams,
     sim: &SimParams,
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
 ) -> Result<SimRun, MobileError> {
     chassis.validate()?;
     start.validate(MobileField::Start)?;
@@ -48,7 +50,7 @@ pub fn follow_path(
     run.states.push(pose);
     let mut finished = false;
     for _ in 0..steps {
-        if should_stop() {
+        if deadline.expired() {
             run.outcome = Outcome::Cancelled;
             finished = true;
             break;
@@ -102,7 +104,7 @@ mod tests {
                 None,
                 &follow,
                 &SimParams::default(),
-                &|| false,
+                Deadline::none(),
             )
             .unwrap();
             assert_eq!(
@@ -143,7 +145,7 @@ mod tests {
                 None,
                 &f,
                 &sim,
-                &|| false,
+                Deadline::none(),
             )
             .unwrap();
             assert_eq!(run.outcome, Outcome::Reached, "{ctl:?}");
@@ -170,7 +172,7 @@ mod tests {
                 None,
                 &f,
                 &sim,
-                &|| false,
+                Deadline::none(),
             )
             .unwrap();
             assert_eq!(run.outcome, Outcome::Reached, "{ctl:?}");
@@ -199,7 +201,7 @@ mod tests {
             Some(&w),
             &f,
             &SimParams::default(),
-            &|| false,
+            Deadline::none(),
         )
         .unwrap();
         assert_eq!(run.outcome, Outcome::Collision);

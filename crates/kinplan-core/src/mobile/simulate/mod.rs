@@ -30,7 +30,7 @@ pub enum Outcome {
     Timeout,
     /// The robot's disc touched an obstacle; the last state is the first colliding one.
     Collision,
-    /// `should_stop` returned true.
+    /// The deadline passed or the caller's cancellation was raised.
     Cancelled,
 }
 

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Outcome, SimParams, SimRun, start_check, step_into};
+use crate::Deadline;
 use crate::mobile::chassis::Chassis;
 use crate::mobile::error::MobileError;
 use crate::mobile::field::MobileField;
@@ -31,10 +32,11 @@ pub struct NavigateParams {
 /// from `start` to `goal` among `world`'s obstacles.
 ///
 /// ```
+/// use kinplan_core::Deadline;
 /// use kinplan_core::mobile::{navigate, Chassis, NavigateParams, Obstacle, Outcome, Point2, Pose, World};
 /// let world = World::new(vec![Obstacle::circle(2.0, 0.0, 0.5)]).unwrap();
 /// let run = navigate(&Chassis::default(), Pose::new(0.0, 0.0, 0.0), Point2::new(4.0, 0.0), &world,
-///                    &NavigateParams::default(), &|| false).unwrap();
+///                    &NavigateParams::default(), Deadline::none()).unwrap();
 /// assert_eq!(run.outcome, Outcome::Reached);
 /// ```
 pub fn navigate(
@@ -43,7 +45,7 @@ pub fn navigate(
     goal: Point2,
     world: &World,
     params: &NavigateParams,
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
 ) -> Result<SimRun, MobileError> {
     chassis.validate()?;
     start.validate(MobileField::Start)?;
@@ -60,11 +62,11 @@ pub fn navigate(
     let mut pose = start;
     run.states.push(pose);
     for k in 0..=steps {
-        if should_stop() {
+        if deadline.expired() {
             run.outcome = Outcome::Cancelled;
             break;
         }
-        if !sensors.sense_until(world, pose, sim.robot_radius, &mut readings, should_stop) {
+        if !sensors.sense_until(world, pose, sim.robot_radius, &mut readings, deadline) {
             run.outcome = Outcome::Cancelled;
             break;
         }
@@ -165,7 +167,7 @@ mod tests {
                 Point2::new(10.0, 0.0),
                 &w,
                 &params,
-                &|| false,
+                Deadline::none(),
             )
             .unwrap();
             if run.outcome != Outcome::Reached {
@@ -199,7 +201,7 @@ mod tests {
             Point2::new(6.0, 0.0),
             &w,
             &p,
-            &|| false,
+            Deadline::none(),
         )
         .unwrap();
         assert_eq!(run.outcome, Outcome::NoPath, "{:?}", run.metrics);
@@ -218,7 +220,7 @@ mod tests {
             Point2::new(6.0, 0.0),
             &w,
             &retry,
-            &|| false,
+            Deadline::none(),
         )
         .unwrap();
         assert_eq!(again.outcome, Outcome::NoPath, "{:?}", again.metrics);
@@ -242,7 +244,7 @@ mod tests {
             Point2::new(10.0, 0.0),
             &w,
             &p,
-            &|| false,
+            Deadline::none(),
         )
         .unwrap();
         let b = navigate(
@@ -251,7 +253,7 @@ mod tests {
             Point2::new(10.0, 0.0),
             &w,
             &p,
-            &|| false,
+            Deadline::none(),
         )
         .unwrap();
         assert_eq!(a, b);
@@ -261,7 +263,7 @@ mod tests {
             Point2::new(10.0, 0.0),
             &w,
             &p,
-            &|| true,
+            Deadline::none().with_cancel(&|| true),
         )
         .unwrap();
         assert_eq!(c.outcome, Outcome::Cancelled);
@@ -274,7 +276,14 @@ mod tests {
         let p = NavigateParams::default();
         let c = Chassis::default();
         assert!(matches!(
-            navigate(&c, Pose::default(), Point2::new(1.0, 0.0), &w, &p, &|| { false }),
+            navigate(
+                &c,
+                Pose::default(),
+                Point2::new(1.0, 0.0),
+                &w,
+                &p,
+                Deadline::none()
+            ),
             Err(MobileError::StartInCollision { obstacle: 0, .. })
         ));
         let bad_dt = NavigateParams {
@@ -297,7 +306,7 @@ mod tests {
                 Point2::new(1.0, 0.0),
                 &w,
                 &bad_dt,
-                &|| false
+                Deadline::none()
             )
             .is_err()
         );
@@ -308,7 +317,7 @@ mod tests {
                 Point2::new(1.0, 0.0),
                 &w,
                 &p,
-                &|| false
+                Deadline::none()
             )
             .is_err()
         );
@@ -320,7 +329,7 @@ mod tests {
                 None,
                 &PathFollowParams::default(),
                 &SimParams::default(),
-                &|| false
+                Deadline::none()
             ),
             Err(MobileError::EmptyPath)
         );

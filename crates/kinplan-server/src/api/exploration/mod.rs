@@ -10,7 +10,6 @@ use tonic::{Request, Response, Status};
 use crate::api::convert::{finite, pose_in};
 use crate::pb::{self, exploration_service_server::ExplorationService};
 use crate::runtime::Shared;
-use crate::runtime::deadline::{soft_deadline, time_budget};
 use crate::status::invalid;
 use crate::status::nbv::nbv_error;
 use crate::status::octree::octree_error;
@@ -93,16 +92,21 @@ impl ExplorationService for ExplorationApi {
         let req = request.into_inner();
         let camera = camera_in(req.camera.as_ref())?;
         let camera_pose = pose_in("camera_pose", req.camera_pose.as_ref())?;
-        let mut params = nbv_params_in(&req)?;
-        params.time_budget = time_budget(params.time_budget, soft_deadline(budget.deadline()));
+        // options.time_budget stays the NBV's own; the request's deadline comes with `b`
+        let params = nbv_params_in(&req)?;
         let reply = self
             .shared
             .compute
             .run(&budget, move |b| -> Result<pb::NextBestViewResponse, Status> {
                 let tree = octree_in("octree", req.octree.as_ref())?;
-                let result = next_best_view(&tree, &params, &camera, &camera_pose, chain.as_deref(), &|| {
-                    b.should_stop()
-                })
+                let result = next_best_view(
+                    &tree,
+                    &params,
+                    &camera,
+                    &camera_pose,
+                    chain.as_deref(),
+                    b.deadline(),
+                )
                 .map_err(|e| nbv_error("options", e))?;
                 Ok(nbv_response(result))
             })
@@ -164,11 +168,11 @@ impl ExplorationService for ExplorationApi {
                     Some(t) => octree_in("octree", Some(t))?,
                     None => Octree::new(resolution).map_err(|e| octree_error("resolution", e))?,
                 };
-                let stop = || b.should_stop();
+                let deadline = b.deadline();
                 let stats = match &scan {
                     Scan::Points(points) => {
                         let o = sensor.translation.vector;
-                        tree.insert_scan(points, &[o.x as f32, o.y as f32, o.z as f32], &params, &stop)
+                        tree.insert_scan(points, &[o.x as f32, o.y as f32, o.z as f32], &params, deadline)
                     }
                     Scan::Depth(d) => tree.insert_depth_image(
                         &d.depth,
@@ -182,7 +186,7 @@ impl ExplorationService for ExplorationApi {
                         },
                         &sensor,
                         &params,
-                        &stop,
+                        deadline,
                     ),
                 }
                 .map_err(|e| octree_error("scan", e))?;

@@ -49,8 +49,6 @@ pub(super) struct Options {
     pub(super) params: IkParams,
     pub(super) position_only: bool,
     pub(super) rng_seed: u64,
-    /// `options.time_budget` (validated), before the deadline is applied.
-    pub(super) time_budget: Option<Duration>,
 }
 
 impl Options {
@@ -144,7 +142,6 @@ impl Options {
             params,
             position_only: o.position_only,
             rng_seed: o.rng_seed,
-            time_budget,
         })
     }
 }

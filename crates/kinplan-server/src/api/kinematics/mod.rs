@@ -2,9 +2,10 @@
 //! solvers behind it ([`kinplan_core::linalg`]); docs/inverse-kinematics.md and docs/linear-solvers.md.
 //!
 //! Thin adapter: admit → resolve the robot → proto options, targets and
-//! matrices into domain values → solve on the CPU pool, with the request's
-//! deadline (less a reply reserve) as the IK time budget and
-//! [`Budget::should_stop`] as the cancellation check → reply. [`IkError`](kinplan_core::ik::IkError)s
+//! matrices into domain values → solve on the CPU pool until the request's
+//! [`Budget::deadline`] (the call's deadline less a reply reserve, and the
+//! caller's cancellation) or `options.time_budget`, whichever ends first →
+//! reply. [`IkError`](kinplan_core::ik::IkError)s
 //! become INVALID_ARGUMENT naming the request field. Not converging is a
 //! status in the reply, never an error.
 
@@ -21,7 +22,7 @@ use tonic::{Request, Response, Status, Streaming};
 use crate::api::convert::{finite_slice, matrix_in};
 use crate::pb::{self, kinematics_service_server::KinematicsService};
 use crate::runtime::Shared;
-use crate::runtime::deadline::{deadline_after, grpc_timeout, soft_deadline, time_budget};
+use crate::runtime::deadline::{call_deadline, grpc_timeout};
 use crate::runtime::{Budget, Compute, ModelStore, catch_unwind};
 use crate::status::ik::{IkAt, ik_error};
 use crate::status::linalg::{SolveAt, linalg_error};
@@ -78,8 +79,7 @@ impl KinematicsService for KinematicsApi {
             .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
         let req = request.into_inner();
-        let mut options = Options::from_proto(req.options.as_ref(), RESTARTS_SOLVE)?;
-        options.params.time_budget = time_budget(options.time_budget, soft_deadline(budget.deadline()));
+        let options = Options::from_proto(req.options.as_ref(), RESTARTS_SOLVE)?;
         let target = target_in("target", req.target.as_ref(), options.position_only)?;
         let seed = (!req.seed.is_empty()).then_some(req.seed);
         let chain = robot.chain.clone();
@@ -93,7 +93,7 @@ impl KinematicsService for KinematicsApi {
                     seed.as_deref(),
                     &options.params,
                     options.rng_seed,
-                    &|| b.should_stop(),
+                    b.deadline(),
                 )
             })
             .await?
@@ -124,7 +124,7 @@ impl KinematicsService for KinematicsApi {
                 ),
             ));
         }
-        let mut options = Options::from_proto(req.options.as_ref(), RESTARTS_SOLVE)?;
+        let options = Options::from_proto(req.options.as_ref(), RESTARTS_SOLVE)?;
         if req.targets.len() * options.params.num_solutions > MAX_BATCH_SOLUTIONS {
             return Err(invalid(
                 "options.num_solutions",
@@ -135,8 +135,7 @@ impl KinematicsService for KinematicsApi {
                 ),
             ));
         }
-        // the explicit budget is per target; the deadline bounds the batch (below)
-        options.params.time_budget = time_budget(options.time_budget, None);
+        // the explicit budget is per target; the deadline bounds the batch
         let targets = req
             .targets
             .iter()
@@ -175,32 +174,28 @@ impl KinematicsService for KinematicsApi {
         };
         let seed = (!req.seed.is_empty()).then_some(req.seed);
         let chain = robot.chain.clone();
-        let soft = soft_deadline(budget.deadline());
         let reply = self
             .shared
             .compute
             .run(&budget, move |b| {
                 let start = Instant::now();
-                let stop = || b.should_stop() || soft.is_some_and(|d| Instant::now() >= d);
                 let seeds = match &per_target {
                     Some(all) => BatchSeeds::PerTarget(all),
                     None => BatchSeeds::shared(seed.as_deref()),
                 };
-                let results =
-                    solve_ik_batch(&chain, &targets, seeds, &options.params, options.rng_seed, &stop);
-                // a cancellation seen while the caller still waits is the deadline
-                let late = soft.is_some_and(|d| Instant::now() >= d);
+                // targets cut by the batch's deadline end TIME_BUDGET
+                let results = solve_ik_batch(
+                    &chain,
+                    &targets,
+                    seeds,
+                    &options.params,
+                    options.rng_seed,
+                    b.deadline(),
+                );
                 let results = results
                     .into_iter()
                     .enumerate()
-                    .map(|(i, r)| {
-                        let mut r = r.map_err(|e| ik_error(e, IkAt::Batch(i)))?;
-                        // Targets cut by the batch's deadline end TIME_BUDGET, not CANCELLED.
-                        if late {
-                            r.cancelled_as_time_budget();
-                        }
-                        Ok(result_out(r))
-                    })
+                    .map(|(i, r)| Ok(result_out(r.map_err(|e| ik_error(e, IkAt::Batch(i)))?)))
                     .collect::<Result<Vec<_>, Status>>()?;
                 Ok::<_, Status>(pb::SolveIkBatchResponse {
                     succeeded: results.iter().filter(|r| r.success).count() as u32,
@@ -225,8 +220,7 @@ impl KinematicsService for KinematicsApi {
             .admit_robot(&request, request.get_ref().robot.as_ref())
             .await?;
         let req = request.into_inner();
-        let mut options = Options::from_proto(req.options.as_ref(), RESTARTS_WARM)?;
-        options.params.time_budget = time_budget(options.time_budget, soft_deadline(budget.deadline()));
+        let options = Options::from_proto(req.options.as_ref(), RESTARTS_WARM)?;
         let chain = robot.chain.clone();
         let seed = if req.seed.is_empty() {
             chain.mid_limits()
@@ -249,9 +243,7 @@ impl KinematicsService for KinematicsApi {
             .shared
             .compute
             .run(&budget, move |b| {
-                track_path(&chain, &targets, &seed, &params, options.rng_seed, &|| {
-                    b.should_stop()
-                })
+                track_path(&chain, &targets, &seed, &params, options.rng_seed, b.deadline())
             })
             .await?
             .map_err(|e| ik_error(e, IkAt::Path(path_field)))?;
@@ -269,7 +261,7 @@ impl KinematicsService for KinematicsApi {
         let permit = self.shared.compute.admit_stream()?;
         // A controller's stream lives as long as the controller runs: only a
         // deadline the client sets bounds it, not the server's default.
-        let deadline = grpc_timeout(request.metadata().as_ref()).and_then(deadline_after);
+        let deadline = call_deadline(grpc_timeout(request.metadata().as_ref()), None);
         let inbound = request.into_inner();
         let (tx, rx) = tokio::sync::mpsc::channel(4);
         let models = self.shared.models.clone();
@@ -327,7 +319,7 @@ impl KinematicsService for KinematicsApi {
                     LinearSolve::Svd(p) => solve_pseudoinverse(&a, &b, &p),
                     LinearSolve::Rlxa(p, seed) => {
                         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-                        solve_angle_relaxation_until(&a, &b, &p, &mut rng, &|| budget.should_stop())
+                        solve_angle_relaxation_until(&a, &b, &p, &mut rng, budget.deadline())
                     }
                 };
                 s.map(|s| (s, start.elapsed()))
@@ -362,7 +354,7 @@ mod tests {
         assert_eq!(p.num_solutions, 1);
         assert_eq!(solve.rng_seed, 0);
         assert_eq!(p.joint_limits, JointLimitMode::Clamp);
-        assert_eq!(solve.time_budget, None);
+        assert_eq!(p.time_budget, None);
         assert!(p.adaptive_damping);
         assert_eq!(p.max_step, 1.0);
         assert_eq!(p.distinct_tolerance, 1e-3);

@@ -71,15 +71,14 @@ pub(super) async fn stream_loop(
         } else {
             msg.seed
         };
-        let mut params = st.options.params;
-        params.time_budget = time_budget(st.options.time_budget, soft_deadline(deadline));
+        let params = st.options.params;
         let chain = st.chain.clone();
         let rng_seed = st.options.rng_seed;
         let workspace = st.workspace.take().unwrap_or_else(|| IkWorkspace::new(&chain));
         let (result, workspace) = compute
             .run(&Budget::new(deadline), move |b| {
                 let mut solver = IkSolver::with_workspace(&chain, workspace);
-                let result = solver.solve(&target, Some(&seed), &params, rng_seed, &|| b.should_stop());
+                let result = solver.solve(&target, Some(&seed), &params, rng_seed, b.deadline());
                 (result, solver.into_workspace())
             })
             .await?;

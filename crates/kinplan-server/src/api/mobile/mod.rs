@@ -14,6 +14,7 @@ use crate::pb::{self, mobile_service_server::MobileService};
 use crate::runtime::Shared;
 use crate::status::invalid;
 use crate::status::mobile::mobile_error;
+use kinplan_core::Deadline;
 use kinplan_core::mobile::{
     GRID_PATH_CONTROLLER, NavigateParams, PathFollowParams, Saturation, StepController, StepOptions,
     follow_path, navigate, navigate_astar,
@@ -97,11 +98,11 @@ impl MobileService for MobileApi {
         }
         // Sensing a world costs up to obstacles × rays: the CPU pool; the rest inline.
         if req.world.is_empty() {
-            control_step(req, &|| false).map(Response::new)
+            control_step(req, Deadline::none()).map(Response::new)
         } else {
             self.shared
                 .compute
-                .run(&budget, move |b| control_step(req, &|| b.should_stop()))
+                .run(&budget, move |b| control_step(req, b.deadline()))
                 .await?
                 .map(Response::new)
         }
@@ -131,9 +132,15 @@ impl MobileService for MobileApi {
             .shared
             .compute
             .run(&budget, move |b| {
-                follow_path(&chassis, start, &path, world.as_ref(), &follow, &sim, &|| {
-                    b.should_stop()
-                })
+                follow_path(
+                    &chassis,
+                    start,
+                    &path,
+                    world.as_ref(),
+                    &follow,
+                    &sim,
+                    b.deadline(),
+                )
             })
             .await?
             .map_err(mobile_error)?;
@@ -164,7 +171,7 @@ impl MobileService for MobileApi {
                 self.shared
                     .compute
                     .run(&budget, move |b| {
-                        navigate(&chassis, start, goal, &world, &params, &|| b.should_stop())
+                        navigate(&chassis, start, goal, &world, &params, b.deadline())
                     })
                     .await?
             }
@@ -174,9 +181,7 @@ impl MobileService for MobileApi {
                 self.shared
                     .compute
                     .run(&budget, move |b| {
-                        navigate_astar(&chassis, start, goal, &world, &astar, &follow, &sim, &|| {
-                            b.should_stop()
-                        })
+                        navigate_astar(&chassis, start, goal, &world, &astar, &follow, &sim, b.deadline())
                     })
                     .await?
             }
@@ -190,7 +195,7 @@ impl MobileService for MobileApi {
 /// [`control_step`] (token decoding, sensing, stepping, saturation, token encoding), the reply.
 fn control_step(
     req: pb::ControlStepRequest,
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
 ) -> Result<pb::ControlStepResponse, Status> {
     let chassis = chassis_in(req.chassis.as_ref());
     let state = pose_in(req.state.as_ref());
@@ -232,7 +237,7 @@ fn control_step(
         &req.state_token,
         &controller,
         &options,
-        should_stop,
+        deadline,
     )
     .map_err(mobile_error)?
     else {

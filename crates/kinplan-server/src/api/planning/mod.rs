@@ -4,7 +4,8 @@
 //! Per request: admission and the robot (cached), the scene converted and
 //! validated, the robot's collision setup (cached per chain), then on the
 //! CPU pool the scene's geometry and BVH, and the planner with the request's
-//! deadline (less a reply reserve) and cancellation.
+//! [`Deadline`] (the call's less a reply reserve, or `options.time_budget`
+//! when that ends first) and cancellation.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,12 +18,12 @@ use crate::api::scene::scene_in;
 use crate::pb::{self, planning_service_server::PlanningService};
 use crate::runtime::Shared;
 use crate::runtime::collision_models::{CollisionSetup, collision_setup};
-use crate::runtime::deadline::work_deadline;
 use crate::runtime::{Budget, models::Resolved};
 use crate::status::collision::{checker_error, collision_error, collision_internal};
 use crate::status::invalid;
 use crate::status::plan::plan_error;
 use convert::{PlanInput, colliding_out, pair_name, plan_input, plan_response, trajectory_out};
+use kinplan_core::Deadline;
 use kinplan_core::collision::{CheckerParams, SceneChecker, SceneGeometry, SceneLimits};
 use kinplan_core::plan::{Goal, IterationReport, PlanControl, PlanStatus, plan};
 
@@ -50,7 +51,6 @@ impl PlanningApi {
         let input = plan_input(req)?;
         let scene = scene_in("scene", req.scene.as_ref(), &SceneLimits::default())?;
         let setup = collision_setup(&self.shared, &robot, &budget).await?;
-        let deadline = work_deadline(input.time_budget, budget.deadline());
         Ok(Prepared {
             _permit: permit,
             budget,
@@ -58,7 +58,6 @@ impl PlanningApi {
             input,
             scene,
             setup,
-            deadline,
         })
     }
 }
@@ -71,14 +70,14 @@ struct Prepared {
     input: PlanInput,
     scene: kinplan_core::collision::Scene,
     setup: Arc<CollisionSetup>,
-    deadline: Option<Instant>,
 }
 
-/// Builds the world and runs the planner (on a CPU-pool thread); `progress`
-/// sees every STOMP iteration.
+/// Builds the world and runs the planner (on a CPU-pool thread) until
+/// `deadline` or the request's own time budget, whichever ends first;
+/// `progress` sees every STOMP iteration.
 fn run_plan<'a>(
     p: &Prepared,
-    should_stop: &'a (dyn Fn() -> bool + Sync),
+    deadline: Deadline<'a>,
     progress: Option<&'a mut dyn FnMut(&IterationReport<'_>)>,
     started: Instant,
 ) -> Result<pb::PlanResponse, Status> {
@@ -90,8 +89,7 @@ fn run_plan<'a>(
         &checker,
         &p.input.request,
         PlanControl {
-            deadline: p.deadline,
-            should_stop,
+            deadline: deadline.min_with_budget(p.input.time_budget),
             progress,
         },
     )
@@ -130,9 +128,7 @@ impl PlanningService for PlanningApi {
         let budget = prepared.budget.clone();
         let reply = compute
             // `prepared` (and with it the admission permit) lives until the plan ends.
-            .run(&budget, move |b| {
-                run_plan(&prepared, &|| b.should_stop(), None, started)
-            })
+            .run(&budget, move |b| run_plan(&prepared, b.deadline(), None, started))
             .await??;
         Ok(Response::new(reply))
     }
@@ -165,8 +161,13 @@ impl PlanningService for PlanningApi {
                             result: None,
                         }));
                     };
-                    let stop = || b.should_stop() || progress_tx.is_closed();
-                    run_plan(&prepared, &stop, Some(&mut send), started)
+                    let gone = || b.cancelled() || progress_tx.is_closed();
+                    run_plan(
+                        &prepared,
+                        b.deadline().with_cancel(&gone),
+                        Some(&mut send),
+                        started,
+                    )
                 })
                 .await;
             let message = match outcome {
@@ -232,7 +233,7 @@ impl PlanningService for PlanningApi {
             .run(&budget, move |b| -> Result<Vec<pb::StateCheck>, Status> {
                 let world = Arc::new(SceneGeometry::build(&scene).map_err(|e| collision_error("scene", e))?);
                 let checker = checker_for(&setup, world, CheckerParams::default())?;
-                each_state(&req.states, &|| b.should_stop(), |q| {
+                each_state(&req.states, b.deadline(), |q| {
                     check_one(&checker, q, max_distance)
                 })
             })
@@ -248,12 +249,12 @@ impl PlanningService for PlanningApi {
 /// the whole batch.
 fn each_state(
     states: &[pb::JointState],
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
     check: impl Fn(&[f64]) -> Result<pb::StateCheck, Status>,
 ) -> Result<Vec<pb::StateCheck>, Status> {
     let mut out = Vec::with_capacity(states.len());
     for (i, s) in states.iter().enumerate() {
-        if i % 64 == 0 && should_stop() {
+        if i % 64 == 0 && deadline.expired() {
             return Err(Status::deadline_exceeded(
                 "the deadline passed while checking states",
             ));
@@ -309,7 +310,7 @@ mod tests {
                 positions: vec![i as f64],
             })
             .collect();
-        let answers = each_state(&states, &|| false, |q| {
+        let answers = each_state(&states, Deadline::none(), |q| {
             assert!(q[0] != 1.0, "a geometry fault on state 1");
             Ok(pb::StateCheck {
                 valid: true,

@@ -10,6 +10,7 @@ use crate::pb::{self, robot_service_server::RobotService};
 use crate::runtime::Shared;
 use crate::runtime::collision_models::collision_setup;
 use crate::status::{invalid, robot_error, too_large};
+use kinplan_core::Deadline;
 use kinplan_core::robot::{BUILTIN_NAMES, Chain, builtin_chain, builtin_urdf, expand_capsules};
 
 mod convert;
@@ -193,7 +194,7 @@ impl RobotService for RobotApi {
             .shared
             .compute
             .run(&budget, move |b| {
-                batch_kinematics(&chain, &q, jacobians, &|| b.should_stop())
+                batch_kinematics(&chain, &q, jacobians, b.deadline())
             })
             .await?
             .ok_or_else(|| Status::deadline_exceeded("the deadline passed during the batch"))?;
@@ -242,12 +243,12 @@ const MAX_BATCH_REPLY_VALUES: usize = 1_500_000;
 
 /// Tool poses (n × 7: x, y, z, qx, qy, qz, qw) and, with `jacobians`, the
 /// flattened 6 × dof Jacobians (n × 6·dof) of every row of `q` (n × dof,
-/// row-major, already checked). `None` when `should_stop` fired.
+/// row-major, already checked). `None` when `deadline` expired.
 fn batch_kinematics(
     chain: &Chain,
     q: &[f64],
     jacobians: bool,
-    should_stop: &dyn Fn() -> bool,
+    deadline: Deadline<'_>,
 ) -> Option<(Vec<f64>, Vec<f64>)> {
     let dof = chain.dof();
     let n = q.len() / dof;
@@ -255,7 +256,7 @@ fn batch_kinematics(
     let mut jac_out = Vec::with_capacity(if jacobians { n * 6 * dof } else { 0 });
     let mut jac = nalgebra::Matrix6xX::zeros(dof);
     for (i, row) in q.chunks_exact(dof).enumerate() {
-        if i % BATCH_CHECK_ROWS == BATCH_CHECK_ROWS - 1 && should_stop() {
+        if i % BATCH_CHECK_ROWS == BATCH_CHECK_ROWS - 1 && deadline.expired() {
             return None;
         }
         let tool = if jacobians {

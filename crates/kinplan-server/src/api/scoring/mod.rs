@@ -199,7 +199,7 @@ fn compare_sets(
     for (k, set) in req.sets.into_iter().enumerate() {
         let mut set_scores = Vec::with_capacity(set.trajectories.len());
         for (i, t) in set.trajectories.into_iter().enumerate() {
-            if budget.should_stop() {
+            if budget.deadline().expired() {
                 return Err(Status::deadline_exceeded(
                     "the request's deadline passed before the work finished",
                 ));

@@ -20,7 +20,7 @@ use tonic::body::Body;
 
 use crate::runtime::catch_unwind;
 use crate::runtime::deadline::{
-    RequestDeadline, answer_reserve, deadline_after, effective_timeout, grpc_timeout,
+    RequestDeadline, answer_reserve, call_deadline, effective_timeout, grpc_timeout,
 };
 use crate::status::code_name;
 
@@ -121,7 +121,7 @@ impl CallLabels {
 
     /// Records a call whose client went away before it was answered (the
     /// stream was reset): DEADLINE_EXCEEDED when that happened at the
-    /// client's deadline (within the reserve [`deadline_after`] keeps, since
+    /// client's deadline (within the reserve [`answer_reserve`] keeps, since
     /// the client's clock started a little before ours), CANCELLED otherwise.
     pub(crate) fn record_abandoned(&self) {
         let timed_out = self.client_deadline.is_some_and(|d| {
@@ -210,7 +210,7 @@ where
         let header = grpc_timeout(request.headers());
         let timeout = effective_timeout(header, self.default_timeout);
         let labels = CallLabels::for_path(request.uri().path()).with_timeout(timeout);
-        let deadline = timeout.and_then(deadline_after);
+        let deadline = call_deadline(header, self.default_timeout);
         request.extensions_mut().insert(RequestDeadline(deadline));
         let cut = self.cut.clone();
         let reply_type = crate::transport::finite::reply_type(request.uri().path());
@@ -284,6 +284,7 @@ use body::observe;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::runtime::deadline::deadline_after;
     use bytes::Bytes;
     use http_body::Frame;
     use http_body_util::BodyExt;

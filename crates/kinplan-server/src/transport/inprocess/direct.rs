@@ -22,7 +22,7 @@ use crate::pb::planning_service_server::PlanningService;
 use crate::pb::robot_service_server::RobotService;
 use crate::pb::scoring_service_server::ScoringService;
 use crate::runtime::catch_unwind;
-use crate::runtime::deadline::{RequestDeadline, deadline_after, effective_timeout};
+use crate::runtime::deadline::{RequestDeadline, call_deadline};
 use crate::status::code_name;
 use crate::transport::finite;
 use crate::transport::guard::{CallLabels, deadline_status, non_finite_status, panic_status};
@@ -92,7 +92,7 @@ where
 {
     let labels = CallLabels::for_path(path);
     let answer: Result<Bytes, Status> = async {
-        let deadline = effective_timeout(timeout, limits.default_timeout).and_then(deadline_after);
+        let deadline = call_deadline(timeout, limits.default_timeout);
         within_limit("request", message.len(), limits.max_message_bytes)?;
         let decoded = Req::decode(message)
             .map_err(|e| Status::internal(format!("failed to decode Protobuf message: {e}")))?;

@@ -4,7 +4,8 @@
 //! Per request: admission and the robot (cached), the scene, the robot's
 //! collision setup (cached per chain, shared with PlanningService), then on
 //! the CPU pool the loop itself with the request's deadline (less a reply
-//! reserve) and cancellation; a client that goes away cancels it.
+//! reserve, or `time_budget` when that ends first) and cancellation; a
+//! client that goes away cancels it.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,7 +18,6 @@ use crate::api::scene::scene_in;
 use crate::pb;
 use crate::runtime::Shared;
 use crate::runtime::collision_models::collision_setup;
-use crate::runtime::deadline::work_deadline;
 use crate::status::collision::collision_error;
 use crate::status::explore::explore_error;
 use crate::status::invalid;
@@ -45,7 +45,6 @@ pub async fn explore_stream(
         return Err(invalid("scene", "is empty: the camera would see nothing"));
     }
     let setup = collision_setup(shared, &robot, &budget).await?;
-    let deadline = work_deadline(time_budget, budget.deadline());
     let (tx, rx) = tokio::sync::mpsc::channel(16);
     let compute = shared.compute.clone();
     tokio::spawn(async move {
@@ -69,10 +68,9 @@ pub async fn explore_stream(
                         event: Some(pb::explore_response::Event::Iteration(iteration_out(&chain, s))),
                     }));
                 };
-                let stop = || b.should_stop() || step_tx.is_closed();
+                let gone = || b.cancelled() || step_tx.is_closed();
                 let ctl = ExploreControl {
-                    deadline,
-                    should_stop: &stop,
+                    deadline: b.deadline().with_cancel(&gone).min_with_budget(time_budget),
                     on_step: Some(&mut send),
                 };
                 let out = explore(&world, &req.start, &params, ctl).map_err(explore_error)?;
