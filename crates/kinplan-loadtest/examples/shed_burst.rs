@@ -2,7 +2,8 @@
 //! threads and four request slots, holds all four with long IK calls, then
 //! sends 200 ListRobots calls at once (and 200 one after another) and reports
 //! each shed call's latency from the moment it was sent, with a Rust client
-//! (so the figure is the server's, not a slow client's).
+//! (so the figure is the server's, not a slow client's). The same burst
+//! answered by the idle server first gives the transport's floor.
 //!
 //! `cargo run --release -p kinplan-loadtest --example shed_burst -- target/release/kinplan`
 
@@ -75,6 +76,15 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     for _ in 0..50 {
         let _ = list(robots.clone()).await;
     }
+    // The floor: the same burst answered (not shed) by an idle server.
+    let idle = futures_join(robots.clone(), 200).await;
+    let mut answered: Vec<f64> = idle.iter().filter(|(_, s)| !*s).map(|(ms, _)| *ms).collect();
+    answered.sort_by(f64::total_cmp);
+    println!(
+        "200 calls at once, idle server (answered): p50 {:.3} ms, p99 {:.3} ms",
+        percentile(&answered, 50.0),
+        percentile(&answered, 99.0)
+    );
     // Four calls that run for seconds: a target 10 m away, unlimited restarts.
     let far = pb::SolveIkRequest {
         robot: Some(pb::RobotRef {
