@@ -59,6 +59,11 @@ pub enum ExploreStatus {
     ConsecutiveFailures,
     /// NBV found no candidate view (no frontier left that passes the filters).
     NoCandidates,
+    /// The visibility check predicted every candidate view to reveal fewer
+    /// than `visibility.min_new_cells` cells: what the views can still
+    /// observe is exhausted (the estimate is the largest lower bound over
+    /// the candidates, [`ExploreOutcome::best_predicted_cells`]).
+    ObservableExhausted,
     /// The deadline passed.
     Timeout,
     /// `should_stop` fired.
@@ -89,6 +94,9 @@ pub struct ChosenView {
     pub utility: f64,
     /// Rank among this iteration's candidates (0 = best).
     pub rank: usize,
+    /// Cells the visibility check predicted the view to reveal at least
+    /// (None without the check).
+    pub predicted_cells: Option<u32>,
 }
 
 /// The motion of one iteration.
@@ -160,8 +168,15 @@ pub struct ExploreOutcome {
     /// Cells the ratio counts (region cells outside the true obstacles).
     pub observable_cells: usize,
     pub totals: CriteriaTotals,
-    /// Views that failed IK or planning, over the whole run.
+    /// Views that failed IK or planning, or were reached and added nothing,
+    /// over the whole run.
     pub failures: usize,
+    /// Executed motions whose scan added no known cell (wasted moves).
+    pub wasted_moves: usize,
+    /// The last NBV call's largest predicted lower bound over the views it
+    /// checked (cells; None without the visibility check): the estimate of
+    /// the observable unknown still within the candidates' reach.
+    pub best_predicted_cells: Option<u32>,
     /// Executed motions that overlapped the true scene.
     pub truth_hits: usize,
     pub final_joints: Vec<f64>,
@@ -376,6 +391,8 @@ pub fn explore(
     let mut totals = CriteriaTotals::default();
     let mut failure_record: Vec<(Point3<f64>, u32)> = Vec::new();
     let (mut failures, mut truth_hits, mut consecutive, mut iterations) = (0usize, 0usize, 0usize, 0usize);
+    let mut wasted_moves = 0usize;
+    let mut best_predicted_cells = None;
     let status = loop {
         if known_ratio >= params.stop.known_ratio {
             break ExploreStatus::Explored;
@@ -401,6 +418,7 @@ pub fn explore(
             free_viewpoint: true,
             gain_in_region: true,
             extra_candidates: params.extra_views.clone(),
+            visibility: params.visibility,
             prior_failures: failure_record.clone(),
             max_results: params.candidates_per_iteration,
             ik_check: params.nbv.ik_check.max(params.candidates_per_iteration),
@@ -418,10 +436,17 @@ pub fn explore(
             ex.should_stop,
         )?;
         times.nbv_us = us(t0);
+        if params.visibility.is_some() && ranked.stages.visibility_checked > 0 {
+            best_predicted_cells = Some(ranked.stages.best_predicted_cells);
+        }
         if ranked.candidates.is_empty() {
             iterations -= 1;
+            let exhausted = ranked.status == crate::nbv::NbvStatus::Complete
+                && ranked.stages.visibility_checked > 0
+                && ranked.stages.after_visibility == 0;
             break match ex.interrupted() {
                 Some(s) => s,
+                None if exhausted => ExploreStatus::ObservableExhausted,
                 None => ExploreStatus::NoCandidates,
             };
         }
@@ -458,6 +483,7 @@ pub fn explore(
                         ig: c.ig,
                         utility: c.utility,
                         rank,
+                        predicted_cells: c.predicted.map(|p| p.first),
                     });
                     step.motion = Some(motion);
                     break;
@@ -491,6 +517,7 @@ pub fn explore(
                 step.failures.push((position, ViewFailure::NoGain));
                 record_failure(&mut failure_record, position, params.nbv.position_threshold);
                 failures += 1;
+                wasted_moves += 1;
                 consecutive += 1;
             } else {
                 consecutive = 0;
@@ -513,6 +540,8 @@ pub fn explore(
         observable_cells: observable.len(),
         totals,
         failures,
+        wasted_moves,
+        best_predicted_cells,
         truth_hits,
         final_joints: q,
         tree: ex.tree,
