@@ -410,6 +410,7 @@ pub fn explore(
         let t_iter = Instant::now();
         let mut times = StageTimes::default();
         let t0 = Instant::now();
+        let ik_check = params.nbv.ik_check.max(params.candidates_per_iteration);
         let nbv_params = NbvParams {
             region: Some(params.region),
             robot_base: Isometry3::identity(),
@@ -420,8 +421,18 @@ pub fn explore(
             extra_candidates: params.extra_views.clone(),
             visibility: params.visibility,
             prior_failures: failure_record.clone(),
-            max_results: params.candidates_per_iteration,
-            ik_check: params.nbv.ik_check.max(params.candidates_per_iteration),
+            // with the visibility check every returned view is predicted to
+            // add cells, but the best predicted ones are often out of reach:
+            // NBV returns and IK-checks four times as many, and the loop
+            // skips the unreachable ones without spending a try on them
+            max_results: match params.visibility {
+                Some(_) => 4 * ik_check,
+                None => params.candidates_per_iteration,
+            },
+            ik_check: match params.visibility {
+                Some(_) => 4 * ik_check,
+                None => ik_check,
+            },
             time_budget: ex.deadline.map(|d| d.saturating_duration_since(Instant::now())),
             seed: params.seed.wrapping_add(iterations as u64),
             ..params.nbv.clone()
@@ -462,8 +473,9 @@ pub fn explore(
         };
         let known = ex.known_checker()?;
         let t_plan = Instant::now();
+        let mut tries = 0usize;
         for (rank, c) in ranked.candidates.iter().enumerate() {
-            if ex.interrupted().is_some() {
+            if ex.interrupted().is_some() || tries >= params.candidates_per_iteration {
                 break;
             }
             let position = Point3::from(c.pose.translation.vector);
@@ -474,6 +486,7 @@ pub fn explore(
                 record_failure(&mut failure_record, position, params.nbv.position_threshold);
                 continue;
             }
+            tries += 1;
             match plan_to(&ex, &known, &q, c, iterations, rank)? {
                 Ok(motion) => {
                     step.view = Some(ChosenView {

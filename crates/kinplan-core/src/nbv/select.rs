@@ -460,7 +460,12 @@ pub fn next_best_view(
                 status = s;
                 break;
             }
-            if kept.len() >= params.max_results {
+            // enough views for the results and for the IK check that follows
+            let wanted = match robot {
+                Some(_) => params.max_results.max(params.ik_check),
+                None => params.max_results,
+            };
+            if kept.len() >= wanted {
                 break;
             }
         }

@@ -315,10 +315,11 @@ fn predicted_cells_stop_at_occupied_cells_and_count_the_first_unknown_one_as_cer
     // cell, 32779 and 32780 follow within the look-ahead of 3
     let p = predict_view(&t, &cam, &pose, &vp, None, &mut ws, &|| false);
     assert_eq!((p.first, p.reached, p.rays), (1, 3, 1));
-    // a region starting at cell 32779 counts only the two later cells, none as certain
+    // a region starting at cell 32779: the unknown cell 32778 outside it is passed
+    // as open, so 32779 is the first unknown region cell, 32780 and 32781 follow
     let region = Some(([32779, 0, 0], [65535, 65535, 65535]));
     let p = predict_view(&t, &cam, &pose, &vp, region, &mut ws, &|| false);
-    assert_eq!((p.first, p.reached), (0, 2));
+    assert_eq!((p.first, p.reached), (1, 3));
     // an occupied cell at 32778 hides everything behind it
     let mut t2 = t.clone();
     let (hit, _) = hm(&t2);

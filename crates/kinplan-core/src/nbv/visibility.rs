@@ -7,11 +7,13 @@
 //! would: a ray ends at its first occupied cell, and every unknown cell it enters is a
 //! cell the scan may reveal. Two counts come out of one walk:
 //!
-//! - `first`: distinct region cells that are the **first** unknown cell of some ray
-//!   before any occupied cell. The real ray must reach that cell (every cell before it
-//!   is known free) and either passes it (free) or ends in it (occupied): either way
-//!   it becomes known. It is a lower bound of what the scan adds (up to the sensor's
-//!   range and the pixel grid), and the "not executed" rule uses it.
+//! - `first`: distinct region cells that are the **first** unknown region cell of some
+//!   ray before any occupied cell. The real ray reaches that cell (every region cell
+//!   before it is known free) and either passes it (free) or ends in it (occupied):
+//!   either way it becomes known. It is a lower bound of what the scan adds (up to the
+//!   sensor's range, the pixel grid, and unknown space outside the region, which is
+//!   passed as open: the views stand in it and the planner treats it so), and the
+//!   "not executed" rule uses it.
 //! - `reached`: distinct region cells among the first `lookahead` unknown cells of each
 //!   ray (an unknown cell is as likely to stop the ray as not; beyond a few of them the
 //!   ray has probably ended). It ranks the views.
@@ -122,8 +124,8 @@ fn in_keys(k: &OcKey, keys: &Option<(OcKey, OcKey)>) -> bool {
 /// docs): the rays through every `pixel_stride`-th pixel (the pixel grid of the
 /// simulated sensor at the same stride) are walked by a 3-D DDA from the camera centre
 /// to depth `far`, each stopping at its first occupied cell or after `lookahead`
-/// unknown cells; only cells with keys in `region_keys` (inclusive; `None` = all) are
-/// counted. Cost: at most `rays · (far / res) · √3` lookups. `should_stop` is polled
+/// unknown cells with keys in `region_keys` (inclusive; `None` = all); unknown cells
+/// outside it are passed as open and not counted. Cost: at most `rays · (far / res) · √3` lookups. `should_stop` is polled
 /// every 64 rays; a stopped view returns what it found so far.
 pub fn predict_view(
     tree: &Octree,
@@ -157,15 +159,16 @@ pub fn predict_view(
                 |k, state, _| match state {
                     CellState::Occupied => false,
                     CellState::Free => true,
+                    // unknown space outside the region is passed as open (the
+                    // views stand in it; the planner treats it so too)
+                    CellState::Unknown if !in_keys(k, &region_keys) => true,
                     CellState::Unknown => {
                         unknown += 1;
-                        if in_keys(k, &region_keys) {
-                            let m = morton(k);
-                            if unknown == 1 {
-                                ws.first.push(m);
-                            }
-                            ws.reached.push(m);
+                        let m = morton(k);
+                        if unknown == 1 {
+                            ws.first.push(m);
                         }
+                        ws.reached.push(m);
                         unknown < params.lookahead
                     }
                 },
