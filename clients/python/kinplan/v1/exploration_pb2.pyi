@@ -283,7 +283,7 @@ class NextBestViewResponse(_message.Message):
     def __init__(self, candidates: _Optional[_Iterable[_Union[ViewCandidate, _Mapping]]] = ..., stages: _Optional[_Union[NbvStages, _Mapping]] = ..., status: _Optional[_Union[NbvStatus, str]] = ..., weights: _Optional[_Union[UtilityWeights, _Mapping]] = ..., reach: _Optional[float] = ..., elapsed: _Optional[float] = ...) -> None: ...
 
 class DepthImage(_message.Message):
-    __slots__ = ("width", "height", "depth", "fx", "fy", "cx", "cy")
+    __slots__ = ("width", "height", "depth", "fx", "fy", "cx", "cy", "depth_mm", "camera")
     WIDTH_FIELD_NUMBER: _ClassVar[int]
     HEIGHT_FIELD_NUMBER: _ClassVar[int]
     DEPTH_FIELD_NUMBER: _ClassVar[int]
@@ -291,6 +291,8 @@ class DepthImage(_message.Message):
     FY_FIELD_NUMBER: _ClassVar[int]
     CX_FIELD_NUMBER: _ClassVar[int]
     CY_FIELD_NUMBER: _ClassVar[int]
+    DEPTH_MM_FIELD_NUMBER: _ClassVar[int]
+    CAMERA_FIELD_NUMBER: _ClassVar[int]
     width: int
     height: int
     depth: _containers.RepeatedScalarFieldContainer[float]
@@ -298,7 +300,9 @@ class DepthImage(_message.Message):
     fy: float
     cx: float
     cy: float
-    def __init__(self, width: _Optional[int] = ..., height: _Optional[int] = ..., depth: _Optional[_Iterable[float]] = ..., fx: _Optional[float] = ..., fy: _Optional[float] = ..., cx: _Optional[float] = ..., cy: _Optional[float] = ...) -> None: ...
+    depth_mm: bytes
+    camera: CameraModel
+    def __init__(self, width: _Optional[int] = ..., height: _Optional[int] = ..., depth: _Optional[_Iterable[float]] = ..., fx: _Optional[float] = ..., fy: _Optional[float] = ..., cx: _Optional[float] = ..., cy: _Optional[float] = ..., depth_mm: _Optional[bytes] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ...) -> None: ...
 
 class InsertScanRequest(_message.Message):
     __slots__ = ("octree", "resolution", "sensor_pose", "points", "depth_image", "max_range", "discretize", "full")
