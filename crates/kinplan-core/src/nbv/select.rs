@@ -159,11 +159,11 @@ pub fn estimate_reach(chain: &Chain) -> f64 {
 /// 3. `f = w_d·D + w_r·R + w_i·Ig`, `D = 1 − ‖p_c − p'‖/(2·d_max)` (d_max the largest
 ///    distance among the survivors), `R = 1 − Δr/π` (Δr the rotation angle between the
 ///    current and the candidate orientation);
-/// 3b. with `visibility`, the best candidates are checked in batches by
+/// 4. with `visibility`, the best candidates are checked in batches by
 ///    [`predict_view`](super::predict_view): views whose lower bound is below
 ///    `min_new_cells` are dropped, the rest get `Ig = reached / max reached` and are
 ///    ranked again by the same `f` (unchecked candidates are not returned);
-/// 4. the best `ik_check` are checked by IK on `robot` for the tip pose
+/// 5. the best `ik_check` are checked by IK on `robot` for the tip pose
 ///    `base⁻¹ · pose · mount⁻¹`; unreachable ones are dropped (or, with
 ///    `count_failures`, kept with `f − failure_penalty · failures`).
 ///
@@ -414,7 +414,7 @@ pub fn next_best_view(
     let rank = |v: &mut Vec<NbvCandidate>| v.sort_by(|a, b| b.utility.total_cmp(&a.utility));
     rank(&mut scored);
 
-    // 3b. visibility: predict the best views' yield by ray casting, drop the ones that
+    // 3b. visibility (step 4 of the doc): predict the best views' yield by ray casting, drop the ones that
     // would add nothing, rank the rest again on the predicted gain
     if let Some(vp) = &params.visibility
         && status == NbvStatus::Complete

@@ -616,7 +616,7 @@ impl Octree {
 /// pixel, a ROS `16UC1` image): `z = mm / 1000`, 0 stays 0 (no return). An odd byte
 /// count is refused naming `field`.
 pub fn depth_from_millimetres(bytes: &[u8], field: &'static str) -> Result<Vec<f32>, OctreeError> {
-    if bytes.len() % 2 != 0 {
+    if !bytes.len().is_multiple_of(2) {
         return Err(OctreeError::WrongLength {
             field,
             expected: bytes.len() + 1,

@@ -241,7 +241,10 @@ const MAX_DEPTH_PIXELS: usize = 1 << 24;
 fn depth_image_in(d: &pb::DepthImage) -> Result<Scan, Status> {
     let (width, height) = (d.width as usize, d.height as usize);
     if width == 0 || height == 0 {
-        return Err(invalid("depth_image.width", "width and height must be at least 1"));
+        return Err(invalid(
+            "depth_image.width",
+            "width and height must be at least 1",
+        ));
     }
     let pixels = width
         .checked_mul(height)
@@ -259,7 +262,10 @@ fn depth_image_in(d: &pb::DepthImage) -> Result<Scan, Status> {
             if d.depth.len() != pixels {
                 return Err(invalid(
                     "depth_image.depth",
-                    format!("has {} values, width x height is {width} x {height}", d.depth.len()),
+                    format!(
+                        "has {} values, width x height is {width} x {height}",
+                        d.depth.len()
+                    ),
                 ));
             }
             d.depth.clone()
