@@ -7,7 +7,9 @@
 //! - `compare OT [runs]`: times `Octree::insert_depth_image` of the same frame into
 //!   fresh trees (median and minimum over `runs`, default 7; set `RAYON_NUM_THREADS=1`
 //!   for one core) and compares every cell of the room's key box with OctoMap's tree
-//!   read from `OT`: same state (unknown / free / occupied) or not.
+//!   read from `OT`: same state (unknown / free / occupied) or not. Then the same with
+//!   `ScanParams::discretize` (end points merged per cell and cast from the cell's
+//!   centre, OctoMap's `discretize`), against the same OctoMap tree (not discretized).
 //!
 //! Run by hand (not in CI):
 //!
@@ -67,7 +69,7 @@ fn write() {
     println!("{} points written to target/frame_points.bin", pts.len());
 }
 
-fn compare(ot: &str, runs: usize) {
+fn compare(ot: &str, runs: usize, discretize: bool) {
     let (cam, pose, depth) = frame();
     let k = cam.intrinsics();
     let mut ms = Vec::new();
@@ -81,7 +83,10 @@ fn compare(ot: &str, runs: usize) {
             cam.height,
             &k,
             &pose,
-            &ScanParams::default(),
+            &ScanParams {
+                discretize,
+                ..ScanParams::default()
+            },
             &|| false,
         )
         .unwrap();
@@ -90,7 +95,7 @@ fn compare(ot: &str, runs: usize) {
     let mut sorted = ms.clone();
     sorted.sort_by(f64::total_cmp);
     println!(
-        "kinplan insert_depth_image: {} pixels, res {RES}, median {:.1} ms, min {:.1} ms over {} runs, threads {}",
+        "kinplan insert_depth_image (discretize {discretize}): {} pixels, res {RES}, median {:.1} ms, min {:.1} ms over {} runs, threads {}",
         depth.len(),
         sorted[sorted.len() / 2],
         sorted[0],
@@ -134,10 +139,15 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         Some("write") => write(),
-        Some("compare") => compare(
-            args.get(1).expect("the OctoMap .ot path"),
-            args.get(2).map_or(7, |v| v.parse().expect("runs")),
-        ),
+        Some("compare") => {
+            for discretize in [false, true] {
+                compare(
+                    args.get(1).expect("the OctoMap .ot path"),
+                    args.get(2).map_or(7, |v| v.parse().expect("runs")),
+                    discretize,
+                );
+            }
+        }
         _ => eprintln!("usage: depth_frame write | compare OT [runs]"),
     }
 }
