@@ -73,11 +73,12 @@ fn compare(ot: &str, runs: usize, discretize: bool) {
     let (cam, pose, depth) = frame();
     let k = cam.intrinsics();
     let mut ms = Vec::new();
+    let mut split = (0u64, 0u64);
     let mut ours = Octree::new(RES).unwrap();
     for _ in 0..runs.max(1) {
         ours = Octree::new(RES).unwrap();
         let t = Instant::now();
-        ours.insert_depth_image(
+        let stats = ours.insert_depth_image(
             &depth,
             cam.width,
             cam.height,
@@ -91,6 +92,7 @@ fn compare(ot: &str, runs: usize, discretize: bool) {
         )
         .unwrap();
         ms.push(t.elapsed().as_secs_f64() * 1e3);
+        split = (stats.trace_us, stats.update_us);
     }
     let mut sorted = ms.clone();
     sorted.sort_by(f64::total_cmp);
@@ -101,6 +103,11 @@ fn compare(ot: &str, runs: usize, discretize: bool) {
         sorted[0],
         ms.len(),
         rayon::current_num_threads()
+    );
+    println!(
+        "  last run: trace {:.1} ms, update {:.1} ms",
+        split.0 as f64 / 1e3,
+        split.1 as f64 / 1e3
     );
     let theirs = Octree::read_ot(&std::fs::read(ot).unwrap(), &OctreeLimits::default()).unwrap();
     let lo = ours
