@@ -78,19 +78,20 @@ fn compare(ot: &str, runs: usize, discretize: bool) {
     for _ in 0..runs.max(1) {
         ours = Octree::new(RES).unwrap();
         let t = Instant::now();
-        let stats = ours.insert_depth_image(
-            &depth,
-            cam.width,
-            cam.height,
-            &k,
-            &pose,
-            &ScanParams {
-                discretize,
-                ..ScanParams::default()
-            },
-            &|| false,
-        )
-        .unwrap();
+        let stats = ours
+            .insert_depth_image(
+                &depth,
+                cam.width,
+                cam.height,
+                &k,
+                &pose,
+                &ScanParams {
+                    discretize,
+                    ..ScanParams::default()
+                },
+                &|| false,
+            )
+            .unwrap();
         ms.push(t.elapsed().as_secs_f64() * 1e3);
         split = (stats.trace_us, stats.update_us);
     }

@@ -344,6 +344,13 @@ fn with_the_visibility_check_no_executed_view_is_wasted_in_the_walled_cell() {
         "{}",
         out.known_ratio
     );
+    // the same run with S0's occlusion-blind choice does waste moves
+    let blind = ExploreParams {
+        visibility: None,
+        ..p
+    };
+    let out = run(&rig, &scene, &blind, &mut Vec::new());
+    assert!(out.wasted_moves >= 1, "{:?}", out.status);
 }
 
 /// The cells of `t` as (key, occupied) pairs, sorted.
