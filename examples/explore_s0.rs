@@ -13,6 +13,12 @@
 //!   RRT-Connect, STOMP and CCSTOMP: OC and CD mean, variance and sum per
 //!   trajectory; per-trajectory values to `target/explore_planners.csv`.
 //!
+//! - `waste [seeds]`: the open and walled cells built with seeds 1..=seeds,
+//!   15 iterations each with RRT-Connect and CCSTOMP, S0's occlusion-blind
+//!   choice beside the visibility check in the same run: wasted moves
+//!   (views reached whose scan added nothing), failures, final known ratio,
+//!   why the loop stopped.
+//!
 //! Usage: cargo run --release -p kinplan-core --example explore_s0 -- tab53 5
 
 use std::fmt::Write as _;
@@ -78,6 +84,9 @@ fn run(
     }
     if std::env::var("RAYS").is_ok() {
         p.nbv.gain = kinplan_core::nbv::GainMethod::Rays { fraction: 0.25 };
+    }
+    if std::env::var("BLIND").is_ok() {
+        p.visibility = None;
     }
     if let Ok(v) = std::env::var("MAX_ITER") {
         p.stop.max_iterations = v.parse().expect("MAX_ITER");
@@ -301,6 +310,63 @@ fn tab54(seeds: u64) {
     std::fs::write("target/explore_planners.csv", csv).expect("csv");
 }
 
+fn waste(seeds: u64) {
+    let s = setup();
+    println!(
+        "| cell | seed | planner | choice | iterations | wasted moves | other failures | initial known | known after | status | best predicted cells | wall s |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for scene_name in ["open", "walled"] {
+        for seed in 1..=seeds {
+            let scene = scene_named(scene_name, seed);
+            for (label, algorithm) in [
+                ("RRT-Connect", Algorithm::RrtConnect),
+                ("CCSTOMP", Algorithm::Ccstomp),
+            ] {
+                for blind in [true, false] {
+                    let truth = Arc::new(
+                        SceneGeometry::build(
+                            &Scene::new(scene.obstacles.clone(), &SceneLimits::default()).expect("scene"),
+                        )
+                        .expect("geometry"),
+                    );
+                    let world = ExploreWorld {
+                        chain: &s.chain,
+                        model: &s.model,
+                        acm: &s.acm,
+                        truth: &truth,
+                    };
+                    let mut p = ExploreParams::new(scene.region, s.chain.dof());
+                    p.plan.algorithm = algorithm;
+                    p.stop.max_iterations = 15;
+                    if blind {
+                        p.visibility = None;
+                    }
+                    let t0 = Instant::now();
+                    let out = explore(&world, &scene.start, &p, ExploreControl::default()).expect("explore");
+                    println!(
+                        "| {scene_name} | {seed} | {label} | {} | {} | {} | {} | {:.3} | {:.3} | {:?} | {} | {:.1} |",
+                        if blind {
+                            "intersection (S0)"
+                        } else {
+                            "visibility check"
+                        },
+                        out.iterations,
+                        out.wasted_moves,
+                        out.failures - out.wasted_moves,
+                        out.initial_known_ratio,
+                        out.known_ratio,
+                        out.status,
+                        out.best_predicted_cells
+                            .map_or("-".to_string(), |c| c.to_string()),
+                        t0.elapsed().as_secs_f64()
+                    );
+                }
+            }
+        }
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let seeds = |i: usize| args.get(i).map_or(3, |v| v.parse().expect("seeds"));
@@ -308,6 +374,9 @@ fn main() {
         Some("scene") => one(args.get(1).map_or("open", String::as_str)),
         Some("tab53") => tab53(seeds(1)),
         Some("tab54") => tab54(seeds(1)),
-        _ => eprintln!("usage: explore_s0 scene <open|walled> | tab53 [seeds] | tab54 [seeds]"),
+        Some("waste") => waste(seeds(1)),
+        _ => {
+            eprintln!("usage: explore_s0 scene <open|walled> | tab53 [seeds] | tab54 [seeds] | waste [seeds]")
+        }
     }
 }

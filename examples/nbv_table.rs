@@ -8,8 +8,8 @@
 use std::time::Instant;
 
 use kinplan_core::nbv::{
-    CameraModel, Frustum, FrustumCounter, GainMethod, GainWorkspace, NbvParams, look_along, next_best_view,
-    ray_gain,
+    CameraModel, Frustum, FrustumCounter, GainMethod, GainWorkspace, NbvParams, VisibilityParams, look_along,
+    next_best_view, ray_gain,
 };
 use kinplan_core::octree::{CellState, Octree, OctreeLimits, ScanParams};
 use nalgebra::{Isometry3, Point3, Vector3};
@@ -190,10 +190,10 @@ fn main() {
     println!("NBV end to end, room @ 0.05 m, robot abb_irb4600_60_205 at the origin, Kinect v2 model:");
     println!();
     println!(
-        "| config | frontier cells | candidates | after ORF | after PTF | after IGF | IK checked / failed | frontier ms | field ms | ORF ms | PTF ms | IGF ms | IK ms | total ms | CPU ms, all threads (run-queue wait ms) |"
+        "| config | frontier cells | candidates | after ORF | after PTF | after IGF | IK checked / failed | frontier ms | field ms | ORF ms | PTF ms | IGF ms | IK ms | visibility ms (checked / dropped) | total ms | CPU ms, all threads (run-queue wait ms) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    let cfgs: [(&str, NbvParams); 3] = [
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let cfgs: [(&str, NbvParams); 5] = [
         (
             "S0 filters (PTF 0.2 m / 20°), intersection gain",
             NbvParams::default(),
@@ -204,6 +204,23 @@ fn main() {
                 position_threshold: 0.0,
                 reach: Some(100.0),
                 ik_check: 0,
+                ..NbvParams::default()
+            },
+        ),
+        (
+            "S0 filters, intersection gain + visibility check",
+            NbvParams {
+                visibility: Some(VisibilityParams::default()),
+                ..NbvParams::default()
+            },
+        ),
+        (
+            "PTF off, no IK, intersection gain + visibility check",
+            NbvParams {
+                position_threshold: 0.0,
+                reach: Some(100.0),
+                ik_check: 0,
+                visibility: Some(VisibilityParams::default()),
                 ..NbvParams::default()
             },
         ),
@@ -241,7 +258,7 @@ fn main() {
         };
         let st = r.stages;
         println!(
-            "| {name} | {} | {} | {} | {} | {} | {} / {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {cpu} |",
+            "| {name} | {} | {} | {} | {} | {} | {} / {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} ({} / {}) | {:.1} | {cpu} |",
             st.frontier_cells,
             st.frontier_candidates + st.caller_candidates,
             st.after_orf,
@@ -255,6 +272,9 @@ fn main() {
             st.ptf_us as f64 / 1e3,
             st.igf_us as f64 / 1e3,
             st.ik_us as f64 / 1e3,
+            st.visibility_us as f64 / 1e3,
+            st.visibility_checked,
+            st.visibility_dropped,
             total
         );
         if let Some(b) = r.candidates.first() {

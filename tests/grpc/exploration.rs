@@ -197,3 +197,130 @@ async fn bad_exploration_input_is_named_by_field() {
     assert_eq!(err.code(), Code::InvalidArgument);
     assert!(err.message().starts_with("camera:"), "{}", err.message());
 }
+
+/// A 4 × 3 depth image of a plane 2 m ahead (fx = fy = 2 px, cx = 1.5,
+/// cy = 1): pixel (u, v) is the point (u − 1.5, v − 1, 2) in the optical
+/// frame, here the world frame (identity sensor pose).
+fn plane_image() -> pb::DepthImage {
+    pb::DepthImage {
+        width: 4,
+        height: 3,
+        depth: vec![2.0; 12],
+        fx: 2.0,
+        fy: 2.0,
+        cx: 1.5,
+        cy: 1.0,
+        ..Default::default()
+    }
+}
+
+#[tokio::test]
+async fn depth_images_in_metres_millimetres_or_with_a_camera_model_insert_like_their_points() {
+    let server = start(ServerConfig::default()).await;
+    let mut exploration = ExplorationServiceClient::new(server.channel.clone());
+    let with = |scan| pb::InsertScanRequest {
+        scan: Some(scan),
+        ..scan_request(None, Vec::new())
+    };
+    let mut xyz = Vec::new();
+    for v in 0..3 {
+        for u in 0..4 {
+            xyz.extend([u as f32 - 1.5, v as f32 - 1.0, 2.0]);
+        }
+    }
+    let by_points = exploration
+        .insert_scan(with(Scan::Points(pb::PointCloud { xyz })))
+        .await
+        .unwrap()
+        .into_inner();
+    let mm = pb::DepthImage {
+        depth: Vec::new(),
+        depth_mm: [2000u16.to_le_bytes(); 12].concat(),
+        ..plane_image()
+    };
+    // the camera model with the same intrinsics: tan(hfov/2) = 1.5/2, tan(vfov/2) = 1/2
+    let camera = pb::DepthImage {
+        fx: 0.0,
+        fy: 0.0,
+        cx: 0.0,
+        cy: 0.0,
+        camera: Some(pb::CameraModel {
+            horizontal_fov: Some(2.0 * 0.75f64.atan()),
+            vertical_fov: Some(2.0 * 0.5f64.atan()),
+            width: Some(4),
+            height: Some(3),
+            ..Default::default()
+        }),
+        ..plane_image()
+    };
+    for image in [plane_image(), mm, camera] {
+        let reply = exploration
+            .insert_scan(with(Scan::DepthImage(image)))
+            .await
+            .unwrap()
+            .into_inner();
+        assert_eq!(reply.occupied_cells, by_points.occupied_cells);
+        assert_eq!(reply.free_cells, by_points.free_cells);
+        assert_eq!(reply.octree.unwrap().data, by_points.octree.clone().unwrap().data);
+    }
+
+    // bad images name their field
+    let cases: Vec<(pb::DepthImage, &str)> = vec![
+        (
+            pb::DepthImage {
+                depth_mm: vec![0; 24],
+                ..plane_image()
+            },
+            "depth_image.depth_mm:",
+        ),
+        (
+            pb::DepthImage {
+                depth: Vec::new(),
+                depth_mm: vec![0; 23],
+                ..plane_image()
+            },
+            "depth_image.depth_mm:",
+        ),
+        (
+            pb::DepthImage {
+                width: 1 << 13,
+                height: 1 << 12,
+                ..plane_image()
+            },
+            "depth_image.width:",
+        ),
+        (
+            pb::DepthImage {
+                fx: 0.0,
+                fy: 0.0,
+                cx: 0.0,
+                cy: 0.0,
+                camera: Some(pb::CameraModel::default()),
+                ..plane_image()
+            },
+            "depth_image.camera.width:",
+        ),
+        (
+            pb::DepthImage {
+                camera: Some(pb::CameraModel::default()),
+                ..plane_image()
+            },
+            "depth_image.camera:",
+        ),
+        (
+            pb::DepthImage {
+                depth: Vec::new(),
+                ..plane_image()
+            },
+            "depth_image.depth:",
+        ),
+    ];
+    for (image, field) in cases {
+        let err = exploration
+            .insert_scan(with(Scan::DepthImage(image)))
+            .await
+            .unwrap_err();
+        assert_eq!(err.code(), Code::InvalidArgument, "{}", err.message());
+        assert!(err.message().starts_with(field), "{field}: {}", err.message());
+    }
+}

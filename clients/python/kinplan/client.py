@@ -320,9 +320,12 @@ class Client:
     def insert_scan(
         self,
         octree: Optional[OctreeSource],
-        points: Any,
+        points: Any = None,
         origin: Any = None,
         *,
+        depth: Any = None,
+        intrinsics: Optional[Sequence[float]] = None,
+        camera: Optional[Dict[str, Any]] = None,
         resolution: float = 0.05,
         max_range: Optional[float] = None,
         discretize: bool = False,
@@ -331,8 +334,15 @@ class Client:
         """Inserts ``points`` (n x 3, world frame, metres) seen from ``origin``
         (3-vector or 4x4 sensor pose) with OctoMap's sensor model into
         ``octree`` (any form :meth:`Octree.read` takes); a new tree at
-        ``resolution`` when ``octree`` is None. Returns the updated tree."""
-        out: Octree = self._run(_exploration.insert_scan(octree, points, origin, resolution, max_range, discretize),
+        ``resolution`` when ``octree`` is None. Returns the updated tree.
+
+        Or a ``depth`` image (height x width; uint16 millimetres or float
+        metres, 0 / NaN = no return) taken from ``origin``, the camera's
+        optical frame (4x4: x right, y down, z forward), with
+        ``intrinsics=(fx, fy, cx, cy)`` in pixels or ``camera=`` a camera
+        model dict (its width and height those of the image)."""
+        out: Octree = self._run(_exploration.insert_scan(octree, points, origin, resolution, max_range, discretize,
+                                                         depth, intrinsics, camera),
                                 timeout)
         return out
 

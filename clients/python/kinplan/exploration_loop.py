@@ -71,9 +71,13 @@ class ExploreStep:
 @dataclass
 class ExploreSummary:
     """How the run ended (status "EXPLORED", "ITERATION_CAP",
-    "CONSECUTIVE_FAILURES", "NO_CANDIDATES", "TIMEOUT" or "CANCELLED"),
-    the known ratio before the first iteration and at the end, the S0
-    criteria summed over every trajectory (S0 Tab. 5.3) and the final tree."""
+    "CONSECUTIVE_FAILURES", "NO_CANDIDATES", "OBSERVABLE_EXHAUSTED",
+    "TIMEOUT" or "CANCELLED"), the known ratio before the first iteration
+    and at the end, the S0 criteria summed over every trajectory (S0 Tab.
+    5.3) and the final tree. ``wasted_moves`` counts views reached whose
+    scan added nothing; ``best_predicted_cells`` is the last visibility
+    check's largest lower bound of the cells a view would reveal (None
+    without the check)."""
 
     status: str
     iterations: int
@@ -87,11 +91,14 @@ class ExploreSummary:
     octree: Octree
     scans: int
     elapsed: float
+    wasted_moves: int = 0
+    best_predicted_cells: Optional[int] = None
 
     def _repr_html_(self) -> str:
         rows = [("status", self.status), ("iterations", self.iterations),
                 ("known ratio", f"{self.initial_known_ratio:.3f} -> {self.known_ratio:.3f}"),
                 ("observable cells", self.observable_cells), ("failed views", self.failures),
+                ("wasted moves", self.wasted_moves),
                 ("trajectories hitting the scene", self.scene_hits), ("elapsed (s)", self.elapsed)]
         rows += [(f"{k} (sum)", v) for k, v in self.totals.items()]
         return html_table("ExploreSummary", rows, "CD, RDM in m; JD, OC in rad; sums over every executed trajectory (S0 Tab. 5.3)")
@@ -100,7 +107,7 @@ class ExploreSummary:
         return (
             f"ExploreSummary({self.status} after {self.iterations} iterations, known "
             f"{self.initial_known_ratio:.3f} -> {self.known_ratio:.3f}, {self.failures} failed views, "
-            f"{self.elapsed:.2f} s)"
+            f"{self.wasted_moves} wasted moves, {self.elapsed:.2f} s)"
         )
 
 
@@ -143,6 +150,8 @@ def _summary(s: exploration_pb2.ExploreSummary) -> ExploreSummary:
         octree=Octree.from_proto(s.octree),
         scans=s.scans,
         elapsed=s.elapsed,
+        wasted_moves=s.wasted_moves,
+        best_predicted_cells=s.best_predicted_cells if s.HasField("best_predicted_cells") else None,
     )
 
 

@@ -117,3 +117,28 @@ def test_nbv_takes_a_region_and_names_an_unknown_option(client):
         client.next_best_view(tree, camera_pose=np.eye(4), pose=np.eye(4))
     with pytest.raises(ValueError, match="region must be"):
         client.next_best_view(tree, camera_pose=np.eye(4), region=[1, 2])
+
+
+def test_a_depth_image_inserts_like_its_hand_back_projected_points(client):
+    # a 6 x 4 image of a plane 2 m ahead, fx = fy = 4 px, cx = 2.5, cy = 1.5:
+    # pixel (u, v) is the point ((u - 2.5) / 2, (v - 1.5) / 2, 2) in the optical frame
+    pose = np.eye(4)
+    pose[:3, 3] = [0.02, 0.03, 0.01]
+    u, v = np.meshgrid(np.arange(6), np.arange(4))
+    pts = np.column_stack([(u.ravel() - 2.5) / 2, (v.ravel() - 1.5) / 2, np.full(24, 2.0)]) + pose[:3, 3]
+    by_points = client.insert_scan(None, pts, origin=pose, resolution=0.1)
+    k = (4.0, 4.0, 2.5, 1.5)
+    metres = client.insert_scan(None, origin=pose, depth=np.full((4, 6), 2.0), intrinsics=k, resolution=0.1)
+    mm = client.insert_scan(None, origin=pose, depth=np.full((4, 6), 2000, dtype=np.uint16), intrinsics=k,
+                            resolution=0.1)
+    assert metres.data == by_points.data and mm.data == by_points.data
+    # a pixel without a return (0 mm) adds no end point
+    holes = np.full((4, 6), 2000, dtype=np.uint16)
+    holes[0, 0] = 0
+    fewer = client.insert_scan(None, origin=pose, depth=holes, intrinsics=k, resolution=0.1)
+    assert client.octree_info(fewer)["occupied_leaves"] == client.octree_info(mm)["occupied_leaves"] - 1
+    with pytest.raises(ValueError):
+        client.insert_scan(None, origin=pose, depth=np.full((4, 6), 2000, dtype=np.int32), intrinsics=k)
+    with pytest.raises(kinplan.KinplanError) as e:
+        client.insert_scan(None, origin=pose, depth=np.full((4, 6), 2.0), camera={"width": 5, "height": 4})
+    assert "depth_image.camera.width" in str(e.value)

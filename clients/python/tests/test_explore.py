@@ -50,6 +50,11 @@ def test_an_exploration_yields_steps_then_a_summary(client):
     info = client.octree_info(summary.octree)
     assert info["resolution"] == pytest.approx(0.2) and info["occupied_leaves"] > 0
     assert "known" in repr(summary) and len(repr(steps[0])) < 200
+    # wasted moves are the views reached whose scan added nothing ("no_gain"):
+    # with the visibility check (on by default) there are none
+    no_gain = sum(1 for s in steps for _, why in s.failures if why == "no_gain")
+    assert summary.wasted_moves == no_gain == 0
+    assert summary.best_predicted_cells is not None
 
 
 def test_bad_exploration_input_raises_naming_the_field(client):

@@ -126,23 +126,56 @@ def _views(reply: exploration_pb2.NextBestViewResponse) -> Views:
 
 
 def insert_scan(octree: Any, points: Any, origin: Any, resolution: float,
-                max_range: Optional[float], discretize: bool) -> Call[Octree]:
-    """InsertScan: ``points`` seen from ``origin`` into ``octree`` (any
-    form :meth:`Octree.read` takes; a new tree when None)."""
-    pts = np.asarray(points, dtype=np.float32)
-    if pts.ndim != 2 or pts.shape[1] != 3:
-        raise ValueError(f"points must be n x 3, got shape {pts.shape}")
+                max_range: Optional[float], discretize: bool, depth: Any = None,
+                intrinsics: Optional[Sequence[float]] = None,
+                camera: Optional[Dict[str, Any]] = None) -> Call[Octree]:
+    """InsertScan: ``points`` seen from ``origin``, or a ``depth`` image taken
+    from the sensor pose ``origin``, into ``octree`` (any form
+    :meth:`Octree.read` takes; a new tree when None)."""
     req = exploration_pb2.InsertScanRequest(
         resolution=float(resolution),
         sensor_pose=_pose(origin),
-        points=exploration_pb2.PointCloud(xyz=pts.ravel().tolist()),
         discretize=discretize,
     )
+    if (points is None) == (depth is None):
+        raise ValueError("give points or depth, not both")
+    if depth is not None:
+        req.depth_image.CopyFrom(_depth_image(depth, intrinsics, camera))
+    else:
+        pts = np.asarray(points, dtype=np.float32)
+        if pts.ndim != 2 or pts.shape[1] != 3:
+            raise ValueError(f"points must be n x 3, got shape {pts.shape}")
+        req.points.CopyFrom(exploration_pb2.PointCloud(xyz=pts.ravel().tolist()))
     if octree is not None:
         req.octree.CopyFrom(Octree.read(octree).to_proto())
     if max_range is not None:
         req.max_range = float(max_range)
     return Call("exploration", "InsertScan", lambda r: Octree.from_proto(r.octree), request=req)
+
+
+def _depth_image(depth: Any, intrinsics: Optional[Sequence[float]],
+                 camera: Optional[Dict[str, Any]]) -> exploration_pb2.DepthImage:
+    """A DepthImage of a height x width array: uint16 in millimetres (sent as
+    little-endian bytes) or float in metres; 0 or NaN is no return."""
+    d = np.asarray(depth)
+    if d.ndim != 2:
+        raise ValueError(f"depth must be a height x width image, got shape {d.shape}")
+    h, w = d.shape
+    msg = exploration_pb2.DepthImage(width=w, height=h)
+    if d.dtype == np.uint16:
+        msg.depth_mm = d.astype("<u2").tobytes()
+    elif np.issubdtype(d.dtype, np.floating):
+        msg.depth.extend(d.astype(np.float32).ravel().tolist())
+    else:
+        raise ValueError(f"depth must be uint16 (mm) or float (m), got {d.dtype}")
+    if (intrinsics is None) == (camera is None):
+        raise ValueError("give intrinsics=(fx, fy, cx, cy) or camera=..., not both")
+    if intrinsics is not None:
+        fx, fy, cx, cy = (float(v) for v in intrinsics)
+        msg.fx, msg.fy, msg.cx, msg.cy = fx, fy, cx, cy
+    else:
+        msg.camera.CopyFrom(exploration_pb2.CameraModel(**dict(camera or {})))
+    return msg
 
 
 def octree_info(octree: Any, box: Any) -> Call[Dict[str, Any]]:

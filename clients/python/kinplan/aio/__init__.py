@@ -223,11 +223,14 @@ class Client:
         views: Views = await self._run(call, timeout)
         return views
 
-    async def insert_scan(self, octree: Optional[OctreeSource], points: Any, origin: Any = None, *,
+    async def insert_scan(self, octree: Optional[OctreeSource], points: Any = None, origin: Any = None, *,
+                          depth: Any = None, intrinsics: Optional[Sequence[float]] = None,
+                          camera: Optional[Dict[str, Any]] = None,
                           resolution: float = 0.05, max_range: Optional[float] = None, discretize: bool = False,
                           timeout: Optional[float] = None) -> Octree:
         """As :meth:`kinplan.Client.insert_scan`."""
-        call = _exploration.insert_scan(octree, points, origin, resolution, max_range, discretize)
+        call = _exploration.insert_scan(octree, points, origin, resolution, max_range, discretize,
+                                        depth, intrinsics, camera)
         out: Octree = await self._run(call, timeout)
         return out
 

@@ -39,6 +39,7 @@ class ExploreStatus(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
     EXPLORE_STATUS_NO_CANDIDATES: _ClassVar[ExploreStatus]
     EXPLORE_STATUS_TIMEOUT: _ClassVar[ExploreStatus]
     EXPLORE_STATUS_CANCELLED: _ClassVar[ExploreStatus]
+    EXPLORE_STATUS_OBSERVABLE_EXHAUSTED: _ClassVar[ExploreStatus]
 
 class ReferenceSceneName(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
     __slots__ = ()
@@ -64,6 +65,7 @@ EXPLORE_STATUS_CONSECUTIVE_FAILURES: ExploreStatus
 EXPLORE_STATUS_NO_CANDIDATES: ExploreStatus
 EXPLORE_STATUS_TIMEOUT: ExploreStatus
 EXPLORE_STATUS_CANCELLED: ExploreStatus
+EXPLORE_STATUS_OBSERVABLE_EXHAUSTED: ExploreStatus
 REFERENCE_SCENE_NAME_UNSPECIFIED: ReferenceSceneName
 REFERENCE_SCENE_NAME_S0_OPEN_CELL: ReferenceSceneName
 REFERENCE_SCENE_NAME_S0_WALLED_CELL: ReferenceSceneName
@@ -111,7 +113,7 @@ class ViewFailure(_message.Message):
     def __init__(self, position: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., count: _Optional[int] = ...) -> None: ...
 
 class NbvOptions(_message.Message):
-    __slots__ = ("region", "frontier_unknown_ratio", "max_frontier_candidates", "field_radius", "standoff", "reach", "position_threshold", "orientation_threshold", "gain_threshold", "gain", "ray_fraction", "weights", "adaptive_weights", "ik_check", "count_failures", "failure_penalty", "prior_failures", "max_results", "time_budget", "seed", "free_viewpoint", "gain_in_region")
+    __slots__ = ("region", "frontier_unknown_ratio", "max_frontier_candidates", "field_radius", "standoff", "reach", "position_threshold", "orientation_threshold", "gain_threshold", "gain", "ray_fraction", "weights", "adaptive_weights", "ik_check", "count_failures", "failure_penalty", "prior_failures", "max_results", "time_budget", "seed", "free_viewpoint", "gain_in_region", "visibility")
     REGION_FIELD_NUMBER: _ClassVar[int]
     FRONTIER_UNKNOWN_RATIO_FIELD_NUMBER: _ClassVar[int]
     MAX_FRONTIER_CANDIDATES_FIELD_NUMBER: _ClassVar[int]
@@ -134,6 +136,7 @@ class NbvOptions(_message.Message):
     SEED_FIELD_NUMBER: _ClassVar[int]
     FREE_VIEWPOINT_FIELD_NUMBER: _ClassVar[int]
     GAIN_IN_REGION_FIELD_NUMBER: _ClassVar[int]
+    VISIBILITY_FIELD_NUMBER: _ClassVar[int]
     region: BoundingBox
     frontier_unknown_ratio: float
     max_frontier_candidates: int
@@ -156,7 +159,20 @@ class NbvOptions(_message.Message):
     seed: int
     free_viewpoint: bool
     gain_in_region: bool
-    def __init__(self, region: _Optional[_Union[BoundingBox, _Mapping]] = ..., frontier_unknown_ratio: _Optional[float] = ..., max_frontier_candidates: _Optional[int] = ..., field_radius: _Optional[float] = ..., standoff: _Optional[float] = ..., reach: _Optional[float] = ..., position_threshold: _Optional[float] = ..., orientation_threshold: _Optional[float] = ..., gain_threshold: _Optional[float] = ..., gain: _Optional[_Union[GainMethod, str]] = ..., ray_fraction: _Optional[float] = ..., weights: _Optional[_Union[UtilityWeights, _Mapping]] = ..., adaptive_weights: _Optional[bool] = ..., ik_check: _Optional[int] = ..., count_failures: _Optional[bool] = ..., failure_penalty: _Optional[float] = ..., prior_failures: _Optional[_Iterable[_Union[ViewFailure, _Mapping]]] = ..., max_results: _Optional[int] = ..., time_budget: _Optional[float] = ..., seed: _Optional[int] = ..., free_viewpoint: _Optional[bool] = ..., gain_in_region: _Optional[bool] = ...) -> None: ...
+    visibility: VisibilityCheck
+    def __init__(self, region: _Optional[_Union[BoundingBox, _Mapping]] = ..., frontier_unknown_ratio: _Optional[float] = ..., max_frontier_candidates: _Optional[int] = ..., field_radius: _Optional[float] = ..., standoff: _Optional[float] = ..., reach: _Optional[float] = ..., position_threshold: _Optional[float] = ..., orientation_threshold: _Optional[float] = ..., gain_threshold: _Optional[float] = ..., gain: _Optional[_Union[GainMethod, str]] = ..., ray_fraction: _Optional[float] = ..., weights: _Optional[_Union[UtilityWeights, _Mapping]] = ..., adaptive_weights: _Optional[bool] = ..., ik_check: _Optional[int] = ..., count_failures: _Optional[bool] = ..., failure_penalty: _Optional[float] = ..., prior_failures: _Optional[_Iterable[_Union[ViewFailure, _Mapping]]] = ..., max_results: _Optional[int] = ..., time_budget: _Optional[float] = ..., seed: _Optional[int] = ..., free_viewpoint: _Optional[bool] = ..., gain_in_region: _Optional[bool] = ..., visibility: _Optional[_Union[VisibilityCheck, _Mapping]] = ...) -> None: ...
+
+class VisibilityCheck(_message.Message):
+    __slots__ = ("batch", "pixel_stride", "lookahead", "min_new_cells")
+    BATCH_FIELD_NUMBER: _ClassVar[int]
+    PIXEL_STRIDE_FIELD_NUMBER: _ClassVar[int]
+    LOOKAHEAD_FIELD_NUMBER: _ClassVar[int]
+    MIN_NEW_CELLS_FIELD_NUMBER: _ClassVar[int]
+    batch: int
+    pixel_stride: int
+    lookahead: int
+    min_new_cells: int
+    def __init__(self, batch: _Optional[int] = ..., pixel_stride: _Optional[int] = ..., lookahead: _Optional[int] = ..., min_new_cells: _Optional[int] = ...) -> None: ...
 
 class NextBestViewRequest(_message.Message):
     __slots__ = ("octree", "camera", "camera_pose", "robot", "robot_base", "camera_mount", "candidate_poses", "options")
@@ -179,7 +195,7 @@ class NextBestViewRequest(_message.Message):
     def __init__(self, octree: _Optional[_Union[_common_pb2.Octree, _Mapping]] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ..., camera_pose: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., robot_base: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., camera_mount: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., candidate_poses: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., options: _Optional[_Union[NbvOptions, _Mapping]] = ...) -> None: ...
 
 class ViewCandidate(_message.Message):
-    __slots__ = ("pose", "frontier", "distance_score", "rotation_score", "information_gain", "unknown_cells", "utility", "reachability", "joints", "failures")
+    __slots__ = ("pose", "frontier", "distance_score", "rotation_score", "information_gain", "unknown_cells", "utility", "reachability", "joints", "failures", "predicted_cells", "predicted_reached")
     POSE_FIELD_NUMBER: _ClassVar[int]
     FRONTIER_FIELD_NUMBER: _ClassVar[int]
     DISTANCE_SCORE_FIELD_NUMBER: _ClassVar[int]
@@ -190,6 +206,8 @@ class ViewCandidate(_message.Message):
     REACHABILITY_FIELD_NUMBER: _ClassVar[int]
     JOINTS_FIELD_NUMBER: _ClassVar[int]
     FAILURES_FIELD_NUMBER: _ClassVar[int]
+    PREDICTED_CELLS_FIELD_NUMBER: _ClassVar[int]
+    PREDICTED_REACHED_FIELD_NUMBER: _ClassVar[int]
     pose: _common_pb2.Pose
     frontier: _common_pb2.Vec3
     distance_score: float
@@ -200,10 +218,12 @@ class ViewCandidate(_message.Message):
     reachability: Reachability
     joints: _containers.RepeatedScalarFieldContainer[float]
     failures: int
-    def __init__(self, pose: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., frontier: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., distance_score: _Optional[float] = ..., rotation_score: _Optional[float] = ..., information_gain: _Optional[float] = ..., unknown_cells: _Optional[float] = ..., utility: _Optional[float] = ..., reachability: _Optional[_Union[Reachability, str]] = ..., joints: _Optional[_Iterable[float]] = ..., failures: _Optional[int] = ...) -> None: ...
+    predicted_cells: int
+    predicted_reached: int
+    def __init__(self, pose: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., frontier: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., distance_score: _Optional[float] = ..., rotation_score: _Optional[float] = ..., information_gain: _Optional[float] = ..., unknown_cells: _Optional[float] = ..., utility: _Optional[float] = ..., reachability: _Optional[_Union[Reachability, str]] = ..., joints: _Optional[_Iterable[float]] = ..., failures: _Optional[int] = ..., predicted_cells: _Optional[int] = ..., predicted_reached: _Optional[int] = ...) -> None: ...
 
 class NbvStages(_message.Message):
-    __slots__ = ("frontier_cells", "frontier_candidates", "caller_candidates", "after_orf", "after_ptf", "after_igf", "ik_checked", "ik_failed", "frontier_time", "field_time", "orf_time", "ptf_time", "igf_time", "ik_time", "ray_steps")
+    __slots__ = ("frontier_cells", "frontier_candidates", "caller_candidates", "after_orf", "after_ptf", "after_igf", "ik_checked", "ik_failed", "frontier_time", "field_time", "orf_time", "ptf_time", "igf_time", "ik_time", "ray_steps", "visibility_checked", "visibility_dropped", "after_visibility", "best_predicted_cells", "visibility_time")
     FRONTIER_CELLS_FIELD_NUMBER: _ClassVar[int]
     FRONTIER_CANDIDATES_FIELD_NUMBER: _ClassVar[int]
     CALLER_CANDIDATES_FIELD_NUMBER: _ClassVar[int]
@@ -219,6 +239,11 @@ class NbvStages(_message.Message):
     IGF_TIME_FIELD_NUMBER: _ClassVar[int]
     IK_TIME_FIELD_NUMBER: _ClassVar[int]
     RAY_STEPS_FIELD_NUMBER: _ClassVar[int]
+    VISIBILITY_CHECKED_FIELD_NUMBER: _ClassVar[int]
+    VISIBILITY_DROPPED_FIELD_NUMBER: _ClassVar[int]
+    AFTER_VISIBILITY_FIELD_NUMBER: _ClassVar[int]
+    BEST_PREDICTED_CELLS_FIELD_NUMBER: _ClassVar[int]
+    VISIBILITY_TIME_FIELD_NUMBER: _ClassVar[int]
     frontier_cells: int
     frontier_candidates: int
     caller_candidates: int
@@ -234,7 +259,12 @@ class NbvStages(_message.Message):
     igf_time: float
     ik_time: float
     ray_steps: int
-    def __init__(self, frontier_cells: _Optional[int] = ..., frontier_candidates: _Optional[int] = ..., caller_candidates: _Optional[int] = ..., after_orf: _Optional[int] = ..., after_ptf: _Optional[int] = ..., after_igf: _Optional[int] = ..., ik_checked: _Optional[int] = ..., ik_failed: _Optional[int] = ..., frontier_time: _Optional[float] = ..., field_time: _Optional[float] = ..., orf_time: _Optional[float] = ..., ptf_time: _Optional[float] = ..., igf_time: _Optional[float] = ..., ik_time: _Optional[float] = ..., ray_steps: _Optional[int] = ...) -> None: ...
+    visibility_checked: int
+    visibility_dropped: int
+    after_visibility: int
+    best_predicted_cells: int
+    visibility_time: float
+    def __init__(self, frontier_cells: _Optional[int] = ..., frontier_candidates: _Optional[int] = ..., caller_candidates: _Optional[int] = ..., after_orf: _Optional[int] = ..., after_ptf: _Optional[int] = ..., after_igf: _Optional[int] = ..., ik_checked: _Optional[int] = ..., ik_failed: _Optional[int] = ..., frontier_time: _Optional[float] = ..., field_time: _Optional[float] = ..., orf_time: _Optional[float] = ..., ptf_time: _Optional[float] = ..., igf_time: _Optional[float] = ..., ik_time: _Optional[float] = ..., ray_steps: _Optional[int] = ..., visibility_checked: _Optional[int] = ..., visibility_dropped: _Optional[int] = ..., after_visibility: _Optional[int] = ..., best_predicted_cells: _Optional[int] = ..., visibility_time: _Optional[float] = ...) -> None: ...
 
 class NextBestViewResponse(_message.Message):
     __slots__ = ("candidates", "stages", "status", "weights", "reach", "elapsed")
@@ -253,7 +283,7 @@ class NextBestViewResponse(_message.Message):
     def __init__(self, candidates: _Optional[_Iterable[_Union[ViewCandidate, _Mapping]]] = ..., stages: _Optional[_Union[NbvStages, _Mapping]] = ..., status: _Optional[_Union[NbvStatus, str]] = ..., weights: _Optional[_Union[UtilityWeights, _Mapping]] = ..., reach: _Optional[float] = ..., elapsed: _Optional[float] = ...) -> None: ...
 
 class DepthImage(_message.Message):
-    __slots__ = ("width", "height", "depth", "fx", "fy", "cx", "cy")
+    __slots__ = ("width", "height", "depth", "fx", "fy", "cx", "cy", "depth_mm", "camera")
     WIDTH_FIELD_NUMBER: _ClassVar[int]
     HEIGHT_FIELD_NUMBER: _ClassVar[int]
     DEPTH_FIELD_NUMBER: _ClassVar[int]
@@ -261,6 +291,8 @@ class DepthImage(_message.Message):
     FY_FIELD_NUMBER: _ClassVar[int]
     CX_FIELD_NUMBER: _ClassVar[int]
     CY_FIELD_NUMBER: _ClassVar[int]
+    DEPTH_MM_FIELD_NUMBER: _ClassVar[int]
+    CAMERA_FIELD_NUMBER: _ClassVar[int]
     width: int
     height: int
     depth: _containers.RepeatedScalarFieldContainer[float]
@@ -268,7 +300,9 @@ class DepthImage(_message.Message):
     fy: float
     cx: float
     cy: float
-    def __init__(self, width: _Optional[int] = ..., height: _Optional[int] = ..., depth: _Optional[_Iterable[float]] = ..., fx: _Optional[float] = ..., fy: _Optional[float] = ..., cx: _Optional[float] = ..., cy: _Optional[float] = ...) -> None: ...
+    depth_mm: bytes
+    camera: CameraModel
+    def __init__(self, width: _Optional[int] = ..., height: _Optional[int] = ..., depth: _Optional[_Iterable[float]] = ..., fx: _Optional[float] = ..., fy: _Optional[float] = ..., cx: _Optional[float] = ..., cy: _Optional[float] = ..., depth_mm: _Optional[bytes] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ...) -> None: ...
 
 class InsertScanRequest(_message.Message):
     __slots__ = ("octree", "resolution", "sensor_pose", "points", "depth_image", "max_range", "discretize", "full")
@@ -357,7 +391,7 @@ class ExploreStopRule(_message.Message):
     def __init__(self, known_ratio: _Optional[float] = ..., max_iterations: _Optional[int] = ..., max_consecutive_failures: _Optional[int] = ...) -> None: ...
 
 class ExploreRequest(_message.Message):
-    __slots__ = ("robot", "start", "scene", "region", "camera", "camera_mount", "nbv", "algorithm", "plan_options", "stop", "resolution", "pixel_stride", "noise_stddev", "candidates_per_iteration", "plan_time_budget", "initial_offsets", "no_initial_offsets", "extra_views", "no_extra_views", "seed", "time_budget", "camera_link")
+    __slots__ = ("robot", "start", "scene", "region", "camera", "camera_mount", "nbv", "algorithm", "plan_options", "stop", "resolution", "pixel_stride", "noise_stddev", "candidates_per_iteration", "plan_time_budget", "initial_offsets", "no_initial_offsets", "extra_views", "no_extra_views", "seed", "time_budget", "visibility", "no_visibility_check", "camera_link")
     ROBOT_FIELD_NUMBER: _ClassVar[int]
     START_FIELD_NUMBER: _ClassVar[int]
     SCENE_FIELD_NUMBER: _ClassVar[int]
@@ -379,6 +413,8 @@ class ExploreRequest(_message.Message):
     NO_EXTRA_VIEWS_FIELD_NUMBER: _ClassVar[int]
     SEED_FIELD_NUMBER: _ClassVar[int]
     TIME_BUDGET_FIELD_NUMBER: _ClassVar[int]
+    VISIBILITY_FIELD_NUMBER: _ClassVar[int]
+    NO_VISIBILITY_CHECK_FIELD_NUMBER: _ClassVar[int]
     CAMERA_LINK_FIELD_NUMBER: _ClassVar[int]
     robot: _common_pb2.RobotRef
     start: _containers.RepeatedScalarFieldContainer[float]
@@ -401,8 +437,10 @@ class ExploreRequest(_message.Message):
     no_extra_views: bool
     seed: int
     time_budget: float
+    visibility: VisibilityCheck
+    no_visibility_check: bool
     camera_link: str
-    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., start: _Optional[_Iterable[float]] = ..., scene: _Optional[_Union[_common_pb2.Scene, _Mapping]] = ..., region: _Optional[_Union[BoundingBox, _Mapping]] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ..., camera_mount: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., nbv: _Optional[_Union[NbvOptions, _Mapping]] = ..., algorithm: _Optional[_Union[_planning_pb2.PlanAlgorithm, str]] = ..., plan_options: _Optional[_Union[_planning_pb2.PlanOptions, _Mapping]] = ..., stop: _Optional[_Union[ExploreStopRule, _Mapping]] = ..., resolution: _Optional[float] = ..., pixel_stride: _Optional[int] = ..., noise_stddev: _Optional[float] = ..., candidates_per_iteration: _Optional[int] = ..., plan_time_budget: _Optional[float] = ..., initial_offsets: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., no_initial_offsets: _Optional[bool] = ..., extra_views: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., no_extra_views: _Optional[bool] = ..., seed: _Optional[int] = ..., time_budget: _Optional[float] = ..., camera_link: _Optional[str] = ...) -> None: ...
+    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., start: _Optional[_Iterable[float]] = ..., scene: _Optional[_Union[_common_pb2.Scene, _Mapping]] = ..., region: _Optional[_Union[BoundingBox, _Mapping]] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ..., camera_mount: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., nbv: _Optional[_Union[NbvOptions, _Mapping]] = ..., algorithm: _Optional[_Union[_planning_pb2.PlanAlgorithm, str]] = ..., plan_options: _Optional[_Union[_planning_pb2.PlanOptions, _Mapping]] = ..., stop: _Optional[_Union[ExploreStopRule, _Mapping]] = ..., resolution: _Optional[float] = ..., pixel_stride: _Optional[int] = ..., noise_stddev: _Optional[float] = ..., candidates_per_iteration: _Optional[int] = ..., plan_time_budget: _Optional[float] = ..., initial_offsets: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., no_initial_offsets: _Optional[bool] = ..., extra_views: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., no_extra_views: _Optional[bool] = ..., seed: _Optional[int] = ..., time_budget: _Optional[float] = ..., visibility: _Optional[_Union[VisibilityCheck, _Mapping]] = ..., no_visibility_check: _Optional[bool] = ..., camera_link: _Optional[str] = ...) -> None: ...
 
 class FailedView(_message.Message):
     __slots__ = ("position", "reason")
@@ -476,7 +514,7 @@ class ExploreTotals(_message.Message):
     def __init__(self, jd: _Optional[float] = ..., cpc: _Optional[float] = ..., cd: _Optional[float] = ..., oc: _Optional[float] = ..., rdm: _Optional[float] = ..., trajectories: _Optional[int] = ...) -> None: ...
 
 class ExploreSummary(_message.Message):
-    __slots__ = ("status", "iterations", "initial_known_ratio", "known_ratio", "observable_cells", "totals", "failures", "scene_hits", "final_joints", "octree", "scans", "elapsed")
+    __slots__ = ("status", "iterations", "initial_known_ratio", "known_ratio", "observable_cells", "totals", "failures", "scene_hits", "final_joints", "octree", "scans", "elapsed", "wasted_moves", "best_predicted_cells")
     STATUS_FIELD_NUMBER: _ClassVar[int]
     ITERATIONS_FIELD_NUMBER: _ClassVar[int]
     INITIAL_KNOWN_RATIO_FIELD_NUMBER: _ClassVar[int]
@@ -489,6 +527,8 @@ class ExploreSummary(_message.Message):
     OCTREE_FIELD_NUMBER: _ClassVar[int]
     SCANS_FIELD_NUMBER: _ClassVar[int]
     ELAPSED_FIELD_NUMBER: _ClassVar[int]
+    WASTED_MOVES_FIELD_NUMBER: _ClassVar[int]
+    BEST_PREDICTED_CELLS_FIELD_NUMBER: _ClassVar[int]
     status: ExploreStatus
     iterations: int
     initial_known_ratio: float
@@ -501,7 +541,9 @@ class ExploreSummary(_message.Message):
     octree: _common_pb2.Octree
     scans: int
     elapsed: float
-    def __init__(self, status: _Optional[_Union[ExploreStatus, str]] = ..., iterations: _Optional[int] = ..., initial_known_ratio: _Optional[float] = ..., known_ratio: _Optional[float] = ..., observable_cells: _Optional[int] = ..., totals: _Optional[_Union[ExploreTotals, _Mapping]] = ..., failures: _Optional[int] = ..., scene_hits: _Optional[int] = ..., final_joints: _Optional[_Iterable[float]] = ..., octree: _Optional[_Union[_common_pb2.Octree, _Mapping]] = ..., scans: _Optional[int] = ..., elapsed: _Optional[float] = ...) -> None: ...
+    wasted_moves: int
+    best_predicted_cells: int
+    def __init__(self, status: _Optional[_Union[ExploreStatus, str]] = ..., iterations: _Optional[int] = ..., initial_known_ratio: _Optional[float] = ..., known_ratio: _Optional[float] = ..., observable_cells: _Optional[int] = ..., totals: _Optional[_Union[ExploreTotals, _Mapping]] = ..., failures: _Optional[int] = ..., scene_hits: _Optional[int] = ..., final_joints: _Optional[_Iterable[float]] = ..., octree: _Optional[_Union[_common_pb2.Octree, _Mapping]] = ..., scans: _Optional[int] = ..., elapsed: _Optional[float] = ..., wasted_moves: _Optional[int] = ..., best_predicted_cells: _Optional[int] = ...) -> None: ...
 
 class ExploreResponse(_message.Message):
     __slots__ = ("iteration", "summary")

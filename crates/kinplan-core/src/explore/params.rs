@@ -5,7 +5,7 @@ use std::time::Duration;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
 use super::{ExploreError, ExploreField, SensorParams};
-use crate::nbv::{CameraModel, NbvParams};
+use crate::nbv::{CameraModel, NbvParams, VisibilityParams};
 use crate::plan::{Algorithm, PlanRequest};
 
 /// Most cells a region may hold (each iteration looks every one up).
@@ -53,8 +53,8 @@ pub struct ExploreParams {
     pub camera_mount: Isometry3<f64>,
     pub sensor: SensorParams,
     /// Next-best-view options. The loop sets `region`, `robot_base`,
-    /// `camera_mount`, `count_failures`, `prior_failures`, `max_results`
-    /// and `seed` itself; the rest (weights, filters, gain method, IK) is
+    /// `camera_mount`, `count_failures`, `prior_failures`, `max_results`,
+    /// `visibility` (from [`ExploreParams::visibility`]) and `seed` itself; the rest (weights, filters, gain method, IK) is
     /// taken from here.
     pub nbv: NbvParams,
     /// Planner and its options. The loop sets `start`, `goal` and `seed`.
@@ -81,6 +81,16 @@ pub struct ExploreParams {
     /// [`ExploreParams::wrist_sweep`] for a 6-joint arm.
     pub initial_offsets: Vec<Vec<f64>>,
     pub stop: StopRule,
+    /// The visibility check NBV runs on its best views before any is tried
+    /// (docs/exploration.md#visibility-check): a view whose rays, cast
+    /// through the octree, reach fewer than `min_new_cells` unknown region
+    /// cells first is never executed, and the loop stops as
+    /// `ObservableExhausted` once every candidate is predicted below it.
+    /// `None`: S0's occlusion-blind choice (a view is judged only after the
+    /// arm went there). Default: [`VisibilityParams::default`] (its pixel
+    /// stride 8 is twice the sensor's default 4, so every predicted ray is
+    /// one the sensor casts).
+    pub visibility: Option<VisibilityParams>,
     /// Seeds the NBV IK restarts, the planner and the sensor noise.
     pub seed: u64,
 }
@@ -156,6 +166,7 @@ impl ExploreParams {
             extra_views: Self::approach_views(&region),
             initial_offsets: Self::wrist_sweep(dof),
             stop: StopRule::default(),
+            visibility: Some(VisibilityParams::default()),
             seed: 0,
         }
     }
@@ -238,6 +249,9 @@ impl ExploreParams {
         }
         self.camera.validate()?;
         self.nbv.validate()?;
+        if let Some(v) = &self.visibility {
+            v.validate()?;
+        }
         Ok(())
     }
 }

@@ -51,6 +51,11 @@ pub enum ExploreStatus {
     ConsecutiveFailures,
     /// NBV found no candidate view (no frontier left that passes the filters).
     NoCandidates,
+    /// The visibility check predicted every candidate view to reveal fewer
+    /// than `visibility.min_new_cells` cells: what the views can still
+    /// observe is exhausted (the estimate is the largest lower bound over
+    /// the candidates, [`ExploreOutcome::best_predicted_cells`]).
+    ObservableExhausted,
     /// The deadline passed.
     Timeout,
     /// The caller's cancellation was raised.
@@ -81,6 +86,9 @@ pub struct ChosenView {
     pub utility: f64,
     /// Rank among this iteration's candidates (0 = best).
     pub rank: usize,
+    /// Cells the visibility check predicted the view to reveal at least
+    /// (None without the check).
+    pub predicted_cells: Option<u32>,
 }
 
 /// The motion of one iteration.
@@ -152,8 +160,15 @@ pub struct ExploreOutcome {
     /// Cells the ratio counts (region cells outside the true obstacles).
     pub observable_cells: usize,
     pub totals: CriteriaTotals,
-    /// Views that failed IK or planning, over the whole run.
+    /// Views that failed IK or planning, or were reached and added nothing,
+    /// over the whole run.
     pub failures: usize,
+    /// Executed motions whose scan added no known cell (wasted moves).
+    pub wasted_moves: usize,
+    /// The last NBV call's largest predicted lower bound over the views it
+    /// checked (cells; None without the visibility check): the estimate of
+    /// the observable unknown still within the candidates' reach.
+    pub best_predicted_cells: Option<u32>,
     /// Executed motions that overlapped the true scene.
     pub truth_hits: usize,
     pub final_joints: Vec<f64>,
@@ -372,6 +387,8 @@ pub fn explore(
     let mut totals = CriteriaTotals::default();
     let mut failure_record: Vec<(Point3<f64>, u32)> = Vec::new();
     let (mut failures, mut truth_hits, mut consecutive, mut iterations) = (0usize, 0usize, 0usize, 0usize);
+    let mut wasted_moves = 0usize;
+    let mut best_predicted_cells = None;
     let status = loop {
         if known_ratio >= params.stop.known_ratio {
             break ExploreStatus::Explored;
@@ -389,6 +406,7 @@ pub fn explore(
         let t_iter = Instant::now();
         let mut times = StageTimes::default();
         let t0 = Instant::now();
+        let ik_check = params.nbv.ik_check.max(params.candidates_per_iteration);
         let nbv_params = NbvParams {
             region: Some(params.region),
             robot_base: Isometry3::identity(),
@@ -397,9 +415,20 @@ pub fn explore(
             free_viewpoint: true,
             gain_in_region: true,
             extra_candidates: params.extra_views.clone(),
+            visibility: params.visibility,
             prior_failures: failure_record.clone(),
-            max_results: params.candidates_per_iteration,
-            ik_check: params.nbv.ik_check.max(params.candidates_per_iteration),
+            // with the visibility check every returned view is predicted to
+            // add cells, but the best predicted ones are often out of reach:
+            // NBV returns and IK-checks four times as many, and the loop
+            // skips the unreachable ones without spending a try on them
+            max_results: match params.visibility {
+                Some(_) => 4 * ik_check,
+                None => params.candidates_per_iteration,
+            },
+            ik_check: match params.visibility {
+                Some(_) => 4 * ik_check,
+                None => ik_check,
+            },
             // bounded by the run's deadline (passed below), not a budget of its own
             time_budget: None,
             seed: params.seed.wrapping_add(iterations as u64),
@@ -415,10 +444,17 @@ pub fn explore(
             ex.deadline,
         )?;
         times.nbv_us = us(t0);
+        if params.visibility.is_some() && ranked.stages.visibility_checked > 0 {
+            best_predicted_cells = Some(ranked.stages.best_predicted_cells);
+        }
         if ranked.candidates.is_empty() {
             iterations -= 1;
+            let exhausted = ranked.status == crate::nbv::NbvStatus::Complete
+                && ranked.stages.visibility_checked > 0
+                && ranked.stages.after_visibility == 0;
             break match ex.interrupted() {
                 Some(s) => s,
+                None if exhausted => ExploreStatus::ObservableExhausted,
                 None => ExploreStatus::NoCandidates,
             };
         }
@@ -434,8 +470,9 @@ pub fn explore(
         };
         let known = ex.known_checker()?;
         let t_plan = Instant::now();
+        let mut tries = 0usize;
         for (rank, c) in ranked.candidates.iter().enumerate() {
-            if ex.interrupted().is_some() {
+            if ex.interrupted().is_some() || tries >= params.candidates_per_iteration {
                 break;
             }
             let position = Point3::from(c.pose.translation.vector);
@@ -446,6 +483,7 @@ pub fn explore(
                 record_failure(&mut failure_record, position, params.nbv.position_threshold);
                 continue;
             }
+            tries += 1;
             match plan_to(&ex, &known, &q, c, iterations, rank)? {
                 Ok(motion) => {
                     step.view = Some(ChosenView {
@@ -455,6 +493,7 @@ pub fn explore(
                         ig: c.ig,
                         utility: c.utility,
                         rank,
+                        predicted_cells: c.predicted.map(|p| p.first),
                     });
                     step.motion = Some(motion);
                     break;
@@ -488,6 +527,7 @@ pub fn explore(
                 step.failures.push((position, ViewFailure::NoGain));
                 record_failure(&mut failure_record, position, params.nbv.position_threshold);
                 failures += 1;
+                wasted_moves += 1;
                 consecutive += 1;
             } else {
                 consecutive = 0;
@@ -510,6 +550,8 @@ pub fn explore(
         observable_cells: observable.len(),
         totals,
         failures,
+        wasted_moves,
+        best_predicted_cells,
         truth_hits,
         final_joints: q,
         tree: ex.tree,

@@ -326,3 +326,140 @@ fn bad_parameters_are_refused_naming_the_field() {
         })
     ));
 }
+
+#[test]
+fn with_the_visibility_check_no_executed_view_is_wasted_in_the_walled_cell() {
+    // the wall hides the cell from the start: the occlusion-blind gain keeps
+    // luring views whose frusta hold unknown cells behind it
+    let rig = irb();
+    let scene = s0_walled_cell(1);
+    let mut p = quick_params(&scene, rig.chain.dof());
+    p.stop.max_iterations = 4;
+    let check = p.visibility.expect("on by default");
+    let mut steps = Vec::new();
+    let out = run(&rig, &scene, &p, &mut steps);
+    assert_eq!(out.wasted_moves, 0, "{:?}", out.status);
+    let mut last = out.initial_known_ratio;
+    for s in &steps {
+        if let Some(v) = &s.view {
+            // an executed view was predicted to reveal enough, and its scan
+            // did add known cells (the independent check: the ratio rose)
+            assert!(v.predicted_cells.unwrap() as usize >= check.min_new_cells);
+            assert!(s.known_ratio > last, "iteration {}", s.iteration);
+        }
+        assert!(s.failures.iter().all(|(_, f)| *f != ViewFailure::NoGain));
+        last = s.known_ratio;
+    }
+    assert!(
+        out.known_ratio > out.initial_known_ratio + 0.2,
+        "{}",
+        out.known_ratio
+    );
+    // the same run with S0's occlusion-blind choice does waste moves
+    let blind = ExploreParams {
+        visibility: None,
+        ..p
+    };
+    let out = run(&rig, &scene, &blind, &mut Vec::new());
+    assert!(out.wasted_moves >= 1, "{:?}", out.status);
+}
+
+/// The cells of `t` as (key, occupied) pairs, sorted.
+fn cells_of(t: &crate::octree::Octree) -> Vec<([u16; 3], bool)> {
+    let mut out = Vec::new();
+    let lo = Point3::new(-1.0, -3.5, -2.0);
+    let hi = Point3::new(5.0, 3.5, 3.0);
+    let (a, b) = (t.key_of(&lo).unwrap(), t.key_of(&hi).unwrap());
+    for x in a[0]..=b[0] {
+        for y in a[1]..=b[1] {
+            for z in a[2]..=b[2] {
+                match t.state_of_key(&[x, y, z]) {
+                    crate::octree::CellState::Unknown => {}
+                    s => out.push(([x, y, z], s == crate::octree::CellState::Occupied)),
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_depth_image_from_the_simulated_camera_inserts_like_its_points() {
+    use crate::octree::{Octree, ScanParams, depth_from_millimetres};
+    // a wall 3 m ahead, a box and a ball before it
+    let world = geometry(vec![
+        Obstacle::new(
+            "wall",
+            Isometry3::translation(3.1, 0.0, 0.0),
+            Geometry::Box {
+                half_extents: Vector3::new(0.1, 5.0, 5.0),
+            },
+        ),
+        Obstacle::new(
+            "box",
+            Isometry3::translation(1.6, 0.3, -0.2),
+            Geometry::Box {
+                half_extents: Vector3::new(0.2, 0.25, 0.3),
+            },
+        ),
+        Obstacle::new(
+            "ball",
+            Isometry3::translation(2.0, -0.5, 0.3),
+            Geometry::Sphere { radius: 0.3 },
+        ),
+    ]);
+    let cam = CameraModel {
+        width: 96,
+        height: 72,
+        ..CameraModel::default()
+    };
+    let pose = look_along(&Point3::new(0.02, 0.03, 0.01), &Vector3::new(1.0, 0.05, -0.1)).unwrap();
+    let sensor = SensorParams {
+        pixel_stride: 1,
+        noise_stddev: 0.0,
+    };
+    let img = render_depth(&world, &cam, &pose, &sensor, 0);
+    assert!(img.returns() > 96 * 72 / 2);
+    let o = pose.translation.vector;
+    let origin = [o.x as f32, o.y as f32, o.z as f32];
+    let p = ScanParams::default();
+    // the points path: back-projected along each pixel's unit ray direction
+    let mut by_points = Octree::new(0.05).unwrap();
+    by_points
+        .insert_scan(&depth_to_points(&img, &cam, &pose, 1), &origin, &p, Deadline::none())
+        .unwrap();
+    // the image path: pinhole intrinsics of the same camera
+    let k = cam.intrinsics();
+    let mut by_image = Octree::new(0.05).unwrap();
+    by_image
+        .insert_depth_image(&img.depth, img.width, img.height, &k, &pose, &p, Deadline::none())
+        .unwrap();
+    let (a, b) = (cells_of(&by_points), cells_of(&by_image));
+    assert!(a.len() > 1000, "{}", a.len());
+    assert_eq!(a, b);
+    // uint16 millimetres: the same as the points of the depths rounded to 1 mm
+    let mm: Vec<u8> = img
+        .depth
+        .iter()
+        .flat_map(|z| ((*z as f64 * 1000.0).round() as u16).to_le_bytes())
+        .collect();
+    let rounded = DepthImage {
+        depth: img
+            .depth
+            .iter()
+            .map(|z| ((*z as f64 * 1000.0).round() / 1000.0) as f32)
+            .collect(),
+        ..img.clone()
+    };
+    let mut by_mm_points = Octree::new(0.05).unwrap();
+    by_mm_points
+        .insert_scan(&depth_to_points(&rounded, &cam, &pose, 1), &origin, &p, Deadline::none())
+        .unwrap();
+    let depth = depth_from_millimetres(&mm, "depth_mm").unwrap();
+    let mut by_mm = Octree::new(0.05).unwrap();
+    by_mm
+        .insert_depth_image(&depth, img.width, img.height, &k, &pose, &p, Deadline::none())
+        .unwrap();
+    assert_eq!(cells_of(&by_mm_points), cells_of(&by_mm));
+    assert!(depth_from_millimetres(&mm[1..], "depth_mm").is_err());
+}

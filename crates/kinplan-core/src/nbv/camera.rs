@@ -70,6 +70,20 @@ impl CameraModel {
         4.0 * (self.hfov / 2.0).tan() * (self.vfov / 2.0).tan() * (self.far.powi(3) - self.near.powi(3)) / 3.0
     }
 
+    /// The pinhole intrinsics of this model's pixel grid (pixels): pixel centres spread
+    /// from edge to edge of the field of view ([`ray_direction`](Self::ray_direction)),
+    /// so `fx = (width − 1) / (2·tan(hfov/2))`, `cx = (width − 1)/2`, and likewise `fy`,
+    /// `cy` with `vfov` and `height` (a single column or row looks along the axis).
+    pub fn intrinsics(&self) -> crate::octree::PinholeIntrinsics {
+        let axis = |n: usize, fov: f64| {
+            let half = (n.max(2) - 1) as f64 / 2.0;
+            (half / (fov / 2.0).tan(), (n.max(1) - 1) as f64 / 2.0)
+        };
+        let (fx, cx) = axis(self.width, self.hfov);
+        let (fy, cy) = axis(self.height, self.vfov);
+        crate::octree::PinholeIntrinsics { fx, fy, cx, cy }
+    }
+
     /// Unit direction (camera frame) of the ray through pixel `(u, v)`, pixel centres
     /// spread evenly so the first and last rays lie on the field-of-view edges.
     pub fn ray_direction(&self, u: usize, v: usize) -> Vector3<f64> {

@@ -10,6 +10,7 @@ mod gain;
 mod grid;
 mod params;
 mod select;
+mod visibility;
 
 #[cfg(test)]
 mod count_tests;
@@ -25,3 +26,4 @@ pub use gain::{
 };
 pub use params::{NbvParams, Weights};
 pub use select::{NbvCandidate, NbvResult, NbvStatus, StageStats, estimate_reach, next_best_view};
+pub use visibility::{PredictWorkspace, ViewPrediction, VisibilityParams, predict_view};

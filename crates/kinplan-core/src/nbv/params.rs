@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use nalgebra::{Isometry3, Point3};
 
-use super::{GainMethod, NbvError};
+use super::{GainMethod, NbvError, VisibilityParams};
 use crate::ik::IkParams;
 
 /// Utility weights of `f = w_d·D + w_r·R + w_i·Ig` (S0 §4.4). Default S0's
@@ -74,6 +74,12 @@ pub struct NbvParams {
     /// and would lure views forever). Ray gains ignore it. Default false.
     pub gain_in_region: bool,
     pub weights: Weights,
+    /// Occlusion-aware visibility check of the best candidates after the first ranking
+    /// (docs/exploration.md#visibility-check): each checked view's rays are cast through
+    /// the tree, views predicted to reveal fewer than `min_new_cells` cells are dropped,
+    /// and the survivors are ranked again with `Ig = reached / max reached` (candidates
+    /// beyond the checked ones are not returned). `None` = off. Default None.
+    pub visibility: Option<VisibilityParams>,
     /// Scale the weights by the unknown share u of the region: `w_i·(0.5 + u)`,
     /// `w_d·(1.5 − u)`, `w_r·(1.5 − u)` (S0 future work; our rule). Default false.
     pub adaptive_weights: bool,
@@ -125,6 +131,7 @@ impl Default for NbvParams {
             gain: GainMethod::Intersection,
             gain_in_region: false,
             weights: Weights::default(),
+            visibility: None,
             adaptive_weights: false,
             ik_check: 10,
             camera_mount: Isometry3::identity(),
@@ -199,6 +206,9 @@ impl NbvParams {
             });
         if !poses_ok {
             return Err(NbvError::NonFinite { field: "pose" });
+        }
+        if let Some(v) = &self.visibility {
+            v.validate()?;
         }
         self.ik.validate()?;
         Ok(())

@@ -14,6 +14,7 @@ use super::count::FrustumCounter;
 use super::frontier::{candidate_pose, frontier_cells, potential_field, unknown_needed};
 use super::gain::{GainMethod, GainWorkspace, ray_gain};
 use super::grid::{Ball, MAX_CELLS, StateGrid};
+use super::visibility::{PredictWorkspace, ViewPrediction, predict_view};
 use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
 use crate::octree::{CellState, Octree};
@@ -54,6 +55,8 @@ pub struct NbvCandidate {
     pub joints: Option<Vec<f64>>,
     /// Planning failures: prior ones matched by position plus this call's.
     pub failures: u32,
+    /// What the view is predicted to reveal, when the visibility check ran on it.
+    pub predicted: Option<ViewPrediction>,
 }
 
 /// Per-stage counts and times (µs) of one request.
@@ -75,6 +78,14 @@ pub struct StageStats {
     pub ik_us: u64,
     /// DDA steps of ray gains.
     pub ray_steps: u64,
+    /// Visibility check: candidates predicted, dropped (lower bound below
+    /// `min_new_cells`), kept.
+    pub visibility_checked: usize,
+    pub visibility_dropped: usize,
+    pub after_visibility: usize,
+    /// Largest lower bound `first` among the predicted views (cells).
+    pub best_predicted_cells: u32,
+    pub visibility_us: u64,
 }
 
 /// Result of [`next_best_view`].
@@ -147,7 +158,11 @@ pub fn estimate_reach(chain: &Chain) -> f64 {
 /// 3. `f = w_d·D + w_r·R + w_i·Ig`, `D = 1 − ‖p_c − p'‖/(2·d_max)` (d_max the largest
 ///    distance among the survivors), `R = 1 − Δr/π` (Δr the rotation angle between the
 ///    current and the candidate orientation);
-/// 4. the best `ik_check` are checked by IK on `robot` for the tip pose
+/// 4. with `visibility`, the best candidates are checked in batches by
+///    [`predict_view`](super::predict_view): views whose lower bound is below
+///    `min_new_cells` are dropped, the rest get `Ig = reached / max reached` and are
+///    ranked again by the same `f` (unchecked candidates are not returned);
+/// 5. the best `ik_check` are checked by IK on `robot` for the tip pose
 ///    `base⁻¹ · pose · mount⁻¹`; unreachable ones are dropped (or, with
 ///    `count_failures`, kept with `f − failure_penalty · failures`).
 ///
@@ -353,6 +368,7 @@ pub fn next_best_view(
             reachable: None,
             joints: None,
             failures: 0,
+            predicted: None,
         });
     }
     st.after_igf = scored.len();
@@ -395,6 +411,82 @@ pub fn next_best_view(
     }
     let rank = |v: &mut Vec<NbvCandidate>| v.sort_by(|a, b| b.utility.total_cmp(&a.utility));
     rank(&mut scored);
+
+    // 3b. visibility (step 4 of the doc): predict the best views' yield by ray casting, drop the ones that
+    // would add nothing, rank the rest again on the predicted gain
+    if let Some(vp) = &params.visibility
+        && status == NbvStatus::Complete
+    {
+        let t = Instant::now();
+        let region_keys = match &region {
+            Some((a, b)) => Some((tree.key_of(a)?, tree.key_of(b)?)),
+            None => None,
+        };
+        let mut kept: Vec<NbvCandidate> = Vec::with_capacity(params.max_results);
+        let mut rest = scored.into_iter();
+        loop {
+            let batch: Vec<NbvCandidate> = rest.by_ref().take(vp.batch).collect();
+            if batch.is_empty() {
+                break;
+            }
+            if let Some(s) = clock.interrupted() {
+                status = s;
+                break;
+            }
+            let preds: Vec<Option<ViewPrediction>> = batch
+                .par_iter()
+                .map_init(PredictWorkspace::default, |ws, c| {
+                    if clock.interrupted().is_some() {
+                        return None;
+                    }
+                    Some(predict_view(tree, camera, &c.pose, vp, region_keys, ws, clock.deadline))
+                })
+                .collect();
+            for (mut c, p) in batch.into_iter().zip(preds) {
+                let Some(p) = p else { continue };
+                st.visibility_checked += 1;
+                st.ray_steps += p.steps;
+                st.best_predicted_cells = st.best_predicted_cells.max(p.first);
+                if (p.first as usize) < vp.min_new_cells {
+                    st.visibility_dropped += 1;
+                    continue;
+                }
+                c.predicted = Some(p);
+                kept.push(c);
+            }
+            if let Some(s) = clock.interrupted() {
+                status = s;
+                break;
+            }
+            // enough views for the results and for the IK check that follows
+            let wanted = match robot {
+                Some(_) => params.max_results.max(params.ik_check),
+                None => params.max_results,
+            };
+            if kept.len() >= wanted {
+                break;
+            }
+        }
+        // Ig = reached / the most reached among the kept views, in [0, 1]
+        let best = kept
+            .iter()
+            .filter_map(|c| c.predicted.map(|p| p.reached))
+            .max()
+            .unwrap_or(1)
+            .max(1) as f64;
+        for c in kept.iter_mut() {
+            let reached = c.predicted.map_or(0, |p| p.reached) as f64;
+            c.ig = reached / best;
+            c.unknown_cells = reached;
+            // failures are counted only with count_failures (0 otherwise)
+            c.utility = w.w_d * c.distance_term + w.w_r * c.rotation_term + w.w_i * c.ig
+                - params.failure_penalty * c.failures as f64;
+        }
+        st.after_visibility = kept.len();
+        scored = kept;
+        rank(&mut scored);
+        st.visibility_us = us(t);
+    }
 
     // 4. reachability
     let t = Instant::now();

@@ -1,6 +1,6 @@
 //! NBV tests against brute force and hand-built trees.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::*;
 use crate::Deadline;
@@ -339,4 +339,109 @@ fn huge_free_cubes_from_a_hostile_tree_stop_at_the_deadline() {
     )
     .unwrap();
     assert!(f.is_empty());
+}
+
+/// One ray along +x from the centre of cell 32768: cells 32768..=32777 are known
+/// free (x < 1 m), the rest unknown unless set.
+fn corridor() -> (Octree, CameraModel, Isometry3<f64>) {
+    let mut t = Octree::new(0.1).unwrap();
+    free_box(&mut t, [32768, 32766, 32766], [32777, 32770, 32770]);
+    let cam = CameraModel {
+        width: 1,
+        height: 1,
+        ..CameraModel::default()
+    };
+    let pose = look_along(&Point3::new(0.05, 0.05, 0.05), &Vector3::x()).unwrap();
+    (t, cam, pose)
+}
+
+#[test]
+fn predicted_cells_stop_at_occupied_cells_and_count_the_first_unknown_one_as_certain() {
+    let vp = VisibilityParams {
+        pixel_stride: 1,
+        lookahead: 3,
+        ..VisibilityParams::default()
+    };
+    let mut ws = PredictWorkspace::default();
+    let (t, cam, pose) = corridor();
+    // the ray leaves the free corridor at x = 1 m: cell 32778 is its first unknown
+    // cell, 32779 and 32780 follow within the look-ahead of 3
+    let p = predict_view(&t, &cam, &pose, &vp, None, &mut ws, Deadline::none());
+    assert_eq!((p.first, p.reached, p.rays), (1, 3, 1));
+    // a region starting at cell 32779: the unknown cell 32778 outside it is passed
+    // as open, so 32779 is the first unknown region cell, 32780 and 32781 follow
+    let region = Some(([32779, 0, 0], [65535, 65535, 65535]));
+    let p = predict_view(&t, &cam, &pose, &vp, region, &mut ws, Deadline::none());
+    assert_eq!((p.first, p.reached), (1, 3));
+    // an occupied cell at 32778 hides everything behind it
+    let mut t2 = t.clone();
+    let (hit, _) = hm(&t2);
+    t2.update_key(&[32778, 32768, 32768], hit);
+    let p = predict_view(&t2, &cam, &pose, &vp, None, &mut ws, Deadline::none());
+    assert_eq!((p.first, p.reached), (0, 0));
+    // an occupied cell at 32780 leaves the two before it
+    let mut t3 = t;
+    t3.update_key(&[32780, 32768, 32768], hit);
+    let p = predict_view(&t3, &cam, &pose, &vp, None, &mut ws, Deadline::none());
+    assert_eq!((p.first, p.reached), (1, 2));
+}
+
+#[test]
+fn a_view_behind_a_wall_is_dropped_by_the_visibility_check() {
+    // known free space x ∈ [0, 1.2) m, y, z ∈ [−1, 1) m; an occupied wall at
+    // x ∈ [1.2, 1.3) covering y < 0; the region x ∈ [1.2, 2.5] beyond is unknown
+    let mut t = Octree::new(0.1).unwrap();
+    free_box(&mut t, [32768, 32758, 32758], [32779, 32777, 32777]);
+    let (hit, _) = hm(&t);
+    for y in 32758..=32767 {
+        for z in 32758..=32777 {
+            t.update_key(&[32780, y, z], hit);
+        }
+    }
+    let cam = CameraModel {
+        hfov: 20f64.to_radians(),
+        vfov: 20f64.to_radians(),
+        width: 64,
+        height: 64,
+        ..CameraModel::default()
+    };
+    // A looks at the wall (its frustum beyond the wall is full of unknown region
+    // cells); B looks past it
+    let a = look_along(&Point3::new(0.55, -0.5, 0.05), &Vector3::x()).unwrap();
+    let b = look_along(&Point3::new(0.55, 0.5, 0.05), &Vector3::x()).unwrap();
+    let blind = NbvParams {
+        region: Some((Point3::new(1.2, -1.0, -1.0), Point3::new(2.5, 1.0, 1.0))),
+        max_frontier_candidates: 0,
+        extra_candidates: vec![a, b],
+        gain_in_region: true,
+        ik_check: 0,
+        max_results: 5,
+        ..NbvParams::default()
+    };
+    let current = look_along(&Point3::new(0.5, 0.0, 0.05), &Vector3::x()).unwrap();
+    let r = next_best_view(&t, &blind, &cam, &current, None, Deadline::none()).unwrap();
+    // the occlusion-blind gain keeps both, A with about as much gain as B
+    assert_eq!(r.candidates.len(), 2);
+    let ig_a = r.candidates.iter().find(|c| c.pose == a).unwrap().ig;
+    let ig_b = r.candidates.iter().find(|c| c.pose == b).unwrap().ig;
+    assert!(ig_a > 0.5 * ig_b, "{ig_a} {ig_b}");
+    let checked = NbvParams {
+        visibility: Some(VisibilityParams::default()),
+        ..blind
+    };
+    let r = next_best_view(&t, &checked, &cam, &current, None, Deadline::none()).unwrap();
+    assert_eq!(r.candidates.len(), 1);
+    let c = &r.candidates[0];
+    assert_eq!(c.pose, b);
+    assert_eq!((r.stages.visibility_checked, r.stages.visibility_dropped), (2, 1));
+    // B's rays (pixels 0, 8, …, 56 of 0..=63 per axis: 8 × 8 rays) enter the
+    // region at x = 1.2 m, 0.65 m ahead; per axis they span from one field-of-view
+    // edge, 0.65·tan 10° = 0.115 m off the axis, to 0.115·(2·56/63 − 1) = 0.089 m
+    // off it on the other side: image right is −y, so y ∈ [0.411, 0.615] (3 cells),
+    // image down is −z, so z ∈ [−0.039, 0.165] (3 cells)
+    let p = c.predicted.unwrap();
+    assert_eq!(p.rays, 64);
+    assert_eq!(p.first, 9, "{p:?}");
+    assert!(p.reached >= p.first);
+    assert!((c.ig - 1.0).abs() < 1e-12);
 }

@@ -27,5 +27,7 @@ pub use key::{
 pub use params::{LogOddsModel, OctreeLimits, SensorModel};
 pub use query::{BoxVolumes, CellVisit, StateFilter};
 pub use ray::{RayHit, RayParams, RayStop};
-pub use scan::{PinholeIntrinsics, ScanParams, ScanStats, ScanStatus, depth_image_points};
+pub use scan::{
+    PinholeIntrinsics, ScanParams, ScanStats, ScanStatus, depth_from_millimetres, depth_image_points,
+};
 pub use tree::{CellState, MAX_RESOLUTION, MIN_RESOLUTION, NodeRef, Octree, SearchCache};

@@ -614,6 +614,23 @@ impl Octree {
     }
 }
 
+/// Depths in metres from a little-endian uint16 image in millimetres (2 bytes per
+/// pixel, a ROS `16UC1` image): `z = mm / 1000`, 0 stays 0 (no return). An odd byte
+/// count is refused naming `field`.
+pub fn depth_from_millimetres(bytes: &[u8], field: &'static str) -> Result<Vec<f32>, OctreeError> {
+    if !bytes.len().is_multiple_of(2) {
+        return Err(OctreeError::WrongLength {
+            field,
+            expected: bytes.len() + 1,
+            got: bytes.len(),
+        });
+    }
+    Ok(bytes
+        .chunks_exact(2)
+        .map(|b| u16::from_le_bytes([b[0], b[1]]) as f32 / 1000.0)
+        .collect())
+}
+
 /// Back-projects a depth image to map-frame points (see
 /// [`Octree::insert_depth_image`]); pixels without a return are left out.
 pub fn depth_image_points(

@@ -121,11 +121,25 @@ pub fn nbv_params_in(req: &pb::NextBestViewRequest) -> Result<NbvParams, Status>
         max_results: o.max_results.map_or(d.max_results, |v| v as usize),
         free_viewpoint: o.free_viewpoint,
         gain_in_region: o.gain_in_region,
+        visibility: o.visibility.as_ref().map(visibility_in),
         time_budget,
         seed: o.seed,
     };
     params.validate().map_err(|e| nbv_error("options", e))?;
     Ok(params)
+}
+
+/// The visibility check's options; unset fields take the domain's defaults
+/// (ranges are checked by `NbvParams::validate`, naming the field).
+pub fn visibility_in(v: &pb::VisibilityCheck) -> kinplan_core::nbv::VisibilityParams {
+    let d = kinplan_core::nbv::VisibilityParams::default();
+    let count = |v: Option<u32>, d: usize| v.map_or(d, |v| v as usize);
+    kinplan_core::nbv::VisibilityParams {
+        batch: count(v.batch, d.batch),
+        pixel_stride: count(v.pixel_stride, d.pixel_stride),
+        lookahead: count(v.lookahead, d.lookahead),
+        min_new_cells: count(v.min_new_cells, d.min_new_cells),
+    }
 }
 
 fn pose_out(t: &nalgebra::Isometry3<f64>) -> pb::Pose {
@@ -155,6 +169,8 @@ pub fn nbv_response(r: NbvResult) -> pb::NextBestViewResponse {
                 } as i32,
                 joints: c.joints.unwrap_or_default(),
                 failures: c.failures,
+                predicted_cells: c.predicted.map(|p| p.first),
+                predicted_reached: c.predicted.map(|p| p.reached),
             })
             .collect(),
         stages: Some(pb::NbvStages {
@@ -173,6 +189,11 @@ pub fn nbv_response(r: NbvResult) -> pb::NextBestViewResponse {
             igf_time: secs(s.igf_us),
             ik_time: secs(s.ik_us),
             ray_steps: s.ray_steps,
+            visibility_checked: s.visibility_checked as u64,
+            visibility_dropped: s.visibility_dropped as u64,
+            after_visibility: s.after_visibility as u64,
+            best_predicted_cells: s.best_predicted_cells,
+            visibility_time: secs(s.visibility_us),
         }),
         status: match r.status {
             NbvStatus::Complete => pb::NbvStatus::Complete,

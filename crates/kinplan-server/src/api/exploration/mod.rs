@@ -138,24 +138,7 @@ impl ExplorationService for ExplorationApi {
                 }
                 Scan::Points(p.xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
             }
-            Some(pb::insert_scan_request::Scan::DepthImage(d)) => {
-                let (w, h) = (d.width as usize, d.height as usize);
-                if w.checked_mul(h) != Some(d.depth.len()) {
-                    return Err(invalid(
-                        "depth_image.depth",
-                        format!("has {} values, width x height is {w} x {h}", d.depth.len()),
-                    ));
-                }
-                for (name, v) in [("fx", d.fx), ("fy", d.fy)] {
-                    let v = finite(&format!("depth_image.{name}"), v)?;
-                    if v <= 0.0 {
-                        return Err(invalid(format!("depth_image.{name}"), "must be > 0"));
-                    }
-                }
-                finite("depth_image.cx", d.cx)?;
-                finite("depth_image.cy", d.cy)?;
-                Scan::Depth(d.clone())
-            }
+            Some(pb::insert_scan_request::Scan::DepthImage(d)) => depth_image_in(d)?,
         };
         let existing = req.octree.clone();
         let resolution = req.resolution;
@@ -174,20 +157,12 @@ impl ExplorationService for ExplorationApi {
                         let o = sensor.translation.vector;
                         tree.insert_scan(points, &[o.x as f32, o.y as f32, o.z as f32], &params, deadline)
                     }
-                    Scan::Depth(d) => tree.insert_depth_image(
-                        &d.depth,
-                        d.width as usize,
-                        d.height as usize,
-                        &PinholeIntrinsics {
-                            fx: d.fx,
-                            fy: d.fy,
-                            cx: d.cx,
-                            cy: d.cy,
-                        },
-                        &sensor,
-                        &params,
-                        deadline,
-                    ),
+                    Scan::Depth {
+                        depth,
+                        width,
+                        height,
+                        intrinsics,
+                    } => tree.insert_depth_image(depth, *width, *height, intrinsics, &sensor, &params, deadline),
                 }
                 .map_err(|e| octree_error("scan", e))?;
                 if stats.status == ScanStatus::Cancelled {
@@ -253,5 +228,107 @@ impl ExplorationService for ExplorationApi {
 
 enum Scan {
     Points(Vec<[f32; 3]>),
-    Depth(pb::DepthImage),
+    Depth {
+        /// Metres along the optical axis, row-major.
+        depth: Vec<f32>,
+        width: usize,
+        height: usize,
+        intrinsics: PinholeIntrinsics,
+    },
+}
+
+/// Most pixels a depth image may hold (the camera model's limit).
+const MAX_DEPTH_PIXELS: usize = 1 << 24;
+
+/// A depth image in metres (float32 or uint16 millimetres) with its
+/// intrinsics (given, or from the camera model), checked field by field.
+fn depth_image_in(d: &pb::DepthImage) -> Result<Scan, Status> {
+    let (width, height) = (d.width as usize, d.height as usize);
+    if width == 0 || height == 0 {
+        return Err(invalid(
+            "depth_image.width",
+            "width and height must be at least 1",
+        ));
+    }
+    let pixels = width
+        .checked_mul(height)
+        .filter(|&n| n <= MAX_DEPTH_PIXELS)
+        .ok_or_else(|| invalid("depth_image.width", "width x height must be at most 2^24 pixels"))?;
+    let depth = match (d.depth.is_empty(), d.depth_mm.is_empty()) {
+        (false, false) => {
+            return Err(invalid(
+                "depth_image.depth_mm",
+                "give depth (metres) or depth_mm (millimetres), not both",
+            ));
+        }
+        (true, true) => return Err(invalid("depth_image.depth", "is required (or depth_mm)")),
+        (false, true) => {
+            if d.depth.len() != pixels {
+                return Err(invalid(
+                    "depth_image.depth",
+                    format!(
+                        "has {} values, width x height is {width} x {height}",
+                        d.depth.len()
+                    ),
+                ));
+            }
+            d.depth.clone()
+        }
+        (true, false) => {
+            if d.depth_mm.len() != 2 * pixels {
+                return Err(invalid(
+                    "depth_image.depth_mm",
+                    format!(
+                        "has {} bytes, width x height x 2 is {}",
+                        d.depth_mm.len(),
+                        2 * pixels
+                    ),
+                ));
+            }
+            kinplan_core::octree::depth_from_millimetres(&d.depth_mm, "depth_image.depth_mm")
+                .map_err(|e| octree_error("depth_image.depth_mm", e))?
+        }
+    };
+    let intrinsics = match &d.camera {
+        Some(c) => {
+            if [d.fx, d.fy, d.cx, d.cy].iter().any(|v| *v != 0.0) {
+                return Err(invalid(
+                    "depth_image.camera",
+                    "give the camera or fx, fy, cx, cy, not both",
+                ));
+            }
+            let cam = camera_in(Some(c))
+                .map_err(|s| Status::invalid_argument(format!("depth_image.{}", s.message())))?;
+            if (cam.width, cam.height) != (width, height) {
+                return Err(invalid(
+                    "depth_image.camera.width",
+                    format!(
+                        "the camera is {} x {}, the image {width} x {height}",
+                        cam.width, cam.height
+                    ),
+                ));
+            }
+            cam.intrinsics()
+        }
+        None => {
+            for (name, v) in [("fx", d.fx), ("fy", d.fy)] {
+                let v = finite(&format!("depth_image.{name}"), v)?;
+                if v <= 0.0 {
+                    return Err(invalid(format!("depth_image.{name}"), "must be > 0"));
+                }
+            }
+            PinholeIntrinsics {
+                fx: d.fx,
+                fy: d.fy,
+                cx: finite("depth_image.cx", d.cx)?,
+                cy: finite("depth_image.cy", d.cy)?,
+            }
+        }
+    };
+    Ok(Scan::Depth {
+        depth,
+        width,
+        height,
+        intrinsics,
+    })
 }

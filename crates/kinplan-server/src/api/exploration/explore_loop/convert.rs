@@ -7,7 +7,7 @@ use std::time::Duration;
 use tonic::Status;
 
 use crate::api::convert::{finite, matrix_in, optional_seconds, pose_in, pose_out, vec3_out};
-use crate::api::exploration::convert::{box_in, camera_in, nbv_params_in};
+use crate::api::exploration::convert::{box_in, camera_in, nbv_params_in, visibility_in};
 use crate::api::planning::convert::{plan_input, trajectory_out};
 use crate::pb;
 use crate::status::invalid;
@@ -98,6 +98,11 @@ pub fn explore_params_in(
             .map(|(i, v)| pose_in(&format!("extra_views[{i}]"), Some(v)))
             .collect::<Result<_, _>>()?;
     }
+    if req.no_visibility_check {
+        p.visibility = None;
+    } else if let Some(v) = &req.visibility {
+        p.visibility = Some(visibility_in(v));
+    }
     p.seed = req.seed;
     if !req.camera_link.is_empty() && req.camera_link != chain.tip_link() {
         let on_robot = chain.links().iter().any(|l| l.name == req.camera_link);
@@ -160,6 +165,7 @@ pub fn iteration_out(chain: &Chain, s: &ExploreStep) -> pb::ExploreIteration {
         utility: v.utility,
         reachability: pb::Reachability::Reachable as i32,
         joints: s.joints.clone(),
+        predicted_cells: v.predicted_cells,
         ..Default::default()
     });
     let (trajectory, criteria, hits_scene) = match &s.motion {
@@ -204,6 +210,7 @@ fn status_out(s: ExploreStatus) -> pb::ExploreStatus {
         ExploreStatus::IterationCap => pb::ExploreStatus::IterationCap,
         ExploreStatus::ConsecutiveFailures => pb::ExploreStatus::ConsecutiveFailures,
         ExploreStatus::NoCandidates => pb::ExploreStatus::NoCandidates,
+        ExploreStatus::ObservableExhausted => pb::ExploreStatus::ObservableExhausted,
         ExploreStatus::Timeout => pb::ExploreStatus::Timeout,
         ExploreStatus::Cancelled => pb::ExploreStatus::Cancelled,
     }
@@ -232,6 +239,8 @@ pub fn summary_out(o: &ExploreOutcome, octree: pb::Octree, elapsed: Duration) ->
         octree: Some(octree),
         scans: count(o.scans),
         elapsed: elapsed.as_secs_f64(),
+        wasted_moves: count(o.wasted_moves),
+        best_predicted_cells: o.best_predicted_cells,
     }
 }
 
