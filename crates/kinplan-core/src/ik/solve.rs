@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use super::analytic::AnalyticArm;
 use super::attempt::{Attempt, Clock};
 use super::workspace::IkWorkspace;
 use super::{IkError, IkMethod, IkParams, IkTarget};
@@ -47,6 +48,11 @@ pub struct IkSolution {
     /// the start of every iteration of the attempt, ending with the error returned;
     /// empty otherwise.
     pub history: Vec<(f64, f64)>,
+    /// Analytic method: the solution's configuration flags; `None` otherwise.
+    pub config: Option<super::analytic::ConfigFlags>,
+    /// Analytic method: a singular pose, where a joint was free and took the
+    /// seed's value (the solutions form a continuous family); false otherwise.
+    pub singular: bool,
 }
 
 /// Everything a request produced.
@@ -136,6 +142,20 @@ pub(crate) fn validate_request(
         IkMethod::Fabrik | IkMethod::LengthRelaxation => {
             super::point_chain::check_servable(chain, target, params.method)?
         }
+        IkMethod::Analytic => {
+            if matches!(target, IkTarget::Position(_)) {
+                return Err(IkError::MethodCannotServe {
+                    method: params.method,
+                    reason: "it needs a full pose target (position and orientation)".into(),
+                });
+            }
+            AnalyticArm::new(chain, params.analytic.geometry_tolerance).map_err(|e| {
+                IkError::MethodCannotServe {
+                    method: params.method,
+                    reason: e.to_string(),
+                }
+            })?;
+        }
         _ => {}
     }
     Ok(())
@@ -220,6 +240,12 @@ impl<'c> IkSolver<'c> {
         clock: &Clock<'_>,
     ) -> IkResult {
         let chain = self.chain;
+        if params.method == IkMethod::Analytic {
+            // validated: the chain is analytic
+            if let Ok(arm) = AnalyticArm::new(chain, params.analytic.geometry_tolerance) {
+                return super::analytic::front::solve_with(chain, &arm, target, seed, params, clock);
+            }
+        }
         let seed_q: Vec<f64> = match seed {
             Some(s) => s.to_vec(),
             None => chain.mid_limits(),
@@ -261,6 +287,8 @@ impl<'c> IkSolver<'c> {
                 status: out.status,
                 attempt,
                 history: ws.history.clone(),
+                config: None,
+                singular: false,
             };
             if out.status == IkStatus::Converged {
                 let distinct = solutions.iter().all(|s| {
@@ -318,6 +346,9 @@ pub(crate) fn run_attempt(
         IkMethod::Fabrik | IkMethod::LengthRelaxation => {
             super::point_chain::run(chain, target, params, ws, clock)
         }
+        // served whole by `analytic::front` before any attempt; as a fallback the
+        // attempt is a Levenberg–Marquardt one
+        IkMethod::Analytic => super::jacobian_methods::run(chain, target, params, ws, rng, clock),
     }
 }
 
