@@ -41,6 +41,18 @@ class RobotDescription:
             return {}
         return {s.name: dict(zip(s.joint_names, s.positions)) for s in self.raw.named_states}
 
+    @property
+    def analytic_family(self) -> str:
+        """The chain's closed-form IK family ("spherical_wrist",
+        "three_parallel"), or "" when ``method="analytic"`` does not apply
+        (then :attr:`analytic_reason` says why)."""
+        return "" if self.raw is None else str(self.raw.analytic_family)
+
+    @property
+    def analytic_reason(self) -> str:
+        """Why the analytic IK method does not apply ("" when it does)."""
+        return "" if self.raw is None else str(self.raw.analytic_reason)
+
     def named_state(self, name: str) -> np.ndarray:
         """The SRDF group state `name` as a joint vector in chain order. A
         chain joint the state does not set is an error naming it."""

@@ -28,7 +28,7 @@ from .v1 import common_pb2, kinematics_pb2
 #: IK methods by name (``None``: the server default, Levenberg-Marquardt).
 #: IK method names (aliases: "levenberg_marquardt", "ji").
 IkMethodName = Literal["lm", "levenberg_marquardt", "jacobian_inverse", "ji", "newton", "ccd", "fabrik",
-                       "length_relaxation"]
+                       "length_relaxation", "analytic"]
 #: Linear solver names of the Jacobian methods (aliases: "pinv", "rlxa", "rlxa_safeguarded").
 LinearSolverName = Literal["svd", "pinv", "angle_relaxation", "rlxa", "angle_relaxation_safeguarded",
                            "rlxa_safeguarded"]
@@ -44,6 +44,7 @@ METHODS = {
     "fabrik": kinematics_pb2.IK_METHOD_FABRIK,
     "length_relaxation": kinematics_pb2.IK_METHOD_LENGTH_RELAXATION,
     "lr": kinematics_pb2.IK_METHOD_LENGTH_RELAXATION,
+    "analytic": kinematics_pb2.IK_METHOD_ANALYTIC,
 }
 
 #: Linear solvers by name (``None``: SVD pseudoinverse).
@@ -225,7 +226,9 @@ class IkOptions:
     ``None`` means the server's documented default.
 
     ``method``: "lm" (Levenberg-Marquardt), "jacobian_inverse", "newton",
-    "ccd", "fabrik", "length_relaxation"; ``linear_solver`` (Jacobian
+    "ccd", "fabrik", "length_relaxation", "analytic" (closed form: every
+    solution, 6-joint arms of the families ``RobotDescription.analytic_family``
+    names); ``linear_solver`` (Jacobian
     methods): "svd", "angle_relaxation", "angle_relaxation_safeguarded";
     tolerances in m and rad; ``max_restarts`` random restarts drawn from
     ``rng_seed``; ``num_solutions`` distinct solutions (two differ when a
@@ -301,13 +304,31 @@ def ik_options_of_args(args: Tuple[Any, ...]) -> kinematics_pb2.IkOptions:
     return ik_options(args[0], args[1], **dict(zip(IK_SHORTCUTS[2:], args[2:])))
 
 
+@dataclass(frozen=True)
+class ConfigFlags:
+    """How a controller names an arm configuration (``method="analytic"``):
+    each flag is the side of a singularity the arm is on.
+    ``shoulder_back``: the wrist lies behind axis 1 (KUKA Status bit 0);
+    ``elbow_down``: joint 3 is below its stretched-arm angle (sin(q3 - q3s) < 0);
+    ``wrist_flipped``: joint 5 is on the negative side of its wrist-singular
+    angle (sin(q5 - q5s) < 0). See docs/inverse-kinematics.md#analytic for
+    the KUKA / ABB / UR names."""
+
+    shoulder_back: bool
+    elbow_down: bool
+    wrist_flipped: bool
+
+
 @dataclass
 class IkSolution:
     """One answer: joints ``q`` (rad, m for prismatic joints), errors of its
     true FK (m, rad), iterations of its attempt, µs since the request began,
     the attempt's status and index (0 = from the seed). With ``history=True``
     in the request, ``history`` is an (iterations + 1) x 2 array of the
-    (position m, orientation rad) error at the start of every iteration."""
+    (position m, orientation rad) error at the start of every iteration.
+    With ``method="analytic"``: ``config`` holds the solution's
+    :class:`ConfigFlags` and ``singular`` says a free joint of a singular pose
+    took the seed's value (``config`` is None for the iterative methods)."""
 
     q: np.ndarray
     position_error: float
@@ -317,6 +338,8 @@ class IkSolution:
     status: str
     attempt: int
     history: Optional[np.ndarray] = None
+    config: Optional[ConfigFlags] = None
+    singular: bool = False
 
     @classmethod
     def from_proto(cls, s: kinematics_pb2.IkSolution) -> "IkSolution":
@@ -334,6 +357,12 @@ class IkSolution:
                 if len(s.position_error_history)
                 else None
             ),
+            (
+                ConfigFlags(s.config.shoulder_back, s.config.elbow_down, s.config.wrist_flipped)
+                if s.HasField("config")
+                else None
+            ),
+            s.singular,
         )
 
 

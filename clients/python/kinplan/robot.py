@@ -214,7 +214,10 @@ class Robot(RobotRefs):
         shortcuts for its fields (``history`` is ``return_history``), and one
         given beside ``options`` replaces its field unless it is at its
         default. ``method``: "lm" (default), "jacobian_inverse", "newton",
-        "ccd", "fabrik", "length_relaxation"; ``linear_solver`` (Jacobian
+        "ccd", "fabrik", "length_relaxation", "analytic" (closed form:
+        with ``num_solutions=1000`` every solution inside the limits, each
+        solution's ``config`` flags set; 6-joint arms whose
+        ``describe().analytic_family`` is not empty); ``linear_solver`` (Jacobian
         methods): "svd" (default), "angle_relaxation",
         "angle_relaxation_safeguarded". Tolerances in m and rad (default
         1e-5); ``max_restarts`` (default 200) random restarts from
