@@ -14,17 +14,20 @@
 //! `cargo run --release -p kinplan-core --example analytic_ik -- <builtin | file.urdf> [N] [out_dir] [tip_link]`
 //!
 //! With `out_dir`: writes `<out_dir>/<robot>.csv` (per pose: the sampled joints,
-//! then `R` row-major and `t` of `T·M⁻¹`, the pose in the product-of-exponentials
-//! convention ik-geo and EAIK use, then our solution count) and
+//! then the rotation of `T·M⁻¹` row-major and the tool position of `T`: the pose
+//! in the convention of ik-geo and EAIK, whose tool frame is aligned with the
+//! base at zero; then our solution count) and
 //! `<out_dir>/<robot>_hp.txt` (the 6 axes `H` and 7 offsets `P`, base frame at
-//! zero, one vector a line) for `benches/analytic_ik/run.py`.
+//! zero, one vector a line; the wrist axes' points at the wrist point) for `benches/analytic_ik/run.py`.
 
 use std::hint::black_box;
 use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-use kinplan_core::ik::analytic::{AnalyticArm, AnalyticParams, AnalyticSolution, Turns, ZeroAxes, wrap};
+use kinplan_core::ik::analytic::{
+    AnalyticArm, AnalyticParams, AnalyticSolution, Family, Turns, ZeroAxes, wrap,
+};
 use kinplan_core::ik::{IkParams, IkSolver, IkTarget};
 use kinplan_core::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 use nalgebra::Isometry3;
@@ -39,10 +42,17 @@ fn load(name: &str, tip: Option<String>) -> (String, Chain) {
             tip_link: tip,
         };
         let chain = parse_chain(&text, &spec, UrdfLimits::default()).expect("parse the URDF");
-        let stem = Path::new(name).file_stem().unwrap().to_string_lossy().into_owned();
+        let stem = Path::new(name)
+            .file_stem()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
         (stem, chain)
     } else {
-        (name.to_string(), (*builtin_chain(name).expect("a built-in robot")).clone())
+        (
+            name.to_string(),
+            (*builtin_chain(name).expect("a built-in robot")).clone(),
+        )
     }
 }
 
@@ -90,7 +100,10 @@ fn main() {
         .map(|_| {
             std::array::from_fn(|i| {
                 let j = &chain.joints()[i];
-                let (lo, hi) = (j.lower.max(-2.0 * std::f64::consts::PI), j.upper.min(2.0 * std::f64::consts::PI));
+                let (lo, hi) = (
+                    j.lower.max(-2.0 * std::f64::consts::PI),
+                    j.upper.min(2.0 * std::f64::consts::PI),
+                );
                 rng.random_range(lo..=hi)
             })
         })
@@ -141,9 +154,15 @@ fn main() {
             let seed: Vec<f64> = chain
                 .joints()
                 .iter()
-                .map(|j| rng.random_range(j.lower.max(-2.0 * std::f64::consts::PI)..=j.upper.min(2.0 * std::f64::consts::PI)))
+                .map(|j| {
+                    rng.random_range(
+                        j.lower.max(-2.0 * std::f64::consts::PI)..=j.upper.min(2.0 * std::f64::consts::PI),
+                    )
+                })
                 .collect();
-            let r = solver.solve(&IkTarget::Pose(*t), Some(&seed), &lm, 0, &|| false).unwrap();
+            let r = solver
+                .solve(&IkTarget::Pose(*t), Some(&seed), &lm, 0, &|| false)
+                .unwrap();
             if let Some(s) = r.solutions.first() {
                 lm_found += 1;
                 if !ans.iter().any(|a| same(a, &s.joints, 1e-6)) {
@@ -169,11 +188,23 @@ fn main() {
         total as f64 / n as f64,
         lm_poses.min(n),
     );
-    println!("RESULT {label} {} {n} {total} {all_count} {missing} {bad_fk} {lm_found} {lm_missed} {us_8:.4} {us_all:.4}", arm.family());
+    println!(
+        "RESULT {label} {} {n} {total} {all_count} {missing} {bad_fk} {lm_found} {lm_missed} {us_8:.4} {us_all:.4}",
+        arm.family()
+    );
 
     if let Some(dir) = out_dir {
         std::fs::create_dir_all(dir).unwrap();
-        let z = ZeroAxes::of(&chain);
+        let mut z = ZeroAxes::of(&chain);
+        // points on the axes may slide along them: the wrist axes' points at the
+        // point where they meet, as ik-geo's spherical and UR-type solvers expect
+        let first_wrist_axis = match arm.family() {
+            Family::SphericalWrist => 3,
+            Family::ThreeParallel => 4,
+        };
+        for p in &mut z.p[first_wrist_axis..] {
+            *p = arm.wrist_point();
+        }
         let m_inv = z.m.inverse();
         let mut f = std::io::BufWriter::new(std::fs::File::create(format!("{dir}/{label}.csv")).unwrap());
         for ((q, t), c) in configs.iter().zip(&poses).zip(&counts) {
@@ -184,7 +215,7 @@ fn main() {
                 .iter()
                 .copied()
                 .chain((0..3).flat_map(|i| (0..3).map(move |j| m[(i, j)])))
-                .chain(g.translation.vector.iter().copied())
+                .chain(t.translation.vector.iter().copied())
                 .map(|x| format!("{x:.17e}"))
                 .collect();
             writeln!(f, "{} {c}", v.join(" ")).unwrap();

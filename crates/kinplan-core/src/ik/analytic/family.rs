@@ -269,4 +269,10 @@ impl AnalyticArm {
     pub fn family(&self) -> Family {
         self.family
     }
+
+    /// Base frame, zero configuration (m): the wrist centre (spherical wrist) or
+    /// the point where axes 5 and 6 meet (three parallel).
+    pub fn wrist_point(&self) -> Vector3<f64> {
+        self.wrist
+    }
 }
