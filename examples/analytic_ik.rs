@@ -26,7 +26,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use kinplan_core::ik::analytic::{
-    AnalyticArm, AnalyticParams, AnalyticSolution, Family, Turns, ZeroAxes, wrap,
+    AnalyticArm, AnalyticParams, AnalyticSolution, Family, Turns, ZeroAxes, analyse, wrap,
 };
 use kinplan_core::ik::{IkParams, IkSolver, IkTarget};
 use kinplan_core::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
@@ -76,6 +76,71 @@ fn time_passes(arm: &AnalyticArm, poses: &[Isometry3<f64>], params: &AnalyticPar
     (best, count)
 }
 
+/// 7-joint arms: joint values drawn inside the limits, the redundant joint held
+/// at its sampled value (chosen by `analyse`), every solution of the other six.
+/// Timed per pose including the reduction and analysis of the held chain.
+fn redundant(label: &str, chain: &Chain, n: usize) {
+    let mut rng = ChaCha8Rng::seed_from_u64(2026);
+    let configs: Vec<Vec<f64>> = (0..n)
+        .map(|_| {
+            chain
+                .joints()
+                .iter()
+                .map(|j| rng.random_range(j.lower..=j.upper))
+                .collect()
+        })
+        .collect();
+    let poses: Vec<Isometry3<f64>> = configs.iter().map(|q| chain.fk(q)).collect();
+    let params = AnalyticParams {
+        turns: Turns::NearestSeed,
+        ..AnalyticParams::default()
+    };
+    let mut out = Vec::new();
+    let (mut missing, mut bad, mut total) = (0, 0, 0usize);
+    if let Err(e) = analyse(chain, &params, configs.first().map(|q| &q[..])) {
+        println!("{label}: {e}");
+        return;
+    }
+    let mut held = None;
+    for (q, t) in configs.iter().zip(&poses) {
+        let r = analyse(chain, &params, Some(q)).expect("analytic with a joint held");
+        held = r.held.map(|(j, _)| (j, r.arm.family()));
+        r.arm.solve_into(t, Some(&r.reduce(q)), &params, &mut out);
+        total += out.len();
+        let full: Vec<Vec<f64>> = out.iter().map(|s| r.expand(&s.joints)).collect();
+        if !full.iter().any(|s| same(s, q, 1e-7)) {
+            missing += 1;
+        }
+        for s in &full {
+            let f = chain.fk(s);
+            if (f.translation.vector - t.translation.vector).norm() > 1e-9
+                || f.rotation.angle_to(&t.rotation) > 1e-9
+            {
+                bad += 1;
+            }
+        }
+    }
+    let mut best = f64::INFINITY;
+    for _ in 0..5 {
+        let t0 = Instant::now();
+        for (q, t) in configs.iter().zip(&poses) {
+            let r = analyse(chain, &params, Some(black_box(q))).unwrap();
+            r.arm.solve_into(black_box(t), None, &params, &mut out);
+            black_box(out.len());
+        }
+        best = best.min(t0.elapsed().as_secs_f64() * 1e6 / n as f64);
+    }
+    let (j, family) = held.unwrap();
+    println!(
+        "{label}: joint {} held at its sampled value, family {family}; {n} poses, {total} solutions ({:.2}/pose); \
+         original configuration missing: {missing}; FK error > 1e-9: {bad}; µs/pose on one core (hold, \
+         analyse, solve): {best:.3}",
+        j + 1,
+        total as f64 / n as f64
+    );
+    println!("RESULT7 {label} {family} {n} {total} {missing} {bad} {best:.4}");
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let name = args.first().map_or("ur5", String::as_str);
@@ -86,6 +151,10 @@ fn main() {
     let lm_poses: usize = std::env::var("LM_POSES").map_or(n, |s| s.parse().unwrap());
 
     let (label, chain) = load(name, tip);
+    if chain.dof() == 7 {
+        redundant(&label, &chain, n);
+        return;
+    }
     let t0 = Instant::now();
     let arm = match AnalyticArm::new(&chain, 1e-9) {
         Ok(a) => a,
@@ -199,7 +268,7 @@ fn main() {
         // points on the axes may slide along them: the wrist axes' points at the
         // point where they meet, as ik-geo's spherical and UR-type solvers expect
         let first_wrist_axis = match arm.family() {
-            Family::SphericalWrist => 3,
+            Family::SphericalWrist | Family::SphericalTwoIntersecting => 3,
             Family::ThreeParallel => 4,
         };
         for p in &mut z.p[first_wrist_axis..] {

@@ -148,6 +148,8 @@ async fn describe_robot_names_the_family_and_refusals_name_the_reason() {
         ("kuka_kr120_r2500_pro", "spherical_wrist"),
         ("abb_irb4600_60_205", "spherical_wrist"),
         ("ur5", "three_parallel"),
+        // held at the middle of its limits (0), joint 3 leaves axes 2 and 4 parallel
+        ("kuka_lbr_iiwa14_r820", "spherical_wrist"),
         ("franka_panda", ""),
     ] {
         let d = robots
@@ -166,7 +168,34 @@ async fn describe_robot_names_the_family_and_refusals_name_the_reason() {
             d.analytic_reason
         );
     }
-    // a 7-joint arm: INVALID_ARGUMENT naming options.method and the reason
+    // the iiwa with joint 3 held at the seed's value: every solution keeps it
+    let q = vec![0.3, 0.6, -0.4, -1.1, 0.5, 0.8, 0.2];
+    let target = fk(&mut robots, "kuka_lbr_iiwa14_r820", &q).await;
+    let reply = ik
+        .solve_ik(pb::SolveIkRequest {
+            robot: named("kuka_lbr_iiwa14_r820"),
+            target: Some(pose_pb(&target)),
+            seed: q.clone(),
+            options: analytic(1000),
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(reply.success);
+    assert!(
+        reply.solutions[0]
+            .joints
+            .iter()
+            .zip(&q)
+            .all(|(a, b)| (a - b).abs() < 1e-9)
+    );
+    for s in &reply.solutions {
+        assert_eq!(s.joints[2], q[2]);
+        let got = fk(&mut robots, "kuka_lbr_iiwa14_r820", &s.joints).await;
+        assert!((got.translation.vector - target.translation.vector).norm() < 1e-9);
+        assert!(got.rotation.angle_to(&target.rotation) < 1e-9);
+    }
+    // a 7-joint arm none of whose joints can be held: INVALID_ARGUMENT naming options.method and the reason
     let q = vec![0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.8];
     let target = fk(&mut robots, "franka_panda", &q).await;
     let status = ik

@@ -49,6 +49,12 @@ class RobotDescription:
         return "" if self.raw is None else str(self.raw.analytic_family)
 
     @property
+    def analytic_held_joint(self) -> int:
+        """7-joint arms: the joint (0-based) the analytic method holds at the
+        seed's value by default; -1 otherwise."""
+        return -1 if self.raw is None else int(self.raw.analytic_held_joint)
+
+    @property
     def analytic_reason(self) -> str:
         """Why the analytic IK method does not apply ("" when it does)."""
         return "" if self.raw is None else str(self.raw.analytic_reason)

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::analytic::AnalyticArm;
+use super::analytic::analyse;
 use super::attempt::{Attempt, Clock};
 use super::workspace::IkWorkspace;
 use super::{IkError, IkMethod, IkParams, IkTarget};
@@ -149,11 +149,9 @@ pub(crate) fn validate_request(
                     reason: "it needs a full pose target (position and orientation)".into(),
                 });
             }
-            AnalyticArm::new(chain, params.analytic.geometry_tolerance).map_err(|e| {
-                IkError::MethodCannotServe {
-                    method: params.method,
-                    reason: e.to_string(),
-                }
+            analyse(chain, &params.analytic, seed).map_err(|e| IkError::MethodCannotServe {
+                method: params.method,
+                reason: e.to_string(),
             })?;
         }
         _ => {}
@@ -242,7 +240,7 @@ impl<'c> IkSolver<'c> {
         let chain = self.chain;
         if params.method == IkMethod::Analytic {
             // validated: the chain is analytic
-            if let Ok(arm) = AnalyticArm::new(chain, params.analytic.geometry_tolerance) {
+            if let Ok(arm) = analyse(chain, &params.analytic, seed) {
                 return super::analytic::front::solve_with(chain, &arm, target, seed, params, clock);
             }
         }

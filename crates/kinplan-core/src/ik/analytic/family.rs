@@ -18,6 +18,10 @@ pub enum Family {
     /// Axes 2, 3, 4 are parallel and axes 5, 6 meet (Universal Robots arms).
     /// Up to 8 solutions.
     ThreeParallel,
+    /// Axes 4, 5, 6 meet (the wrist centre) and axes 1, 2 meet (a spherical
+    /// shoulder): a 7-joint S-R-S arm such as the iiwa with its third joint
+    /// held. Up to 8 solutions.
+    SphericalTwoIntersecting,
 }
 
 impl Family {
@@ -26,6 +30,7 @@ impl Family {
         match self {
             Family::SphericalWrist => "spherical_wrist",
             Family::ThreeParallel => "three_parallel",
+            Family::SphericalTwoIntersecting => "spherical_two_intersecting",
         }
     }
 }
@@ -123,6 +128,8 @@ pub struct AnalyticArm {
     pub(super) m_inv: Isometry3<f64>,
     /// Spherical wrist: the wrist centre; three parallel: where axes 5 and 6 meet.
     pub(super) wrist: Vector3<f64>,
+    /// Where axes 1 and 2 meet (spherical two intersecting only; else zero).
+    pub(super) shoulder: Vector3<f64>,
     /// Unit `h₂ × h₁`, signed to point from axis 1 towards the wrist at zero.
     pub(super) forward: Vector3<f64>,
     /// Joint-3 angle at which the arm from axis 2 to the wrist (spherical) or
@@ -167,7 +174,7 @@ impl AnalyticArm {
             return Err(not(format!(
                 "it has {n} joints; the analytic solvers cover 6-joint arms{}",
                 if n == 7 {
-                    " (a redundant 7-joint arm with a chosen joint is not implemented)"
+                    " (hold one of a 7-joint arm's joints: ik::analytic::analyse)"
                 } else {
                     ""
                 }
@@ -185,20 +192,30 @@ impl AnalyticArm {
         let spherical = meet(&p[3], &h[3], &p[4], &h[4], tol)
             .filter(|(w, d)| *d <= tol && point_line_distance(w, &p[5], &h[5]) <= tol)
             .map(|(w, _)| w);
+        let mut shoulder = Vector3::zeros();
         let (family, wrist) = if let Some(w) = spherical {
-            if !parallel(&h[1], &h[2], tol) {
-                return Err(not(
-                    "it has a spherical wrist, but axes 2 and 3 are not parallel (a general \
-                     3-joint position problem is not implemented)",
-                ));
-            }
             if parallel(&h[4], &h[5], tol) {
                 return Err(not("wrist axes 5 and 6 are parallel"));
             }
             if point_line_distance(&w, &p[2], &h[2]) <= tol {
                 return Err(not("the wrist centre lies on axis 3"));
             }
-            (Family::SphericalWrist, w)
+            if parallel(&h[1], &h[2], tol) {
+                (Family::SphericalWrist, w)
+            } else if let Some((s, d)) = meet(&p[0], &h[0], &p[1], &h[1], tol)
+                && d <= tol
+            {
+                if point_line_distance(&s, &p[2], &h[2]) <= tol {
+                    return Err(not("the shoulder (where axes 1 and 2 meet) lies on axis 3"));
+                }
+                shoulder = s;
+                (Family::SphericalTwoIntersecting, w)
+            } else {
+                return Err(not(
+                    "it has a spherical wrist, but axes 2 and 3 are not parallel and axes 1 and 2 do \
+                     not meet (a general 3-joint position problem is not implemented)",
+                ));
+            }
         } else if parallel(&h[1], &h[2], tol) && parallel(&h[1], &h[3], tol) {
             let Some((w, d)) = meet(&p[4], &h[4], &p[5], &h[5], tol) else {
                 return Err(not(
@@ -229,13 +246,14 @@ impl AnalyticArm {
         }
         // the arm from axis 2 through joint 3 to `far` is stretched when
         // rot(h₃, q₃)(far − p₃) points along (p₃ − p₂) in the plane normal to h₃
-        let far = match family {
-            Family::SphericalWrist => wrist,
-            Family::ThreeParallel => p[3],
+        let (far, near) = match family {
+            Family::SphericalWrist => (wrist, p[1]),
+            Family::ThreeParallel => (p[3], p[1]),
+            Family::SphericalTwoIntersecting => (wrist, shoulder),
         };
-        let q3_stretched = sp1(&h[2], &(far - p[2]), &(p[2] - p[1]), 1.0).angles[0];
+        let q3_stretched = sp1(&h[2], &(far - p[2]), &(p[2] - near), 1.0).angles[0];
         let singular_with = match family {
-            Family::SphericalWrist => h[3],
+            Family::SphericalWrist | Family::SphericalTwoIntersecting => h[3],
             Family::ThreeParallel => h[1],
         };
         let q5_singular = sp1(&h[4], &h[5], &singular_with, 1.0).angles[0];
@@ -253,6 +271,7 @@ impl AnalyticArm {
             p,
             m_inv: z.m.inverse(),
             wrist,
+            shoulder,
             forward,
             q3_stretched,
             q5_singular,

@@ -2,16 +2,23 @@
 //! by forward kinematics, ranked by distance to the seed (or configuration
 //! first, then distance), as an [`IkResult`].
 
-use super::family::AnalyticArm;
+use super::redundant::ReducedArm;
 use super::solve::AnalyticSolution;
 use crate::ik::attempt::Clock;
 use crate::ik::{IkParams, IkResult, IkSolution, IkStatus, IkTarget, pose_error};
 use crate::robot::Chain;
 
-fn solution(chain: &Chain, target: &IkTarget, s: &AnalyticSolution, clock: &Clock<'_>) -> IkSolution {
-    let e = pose_error(&chain.fk(&s.joints), target);
+fn solution(
+    chain: &Chain,
+    arm: &ReducedArm,
+    target: &IkTarget,
+    s: &AnalyticSolution,
+    clock: &Clock<'_>,
+) -> IkSolution {
+    let joints = arm.expand(&s.joints);
+    let e = pose_error(&chain.fk(&joints), target);
     IkSolution {
-        joints: s.joints.to_vec(),
+        joints,
         position_error: e.position,
         orientation_error: e.orientation,
         iterations: 0,
@@ -33,7 +40,7 @@ fn solution(chain: &Chain, target: &IkTarget, s: &AnalyticSolution, clock: &Cloc
 /// and the stop reason is `MaxIterations`.
 pub(crate) fn solve_with(
     chain: &Chain,
-    arm: &AnalyticArm,
+    reduced: &ReducedArm,
     target: &IkTarget,
     seed: Option<&[f64]>,
     params: &IkParams,
@@ -42,11 +49,13 @@ pub(crate) fn solve_with(
     let IkTarget::Pose(pose) = target else {
         unreachable!("validate_request refuses position targets for the analytic method")
     };
-    let mut raw = Vec::with_capacity(64);
-    arm.solve_into(pose, seed, &params.analytic, &mut raw);
+    let arm = &reduced.arm;
     let seed_q: Vec<f64> = seed.map_or_else(|| chain.mid_limits(), <[f64]>::to_vec);
-    let seed_config = arm.config_of(&seed_q);
-    let dist = |q: &[f64; 6]| q.iter().zip(&seed_q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+    let seed6 = reduced.reduce(&seed_q);
+    let mut raw = Vec::with_capacity(64);
+    arm.solve_into(pose, Some(&seed6), &params.analytic, &mut raw);
+    let seed_config = arm.config_of(&seed6);
+    let dist = |q: &[f64; 6]| q.iter().zip(&seed6).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
     let hold = params.analytic.hold_configuration;
     raw.sort_by(|a, b| {
         let ka = (hold && a.config != seed_config, dist(&a.joints));
@@ -58,7 +67,7 @@ pub(crate) fn solve_with(
         if solutions.len() >= params.num_solutions {
             break;
         }
-        let sol = solution(chain, target, s, clock);
+        let sol = solution(chain, reduced, target, s, clock);
         if sol.position_error <= params.position_tolerance
             && sol.orientation_error <= params.orientation_tolerance
         {
@@ -66,10 +75,10 @@ pub(crate) fn solve_with(
         }
     }
     let best_attempt = if solutions.is_empty() {
-        arm.nearest(pose, seed, &params.analytic, &mut raw);
+        arm.nearest(pose, Some(&seed6), &params.analytic, &mut raw);
         raw.iter()
             .map(|s| {
-                let mut b = solution(chain, target, s, clock);
+                let mut b = solution(chain, reduced, target, s, clock);
                 b.status = IkStatus::MaxIterations;
                 b
             })

@@ -5,6 +5,7 @@
 mod family;
 pub(crate) mod front;
 mod params;
+mod redundant;
 mod solve;
 mod subproblems;
 
@@ -14,5 +15,6 @@ mod tests;
 pub use family::{AnalyticArm, Family, NotAnalytic, ZeroAxes};
 pub use front::solve_analytic;
 pub use params::{AnalyticParams, Turns};
+pub use redundant::{ReducedArm, analyse};
 pub use solve::{AnalyticSolution, ConfigFlags, MAX_TURNS};
 pub use subproblems::{Angles, DEGENERATE, Pairs, rot, sp1, sp2, sp3, sp4, wrap};

@@ -28,6 +28,10 @@ pub struct AnalyticParams {
     /// to the seed), so a stream keeps one configuration. Default false: by
     /// distance only.
     pub hold_configuration: bool,
+    /// 7-joint chains: the joint (0-based chain index) held at the seed's value
+    /// so that the other six are solved in closed form; `None` = the first of
+    /// joints 3, 4, 5, 2, 6, 1, 7 that leaves a covered arm. Default none.
+    pub redundant_joint: Option<usize>,
 }
 
 impl Default for AnalyticParams {
@@ -37,6 +41,7 @@ impl Default for AnalyticParams {
             solve_tolerance: 1e-9,
             turns: Turns::All,
             hold_configuration: false,
+            redundant_joint: None,
         }
     }
 }

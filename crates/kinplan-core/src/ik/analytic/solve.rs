@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::family::{AnalyticArm, Family};
 use super::params::{AnalyticParams, Turns};
-use super::subproblems::{Angles, rot, sp1, sp3, sp4, wrap};
+use super::subproblems::{Angles, rot, sp1, sp2, sp3, sp4, wrap};
 
 /// Most whole-turn variants returned per joint with [`Turns::All`].
 pub const MAX_TURNS: usize = 4;
@@ -98,7 +98,7 @@ impl AnalyticArm {
     /// ```
     pub fn config_of(&self, q: &[f64]) -> ConfigFlags {
         let last = match self.family {
-            Family::SphericalWrist => 2,
+            Family::SphericalWrist | Family::SphericalTwoIntersecting => 2,
             Family::ThreeParallel => 3,
         };
         let mut x = self.wrist;
@@ -176,6 +176,9 @@ impl AnalyticArm {
         match self.family {
             Family::SphericalWrist => self.spherical(&g, &seed, keep_inexact, tol, &mut base),
             Family::ThreeParallel => self.three_parallel(&g, &seed, keep_inexact, tol, &mut base),
+            Family::SphericalTwoIntersecting => {
+                self.spherical_shoulder(&g, &seed, keep_inexact, tol, &mut base)
+            }
         }
         base
     }
@@ -231,6 +234,60 @@ impl AnalyticArm {
                     }
                     let singular = a1.free || a3.free || a2.free || a5.free || a4.free || a6.free;
                     let q = [q1, q2, q3, q4, q5, a6.angles[0]];
+                    out.push(q, self.flags(&(y - p[0]), q3, q5), singular, exact);
+                }
+            }
+        }
+    }
+
+    /// Spherical wrist and spherical shoulder `s` (axes 1, 2 meet): `q₃` by
+    /// subproblem 3 from `‖E₃ w₀ − s‖ = ‖w − s‖`, `(q₁, q₂)` by subproblem 2 from
+    /// `R₁R₂ (E₃ w₀ − s) = w − s`, then the wrist as for [`Family::SphericalWrist`].
+    fn spherical_shoulder(&self, g: &Isometry3<f64>, seed: &[f64; 6], keep: bool, tol: f64, out: &mut Base) {
+        let (h, p, s) = (&self.h, &self.p, self.shoulder);
+        let rg = *g.rotation.to_rotation_matrix().matrix();
+        let w = (g * nalgebra::Point3::from(self.wrist)).coords;
+        let a3 = pick(
+            sp3(&h[2], &(self.wrist - p[2]), &(s - p[2]), (w - s).norm(), tol),
+            seed[2],
+        );
+        if !a3.exact && !keep {
+            return;
+        }
+        for &q3 in a3.as_slice() {
+            let r3 = rot(&h[2], q3);
+            let v = r3 * (self.wrist - p[2]) + p[2] - s;
+            let pairs = sp2(&h[0], &h[1], &v, &(w - s), tol);
+            if !pairs.exact && !keep {
+                continue;
+            }
+            for &(q1, q2) in &pairs.pairs[..pairs.count] {
+                // shoulder singularity (w on axis 1): q₁ from the seed, q₂ follows
+                let (q1, q2) = if pairs.free.0 {
+                    let q1 = wrap(seed[0]);
+                    let a2 = pick(sp1(&h[1], &v, &rot(&h[0], q1).tr_mul(&(w - s)), tol), seed[1]);
+                    (q1, a2.angles[0])
+                } else {
+                    (q1, q2)
+                };
+                let r1 = rot(&h[0], q1);
+                let y = self.inv_apply(0, &r1, &w);
+                let r36 = (r1 * rot(&h[1], q2) * r3).tr_mul(&rg);
+                let a5 = pick(sp4(&h[3], &h[4], &h[5], h[3].dot(&(r36 * h[5])), tol), seed[4]);
+                if !a5.exact && !keep {
+                    continue;
+                }
+                for &q5 in a5.as_slice() {
+                    let r5 = rot(&h[4], q5);
+                    let a4 = pick(sp1(&h[3], &(r5 * h[5]), &(r36 * h[5]), tol), seed[3]);
+                    let r45 = rot(&h[3], a4.angles[0]) * r5;
+                    let a6 = pick(sp1(&h[5], &self.x6, &(r45.tr_mul(&r36) * self.x6), tol), seed[5]);
+                    let exact = a3.exact && pairs.exact && a5.exact && a4.exact && a6.exact;
+                    if !exact && !keep {
+                        continue;
+                    }
+                    let singular = a3.free || pairs.free.0 || pairs.free.1 || a5.free || a4.free || a6.free;
+                    let q = [q1, q2, q3, a4.angles[0], q5, a6.angles[0]];
                     out.push(q, self.flags(&(y - p[0]), q3, q5), singular, exact);
                 }
             }

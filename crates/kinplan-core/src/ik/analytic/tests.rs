@@ -373,3 +373,87 @@ fn numerical_search_finds_nothing_the_analytic_solver_missed() {
         }
     }
 }
+
+const SHOULDER_ARM: &str = r#"<robot name="hand_shoulder">
+  <link name="base"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="l4"/><link name="l5"/><link name="l6"/><link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0"/><axis xyz="0 0 1"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/><origin xyz="0 0 1"/><axis xyz="1 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j4" type="revolute"><parent link="l3"/><child link="l4"/><origin xyz="1 0 0"/><axis xyz="1 0 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j5" type="revolute"><parent link="l4"/><child link="l5"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j6" type="revolute"><parent link="l5"/><child link="l6"/><origin xyz="0 0 0"/><axis xyz="1 0 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="flange" type="fixed"><parent link="l6"/><child link="tool"/><origin xyz="0.5 0 0"/></joint>
+</robot>"#;
+
+#[test]
+fn spherical_shoulder_hand_arm_has_the_hand_derived_positions() {
+    // Shoulder axes z, y meet at the origin; upper arm 1 m up; elbow about
+    // (1, 1, 0)/√2; forearm 1 m along x. The forearm at elbow angle θ is
+    // (½ + ½cos θ, ½ − ½cos θ, −sin θ/√2), so ‖w − s‖² = 2 − √2 sin θ. For
+    // the zero pose (w = (1, 0, 1)): θ = 0 with (q₁, q₂) = (0, 0) or
+    // (π, −π/2) (upper arm to −x, then turned round), and θ = π (forearm
+    // along y, w₀ = (0, 1, 1)) with q₂ = 0 tangent and q₁ = −π/2.
+    let (chain, arm) = hand_arm(SHOULDER_ARM);
+    assert_eq!(arm.family(), Family::SphericalTwoIntersecting);
+    let t = chain.fk(&[0.0, 0.0, 0.0, 0.0, FRAC_PI_4, 0.0]);
+    let mut out = Vec::new();
+    arm.solve_into(&t, None, &nearest_params(), &mut out);
+    for want in [[0.0, 0.0, 0.0], [PI, -FRAC_PI_2, 0.0], [-FRAC_PI_2, 0.0, PI]] {
+        assert!(
+            out.iter().any(|s| same_angles(&s.joints[..3], &want, 1e-7)),
+            "{want:?} missing from {:?}",
+            out.iter().map(|s| s.joints).collect::<Vec<_>>()
+        );
+    }
+    assert!(out.iter().all(|s| pose_close(&chain.fk(&s.joints), &t, 1e-9)));
+    // and random configurations come back
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    for _ in 0..2000 {
+        let q: [f64; 6] = std::array::from_fn(|_| rng.random_range(-3.0..3.0));
+        let t = chain.fk(&q);
+        arm.solve_into(&t, Some(&q), &nearest_params(), &mut out);
+        assert!(out.iter().any(|s| same_angles(&s.joints, &q, 1e-7)), "{q:?}");
+        assert!(out.iter().all(|s| pose_close(&chain.fk(&s.joints), &t, 1e-9)));
+    }
+}
+
+#[test]
+fn iiwa_with_joint_3_held_round_trips() {
+    let chain = builtin_chain("kuka_lbr_iiwa14_r820").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let params = IkParams {
+        method: IkMethod::Analytic,
+        num_solutions: 1000,
+        analytic: nearest_params(),
+        ..IkParams::default()
+    };
+    for _ in 0..1000 {
+        let q: Vec<f64> = chain
+            .joints()
+            .iter()
+            .map(|j| rng.random_range(j.lower..=j.upper))
+            .collect();
+        let t = chain.fk(&q);
+        let reduced = analyse(&chain, &params.analytic, Some(&q)).unwrap();
+        assert_eq!(reduced.held, Some((2, q[2])));
+        let r = solve_ik(&chain, &IkTarget::Pose(t), Some(&q), &params, 0, &|| false).unwrap();
+        assert!(r.success(), "{q:?}");
+        assert!(
+            same_angles(&r.solutions[0].joints, &q, 1e-7),
+            "{q:?} vs {:?}",
+            r.solutions[0].joints
+        );
+        for s in &r.solutions {
+            assert_eq!(s.joints.len(), 7);
+            assert_eq!(s.joints[2], q[2]);
+            assert!(pose_close(&chain.fk(&s.joints), &t, 1e-9));
+        }
+    }
+    // holding joint 7 leaves axes 4, 5, 6 not meeting: refused with the reason
+    let bad = AnalyticParams {
+        redundant_joint: Some(6),
+        ..AnalyticParams::default()
+    };
+    let e = analyse(&chain, &bad, None).unwrap_err().reason;
+    assert!(e.starts_with("with joint 7 held"), "{e}");
+}

@@ -148,6 +148,7 @@ impl Options {
                 } else {
                     Turns::All
                 },
+                redundant_joint: o.redundant_joint.map(|j| j as usize),
                 ..d.analytic
             },
             ..d
