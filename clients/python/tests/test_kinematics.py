@@ -290,3 +290,21 @@ def test_analytic_ik_refuses_a_7_joint_arm_naming_why(client):
     with pytest.raises(kinplan.InvalidArgument) as e:
         robot.ik(T, method="analytic")
     assert "chain is not analytic" in str(e.value)
+
+
+def test_analytic_options_hold_turns_and_start(client):
+    robot = client.robot("ur5")
+    q = np.array([0.3, -1.2, 1.4, -0.8, 1.1, 0.2])
+    T = robot.fk(q)
+    # one whole-turn variant per joint: the 8 configurations of a generic pose
+    r = robot.ik(T, seed=q, method="analytic", num_solutions=1000, nearest_turn_only=True)
+    assert len(r.solutions) == 8 and len({s.config for s in r.solutions}) == 8
+    # hold_configuration: the seed's flags first even when another configuration is nearer
+    other = r.solutions[1]
+    held = robot.ik(T, seed=other.q + 0.4, method="analytic", num_solutions=3, hold_configuration=True,
+                    options=kinplan.IkOptions(method="analytic", nearest_turn_only=True))
+    assert held.solutions[0].config == other.config
+    # analytic_start: LM from a far seed begins on the nearest closed-form solution
+    far = np.array([1.5, -0.2, 0.3, 0.9, -0.7, 1.4])
+    s = robot.ik(T, seed=far, max_restarts=0, analytic_start=True)
+    assert s.success and s.iterations == 0

@@ -114,6 +114,10 @@ pub struct IkParams {
     /// Options of the analytic method (tolerances, whole turns, holding the
     /// seed's configuration). Default [`AnalyticParams::default`].
     pub analytic: AnalyticParams,
+    /// Iterative methods, pose targets: start the first attempt from the analytic
+    /// solution nearest the seed when the chain has one (else from the seed).
+    /// Default false.
+    pub analytic_start: bool,
 }
 
 impl Default for IkParams {
@@ -142,6 +146,7 @@ impl Default for IkParams {
             time_budget: None,
             record_history: false,
             analytic: AnalyticParams::default(),
+            analytic_start: false,
         }
     }
 }
@@ -202,7 +207,7 @@ impl IkParams {
                 reason: "must be > 0 when set",
             });
         }
-        if self.method == IkMethod::Analytic {
+        if self.method == IkMethod::Analytic || self.analytic_start {
             self.analytic.validate()?;
         }
         if self.method.is_jacobian_method() && self.linear_solver == LinearSolverKind::AngleRelaxation {

@@ -244,10 +244,13 @@ impl<'c> IkSolver<'c> {
                 return super::analytic::front::solve_with(chain, &arm, target, seed, params, clock);
             }
         }
-        let seed_q: Vec<f64> = match seed {
+        let mut seed_q: Vec<f64> = match seed {
             Some(s) => s.to_vec(),
             None => chain.mid_limits(),
         };
+        if params.analytic_start {
+            analytic_start(chain, target, params, &mut seed_q);
+        }
         let mut rng = ChaCha8Rng::seed_from_u64(rng_seed);
         // same request ⇒ same floating-point path, whatever was solved before
         self.ws.svd.reset();
@@ -325,6 +328,29 @@ impl<'c> IkSolver<'c> {
             total_iterations,
             elapsed_us: clock.elapsed_us(),
         }
+    }
+}
+
+/// Replaces `seed_q` by the analytic solution nearest it (Euclidean joint
+/// distance) when the chain has a closed form and the target is a pose.
+fn analytic_start(chain: &Chain, target: &IkTarget, params: &IkParams, seed_q: &mut Vec<f64>) {
+    let IkTarget::Pose(pose) = target else { return };
+    let Ok(reduced) = analyse(chain, &params.analytic, Some(seed_q)) else {
+        return;
+    };
+    let seed6 = reduced.reduce(seed_q);
+    let mut out = Vec::new();
+    let near = super::analytic::AnalyticParams {
+        turns: super::analytic::Turns::NearestSeed,
+        ..params.analytic
+    };
+    reduced.arm.solve_into(pose, Some(&seed6), &near, &mut out);
+    let dist = |q: &[f64; 6]| q.iter().zip(&seed6).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+    if let Some(best) = out
+        .iter()
+        .min_by(|a, b| dist(&a.joints).total_cmp(&dist(&b.joints)))
+    {
+        *seed_q = reduced.expand(&best.joints);
     }
 }
 

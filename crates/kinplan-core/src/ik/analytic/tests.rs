@@ -457,3 +457,53 @@ fn iiwa_with_joint_3_held_round_trips() {
     let e = analyse(&chain, &bad, None).unwrap_err().reason;
     assert!(e.starts_with("with joint 7 held"), "{e}");
 }
+
+#[test]
+fn analytic_start_puts_lm_on_the_nearest_closed_form_solution() {
+    // from a far seed, LM started from the nearest analytic solution needs no
+    // iteration beyond checking it, and answers exactly that solution
+    let chain = builtin_chain("ur5").unwrap();
+    let q = [0.3, -1.2, 1.4, -0.8, 1.1, 0.2];
+    let seed = [1.5, -0.2, 0.3, 0.9, -0.7, 1.4];
+    let t = IkTarget::Pose(chain.fk(&q));
+    let lm = IkParams {
+        max_restarts: 0,
+        analytic_start: true,
+        ..IkParams::default()
+    };
+    let r = solve_ik(&chain, &t, Some(&seed), &lm, 0, &|| false).unwrap();
+    assert!(r.success());
+    assert_eq!(r.solutions[0].iterations, 0);
+    let all = solve_ik(
+        &chain,
+        &t,
+        Some(&seed),
+        &IkParams {
+            method: IkMethod::Analytic,
+            analytic: nearest_params(),
+            ..IkParams::default()
+        },
+        0,
+        &|| false,
+    )
+    .unwrap();
+    assert!(same_angles(
+        &r.solutions[0].joints,
+        &all.solutions[0].joints,
+        1e-12
+    ));
+    // without it, the same LM attempt iterates
+    let plain = solve_ik(
+        &chain,
+        &t,
+        Some(&seed),
+        &IkParams {
+            analytic_start: false,
+            ..lm
+        },
+        0,
+        &|| false,
+    )
+    .unwrap();
+    assert!(plain.solutions.first().is_none_or(|s| s.iterations > 0));
+}

@@ -139,6 +139,7 @@ impl Options {
             distinct_tolerance: o.distinct_tolerance.unwrap_or(d.distinct_tolerance),
             time_budget,
             record_history: o.return_history,
+            analytic_start: o.analytic_start,
             analytic: AnalyticParams {
                 // warm calls (TrackPath, StreamIk) pass their restart default and
                 // hold the previous answer's configuration unless told otherwise
