@@ -46,8 +46,17 @@ pub(crate) fn solve_with(
     params: &IkParams,
     clock: &Clock<'_>,
 ) -> IkResult {
+    // validate_request refuses position targets for this method; answer one with
+    // nothing rather than panic should a caller skip it
     let IkTarget::Pose(pose) = target else {
-        unreachable!("validate_request refuses position targets for the analytic method")
+        return IkResult {
+            solutions: Vec::new(),
+            best_attempt: None,
+            stop_reason: IkStatus::MaxIterations,
+            attempts: 0,
+            total_iterations: 0,
+            elapsed_us: clock.elapsed_us(),
+        };
     };
     let arm = &reduced.arm;
     let seed_q: Vec<f64> = seed.map_or_else(|| chain.mid_limits(), <[f64]>::to_vec);
