@@ -1,6 +1,7 @@
 //! End-to-end tests, one binary: each module starts the real server on a free
 //! loopback port and calls it over gRPC, as clients do.
 
+mod analytic;
 mod exploration;
 mod explore;
 mod hardening;

@@ -68,6 +68,7 @@ pb::IkMethod method_to_proto(IkMethod m) {
     case IkMethod::Ccd: return pb::IK_METHOD_CCD;
     case IkMethod::Fabrik: return pb::IK_METHOD_FABRIK;
     case IkMethod::LengthRelaxation: return pb::IK_METHOD_LENGTH_RELAXATION;
+    case IkMethod::Analytic: return pb::IK_METHOD_ANALYTIC;
     case IkMethod::LevenbergMarquardt: break;
   }
   return pb::IK_METHOD_LEVENBERG_MARQUARDT;

@@ -22,7 +22,7 @@ from .local_server import LocalServer
 from .octree import Octree, Views
 from . import scenes
 from .exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
-from .kinematics import IkBatchResult, IkOptions, IkResult, IkSolution, LinearSolution, TrackResult
+from .kinematics import ConfigFlags, IkBatchResult, IkOptions, IkResult, IkSolution, LinearSolution, TrackResult
 from .robot import IkStream, Robot
 from .mobile import Mobile, MobileRun, StepResult, WheelKinematics
 from .planning import Box, Capsule, Cylinder, Mesh, OctreeObstacle, Plan, Sphere, StateChecks
@@ -47,6 +47,7 @@ __all__ = [
     "IkBatchResult",
     "IkOptions",
     "IkResult",
+    "ConfigFlags",
     "IkSolution",
     "IkStream",
     "Cancelled",

@@ -41,6 +41,24 @@ class RobotDescription:
             return {}
         return {s.name: dict(zip(s.joint_names, s.positions)) for s in self.raw.named_states}
 
+    @property
+    def analytic_family(self) -> str:
+        """The chain's closed-form IK family ("spherical_wrist",
+        "three_parallel"), or "" when ``method="analytic"`` does not apply
+        (then :attr:`analytic_reason` says why)."""
+        return "" if self.raw is None else str(self.raw.analytic_family)
+
+    @property
+    def analytic_held_joint(self) -> int:
+        """7-joint arms: the joint (0-based) the analytic method holds at the
+        seed's value by default; -1 otherwise."""
+        return -1 if self.raw is None else int(self.raw.analytic_held_joint)
+
+    @property
+    def analytic_reason(self) -> str:
+        """Why the analytic IK method does not apply ("" when it does)."""
+        return "" if self.raw is None else str(self.raw.analytic_reason)
+
     def named_state(self, name: str) -> np.ndarray:
         """The SRDF group state `name` as a joint vector in chain order. A
         chain joint the state does not set is an error naming it."""

@@ -28,7 +28,7 @@ from .v1 import common_pb2, kinematics_pb2
 #: IK methods by name (``None``: the server default, Levenberg-Marquardt).
 #: IK method names (aliases: "levenberg_marquardt", "ji").
 IkMethodName = Literal["lm", "levenberg_marquardt", "jacobian_inverse", "ji", "newton", "ccd", "fabrik",
-                       "length_relaxation"]
+                       "length_relaxation", "analytic"]
 #: Linear solver names of the Jacobian methods (aliases: "pinv", "rlxa", "rlxa_safeguarded").
 LinearSolverName = Literal["svd", "pinv", "angle_relaxation", "rlxa", "angle_relaxation_safeguarded",
                            "rlxa_safeguarded"]
@@ -44,6 +44,7 @@ METHODS = {
     "fabrik": kinematics_pb2.IK_METHOD_FABRIK,
     "length_relaxation": kinematics_pb2.IK_METHOD_LENGTH_RELAXATION,
     "lr": kinematics_pb2.IK_METHOD_LENGTH_RELAXATION,
+    "analytic": kinematics_pb2.IK_METHOD_ANALYTIC,
 }
 
 #: Linear solvers by name (``None``: SVD pseudoinverse).
@@ -150,13 +151,18 @@ def ik_options(
     distinct_tolerance: Optional[float] = None,
     rlxa_max_iterations: Optional[int] = None,
     history: bool = False,
+    hold_configuration: Optional[bool] = None,
+    nearest_turn_only: bool = False,
+    redundant_joint: Optional[int] = None,
+    analytic_start: bool = False,
 ) -> kinematics_pb2.IkOptions:
     """IkOptions from Python values; ``None`` means the server's documented
     default. Values are checked by the server, which names a bad field.
     Built once per distinct set of arguments (a request copies the message)."""
     key: Any = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
            damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
-           max_step, distinct_tolerance, rlxa_max_iterations, history)
+           max_step, distinct_tolerance, rlxa_max_iterations, history, hold_configuration, nearest_turn_only,
+           redundant_joint, analytic_start)
     try:
         cached = _IK_OPTIONS_CACHE.get(key)
     except TypeError:  # an unhashable argument: build without the cache
@@ -167,7 +173,8 @@ def ik_options(
         return out
     o = _build_ik_options(method, linear_solver, position_tolerance, orientation_tolerance, position_only,
                           max_iterations, damping, max_restarts, num_solutions, rng_seed, joint_limits,
-                          time_budget, adaptive_damping, max_step, distinct_tolerance, rlxa_max_iterations, history)
+                          time_budget, adaptive_damping, max_step, distinct_tolerance, rlxa_max_iterations, history,
+                          hold_configuration, nearest_turn_only, redundant_joint, analytic_start)
     if key is not None and len(_IK_OPTIONS_CACHE) < 256:
         _IK_OPTIONS_CACHE[key] = kinematics_pb2.IkOptions()
         _IK_OPTIONS_CACHE[key].CopyFrom(o)
@@ -181,7 +188,8 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
                       position_only: Any, max_iterations: Any, damping: Any, max_restarts: Any,
                       num_solutions: Any, rng_seed: Any, joint_limits: Any, time_budget: Any,
                       adaptive_damping: Any, max_step: Any, distinct_tolerance: Any, rlxa_max_iterations: Any,
-                      history: Any) -> kinematics_pb2.IkOptions:
+                      history: Any, hold_configuration: Any = None, nearest_turn_only: Any = False,
+                      redundant_joint: Any = None, analytic_start: Any = False) -> kinematics_pb2.IkOptions:
     o = kinematics_pb2.IkOptions(
         method=_choice(METHODS, method, "method"),
         linear_solver=_choice(LINEAR_SOLVERS, linear_solver, "linear_solver"),
@@ -191,6 +199,8 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
         rng_seed=int(rng_seed),
         joint_limits=_choice(JOINT_LIMITS, joint_limits, "joint_limits"),
         return_history=bool(history),
+        nearest_turn_only=bool(nearest_turn_only),
+        analytic_start=bool(analytic_start),
     )
     for name, value, kind in (
         ("position_tolerance", position_tolerance, float),
@@ -202,6 +212,8 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
         ("max_step", max_step, float),
         ("distinct_tolerance", distinct_tolerance, float),
         ("rlxa_max_iterations", rlxa_max_iterations, int),
+        ("hold_configuration", hold_configuration, bool),
+        ("redundant_joint", redundant_joint, int),
     ):
         if value is not None:
             setattr(o, name, kind(value))
@@ -213,9 +225,9 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
 IK_OPTION_FIELDS = ("method", "linear_solver", "position_tolerance", "orientation_tolerance", "position_only",
                     "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits",
                     "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations",
-                    "return_history")
+                    "return_history", "hold_configuration", "nearest_turn_only", "redundant_joint", "analytic_start")
 #: The keyword shortcuts of ``robot.ik`` and friends, in the same order.
-IK_SHORTCUTS = IK_OPTION_FIELDS[:-1] + ("history",)
+IK_SHORTCUTS = tuple("history" if f == "return_history" else f for f in IK_OPTION_FIELDS)
 
 
 @dataclass(frozen=True)
@@ -225,7 +237,9 @@ class IkOptions:
     ``None`` means the server's documented default.
 
     ``method``: "lm" (Levenberg-Marquardt), "jacobian_inverse", "newton",
-    "ccd", "fabrik", "length_relaxation"; ``linear_solver`` (Jacobian
+    "ccd", "fabrik", "length_relaxation", "analytic" (closed form: every
+    solution, 6-joint arms of the families ``RobotDescription.analytic_family``
+    names); ``linear_solver`` (Jacobian
     methods): "svd", "angle_relaxation", "angle_relaxation_safeguarded";
     tolerances in m and rad; ``max_restarts`` random restarts drawn from
     ``rng_seed``; ``num_solutions`` distinct solutions (two differ when a
@@ -233,7 +247,12 @@ class IkOptions:
     "clamp" or "ignore"; ``time_budget`` in s; ``adaptive_damping``,
     ``damping`` and ``max_step`` steer the Jacobian step;
     ``rlxa_max_iterations`` caps the angle-relaxation solve;
-    ``return_history`` returns each solution's per-iteration errors.
+    ``return_history`` returns each solution's per-iteration errors;
+    ``hold_configuration``, ``nearest_turn_only`` and ``redundant_joint``
+    steer ``method="analytic"`` (the seed's configuration first; one
+    whole-turn variant per joint; the joint of a 7-joint arm held at the
+    seed's value); ``analytic_start`` starts the iterative methods from the
+    closed-form solution nearest the seed.
 
     Pass it as ``robot.ik(T, options=IkOptions(...))`` (also ``ik_batch``,
     ``track``, ``stream_ik``); a keyword shortcut given beside it
@@ -258,6 +277,10 @@ class IkOptions:
     distinct_tolerance: Optional[float] = None
     rlxa_max_iterations: Optional[int] = None
     return_history: bool = False
+    hold_configuration: Optional[bool] = None
+    nearest_turn_only: bool = False
+    redundant_joint: Optional[int] = None
+    analytic_start: bool = False
 
     def __post_init__(self) -> None:
         _choice(METHODS, self.method, "method")
@@ -301,13 +324,31 @@ def ik_options_of_args(args: Tuple[Any, ...]) -> kinematics_pb2.IkOptions:
     return ik_options(args[0], args[1], **dict(zip(IK_SHORTCUTS[2:], args[2:])))
 
 
+@dataclass(frozen=True)
+class ConfigFlags:
+    """How a controller names an arm configuration (``method="analytic"``):
+    each flag is the side of a singularity the arm is on.
+    ``shoulder_back``: the wrist lies behind axis 1 (KUKA Status bit 0);
+    ``elbow_down``: joint 3 is below its stretched-arm angle (sin(q3 - q3s) < 0);
+    ``wrist_flipped``: joint 5 is on the negative side of its wrist-singular
+    angle (sin(q5 - q5s) < 0). See docs/inverse-kinematics.md#analytic for
+    the KUKA / ABB / UR names."""
+
+    shoulder_back: bool
+    elbow_down: bool
+    wrist_flipped: bool
+
+
 @dataclass
 class IkSolution:
     """One answer: joints ``q`` (rad, m for prismatic joints), errors of its
     true FK (m, rad), iterations of its attempt, µs since the request began,
     the attempt's status and index (0 = from the seed). With ``history=True``
     in the request, ``history`` is an (iterations + 1) x 2 array of the
-    (position m, orientation rad) error at the start of every iteration."""
+    (position m, orientation rad) error at the start of every iteration.
+    With ``method="analytic"``: ``config`` holds the solution's
+    :class:`ConfigFlags` and ``singular`` says a free joint of a singular pose
+    took the seed's value (``config`` is None for the iterative methods)."""
 
     q: np.ndarray
     position_error: float
@@ -317,6 +358,8 @@ class IkSolution:
     status: str
     attempt: int
     history: Optional[np.ndarray] = None
+    config: Optional[ConfigFlags] = None
+    singular: bool = False
 
     @classmethod
     def from_proto(cls, s: kinematics_pb2.IkSolution) -> "IkSolution":
@@ -334,6 +377,12 @@ class IkSolution:
                 if len(s.position_error_history)
                 else None
             ),
+            (
+                ConfigFlags(s.config.shoulder_back, s.config.elbow_down, s.config.wrist_flipped)
+                if s.HasField("config")
+                else None
+            ),
+            s.singular,
         )
 
 

@@ -203,6 +203,10 @@ class Robot(RobotRefs):
         distinct_tolerance: Optional[float] = None,
         rlxa_max_iterations: Optional[int] = None,
         history: bool = False,
+        hold_configuration: Optional[bool] = None,
+        nearest_turn_only: bool = False,
+        redundant_joint: Optional[int] = None,
+        analytic_start: bool = False,
         timeout: Optional[float] = None,
     ) -> IkResult:
         """Joints that put the tool at ``T`` (4x4, or (position, quaternion
@@ -214,7 +218,10 @@ class Robot(RobotRefs):
         shortcuts for its fields (``history`` is ``return_history``), and one
         given beside ``options`` replaces its field unless it is at its
         default. ``method``: "lm" (default), "jacobian_inverse", "newton",
-        "ccd", "fabrik", "length_relaxation"; ``linear_solver`` (Jacobian
+        "ccd", "fabrik", "length_relaxation", "analytic" (closed form:
+        with ``num_solutions=1000`` every solution inside the limits, each
+        solution's ``config`` flags set; 6-joint arms whose
+        ``describe().analytic_family`` is not empty); ``linear_solver`` (Jacobian
         methods): "svd" (default), "angle_relaxation",
         "angle_relaxation_safeguarded". Tolerances in m and rad (default
         1e-5); ``max_restarts`` (default 200) random restarts from
@@ -227,7 +234,8 @@ class Robot(RobotRefs):
         matrix = isinstance(T, np.ndarray) and T.shape == (4, 4)
         args = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
                 damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
-                max_step, distinct_tolerance, rlxa_max_iterations, history)
+                max_step, distinct_tolerance, rlxa_max_iterations, history, hold_configuration, nearest_turn_only,
+                redundant_joint, analytic_start)
         if options is not None:
             args = resolve_ik_args(options, args)
         if not matrix:

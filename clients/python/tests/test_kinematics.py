@@ -254,3 +254,57 @@ def test_error_history_on_request(client):
     assert abs(s.history[0, 0] - dp) < 1e-9 and abs(s.history[0, 1] - dr) < 1e-6
     assert tuple(s.history[-1]) == (s.position_error, s.orientation_error)
     assert robot.ik(T, seed=seed).solutions[0].history is None
+
+
+@pytest.mark.parametrize("name", ["kuka_kr120_r2500_pro", "ur5"])
+def test_analytic_ik_returns_every_solution_with_flags(client, name):
+    robot = client.robot(name)
+    d = robot.describe()
+    assert d.analytic_family in ("spherical_wrist", "three_parallel") and d.analytic_reason == ""
+    rng = np.random.default_rng(3)
+    q = random_q(robot, rng)
+    T = robot.fk(q)
+    r = robot.ik(T, seed=q, method="analytic", num_solutions=1000)
+    assert r.success and r.status == "converged", r
+    # the seed's configuration first; every solution reaches T by the server's FK
+    assert np.allclose(r.solutions[0].q, q, atol=1e-9)
+    configs = set()
+    for s in r.solutions[:24]:
+        # the 4x4 difference (acos of the trace would lose half the digits)
+        err = np.abs(robot.fk(s.q) - T).max()
+        assert err <= 1e-9, err
+        assert isinstance(s.config, kinplan.ConfigFlags) and not s.singular
+        configs.add(s.config)
+    dist = [float(np.sum((s.q - q) ** 2)) for s in r.solutions]
+    assert dist == sorted(dist)
+    assert len(configs) >= 2
+    # the iterative methods carry no flags
+    assert robot.ik(T, seed=q).solutions[0].config is None
+
+
+def test_analytic_ik_refuses_a_7_joint_arm_naming_why(client):
+    robot = client.robot("franka_panda")
+    assert robot.describe().analytic_family == ""
+    assert "7 joints" in robot.describe().analytic_reason
+    T = robot.fk([0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.8])
+    with pytest.raises(kinplan.InvalidArgument) as e:
+        robot.ik(T, method="analytic")
+    assert "chain is not analytic" in str(e.value)
+
+
+def test_analytic_options_hold_turns_and_start(client):
+    robot = client.robot("ur5")
+    q = np.array([0.3, -1.2, 1.4, -0.8, 1.1, 0.2])
+    T = robot.fk(q)
+    # one whole-turn variant per joint: the 8 configurations of a generic pose
+    r = robot.ik(T, seed=q, method="analytic", num_solutions=1000, nearest_turn_only=True)
+    assert len(r.solutions) == 8 and len({s.config for s in r.solutions}) == 8
+    # hold_configuration: the seed's flags first even when another configuration is nearer
+    other = r.solutions[1]
+    held = robot.ik(T, seed=other.q + 0.4, method="analytic", num_solutions=3, hold_configuration=True,
+                    options=kinplan.IkOptions(method="analytic", nearest_turn_only=True))
+    assert held.solutions[0].config == other.config
+    # analytic_start: LM from a far seed begins on the nearest closed-form solution
+    far = np.array([1.5, -0.2, 0.3, 0.9, -0.7, 1.4])
+    s = robot.ik(T, seed=far, max_restarts=0, analytic_start=True)
+    assert s.success and s.iterations == 0

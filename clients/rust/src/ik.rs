@@ -20,6 +20,9 @@ pub enum IkMethod {
     Ccd,
     Fabrik,
     LengthRelaxation,
+    /// Closed form: every solution of a pose (6-joint arms of the families
+    /// `DescribeRobot.analytic_family` names), ranked by distance to the seed.
+    Analytic,
 }
 
 /// Linear solver of the Jacobian methods (docs/linear-solvers.md). S2 predicts, and
@@ -67,6 +70,7 @@ impl IkOptions {
             IkMethod::Ccd => pb::IkMethod::Ccd,
             IkMethod::Fabrik => pb::IkMethod::Fabrik,
             IkMethod::LengthRelaxation => pb::IkMethod::LengthRelaxation,
+            IkMethod::Analytic => pb::IkMethod::Analytic,
         };
         let solver = match self.solver {
             LinearSolver::SvdPseudoinverse => pb::LinearSolver::SvdPseudoinverse,

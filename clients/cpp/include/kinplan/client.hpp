@@ -71,7 +71,7 @@ struct ClientOptions {
 };
 
 /// IK algorithm (kinematics.proto IkMethod).
-enum class IkMethod { LevenbergMarquardt, JacobianInverse, Newton, Ccd, Fabrik, LengthRelaxation };
+enum class IkMethod { LevenbergMarquardt, JacobianInverse, Newton, Ccd, Fabrik, LengthRelaxation, Analytic };
 
 /// The IK options that matter to most callers; unset ones take the server's
 /// defaults (kinematics.proto IkOptions).

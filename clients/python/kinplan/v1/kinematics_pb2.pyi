@@ -17,6 +17,7 @@ class IkMethod(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
     IK_METHOD_CCD: _ClassVar[IkMethod]
     IK_METHOD_FABRIK: _ClassVar[IkMethod]
     IK_METHOD_LENGTH_RELAXATION: _ClassVar[IkMethod]
+    IK_METHOD_ANALYTIC: _ClassVar[IkMethod]
 
 class LinearSolver(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
     __slots__ = ()
@@ -52,6 +53,7 @@ IK_METHOD_NEWTON: IkMethod
 IK_METHOD_CCD: IkMethod
 IK_METHOD_FABRIK: IkMethod
 IK_METHOD_LENGTH_RELAXATION: IkMethod
+IK_METHOD_ANALYTIC: IkMethod
 LINEAR_SOLVER_UNSPECIFIED: LinearSolver
 LINEAR_SOLVER_SVD_PSEUDOINVERSE: LinearSolver
 LINEAR_SOLVER_ANGLE_RELAXATION: LinearSolver
@@ -70,7 +72,7 @@ LINEAR_SOLVE_STATUS_CONVERGED: LinearSolveStatus
 LINEAR_SOLVE_STATUS_ITERATION_CAP: LinearSolveStatus
 
 class IkOptions(_message.Message):
-    __slots__ = ("method", "linear_solver", "position_tolerance", "orientation_tolerance", "position_only", "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits", "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations", "return_history")
+    __slots__ = ("method", "linear_solver", "position_tolerance", "orientation_tolerance", "position_only", "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits", "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations", "return_history", "hold_configuration", "nearest_turn_only", "redundant_joint", "analytic_start")
     METHOD_FIELD_NUMBER: _ClassVar[int]
     LINEAR_SOLVER_FIELD_NUMBER: _ClassVar[int]
     POSITION_TOLERANCE_FIELD_NUMBER: _ClassVar[int]
@@ -88,6 +90,10 @@ class IkOptions(_message.Message):
     DISTINCT_TOLERANCE_FIELD_NUMBER: _ClassVar[int]
     RLXA_MAX_ITERATIONS_FIELD_NUMBER: _ClassVar[int]
     RETURN_HISTORY_FIELD_NUMBER: _ClassVar[int]
+    HOLD_CONFIGURATION_FIELD_NUMBER: _ClassVar[int]
+    NEAREST_TURN_ONLY_FIELD_NUMBER: _ClassVar[int]
+    REDUNDANT_JOINT_FIELD_NUMBER: _ClassVar[int]
+    ANALYTIC_START_FIELD_NUMBER: _ClassVar[int]
     method: IkMethod
     linear_solver: LinearSolver
     position_tolerance: float
@@ -105,7 +111,21 @@ class IkOptions(_message.Message):
     distinct_tolerance: float
     rlxa_max_iterations: int
     return_history: bool
-    def __init__(self, method: _Optional[_Union[IkMethod, str]] = ..., linear_solver: _Optional[_Union[LinearSolver, str]] = ..., position_tolerance: _Optional[float] = ..., orientation_tolerance: _Optional[float] = ..., position_only: _Optional[bool] = ..., max_iterations: _Optional[int] = ..., damping: _Optional[float] = ..., max_restarts: _Optional[int] = ..., num_solutions: _Optional[int] = ..., rng_seed: _Optional[int] = ..., joint_limits: _Optional[_Union[JointLimitMode, str]] = ..., time_budget: _Optional[float] = ..., adaptive_damping: _Optional[bool] = ..., max_step: _Optional[float] = ..., distinct_tolerance: _Optional[float] = ..., rlxa_max_iterations: _Optional[int] = ..., return_history: _Optional[bool] = ...) -> None: ...
+    hold_configuration: bool
+    nearest_turn_only: bool
+    redundant_joint: int
+    analytic_start: bool
+    def __init__(self, method: _Optional[_Union[IkMethod, str]] = ..., linear_solver: _Optional[_Union[LinearSolver, str]] = ..., position_tolerance: _Optional[float] = ..., orientation_tolerance: _Optional[float] = ..., position_only: _Optional[bool] = ..., max_iterations: _Optional[int] = ..., damping: _Optional[float] = ..., max_restarts: _Optional[int] = ..., num_solutions: _Optional[int] = ..., rng_seed: _Optional[int] = ..., joint_limits: _Optional[_Union[JointLimitMode, str]] = ..., time_budget: _Optional[float] = ..., adaptive_damping: _Optional[bool] = ..., max_step: _Optional[float] = ..., distinct_tolerance: _Optional[float] = ..., rlxa_max_iterations: _Optional[int] = ..., return_history: _Optional[bool] = ..., hold_configuration: _Optional[bool] = ..., nearest_turn_only: _Optional[bool] = ..., redundant_joint: _Optional[int] = ..., analytic_start: _Optional[bool] = ...) -> None: ...
+
+class ConfigFlags(_message.Message):
+    __slots__ = ("shoulder_back", "elbow_down", "wrist_flipped")
+    SHOULDER_BACK_FIELD_NUMBER: _ClassVar[int]
+    ELBOW_DOWN_FIELD_NUMBER: _ClassVar[int]
+    WRIST_FLIPPED_FIELD_NUMBER: _ClassVar[int]
+    shoulder_back: bool
+    elbow_down: bool
+    wrist_flipped: bool
+    def __init__(self, shoulder_back: _Optional[bool] = ..., elbow_down: _Optional[bool] = ..., wrist_flipped: _Optional[bool] = ...) -> None: ...
 
 class SolveIkRequest(_message.Message):
     __slots__ = ("robot", "target", "seed", "options")
@@ -120,7 +140,7 @@ class SolveIkRequest(_message.Message):
     def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., target: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., seed: _Optional[_Iterable[float]] = ..., options: _Optional[_Union[IkOptions, _Mapping]] = ...) -> None: ...
 
 class IkSolution(_message.Message):
-    __slots__ = ("joints", "position_error", "orientation_error", "iterations", "elapsed_us", "status", "attempt", "position_error_history", "orientation_error_history")
+    __slots__ = ("joints", "position_error", "orientation_error", "iterations", "elapsed_us", "status", "attempt", "position_error_history", "orientation_error_history", "config", "singular")
     JOINTS_FIELD_NUMBER: _ClassVar[int]
     POSITION_ERROR_FIELD_NUMBER: _ClassVar[int]
     ORIENTATION_ERROR_FIELD_NUMBER: _ClassVar[int]
@@ -130,6 +150,8 @@ class IkSolution(_message.Message):
     ATTEMPT_FIELD_NUMBER: _ClassVar[int]
     POSITION_ERROR_HISTORY_FIELD_NUMBER: _ClassVar[int]
     ORIENTATION_ERROR_HISTORY_FIELD_NUMBER: _ClassVar[int]
+    CONFIG_FIELD_NUMBER: _ClassVar[int]
+    SINGULAR_FIELD_NUMBER: _ClassVar[int]
     joints: _containers.RepeatedScalarFieldContainer[float]
     position_error: float
     orientation_error: float
@@ -139,7 +161,9 @@ class IkSolution(_message.Message):
     attempt: int
     position_error_history: _containers.RepeatedScalarFieldContainer[float]
     orientation_error_history: _containers.RepeatedScalarFieldContainer[float]
-    def __init__(self, joints: _Optional[_Iterable[float]] = ..., position_error: _Optional[float] = ..., orientation_error: _Optional[float] = ..., iterations: _Optional[int] = ..., elapsed_us: _Optional[int] = ..., status: _Optional[_Union[IkStatus, str]] = ..., attempt: _Optional[int] = ..., position_error_history: _Optional[_Iterable[float]] = ..., orientation_error_history: _Optional[_Iterable[float]] = ...) -> None: ...
+    config: ConfigFlags
+    singular: bool
+    def __init__(self, joints: _Optional[_Iterable[float]] = ..., position_error: _Optional[float] = ..., orientation_error: _Optional[float] = ..., iterations: _Optional[int] = ..., elapsed_us: _Optional[int] = ..., status: _Optional[_Union[IkStatus, str]] = ..., attempt: _Optional[int] = ..., position_error_history: _Optional[_Iterable[float]] = ..., orientation_error_history: _Optional[_Iterable[float]] = ..., config: _Optional[_Union[ConfigFlags, _Mapping]] = ..., singular: _Optional[bool] = ...) -> None: ...
 
 class SolveIkResponse(_message.Message):
     __slots__ = ("solutions", "best_attempt", "success", "status", "attempts", "total_iterations", "elapsed_us", "model_id")

@@ -27,6 +27,10 @@ pub enum IkParam {
     TimeBudget,
     /// The link lengths handed to FABRIK or length relaxation.
     Lengths,
+    /// `AnalyticParams::geometry_tolerance`.
+    GeometryTolerance,
+    /// `AnalyticParams::solve_tolerance`.
+    SolveTolerance,
 }
 
 /// A parameter of a sampled path ([`line_path`](super::line_path),
@@ -62,6 +66,8 @@ impl IkParam {
             IkParam::DistinctTolerance => "distinct_tolerance",
             IkParam::TimeBudget => "time_budget",
             IkParam::Lengths => "lengths",
+            IkParam::GeometryTolerance => "geometry_tolerance",
+            IkParam::SolveTolerance => "solve_tolerance",
         }
     }
 }

@@ -1,6 +1,8 @@
 //! Inverse kinematics: Jacobian methods (with SVD or RLXA), CCD, FABRIK, length
-//! relaxation, restarts and time budgets, batches and Cartesian path tracking.
+//! relaxation, closed-form (analytic) solvers, restarts and time budgets, batches
+//! and Cartesian path tracking.
 
+pub mod analytic;
 mod attempt;
 mod ccd;
 mod error;

@@ -2,6 +2,7 @@
 
 use std::time::Duration;
 
+use super::analytic::AnalyticParams;
 use super::{IkError, IkParam};
 use crate::linalg::{LinearSolverKind, RlxaParams};
 
@@ -21,11 +22,14 @@ pub enum IkMethod {
     Fabrik,
     /// Length relaxation (S2 §4.1), revolute chains, position targets.
     LengthRelaxation,
+    /// Closed form by subproblem decomposition ([`analytic`](super::analytic)):
+    /// every solution, 6R arms of the covered families, pose targets.
+    Analytic,
 }
 
 impl IkMethod {
     /// The method's name on the wire and in the Python client
-    /// ("jacobian_inverse", "lm", "newton", "ccd", "fabrik", "length_relaxation").
+    /// ("jacobian_inverse", "lm", "newton", "ccd", "fabrik", "length_relaxation", "analytic").
     pub fn name(self) -> &'static str {
         match self {
             IkMethod::JacobianInverse => "jacobian_inverse",
@@ -34,6 +38,7 @@ impl IkMethod {
             IkMethod::Ccd => "ccd",
             IkMethod::Fabrik => "fabrik",
             IkMethod::LengthRelaxation => "length_relaxation",
+            IkMethod::Analytic => "analytic",
         }
     }
 
@@ -108,6 +113,13 @@ pub struct IkParams {
     /// ([`IkSolution::history`](super::IkSolution::history)). Default off (nothing is
     /// recorded, nothing allocated).
     pub record_history: bool,
+    /// Options of the analytic method (tolerances, whole turns, holding the
+    /// seed's configuration). Default [`AnalyticParams::default`].
+    pub analytic: AnalyticParams,
+    /// Iterative methods, pose targets: start the first attempt from the analytic
+    /// solution nearest the seed when the chain has one (else from the seed).
+    /// Default false.
+    pub analytic_start: bool,
 }
 
 impl Default for IkParams {
@@ -135,6 +147,8 @@ impl Default for IkParams {
             stall_iterations: 6,
             time_budget: None,
             record_history: false,
+            analytic: AnalyticParams::default(),
+            analytic_start: false,
         }
     }
 }
@@ -194,6 +208,9 @@ impl IkParams {
                 value: 0.0,
                 reason: "must be > 0 when set",
             });
+        }
+        if self.method == IkMethod::Analytic || self.analytic_start {
+            self.analytic.validate()?;
         }
         if self.method.is_jacobian_method() && self.linear_solver == LinearSolverKind::AngleRelaxation {
             self.rlxa.validate()?;

@@ -6,6 +6,7 @@ use std::time::Instant;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use super::analytic::analyse;
 use super::attempt::{Attempt, Clock};
 use super::workspace::IkWorkspace;
 use super::{IkError, IkMethod, IkParams, IkTarget};
@@ -48,6 +49,11 @@ pub struct IkSolution {
     /// the start of every iteration of the attempt, ending with the error returned;
     /// empty otherwise.
     pub history: Vec<(f64, f64)>,
+    /// Analytic method: the solution's configuration flags; `None` otherwise.
+    pub config: Option<super::analytic::ConfigFlags>,
+    /// Analytic method: a singular pose, where a joint was free and took the
+    /// seed's value (the solutions form a continuous family); false otherwise.
+    pub singular: bool,
 }
 
 /// Everything a request produced.
@@ -105,6 +111,18 @@ pub(crate) fn validate_request(
     match params.method {
         IkMethod::Fabrik | IkMethod::LengthRelaxation => {
             super::point_chain::check_servable(chain, target, params.method)?
+        }
+        IkMethod::Analytic => {
+            if matches!(target, IkTarget::Position(_)) {
+                return Err(IkError::MethodCannotServe {
+                    method: params.method,
+                    reason: "it needs a full pose target (position and orientation)".into(),
+                });
+            }
+            analyse(chain, &params.analytic, seed).map_err(|e| IkError::MethodCannotServe {
+                method: params.method,
+                reason: e.to_string(),
+            })?;
         }
         _ => {}
     }
@@ -188,10 +206,19 @@ impl<'c> IkSolver<'c> {
         clock: &Clock<'_>,
     ) -> IkResult {
         let chain = self.chain;
-        let seed_q: Vec<f64> = match seed {
+        if params.method == IkMethod::Analytic {
+            // validated: the chain is analytic
+            if let Ok(arm) = analyse(chain, &params.analytic, seed) {
+                return super::analytic::front::solve_with(chain, &arm, target, seed, params, clock);
+            }
+        }
+        let mut seed_q: Vec<f64> = match seed {
             Some(s) => s.to_vec(),
             None => chain.mid_limits(),
         };
+        if params.analytic_start {
+            analytic_start(chain, target, params, &mut seed_q);
+        }
         let mut rng = ChaCha8Rng::seed_from_u64(rng_seed);
         // same request ⇒ same floating-point path, whatever was solved before
         self.ws.svd.reset();
@@ -229,6 +256,8 @@ impl<'c> IkSolver<'c> {
                 status: out.status,
                 attempt,
                 history: ws.history.clone(),
+                config: None,
+                singular: false,
             };
             if out.status == IkStatus::Converged {
                 let distinct = solutions.iter().all(|s| {
@@ -270,6 +299,29 @@ impl<'c> IkSolver<'c> {
     }
 }
 
+/// Replaces `seed_q` by the analytic solution nearest it (Euclidean joint
+/// distance) when the chain has a closed form and the target is a pose.
+fn analytic_start(chain: &Chain, target: &IkTarget, params: &IkParams, seed_q: &mut Vec<f64>) {
+    let IkTarget::Pose(pose) = target else { return };
+    let Ok(reduced) = analyse(chain, &params.analytic, Some(seed_q)) else {
+        return;
+    };
+    let seed6 = reduced.reduce(seed_q);
+    let mut out = Vec::new();
+    let near = super::analytic::AnalyticParams {
+        turns: super::analytic::Turns::NearestSeed,
+        ..params.analytic
+    };
+    reduced.arm.solve_into(pose, Some(&seed6), &near, &mut out);
+    let dist = |q: &[f64; 6]| q.iter().zip(&seed6).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+    if let Some(best) = out
+        .iter()
+        .min_by(|a, b| dist(&a.joints).total_cmp(&dist(&b.joints)))
+    {
+        *seed_q = reduced.expand(&best.joints);
+    }
+}
+
 pub(crate) fn run_attempt(
     chain: &Chain,
     target: &IkTarget,
@@ -286,6 +338,9 @@ pub(crate) fn run_attempt(
         IkMethod::Fabrik | IkMethod::LengthRelaxation => {
             super::point_chain::run(chain, target, params, ws, clock)
         }
+        // served whole by `analytic::front` before any attempt; as a fallback the
+        // attempt is a Levenberg–Marquardt one
+        IkMethod::Analytic => super::jacobian_methods::run(chain, target, params, ws, rng, clock),
     }
 }
 

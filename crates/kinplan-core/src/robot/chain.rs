@@ -234,6 +234,42 @@ impl Chain {
         j
     }
 
+    /// The chain with joint `index` held at `value` (rad or m): its motion is
+    /// folded into the next joint's origin (or the tip offset), and the links
+    /// hanging from it move to the joint before. Forward kinematics of the
+    /// result at `q` equals this chain's at `q` with `value` inserted at `index`.
+    /// `None` when `index` is out of range.
+    ///
+    /// ```
+    /// let iiwa = kinplan_core::robot::builtin_chain("kuka_lbr_iiwa14_r820").unwrap();
+    /// let six = iiwa.with_joint_fixed(2, 0.4).unwrap();
+    /// let q6 = [0.1, 0.2, -0.3, 0.4, 0.5, 0.6];
+    /// let q7 = [0.1, 0.2, 0.4, -0.3, 0.4, 0.5, 0.6];
+    /// let (a, b) = (six.fk(&q6), iiwa.fk(&q7));
+    /// assert!((a.translation.vector - b.translation.vector).norm() < 1e-12);
+    /// ```
+    pub fn with_joint_fixed(&self, index: usize, value: f64) -> Option<Chain> {
+        let removed = self.joints.get(index)?;
+        let fold = removed.origin * removed.motion(value);
+        let mut out = self.clone();
+        out.joints.remove(index);
+        match out.joints.get_mut(index) {
+            Some(next) => next.origin = fold * next.origin,
+            None => out.tip_offset = fold * out.tip_offset,
+        }
+        for link in &mut out.links {
+            match link.after_joint {
+                Some(j) if j == index => {
+                    link.offset = fold * link.offset;
+                    link.after_joint = index.checked_sub(1);
+                }
+                Some(j) if j > index => link.after_joint = Some(j - 1),
+                _ => {}
+            }
+        }
+        Some(out)
+    }
+
     /// The middle of each joint's range (0 for unlimited joints).
     pub fn mid_limits(&self) -> Vec<f64> {
         self.joints

@@ -66,6 +66,8 @@ pub fn param_field(param: IkParam) -> &'static str {
         IkParam::DistinctTolerance => "options.distinct_tolerance",
         IkParam::TimeBudget => "options.time_budget",
         IkParam::Lengths => "robot",
+        // not settable on the wire (the service uses the domain defaults)
+        IkParam::GeometryTolerance | IkParam::SolveTolerance => "options.method",
     }
 }
 

@@ -13,6 +13,7 @@ use crate::pb;
 use crate::status::ik::{IkAt, PathAt, ik_error};
 use crate::status::linalg::{SolveAt, linalg_error};
 use crate::status::{invalid, too_large};
+use kinplan_core::ik::analytic::{AnalyticParams, ConfigFlags, Turns};
 use kinplan_core::ik::{
     IkMethod, IkParams, IkResult, IkSolution, IkStatus, IkTarget, JointLimitMode, TrackResult, circle_path,
     line_path,
@@ -68,6 +69,7 @@ impl Options {
             Ok(pb::IkMethod::Ccd) => IkMethod::Ccd,
             Ok(pb::IkMethod::Fabrik) => IkMethod::Fabrik,
             Ok(pb::IkMethod::LengthRelaxation) => IkMethod::LengthRelaxation,
+            Ok(pb::IkMethod::Analytic) => IkMethod::Analytic,
             Err(_) => return Err(invalid("options.method", format!("unknown value {}", o.method))),
         };
         let mut rlxa = d.rlxa;
@@ -135,6 +137,19 @@ impl Options {
             distinct_tolerance: o.distinct_tolerance.unwrap_or(d.distinct_tolerance),
             time_budget,
             record_history: o.return_history,
+            analytic_start: o.analytic_start,
+            analytic: AnalyticParams {
+                // warm calls (TrackPath, StreamIk) pass their restart default and
+                // hold the previous answer's configuration unless told otherwise
+                hold_configuration: o.hold_configuration.unwrap_or(default_restarts.is_some()),
+                turns: if o.nearest_turn_only {
+                    Turns::NearestSeed
+                } else {
+                    Turns::All
+                },
+                redundant_joint: o.redundant_joint.map(|j| j as usize),
+                ..d.analytic
+            },
             ..d
         };
         params.validate().map_err(|e| ik_error(e, IkAt::Target))?;
@@ -258,6 +273,16 @@ pub(super) fn solution_out(s: IkSolution) -> pb::IkSolution {
         attempt: s.attempt as u32,
         position_error_history: s.history.iter().map(|h| h.0).collect(),
         orientation_error_history: s.history.iter().map(|h| h.1).collect(),
+        config: s.config.map(config_out),
+        singular: s.singular,
+    }
+}
+
+pub(super) fn config_out(c: ConfigFlags) -> pb::ConfigFlags {
+    pb::ConfigFlags {
+        shoulder_back: c.shoulder_back,
+        elbow_down: c.elbow_down,
+        wrist_flipped: c.wrist_flipped,
     }
 }
 

@@ -3,10 +3,12 @@
 
 use crate::api::convert::{pose_out, vec3_out};
 use crate::pb;
+use kinplan_core::ik::analytic::{AnalyticParams, analyse};
 use kinplan_core::robot::{Chain, JointKind, Shape};
 
 /// A chain's description: joints, links with their collision shapes, the tip.
 pub(super) fn describe(chain: &Chain, model_id: Vec<u8>) -> pb::DescribeRobotResponse {
+    let analytic = analyse(chain, &AnalyticParams::default(), None);
     let joints = chain
         .joints()
         .iter()
@@ -53,6 +55,15 @@ pub(super) fn describe(chain: &Chain, model_id: Vec<u8>) -> pb::DescribeRobotRes
         urdf: String::new(),
         collision_bodies: Vec::new(),
         named_states: Vec::new(),
+        analytic_family: analytic
+            .as_ref()
+            .map_or_else(|_| String::new(), |a| a.arm.family().name().into()),
+        analytic_held_joint: analytic
+            .as_ref()
+            .ok()
+            .and_then(|a| a.held)
+            .map_or(-1, |(j, _)| j as i32),
+        analytic_reason: analytic.err().map_or_else(String::new, |e| e.reason),
     }
 }
 

@@ -1,0 +1,66 @@
+//! Options of the analytic solvers, with units, defaults and validation.
+
+use super::super::{IkError, IkParam};
+
+/// Which whole-turn variants of a wide-range joint's angle are returned.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub enum Turns {
+    /// Every `q + 2πk` inside the limits (at most [`MAX_TURNS`](super::MAX_TURNS)
+    /// per joint, nearest zero first); a continuous joint gives its value in (−π, π].
+    #[default]
+    All,
+    /// Only the variant nearest the seed (or zero without a seed).
+    NearestSeed,
+}
+
+/// Options of [`AnalyticArm`](super::AnalyticArm) analysis and solving.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AnalyticParams {
+    /// Two axes are parallel when `‖hᵢ × hⱼ‖ ≤` this (rad), and lines meet when
+    /// their distance is `≤` this (m, scaled by 1 m). Default 1e-9.
+    pub geometry_tolerance: f64,
+    /// A subproblem answer is exact when its residual is `≤` this (m for
+    /// positions, dimensionless for unit directions). Default 1e-9.
+    pub solve_tolerance: f64,
+    /// Whole-turn variants returned. Default all.
+    pub turns: Turns,
+    /// Rank solutions with the seed's configuration flags first (then by distance
+    /// to the seed), so a stream keeps one configuration. Default false: by
+    /// distance only.
+    pub hold_configuration: bool,
+    /// 7-joint chains: the joint (0-based chain index) held at the seed's value
+    /// so that the other six are solved in closed form; `None` = the first of
+    /// joints 3, 4, 5, 2, 6, 1, 7 that leaves a covered arm. Default none.
+    pub redundant_joint: Option<usize>,
+}
+
+impl Default for AnalyticParams {
+    fn default() -> Self {
+        Self {
+            geometry_tolerance: 1e-9,
+            solve_tolerance: 1e-9,
+            turns: Turns::All,
+            hold_configuration: false,
+            redundant_joint: None,
+        }
+    }
+}
+
+impl AnalyticParams {
+    /// Rejects non-finite or non-positive tolerances, naming the field.
+    pub fn validate(&self) -> Result<(), IkError> {
+        for (field, value) in [
+            (IkParam::GeometryTolerance, self.geometry_tolerance),
+            (IkParam::SolveTolerance, self.solve_tolerance),
+        ] {
+            if !(value.is_finite() && value > 0.0 && value < 1.0) {
+                return Err(IkError::InvalidParam {
+                    field,
+                    value,
+                    reason: "must be finite, > 0 and < 1",
+                });
+            }
+        }
+        Ok(())
+    }
+}

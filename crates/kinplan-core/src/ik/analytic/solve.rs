@@ -1,0 +1,436 @@
+//! The closed-form solvers of the two 6R families by subproblem
+//! decomposition, their configuration flags, and whole-turn enumeration.
+
+use nalgebra::{Isometry3, Matrix3, Vector3};
+
+use super::family::{AnalyticArm, Family};
+use super::params::{AnalyticParams, Turns};
+use super::subproblems::{Angles, rot, sp1, sp2, sp3, sp4, wrap};
+
+/// Most whole-turn variants returned per joint with [`Turns::All`].
+pub const MAX_TURNS: usize = 4;
+
+/// How a controller names a solution: three booleans, each the side of a
+/// singularity the arm is on (docs/inverse-kinematics.md#analytic).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct ConfigFlags {
+    /// The wrist point lies behind axis 1: `(E₁⁻¹ w − p₁)·f < 0` with `f` the
+    /// arm's forward direction at joint 1 = 0 (KUKA Status bit 0, "overhead").
+    pub shoulder_back: bool,
+    /// `sin(q₃ − q₃ˢ) < 0` with `q₃ˢ` the stretched-arm angle of joint 3.
+    pub elbow_down: bool,
+    /// `sin(q₅ − q₅ˢ) < 0` with `q₅ˢ` the wrist-singular angle of joint 5.
+    pub wrist_flipped: bool,
+}
+
+/// One closed-form solution.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AnalyticSolution {
+    /// Joint values (rad), chain order, inside the limits.
+    pub joints: [f64; 6],
+    pub config: ConfigFlags,
+    /// At a singular pose a joint could take any value; it was set to the
+    /// seed's (or 0) and the set of solutions is a continuous family.
+    pub singular: bool,
+    /// Every subproblem held exactly; false only for the least-squares answers
+    /// of [`AnalyticArm::nearest`].
+    pub exact: bool,
+}
+
+/// The choice for a free angle: the seed's value, wrapped.
+fn pick(a: Angles, seed: f64) -> Angles {
+    if a.free {
+        Angles {
+            angles: [wrap(seed), wrap(seed)],
+            ..a
+        }
+    } else {
+        a
+    }
+}
+
+/// Up to 8 base solutions (angles in (−π, π]).
+struct Base {
+    n: usize,
+    sols: [AnalyticSolution; 8],
+}
+
+impl Base {
+    fn push(&mut self, joints: [f64; 6], config: ConfigFlags, singular: bool, exact: bool) {
+        if self.n < 8 {
+            self.sols[self.n] = AnalyticSolution {
+                joints,
+                config,
+                singular,
+                exact,
+            };
+            self.n += 1;
+        }
+    }
+}
+
+impl AnalyticArm {
+    /// `E⁻¹ x = rot(hᵢ, −θ)(x − pᵢ) + pᵢ` given `rᵢ = rot(hᵢ, θ)`.
+    #[inline]
+    fn inv_apply(&self, i: usize, r: &Matrix3<f64>, x: &Vector3<f64>) -> Vector3<f64> {
+        r.tr_mul(&(x - self.p[i])) + self.p[i]
+    }
+
+    fn flags(&self, y_minus_p1: &Vector3<f64>, q3: f64, q5: f64) -> ConfigFlags {
+        ConfigFlags {
+            shoulder_back: y_minus_p1.dot(&self.forward) < 0.0,
+            elbow_down: (q3 - self.q3_stretched).sin() < 0.0,
+            wrist_flipped: (q5 - self.q5_singular).sin() < 0.0,
+        }
+    }
+
+    /// The configuration flags of joint values `q` (6 values).
+    ///
+    /// ```
+    /// use kinplan_core::ik::analytic::{AnalyticArm, AnalyticParams};
+    /// let chain = kinplan_core::robot::builtin_chain("ur5").unwrap();
+    /// let arm = AnalyticArm::new(&chain, 1e-9).unwrap();
+    /// let q = [0.3, -1.2, 1.4, -0.8, 1.1, 0.2];
+    /// let mut out = Vec::new();
+    /// arm.solve_into(&chain.fk(&q), Some(&q), &AnalyticParams::default(), &mut out);
+    /// let same = out.iter().find(|s| s.joints.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-9)).unwrap();
+    /// assert_eq!(same.config, arm.config_of(&q));
+    /// ```
+    pub fn config_of(&self, q: &[f64]) -> ConfigFlags {
+        let last = match self.family {
+            Family::SphericalWrist | Family::SphericalTwoIntersecting => 2,
+            Family::ThreeParallel => 3,
+        };
+        let mut x = self.wrist;
+        for i in (1..=last).rev() {
+            x = rot(&self.h[i], q[i]) * (x - self.p[i]) + self.p[i];
+        }
+        self.flags(&(x - self.p[0]), q[2], q[4])
+    }
+
+    /// Every solution for tool pose `target` (base frame) inside the joint
+    /// limits, written into `out` (cleared; no allocation once its capacity
+    /// suffices): up to 8 configurations, each with its whole-turn variants
+    /// ([`AnalyticParams::turns`]). Free joints of singular poses take the
+    /// seed's value (0 without a seed). Unreachable poses give none (see
+    /// [`AnalyticArm::nearest`]).
+    ///
+    /// Spherical wrist, with `G = T M⁻¹ = E₁⋯E₆` and wrist centre `w₀`:
+    /// `w = G w₀ = E₁E₂E₃ w₀`; `q₁` by subproblem 4 from
+    /// `h₂ᵀ E₁⁻¹ w = h₂ᵀ w₀` (axes 2, 3 parallel keep the `h₂` component);
+    /// `q₃` by subproblem 3 from `‖E₃ w₀ − p₂‖ = ‖E₁⁻¹ w − p₂‖`; `q₂` by
+    /// subproblem 1; then `R₃₆ = (R₁R₂R₃)ᵀ R_G = R₄R₅R₆`: `q₅` by subproblem 4
+    /// from `h₄ᵀ R₅ h₆ = h₄ᵀ R₃₆ h₆`, `q₄` and `q₆` by subproblem 1.
+    ///
+    /// Three parallel (axes 2–4 parallel, 5 and 6 meeting at `w₀`): `q₁` by
+    /// subproblem 4 from `h₂ᵀ E₁⁻¹ G w₀ = h₂ᵀ w₀`; `q₅` by subproblem 4 from
+    /// `h₂ᵀ R₅ h₆ = (R₁h₂)ᵀ R_G h₆`; `q₆` by subproblem 1 from
+    /// `R₆ (R_Gᵀ R₁ h₂) = R₅ᵀ h₂`; the sum `q₂ ± q₃ ± q₄` by subproblem 1 on
+    /// `R₂₃₄ = R₁ᵀ R_G R₆ᵀ R₅ᵀ`; the point `y = E₁⁻¹ G E₆⁻¹ E₅⁻¹ p₄ = E₂E₃ p₄`
+    /// gives `q₃` (subproblem 3) and `q₂` (subproblem 1). Source: Elias & Wen,
+    /// IK-Geo (2025), the "spherical, two parallel" and "three parallel, two
+    /// intersecting" decompositions; our own derivation and code.
+    pub fn solve_into(
+        &self,
+        target: &Isometry3<f64>,
+        seed: Option<&[f64]>,
+        params: &AnalyticParams,
+        out: &mut Vec<AnalyticSolution>,
+    ) {
+        out.clear();
+        let base = self.base(target, seed, false, params.solve_tolerance);
+        for s in &base.sols[..base.n] {
+            self.push_turns(s, seed, params.turns, out);
+        }
+    }
+
+    /// The least-squares answers of every branch (exact or not), without limits
+    /// or turns: for an unreachable pose, the candidates nearest to reaching it.
+    pub fn nearest(
+        &self,
+        target: &Isometry3<f64>,
+        seed: Option<&[f64]>,
+        params: &AnalyticParams,
+        out: &mut Vec<AnalyticSolution>,
+    ) {
+        out.clear();
+        let base = self.base(target, seed, true, params.solve_tolerance);
+        out.extend_from_slice(&base.sols[..base.n]);
+    }
+
+    fn base(&self, target: &Isometry3<f64>, seed: Option<&[f64]>, keep_inexact: bool, tol: f64) -> Base {
+        let g = target * self.m_inv;
+        let seed = match seed {
+            Some(s) if s.len() == 6 => [s[0], s[1], s[2], s[3], s[4], s[5]],
+            _ => [0.0; 6],
+        };
+        let mut base = Base {
+            n: 0,
+            sols: [AnalyticSolution {
+                joints: [0.0; 6],
+                config: ConfigFlags::default(),
+                singular: false,
+                exact: true,
+            }; 8],
+        };
+        match self.family {
+            Family::SphericalWrist => self.spherical(&g, &seed, keep_inexact, tol, &mut base),
+            Family::ThreeParallel => self.three_parallel(&g, &seed, keep_inexact, tol, &mut base),
+            Family::SphericalTwoIntersecting => {
+                self.spherical_shoulder(&g, &seed, keep_inexact, tol, &mut base)
+            }
+        }
+        base
+    }
+
+    fn spherical(&self, g: &Isometry3<f64>, seed: &[f64; 6], keep: bool, tol: f64, out: &mut Base) {
+        let (h, p) = (&self.h, &self.p);
+        let rg = *g.rotation.to_rotation_matrix().matrix();
+        let w = g * nalgebra::Point3::from(self.wrist);
+        let w = w.coords;
+        let a1 = pick(
+            sp4(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
+            seed[0],
+        );
+        if !a1.exact && !keep {
+            return;
+        }
+        for &q1 in a1.as_slice() {
+            let r1 = rot(&h[0], q1);
+            let y = self.inv_apply(0, &r1, &w);
+            let a3 = pick(
+                sp3(
+                    &h[2],
+                    &(self.wrist - p[2]),
+                    &(p[1] - p[2]),
+                    (y - p[1]).norm(),
+                    tol,
+                ),
+                seed[2],
+            );
+            if !a3.exact && !keep {
+                continue;
+            }
+            for &q3 in a3.as_slice() {
+                let r3 = rot(&h[2], q3);
+                let e3w = r3 * (self.wrist - p[2]) + p[2];
+                let a2 = pick(sp1(&h[1], &(e3w - p[1]), &(y - p[1]), tol), seed[1]);
+                let q2 = a2.angles[0];
+                let r123 = r1 * rot(&h[1], q2) * r3;
+                let r36 = r123.tr_mul(&rg);
+                let a5 = pick(sp4(&h[3], &h[4], &h[5], h[3].dot(&(r36 * h[5])), tol), seed[4]);
+                if !a5.exact && !keep {
+                    continue;
+                }
+                for &q5 in a5.as_slice() {
+                    let r5 = rot(&h[4], q5);
+                    let a4 = pick(sp1(&h[3], &(r5 * h[5]), &(r36 * h[5]), tol), seed[3]);
+                    let q4 = a4.angles[0];
+                    let r45 = rot(&h[3], q4) * r5;
+                    let a6 = pick(sp1(&h[5], &self.x6, &(r45.tr_mul(&r36) * self.x6), tol), seed[5]);
+                    let exact = a1.exact && a3.exact && a2.exact && a5.exact && a4.exact && a6.exact;
+                    if !exact && !keep {
+                        continue;
+                    }
+                    let singular = a1.free || a3.free || a2.free || a5.free || a4.free || a6.free;
+                    let q = [q1, q2, q3, q4, q5, a6.angles[0]];
+                    out.push(q, self.flags(&(y - p[0]), q3, q5), singular, exact);
+                }
+            }
+        }
+    }
+
+    /// Spherical wrist and spherical shoulder `s` (axes 1, 2 meet): `q₃` by
+    /// subproblem 3 from `‖E₃ w₀ − s‖ = ‖w − s‖`, `(q₁, q₂)` by subproblem 2 from
+    /// `R₁R₂ (E₃ w₀ − s) = w − s`, then the wrist as for [`Family::SphericalWrist`].
+    fn spherical_shoulder(&self, g: &Isometry3<f64>, seed: &[f64; 6], keep: bool, tol: f64, out: &mut Base) {
+        let (h, p, s) = (&self.h, &self.p, self.shoulder);
+        let rg = *g.rotation.to_rotation_matrix().matrix();
+        let w = (g * nalgebra::Point3::from(self.wrist)).coords;
+        let a3 = pick(
+            sp3(&h[2], &(self.wrist - p[2]), &(s - p[2]), (w - s).norm(), tol),
+            seed[2],
+        );
+        if !a3.exact && !keep {
+            return;
+        }
+        for &q3 in a3.as_slice() {
+            let r3 = rot(&h[2], q3);
+            let v = r3 * (self.wrist - p[2]) + p[2] - s;
+            let pairs = sp2(&h[0], &h[1], &v, &(w - s), tol);
+            if !pairs.exact && !keep {
+                continue;
+            }
+            for &(q1, q2) in &pairs.pairs[..pairs.count] {
+                // shoulder singularity (w on axis 1): q₁ from the seed, q₂ follows
+                let (q1, q2) = if pairs.free.0 {
+                    let q1 = wrap(seed[0]);
+                    let a2 = pick(sp1(&h[1], &v, &rot(&h[0], q1).tr_mul(&(w - s)), tol), seed[1]);
+                    (q1, a2.angles[0])
+                } else {
+                    (q1, q2)
+                };
+                let r1 = rot(&h[0], q1);
+                let y = self.inv_apply(0, &r1, &w);
+                let r36 = (r1 * rot(&h[1], q2) * r3).tr_mul(&rg);
+                let a5 = pick(sp4(&h[3], &h[4], &h[5], h[3].dot(&(r36 * h[5])), tol), seed[4]);
+                if !a5.exact && !keep {
+                    continue;
+                }
+                for &q5 in a5.as_slice() {
+                    let r5 = rot(&h[4], q5);
+                    let a4 = pick(sp1(&h[3], &(r5 * h[5]), &(r36 * h[5]), tol), seed[3]);
+                    let r45 = rot(&h[3], a4.angles[0]) * r5;
+                    let a6 = pick(sp1(&h[5], &self.x6, &(r45.tr_mul(&r36) * self.x6), tol), seed[5]);
+                    let exact = a3.exact && pairs.exact && a5.exact && a4.exact && a6.exact;
+                    if !exact && !keep {
+                        continue;
+                    }
+                    let singular = a3.free || pairs.free.0 || pairs.free.1 || a5.free || a4.free || a6.free;
+                    let q = [q1, q2, q3, a4.angles[0], q5, a6.angles[0]];
+                    out.push(q, self.flags(&(y - p[0]), q3, q5), singular, exact);
+                }
+            }
+        }
+    }
+
+    fn three_parallel(&self, g: &Isometry3<f64>, seed: &[f64; 6], keep: bool, tol: f64, out: &mut Base) {
+        let (h, p) = (&self.h, &self.p);
+        let rg = *g.rotation.to_rotation_matrix().matrix();
+        let w = (g * nalgebra::Point3::from(self.wrist)).coords;
+        let a1 = pick(
+            sp4(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
+            seed[0],
+        );
+        if !a1.exact && !keep {
+            return;
+        }
+        let rg6 = rg * h[5];
+        for &q1 in a1.as_slice() {
+            let r1 = rot(&h[0], q1);
+            let r1h2 = r1 * h[1];
+            let a5 = pick(sp4(&h[1], &h[4], &h[5], r1h2.dot(&rg6), tol), seed[4]);
+            if !a5.exact && !keep {
+                continue;
+            }
+            let yw = self.inv_apply(0, &r1, &w) - p[0];
+            for &q5 in a5.as_slice() {
+                let r5 = rot(&h[4], q5);
+                let a6 = pick(sp1(&h[5], &rg.tr_mul(&r1h2), &r5.tr_mul(&h[1]), tol), seed[5]);
+                let q6 = a6.angles[0];
+                let r6 = rot(&h[5], q6);
+                let r234 = r1.tr_mul(&rg) * r6.transpose() * r5.transpose();
+                let theta = sp1(&h[1], &self.x2, &(r234 * self.x2), tol);
+                // y = E₁⁻¹ G E₆⁻¹ E₅⁻¹ p₄
+                let a = self.inv_apply(4, &r5, &p[3]);
+                let b = self.inv_apply(5, &r6, &a);
+                let c = g * nalgebra::Point3::from(b);
+                let y = self.inv_apply(0, &r1, &c.coords);
+                let a3 = pick(
+                    sp3(&h[2], &(p[3] - p[2]), &(p[1] - p[2]), (y - p[1]).norm(), tol),
+                    seed[2],
+                );
+                if !a3.exact && !keep {
+                    continue;
+                }
+                for &q3 in a3.as_slice() {
+                    let e3 = rot(&h[2], q3) * (p[3] - p[2]) + p[2];
+                    let a2 = pick(sp1(&h[1], &(e3 - p[1]), &(y - p[1]), tol), seed[1]);
+                    let q2 = a2.angles[0];
+                    let q4 = wrap(self.s4 * (theta.angles[0] - q2 - self.s3 * q3));
+                    let exact = a1.exact && a5.exact && a6.exact && theta.exact && a3.exact && a2.exact;
+                    if !exact && !keep {
+                        continue;
+                    }
+                    let singular = a1.free || a5.free || a6.free || a3.free || a2.free;
+                    out.push([q1, q2, q3, q4, q5, q6], self.flags(&yw, q3, q5), singular, exact);
+                }
+            }
+        }
+    }
+
+    /// Appends the whole-turn variants of `s` that lie inside the limits.
+    fn push_turns(
+        &self,
+        s: &AnalyticSolution,
+        seed: Option<&[f64]>,
+        turns: Turns,
+        out: &mut Vec<AnalyticSolution>,
+    ) {
+        use std::f64::consts::TAU;
+        let eps = 1e-9;
+        let mut cand = [[0.0f64; MAX_TURNS]; 6];
+        let mut count = [0usize; 6];
+        for i in 0..6 {
+            let q = s.joints[i];
+            let (lo, hi) = self.limits[i];
+            if self.continuous[i] {
+                let v = match (turns, seed) {
+                    (Turns::NearestSeed, Some(sd)) => q + TAU * ((sd[i] - q) / TAU).round(),
+                    _ => q,
+                };
+                cand[i][0] = v;
+                count[i] = 1;
+                continue;
+            }
+            let k_lo = ((lo - eps - q) / TAU).ceil() as i64;
+            let k_hi = ((hi + eps - q) / TAU).floor() as i64;
+            if k_lo > k_hi {
+                return; // outside the limits at every turn
+            }
+            let clampq = |k: i64| (q + TAU * k as f64).clamp(lo, hi);
+            match turns {
+                Turns::NearestSeed => {
+                    let target = seed.map_or(0.0, |sd| sd[i]);
+                    let k = (((target - q) / TAU).round() as i64).clamp(k_lo, k_hi);
+                    cand[i][0] = clampq(k);
+                    count[i] = 1;
+                }
+                Turns::All => {
+                    // nearest zero first when there are more than MAX_TURNS
+                    let k0 = ((-q / TAU).round() as i64).clamp(k_lo, k_hi);
+                    let mut n = 0;
+                    let mut step = 0i64;
+                    while n < MAX_TURNS && (k0 - step >= k_lo || k0 + step <= k_hi) {
+                        for k in if step == 0 {
+                            [k0, k0]
+                        } else {
+                            [k0 - step, k0 + step]
+                        } {
+                            if n < MAX_TURNS
+                                && (k_lo..=k_hi).contains(&k)
+                                && (step != 0 || n == 0)
+                                && !cand[i][..n].contains(&clampq(k))
+                            {
+                                cand[i][n] = clampq(k);
+                                n += 1;
+                            }
+                        }
+                        step += 1;
+                    }
+                    count[i] = n;
+                }
+            }
+        }
+        let mut idx = [0usize; 6];
+        loop {
+            let mut sol = *s;
+            for i in 0..6 {
+                sol.joints[i] = cand[i][idx[i]];
+            }
+            out.push(sol);
+            let mut i = 0;
+            while i < 6 {
+                idx[i] += 1;
+                if idx[i] < count[i] {
+                    break;
+                }
+                idx[i] = 0;
+                i += 1;
+            }
+            if i == 6 {
+                break;
+            }
+        }
+    }
+}

@@ -1,0 +1,509 @@
+//! Round trips on the built-in arms, hand-made arms with hand-derived
+//! solutions, singular poses, refusals, and a numerical cross-check.
+
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+use nalgebra::Isometry3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::*;
+use crate::ik::{IkMethod, IkParams, IkTarget, solve_ik};
+use crate::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
+
+fn pose_close(a: &Isometry3<f64>, b: &Isometry3<f64>, tol: f64) -> bool {
+    (a.translation.vector - b.translation.vector).norm() <= tol && a.rotation.angle_to(&b.rotation) <= tol
+}
+
+fn random_q(chain: &Chain, rng: &mut ChaCha8Rng) -> [f64; 6] {
+    std::array::from_fn(|i| {
+        let j = &chain.joints()[i];
+        let (lo, hi) = (j.lower.max(-2.0 * PI), j.upper.min(2.0 * PI));
+        rng.random_range(lo..=hi)
+    })
+}
+
+fn same_angles(a: &[f64], b: &[f64], tol: f64) -> bool {
+    a.iter().zip(b).all(|(x, y)| wrap(x - y).abs() <= tol)
+}
+
+/// Every solution reproduces the pose to 1e-9 and lies inside the limits; the
+/// configuration the pose came from is among them (exactly, with
+/// `Turns::NearestSeed` and the configuration as the seed).
+fn round_trip(name: &str, family: Family, n: usize) {
+    let chain = builtin_chain(name).unwrap();
+    let arm = AnalyticArm::new(&chain, 1e-9).unwrap();
+    assert_eq!(arm.family(), family, "{name}");
+    let params = AnalyticParams {
+        turns: Turns::NearestSeed,
+        ..AnalyticParams::default()
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let mut out = Vec::new();
+    let mut total = 0;
+    for _ in 0..n {
+        let q = random_q(&chain, &mut rng);
+        let t = chain.fk(&q);
+        arm.solve_into(&t, Some(&q), &params, &mut out);
+        total += out.len();
+        assert!(
+            out.iter()
+                .any(|s| s.joints.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-8)),
+            "{name}: {q:?} not among {:?}",
+            out.iter().map(|s| s.joints).collect::<Vec<_>>()
+        );
+        for s in &out {
+            assert!(
+                pose_close(&chain.fk(&s.joints), &t, 1e-9),
+                "{name}: {:?} for {q:?}",
+                s.joints
+            );
+            for (v, j) in s.joints.iter().zip(chain.joints()) {
+                assert!(*v >= j.lower && *v <= j.upper, "{name}: {v} outside {}", j.name);
+            }
+        }
+        let same = out
+            .iter()
+            .find(|s| s.joints.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-8));
+        assert_eq!(same.unwrap().config, arm.config_of(&q), "{name}");
+    }
+    // the flags tell the (up to 8) configurations apart
+    assert!(total >= 4 * n, "{name}: only {total} solutions for {n} poses");
+}
+
+#[test]
+fn round_trip_kr210() {
+    round_trip("kuka_kr210_r2700_extra", Family::SphericalWrist, 10_000);
+}
+#[test]
+fn round_trip_kr120() {
+    round_trip("kuka_kr120_r2500_pro", Family::SphericalWrist, 10_000);
+}
+#[test]
+fn round_trip_irb4600() {
+    round_trip("abb_irb4600_60_205", Family::SphericalWrist, 10_000);
+}
+#[test]
+fn round_trip_ur5() {
+    round_trip("ur5", Family::ThreeParallel, 10_000);
+}
+
+#[test]
+fn configurations_are_distinct_flags() {
+    // a generic UR5 pose has 8 solutions in (−π, π] with 8 different flag triples
+    let chain = builtin_chain("ur5").unwrap();
+    let arm = AnalyticArm::new(&chain, 1e-9).unwrap();
+    let q = [0.3, -1.2, 1.4, -0.8, 1.1, 0.2];
+    let mut out = Vec::new();
+    let params = AnalyticParams {
+        turns: Turns::NearestSeed,
+        ..AnalyticParams::default()
+    };
+    arm.solve_into(&chain.fk(&q), None, &params, &mut out);
+    assert_eq!(out.len(), 8);
+    let flags: std::collections::HashSet<_> = out.iter().map(|s| s.config).collect();
+    assert_eq!(flags.len(), 8);
+    // every joint of the UR5 spans ±2π: each of the 6 joints has 2 turn variants
+    arm.solve_into(&chain.fk(&q), None, &AnalyticParams::default(), &mut out);
+    assert_eq!(out.len(), 8 * 64);
+}
+
+const SPHERICAL_ARM: &str = r#"<robot name="hand_spherical">
+  <link name="base"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="l4"/><link name="l5"/><link name="l6"/><link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0"/><axis xyz="0 0 1"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/><origin xyz="0 0 1"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j4" type="revolute"><parent link="l3"/><child link="l4"/><origin xyz="1 0 0"/><axis xyz="1 0 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j5" type="revolute"><parent link="l4"/><child link="l5"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j6" type="revolute"><parent link="l5"/><child link="l6"/><origin xyz="0 0 0"/><axis xyz="1 0 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="flange" type="fixed"><parent link="l6"/><child link="tool"/><origin xyz="0.5 0 0"/></joint>
+</robot>"#;
+
+const PARALLEL_ARM: &str = r#"<robot name="hand_parallel">
+  <link name="base"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="l4"/><link name="l5"/><link name="l6"/><link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0"/><axis xyz="0 0 1"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/><origin xyz="1 0 0"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j4" type="revolute"><parent link="l3"/><child link="l4"/><origin xyz="1 0 0"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j5" type="revolute"><parent link="l4"/><child link="l5"/><origin xyz="0 0 0"/><axis xyz="0 0 1"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j6" type="revolute"><parent link="l5"/><child link="l6"/><origin xyz="0 0 -0.5"/><axis xyz="1 0 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="flange" type="fixed"><parent link="l6"/><child link="tool"/><origin xyz="0.5 0 0"/></joint>
+</robot>"#;
+
+fn hand_arm(urdf: &str) -> (Chain, AnalyticArm) {
+    let chain = parse_chain(urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap();
+    let arm = AnalyticArm::new(&chain, 1e-9).unwrap();
+    (chain, arm)
+}
+
+fn nearest_params() -> AnalyticParams {
+    AnalyticParams {
+        turns: Turns::NearestSeed,
+        ..AnalyticParams::default()
+    }
+}
+
+#[test]
+fn spherical_hand_arm_has_the_hand_derived_solutions() {
+    // Shoulder at the origin, upper arm 1 m up, forearm 1 m forward, wrist
+    // (x, y, x axes) at (1, 0, 1), flange 0.5 m further; target: the pose of
+    // q = (0, 0, 0, 0, π/4, 0). The wrist centre is reached with the shoulder
+    // in front (q₁ = 0) by (q₂, q₃) = (0, 0) and (π/2, −π) (upper arm forward,
+    // forearm up), behind (q₁ = π) by (0, π) and (−π/2, 0). The wrist then
+    // undoes R₁₂₃: R₃₆ = rot(y, π/4), rot(y, 3π/4), rot(x, π) rot(y, π/4) and
+    // rot(x, π) rot(y, 3π/4) (using rot(z, π) = rot(x, π) rot(y, π)), each
+    // solved by (q₄, q₅, q₆) = (a, b, c) and its flip (a + π, −b, c + π).
+    let (chain, arm) = hand_arm(SPHERICAL_ARM);
+    assert_eq!(arm.family(), Family::SphericalWrist);
+    let t = chain.fk(&[0.0, 0.0, 0.0, 0.0, FRAC_PI_4, 0.0]);
+    let mut out = Vec::new();
+    arm.solve_into(&t, None, &nearest_params(), &mut out);
+    assert_eq!(out.len(), 8);
+    let q4 = FRAC_PI_4;
+    let q34 = 3.0 * FRAC_PI_4;
+    for want in [
+        [0.0, 0.0, 0.0, 0.0, q4, 0.0],
+        [0.0, 0.0, 0.0, PI, -q4, PI],
+        [0.0, FRAC_PI_2, -PI, 0.0, q34, 0.0],
+        [0.0, FRAC_PI_2, -PI, PI, -q34, PI],
+        [PI, 0.0, PI, PI, q4, 0.0],
+        [PI, 0.0, PI, 0.0, -q4, PI],
+        [PI, -FRAC_PI_2, 0.0, PI, q34, 0.0],
+        [PI, -FRAC_PI_2, 0.0, 0.0, -q34, PI],
+    ] {
+        assert!(
+            out.iter().any(|s| same_angles(&s.joints, &want, 1e-12)),
+            "{want:?} missing from {:?}",
+            out.iter().map(|s| s.joints).collect::<Vec<_>>()
+        );
+    }
+    for s in &out {
+        assert!(pose_close(&chain.fk(&s.joints), &t, 1e-12));
+        assert!(!s.singular);
+    }
+    // the shoulder flag separates q₁ = 0 from q₁ = π
+    for s in &out {
+        assert_eq!(
+            s.config.shoulder_back,
+            wrap(s.joints[0] - PI).abs() < 1e-9,
+            "{:?}",
+            s.joints
+        );
+    }
+}
+
+#[test]
+fn parallel_hand_arm_has_the_mirrored_elbow() {
+    // Equal 1 m links on parallel axes 2, 3, 4: the elbow mirror of (q₂, q₃, q₄)
+    // is (q₂ + q₃, −q₃, q₄ + q₃) with q₁, q₅, q₆ unchanged.
+    let (chain, arm) = hand_arm(PARALLEL_ARM);
+    assert_eq!(arm.family(), Family::ThreeParallel);
+    // (p₄ stays within 1.72 m of the shoulder whatever the wrist does, so all 8 exist)
+    let q = [0.0, 1.2, -2.4, 0.3, 0.4, 0.5];
+    let mirror = [0.0, -1.2, 2.4, -2.1, 0.4, 0.5];
+    let t = chain.fk(&q);
+    let mut out = Vec::new();
+    arm.solve_into(&t, None, &nearest_params(), &mut out);
+    assert_eq!(out.len(), 8);
+    let a = out.iter().find(|s| same_angles(&s.joints, &q, 1e-12)).unwrap();
+    let b = out
+        .iter()
+        .find(|s| same_angles(&s.joints, &mirror, 1e-12))
+        .unwrap();
+    assert_ne!(a.config.elbow_down, b.config.elbow_down);
+    assert_eq!(a.config.shoulder_back, b.config.shoulder_back);
+    for s in &out {
+        assert!(pose_close(&chain.fk(&s.joints), &t, 1e-12));
+    }
+}
+
+#[test]
+fn wrist_singularity_gives_the_seeds_wrist_angle() {
+    // KR 210 at q₅ = 0: axes 4 and 6 line up, only q₄ + q₆ (here, with these
+    // axis signs) is fixed; q₄ takes the seed's value and q₆ follows.
+    let chain = builtin_chain("kuka_kr210_r2700_extra").unwrap();
+    let arm = AnalyticArm::new(&chain, 1e-9).unwrap();
+    let q = [0.1, -0.5, 0.4, 0.7, 0.0, 0.2];
+    let t = chain.fk(&q);
+    let mut out = Vec::new();
+    let seed = [0.0, 0.0, 0.0, 0.5, 0.0, 0.0];
+    arm.solve_into(&t, Some(&seed), &nearest_params(), &mut out);
+    assert!(!out.is_empty());
+    for s in &out {
+        assert!(s.joints.iter().all(|v| v.is_finite()));
+        assert!(pose_close(&chain.fk(&s.joints), &t, 1e-9));
+    }
+    let on_branch = out
+        .iter()
+        .find(|s| same_angles(&s.joints[..3], &q[..3], 1e-9) && s.joints[4].abs() < 1e-6)
+        .unwrap();
+    assert!(on_branch.singular);
+    assert!((on_branch.joints[3] - 0.5).abs() < 1e-9);
+    // q₄ + q₆ is what the pose fixes: 0.7 + 0.2
+    assert!(wrap(on_branch.joints[3] + on_branch.joints[5] - 0.9).abs() < 1e-9);
+}
+
+#[test]
+fn shoulder_singularity_gives_the_seeds_base_angle() {
+    // Hand arm with the wrist centre on axis 1 (upper arm −45°, forearm +45°
+    // above the horizontal: w = (0, 0, √2)): q₁ is free and taken from the seed.
+    let (chain, arm) = hand_arm(SPHERICAL_ARM);
+    let q = [0.3, -FRAC_PI_4, 0.0, 0.2, 0.5, 0.1];
+    let t = chain.fk(&q);
+    let mut out = Vec::new();
+    arm.solve_into(&t, Some(&q), &nearest_params(), &mut out);
+    assert!(!out.is_empty());
+    assert!(
+        out.iter()
+            .all(|s| s.singular && (s.joints[0] - 0.3).abs() < 1e-12)
+    );
+    assert!(out.iter().any(|s| same_angles(&s.joints, &q, 1e-9)));
+    for s in &out {
+        assert!(s.joints.iter().all(|v| v.is_finite()));
+        assert!(pose_close(&chain.fk(&s.joints), &t, 1e-9));
+    }
+}
+
+#[test]
+fn unreachable_pose_gives_none_and_finite_nearest() {
+    let chain = builtin_chain("ur5").unwrap();
+    let arm = AnalyticArm::new(&chain, 1e-9).unwrap();
+    let far = Isometry3::translation(5.0, 0.0, 0.0);
+    let mut out = Vec::new();
+    arm.solve_into(&far, None, &AnalyticParams::default(), &mut out);
+    assert!(out.is_empty());
+    arm.nearest(&far, None, &AnalyticParams::default(), &mut out);
+    assert!(!out.is_empty());
+    assert!(
+        out.iter()
+            .all(|s| !s.exact && s.joints.iter().all(|v| v.is_finite()))
+    );
+}
+
+#[test]
+fn not_analytic_says_why() {
+    let e = |name: &str| {
+        AnalyticArm::new(&builtin_chain(name).unwrap(), 1e-9)
+            .unwrap_err()
+            .reason
+    };
+    assert!(e("franka_panda").contains("7 joints"));
+    assert!(e("planar_6").contains("axes 1 and 2 are parallel"));
+    // the spherical arm with its wrist centre moved off axis 6
+    let bent = SPHERICAL_ARM.replace(
+        r#"<origin xyz="0 0 0"/><axis xyz="1 0 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="flange""#,
+        r#"<origin xyz="0 0 0.1"/><axis xyz="1 0 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="flange""#,
+    );
+    let chain = parse_chain(&bent, &ChainSpec::default(), UrdfLimits::default()).unwrap();
+    let reason = AnalyticArm::new(&chain, 1e-9).unwrap_err().reason;
+    assert!(reason.contains("do not meet"), "{reason}");
+}
+
+#[test]
+fn solve_ik_analytic_ranks_and_refuses() {
+    let chain = builtin_chain("kuka_kr120_r2500_pro").unwrap();
+    let q = [0.4, -0.9, 0.7, 1.0, 0.8, -0.5];
+    let params = IkParams {
+        method: IkMethod::Analytic,
+        num_solutions: 1000,
+        ..IkParams::default()
+    };
+    let r = solve_ik(
+        &chain,
+        &IkTarget::Pose(chain.fk(&q)),
+        Some(&q),
+        &params,
+        0,
+        crate::Deadline::none(),
+    )
+    .unwrap();
+    assert!(r.success());
+    assert!(same_angles(&r.solutions[0].joints, &q, 1e-9));
+    let d = |s: &crate::ik::IkSolution| s.joints.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum::<f64>();
+    assert!(r.solutions.windows(2).all(|w| d(&w[0]) <= d(&w[1])));
+    assert!(r.solutions.iter().all(|s| s.config.is_some()));
+    // position targets and non-analytic chains are refused, naming why
+    let pos = IkTarget::Position(nalgebra::Point3::new(1.0, 0.0, 1.0));
+    assert!(solve_ik(&chain, &pos, None, &params, 0, crate::Deadline::none()).is_err());
+    let panda = builtin_chain("franka_panda").unwrap();
+    let e = solve_ik(
+        &panda,
+        &IkTarget::Pose(panda.fk(&[0.0; 7])),
+        None,
+        &params,
+        0,
+        crate::Deadline::none(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("chain is not analytic"), "{e}");
+}
+
+#[test]
+fn numerical_search_finds_nothing_the_analytic_solver_missed() {
+    // 64 Levenberg–Marquardt runs from random seeds per pose: each converged
+    // answer must be one of the analytic solutions (modulo whole turns).
+    for name in ["ur5", "kuka_kr210_r2700_extra"] {
+        let chain = builtin_chain(name).unwrap();
+        let arm = AnalyticArm::new(&chain, 1e-9).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let lm = IkParams {
+            max_restarts: 0,
+            position_tolerance: 1e-9,
+            orientation_tolerance: 1e-9,
+            ..IkParams::default()
+        };
+        let mut out = Vec::new();
+        for _ in 0..3 {
+            let q = random_q(&chain, &mut rng);
+            let t = chain.fk(&q);
+            arm.solve_into(&t, None, &nearest_params(), &mut out);
+            for _ in 0..64 {
+                let seed = random_q(&chain, &mut rng);
+                let r = solve_ik(&chain, &IkTarget::Pose(t), Some(&seed), &lm, 0, crate::Deadline::none()).unwrap();
+                if let Some(s) = r.solutions.first() {
+                    assert!(
+                        out.iter().any(|a| same_angles(&a.joints, &s.joints, 1e-6)),
+                        "{name}: LM found {:?}, not among the analytic solutions",
+                        s.joints
+                    );
+                }
+            }
+        }
+    }
+}
+
+const SHOULDER_ARM: &str = r#"<robot name="hand_shoulder">
+  <link name="base"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="l4"/><link name="l5"/><link name="l6"/><link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0"/><axis xyz="0 0 1"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/><origin xyz="0 0 1"/><axis xyz="1 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j4" type="revolute"><parent link="l3"/><child link="l4"/><origin xyz="1 0 0"/><axis xyz="1 0 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j5" type="revolute"><parent link="l4"/><child link="l5"/><origin xyz="0 0 0"/><axis xyz="0 1 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="j6" type="revolute"><parent link="l5"/><child link="l6"/><origin xyz="0 0 0"/><axis xyz="1 0 0"/><limit lower="-3.2" upper="3.2" effort="0" velocity="1"/></joint>
+  <joint name="flange" type="fixed"><parent link="l6"/><child link="tool"/><origin xyz="0.5 0 0"/></joint>
+</robot>"#;
+
+#[test]
+fn spherical_shoulder_hand_arm_has_the_hand_derived_positions() {
+    // Shoulder axes z, y meet at the origin; upper arm 1 m up; elbow about
+    // (1, 1, 0)/√2; forearm 1 m along x. The forearm at elbow angle θ is
+    // (½ + ½cos θ, ½ − ½cos θ, −sin θ/√2), so ‖w − s‖² = 2 − √2 sin θ. For
+    // the zero pose (w = (1, 0, 1)): θ = 0 with (q₁, q₂) = (0, 0) or
+    // (π, −π/2) (upper arm to −x, then turned round), and θ = π (forearm
+    // along y, w₀ = (0, 1, 1)) with q₂ = 0 tangent and q₁ = −π/2.
+    let (chain, arm) = hand_arm(SHOULDER_ARM);
+    assert_eq!(arm.family(), Family::SphericalTwoIntersecting);
+    let t = chain.fk(&[0.0, 0.0, 0.0, 0.0, FRAC_PI_4, 0.0]);
+    let mut out = Vec::new();
+    arm.solve_into(&t, None, &nearest_params(), &mut out);
+    for want in [[0.0, 0.0, 0.0], [PI, -FRAC_PI_2, 0.0], [-FRAC_PI_2, 0.0, PI]] {
+        assert!(
+            out.iter().any(|s| same_angles(&s.joints[..3], &want, 1e-7)),
+            "{want:?} missing from {:?}",
+            out.iter().map(|s| s.joints).collect::<Vec<_>>()
+        );
+    }
+    assert!(out.iter().all(|s| pose_close(&chain.fk(&s.joints), &t, 1e-9)));
+    // and random configurations come back
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    for _ in 0..2000 {
+        let q: [f64; 6] = std::array::from_fn(|_| rng.random_range(-3.0..3.0));
+        let t = chain.fk(&q);
+        arm.solve_into(&t, Some(&q), &nearest_params(), &mut out);
+        assert!(out.iter().any(|s| same_angles(&s.joints, &q, 1e-7)), "{q:?}");
+        assert!(out.iter().all(|s| pose_close(&chain.fk(&s.joints), &t, 1e-9)));
+    }
+}
+
+#[test]
+fn iiwa_with_joint_3_held_round_trips() {
+    let chain = builtin_chain("kuka_lbr_iiwa14_r820").unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    let params = IkParams {
+        method: IkMethod::Analytic,
+        num_solutions: 1000,
+        analytic: nearest_params(),
+        ..IkParams::default()
+    };
+    for _ in 0..1000 {
+        let q: Vec<f64> = chain
+            .joints()
+            .iter()
+            .map(|j| rng.random_range(j.lower..=j.upper))
+            .collect();
+        let t = chain.fk(&q);
+        let reduced = analyse(&chain, &params.analytic, Some(&q)).unwrap();
+        assert_eq!(reduced.held, Some((2, q[2])));
+        let r = solve_ik(&chain, &IkTarget::Pose(t), Some(&q), &params, 0, crate::Deadline::none()).unwrap();
+        assert!(r.success(), "{q:?}");
+        assert!(
+            same_angles(&r.solutions[0].joints, &q, 1e-7),
+            "{q:?} vs {:?}",
+            r.solutions[0].joints
+        );
+        for s in &r.solutions {
+            assert_eq!(s.joints.len(), 7);
+            assert_eq!(s.joints[2], q[2]);
+            assert!(pose_close(&chain.fk(&s.joints), &t, 1e-9));
+        }
+    }
+    // holding joint 7 leaves axes 4, 5, 6 not meeting: refused with the reason
+    let bad = AnalyticParams {
+        redundant_joint: Some(6),
+        ..AnalyticParams::default()
+    };
+    let e = analyse(&chain, &bad, None).unwrap_err().reason;
+    assert!(e.starts_with("with joint 7 held"), "{e}");
+}
+
+#[test]
+fn analytic_start_puts_lm_on_the_nearest_closed_form_solution() {
+    // from a far seed, LM started from the nearest analytic solution needs no
+    // iteration beyond checking it, and answers exactly that solution
+    let chain = builtin_chain("ur5").unwrap();
+    let q = [0.3, -1.2, 1.4, -0.8, 1.1, 0.2];
+    let seed = [1.5, -0.2, 0.3, 0.9, -0.7, 1.4];
+    let t = IkTarget::Pose(chain.fk(&q));
+    let lm = IkParams {
+        max_restarts: 0,
+        analytic_start: true,
+        ..IkParams::default()
+    };
+    let r = solve_ik(&chain, &t, Some(&seed), &lm, 0, crate::Deadline::none()).unwrap();
+    assert!(r.success());
+    assert_eq!(r.solutions[0].iterations, 0);
+    let all = solve_ik(
+        &chain,
+        &t,
+        Some(&seed),
+        &IkParams {
+            method: IkMethod::Analytic,
+            analytic: nearest_params(),
+            ..IkParams::default()
+        },
+        0,
+        crate::Deadline::none(),
+    )
+    .unwrap();
+    assert!(same_angles(
+        &r.solutions[0].joints,
+        &all.solutions[0].joints,
+        1e-12
+    ));
+    // without it, the same LM attempt iterates
+    let plain = solve_ik(
+        &chain,
+        &t,
+        Some(&seed),
+        &IkParams {
+            analytic_start: false,
+            ..lm
+        },
+        0,
+        crate::Deadline::none(),
+    )
+    .unwrap();
+    assert!(plain.solutions.first().is_none_or(|s| s.iterations > 0));
+}

@@ -1,0 +1,303 @@
+//! Closed-form IK runner: N random reachable poses of a 6R arm (FK of joints
+//! drawn uniformly inside the limits, ChaCha8 seed 2026), every solution of
+//! each by the analytic solver on one core.
+//!
+//! Checks (untimed): every solution's FK matches the pose (position ≤ 1e-9 m,
+//! rotation ≤ 1e-9 rad), the sampled configuration is among the solutions
+//! (modulo 2π), and Levenberg–Marquardt from `LM_SEEDS` random seeds per pose
+//! (default 64, on the first `LM_POSES` poses, default all) finds no solution
+//! the analytic solver missed.
+//! Timing: best of 5 passes over all poses, µs per pose, for the 8-configuration
+//! answer (`Turns::NearestSeed`, no seed: each joint's turn nearest zero) and
+//! for every whole-turn variant (`Turns::All`).
+//!
+//! `cargo run --release -p kinplan-core --example analytic_ik -- <builtin | file.urdf> [N] [out_dir] [tip_link]`
+//!
+//! With `out_dir`: writes `<out_dir>/<robot>.csv` (per pose: the sampled joints,
+//! then the rotation of `T·M⁻¹` row-major and the tool position of `T`: the pose
+//! in the convention of ik-geo and EAIK, whose tool frame is aligned with the
+//! base at zero; then our solution count) and
+//! `<out_dir>/<robot>_hp.txt` (the 6 axes `H` and 7 offsets `P`, base frame at
+//! zero, one vector a line; the wrist axes' points at the wrist point) for `benches/analytic_ik/run.py`.
+
+use std::hint::black_box;
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+use kinplan_core::ik::analytic::{
+    AnalyticArm, AnalyticParams, AnalyticSolution, Family, Turns, ZeroAxes, analyse, wrap,
+};
+use kinplan_core::ik::{IkParams, IkSolver, IkTarget};
+use kinplan_core::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
+use nalgebra::Isometry3;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn load(name: &str, tip: Option<String>) -> (String, Chain) {
+    if Path::new(name).exists() {
+        let text = std::fs::read_to_string(name).expect("read the URDF");
+        let spec = ChainSpec {
+            base_link: None,
+            tip_link: tip,
+        };
+        let chain = parse_chain(&text, &spec, UrdfLimits::default()).expect("parse the URDF");
+        let stem = Path::new(name)
+            .file_stem()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        (stem, chain)
+    } else {
+        (
+            name.to_string(),
+            (*builtin_chain(name).expect("a built-in robot")).clone(),
+        )
+    }
+}
+
+fn same(a: &[f64], b: &[f64], tol: f64) -> bool {
+    a.iter().zip(b).all(|(x, y)| wrap(x - y).abs() <= tol)
+}
+
+fn time_passes(arm: &AnalyticArm, poses: &[Isometry3<f64>], params: &AnalyticParams) -> (f64, usize) {
+    let mut out: Vec<AnalyticSolution> = Vec::with_capacity(4096);
+    let mut best = f64::INFINITY;
+    let mut count = 0;
+    for _ in 0..5 {
+        count = 0;
+        let t0 = Instant::now();
+        for p in poses {
+            arm.solve_into(black_box(p), None, params, &mut out);
+            count += black_box(out.len());
+        }
+        best = best.min(t0.elapsed().as_secs_f64() * 1e6 / poses.len() as f64);
+    }
+    (best, count)
+}
+
+/// 7-joint arms: joint values drawn inside the limits, the redundant joint held
+/// at its sampled value (chosen by `analyse`), every solution of the other six.
+/// Timed per pose including the reduction and analysis of the held chain.
+fn redundant(label: &str, chain: &Chain, n: usize) {
+    let mut rng = ChaCha8Rng::seed_from_u64(2026);
+    let configs: Vec<Vec<f64>> = (0..n)
+        .map(|_| {
+            chain
+                .joints()
+                .iter()
+                .map(|j| rng.random_range(j.lower..=j.upper))
+                .collect()
+        })
+        .collect();
+    let poses: Vec<Isometry3<f64>> = configs.iter().map(|q| chain.fk(q)).collect();
+    let params = AnalyticParams {
+        turns: Turns::NearestSeed,
+        ..AnalyticParams::default()
+    };
+    let mut out = Vec::new();
+    let (mut missing, mut bad, mut total) = (0, 0, 0usize);
+    if let Err(e) = analyse(chain, &params, configs.first().map(|q| &q[..])) {
+        println!("{label}: {e}");
+        return;
+    }
+    let mut held = None;
+    for (q, t) in configs.iter().zip(&poses) {
+        let r = analyse(chain, &params, Some(q)).expect("analytic with a joint held");
+        held = r.held.map(|(j, _)| (j, r.arm.family()));
+        r.arm.solve_into(t, Some(&r.reduce(q)), &params, &mut out);
+        total += out.len();
+        let full: Vec<Vec<f64>> = out.iter().map(|s| r.expand(&s.joints)).collect();
+        if !full.iter().any(|s| same(s, q, 1e-7)) {
+            missing += 1;
+        }
+        for s in &full {
+            let f = chain.fk(s);
+            if (f.translation.vector - t.translation.vector).norm() > 1e-9
+                || f.rotation.angle_to(&t.rotation) > 1e-9
+            {
+                bad += 1;
+            }
+        }
+    }
+    let mut best = f64::INFINITY;
+    for _ in 0..5 {
+        let t0 = Instant::now();
+        for (q, t) in configs.iter().zip(&poses) {
+            let r = analyse(chain, &params, Some(black_box(q))).unwrap();
+            r.arm.solve_into(black_box(t), None, &params, &mut out);
+            black_box(out.len());
+        }
+        best = best.min(t0.elapsed().as_secs_f64() * 1e6 / n as f64);
+    }
+    let (j, family) = held.unwrap();
+    println!(
+        "{label}: joint {} held at its sampled value, family {family}; {n} poses, {total} solutions ({:.2}/pose); \
+         original configuration missing: {missing}; FK error > 1e-9: {bad}; µs/pose on one core (hold, \
+         analyse, solve): {best:.3}",
+        j + 1,
+        total as f64 / n as f64
+    );
+    println!("RESULT7 {label} {family} {n} {total} {missing} {bad} {best:.4}");
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let name = args.first().map_or("ur5", String::as_str);
+    let n: usize = args.get(1).map_or(10_000, |s| s.parse().expect("N"));
+    let out_dir = args.get(2).filter(|s| !s.is_empty());
+    let tip = args.get(3).cloned();
+    let lm_seeds: usize = std::env::var("LM_SEEDS").map_or(64, |s| s.parse().unwrap());
+    let lm_poses: usize = std::env::var("LM_POSES").map_or(n, |s| s.parse().unwrap());
+
+    let (label, chain) = load(name, tip);
+    if chain.dof() == 7 {
+        redundant(&label, &chain, n);
+        return;
+    }
+    let t0 = Instant::now();
+    let arm = match AnalyticArm::new(&chain, 1e-9) {
+        Ok(a) => a,
+        Err(e) => {
+            println!("{label}: {e}");
+            return;
+        }
+    };
+    let analyse_us = t0.elapsed().as_secs_f64() * 1e6;
+    let mut rng = ChaCha8Rng::seed_from_u64(2026);
+    let configs: Vec<[f64; 6]> = (0..n)
+        .map(|_| {
+            std::array::from_fn(|i| {
+                let j = &chain.joints()[i];
+                let (lo, hi) = (
+                    j.lower.max(-2.0 * std::f64::consts::PI),
+                    j.upper.min(2.0 * std::f64::consts::PI),
+                );
+                rng.random_range(lo..=hi)
+            })
+        })
+        .collect();
+    let poses: Vec<Isometry3<f64>> = configs.iter().map(|q| chain.fk(q)).collect();
+
+    // checks
+    let nearest = AnalyticParams {
+        turns: Turns::NearestSeed,
+        ..AnalyticParams::default()
+    };
+    let mut out = Vec::new();
+    let (mut missing, mut bad_fk, mut total, mut worst_p, mut worst_r) = (0, 0, 0usize, 0.0f64, 0.0f64);
+    let mut counts = Vec::with_capacity(n);
+    let mut answers: Vec<Vec<[f64; 6]>> = Vec::with_capacity(n);
+    for (q, t) in configs.iter().zip(&poses) {
+        arm.solve_into(t, None, &nearest, &mut out);
+        total += out.len();
+        counts.push(out.len());
+        if !out.iter().any(|s| same(&s.joints, q, 1e-7)) {
+            missing += 1;
+        }
+        for s in &out {
+            let f = chain.fk(&s.joints);
+            let dp = (f.translation.vector - t.translation.vector).norm();
+            let dr = f.rotation.angle_to(&t.rotation);
+            worst_p = worst_p.max(dp);
+            worst_r = worst_r.max(dr);
+            if dp > 1e-9 || dr > 1e-9 {
+                bad_fk += 1;
+            }
+        }
+        answers.push(out.iter().map(|s| s.joints).collect());
+    }
+
+    // numerical cross-check
+    let lm = IkParams {
+        max_restarts: 0,
+        position_tolerance: 1e-10,
+        orientation_tolerance: 1e-10,
+        ..IkParams::default()
+    };
+    let mut solver = IkSolver::new(&chain);
+    let (mut lm_found, mut lm_missed) = (0usize, 0usize);
+    let t_lm = Instant::now();
+    for (t, ans) in poses.iter().zip(&answers).take(lm_poses) {
+        for _ in 0..lm_seeds {
+            let seed: Vec<f64> = chain
+                .joints()
+                .iter()
+                .map(|j| {
+                    rng.random_range(
+                        j.lower.max(-2.0 * std::f64::consts::PI)..=j.upper.min(2.0 * std::f64::consts::PI),
+                    )
+                })
+                .collect();
+            let r = solver
+                .solve(&IkTarget::Pose(*t), Some(&seed), &lm, 0, kinplan_core::Deadline::none())
+                .unwrap();
+            if let Some(s) = r.solutions.first() {
+                lm_found += 1;
+                if !ans.iter().any(|a| same(a, &s.joints, 1e-6)) {
+                    lm_missed += 1;
+                    if lm_missed <= 3 {
+                        eprintln!("LM found {:?}, not among {:?}", s.joints, ans);
+                    }
+                }
+            }
+        }
+    }
+    let lm_s = t_lm.elapsed().as_secs_f64();
+
+    let (us_8, _) = time_passes(&arm, &poses, &nearest);
+    let (us_all, all_count) = time_passes(&arm, &poses, &AnalyticParams::default());
+    println!(
+        "{label}: family {} (analysis {analyse_us:.1} µs); {n} poses, {total} solutions in (−π, π] \
+         ({:.2}/pose), {all_count} with every whole turn; original configuration missing: {missing}; \
+         solutions with FK error > 1e-9: {bad_fk} (worst {worst_p:.1e} m, {worst_r:.1e} rad); \
+         LM {lm_seeds} seeds × {} poses: {lm_found} converged, {lm_missed} not among ours ({lm_s:.1} s); \
+         µs/pose on one core: {us_8:.3} (turn nearest zero), {us_all:.3} (all turns)",
+        arm.family(),
+        total as f64 / n as f64,
+        lm_poses.min(n),
+    );
+    println!(
+        "RESULT {label} {} {n} {total} {all_count} {missing} {bad_fk} {lm_found} {lm_missed} {us_8:.4} {us_all:.4}",
+        arm.family()
+    );
+
+    if let Some(dir) = out_dir {
+        std::fs::create_dir_all(dir).unwrap();
+        let mut z = ZeroAxes::of(&chain);
+        // points on the axes may slide along them: the wrist axes' points at the
+        // point where they meet, as ik-geo's spherical and UR-type solvers expect
+        let first_wrist_axis = match arm.family() {
+            Family::SphericalWrist | Family::SphericalTwoIntersecting => 3,
+            Family::ThreeParallel => 4,
+        };
+        for p in &mut z.p[first_wrist_axis..] {
+            *p = arm.wrist_point();
+        }
+        let m_inv = z.m.inverse();
+        let mut f = std::io::BufWriter::new(std::fs::File::create(format!("{dir}/{label}.csv")).unwrap());
+        for ((q, t), c) in configs.iter().zip(&poses).zip(&counts) {
+            let g = t * m_inv;
+            let r = g.rotation.to_rotation_matrix();
+            let m = r.matrix();
+            let v: Vec<String> = q
+                .iter()
+                .copied()
+                .chain((0..3).flat_map(|i| (0..3).map(move |j| m[(i, j)])))
+                .chain(t.translation.vector.iter().copied())
+                .map(|x| format!("{x:.17e}"))
+                .collect();
+            writeln!(f, "{} {c}", v.join(" ")).unwrap();
+        }
+        let mut hp = std::fs::File::create(format!("{dir}/{label}_hp.txt")).unwrap();
+        for h in &z.h {
+            writeln!(hp, "{:.17e} {:.17e} {:.17e}", h.x, h.y, h.z).unwrap();
+        }
+        let mut prev = nalgebra::Vector3::zeros();
+        for p in z.p.iter().chain(std::iter::once(&z.m.translation.vector)) {
+            let d = p - prev;
+            writeln!(hp, "{:.17e} {:.17e} {:.17e}", d.x, d.y, d.z).unwrap();
+            prev = *p;
+        }
+    }
+}

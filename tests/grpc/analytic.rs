@@ -1,0 +1,309 @@
+//! The analytic IK method over gRPC: every solution of a pose (each checked with
+//! the server's forward kinematics), ranked by distance to the seed, with
+//! configuration flags; DescribeRobot's family; refusals; and StreamIk along
+//! S2's circle keeping one configuration.
+
+use std::f64::consts::PI;
+
+use kinplan_server::ServerConfig;
+use kinplan_server::pb::{
+    self, kinematics_service_client::KinematicsServiceClient, robot_service_client::RobotServiceClient,
+};
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use tonic::Code;
+use tonic::transport::Channel;
+
+use crate::{named, start};
+
+fn pose_pb(t: &Isometry3<f64>) -> pb::Pose {
+    let q = t.rotation.quaternion();
+    let p = t.translation.vector;
+    pb::Pose {
+        position: Some(pb::Vec3 {
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        }),
+        orientation: Some(pb::Quaternion {
+            x: q.i,
+            y: q.j,
+            z: q.k,
+            w: q.w,
+        }),
+    }
+}
+
+fn iso(p: &pb::Pose) -> Isometry3<f64> {
+    let t = p.position.unwrap();
+    let q = p.orientation.unwrap();
+    Isometry3::from_parts(
+        Translation3::new(t.x, t.y, t.z),
+        UnitQuaternion::new_normalize(Quaternion::new(q.w, q.x, q.y, q.z)),
+    )
+}
+
+async fn fk(robots: &mut RobotServiceClient<Channel>, name: &str, q: &[f64]) -> Isometry3<f64> {
+    let reply = robots
+        .forward_kinematics(pb::ForwardKinematicsRequest {
+            robot: named(name),
+            joint_positions: q.to_vec(),
+            include_links: false,
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    iso(reply.tool_pose.as_ref().unwrap())
+}
+
+fn analytic(num_solutions: u32) -> Option<pb::IkOptions> {
+    Some(pb::IkOptions {
+        method: pb::IkMethod::Analytic as i32,
+        num_solutions,
+        ..Default::default()
+    })
+}
+
+#[tokio::test]
+async fn analytic_ik_returns_every_solution_ranked_with_flags() {
+    let server = start(ServerConfig::default()).await;
+    let mut ik = KinematicsServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    for (name, q, expect) in [
+        // ±185°/±350° KUKA joints: 8 configurations, A4 and A6 in two turns each where the
+        // limits allow; the UR5's ±2π joints: each of the 8 in 2⁶ turn variants
+        (
+            "kuka_kr210_r2700_extra",
+            vec![0.3, -1.2, 0.9, 0.4, 0.7, -0.3],
+            None,
+        ),
+        ("ur5", vec![0.3, -1.2, 1.4, -0.8, 1.1, 0.2], Some(8 * 64)),
+    ] {
+        let target = fk(&mut robots, name, &q).await;
+        let reply = ik
+            .solve_ik(pb::SolveIkRequest {
+                robot: named(name),
+                target: Some(pose_pb(&target)),
+                seed: q.clone(),
+                options: analytic(1000),
+            })
+            .await
+            .unwrap()
+            .into_inner();
+        assert!(reply.success, "{name}");
+        if let Some(n) = expect {
+            assert_eq!(reply.solutions.len(), n, "{name}");
+        }
+        // the seed's own configuration first, at distance zero
+        let first = &reply.solutions[0];
+        assert!(
+            first.joints.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1e-9),
+            "{name}"
+        );
+        let dist = |s: &pb::IkSolution| s.joints.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum::<f64>();
+        assert!(
+            reply.solutions.windows(2).all(|w| dist(&w[0]) <= dist(&w[1])),
+            "{name}"
+        );
+        let mut flags = std::collections::HashSet::new();
+        for (i, s) in reply.solutions.iter().enumerate() {
+            // every answer reaches the pose by the server's own FK
+            let got = fk(&mut robots, name, &s.joints).await;
+            let dp = (got.translation.vector - target.translation.vector).norm();
+            let dr = got.rotation.angle_to(&target.rotation);
+            assert!(dp < 1e-9 && dr < 1e-9, "{name} solution {i}: {dp} m, {dr} rad");
+            let c = s.config.unwrap();
+            flags.insert((c.shoulder_back, c.elbow_down, c.wrist_flipped));
+            assert_eq!(s.status, pb::IkStatus::Converged as i32);
+            assert!(!s.singular);
+            if i > 40 {
+                break; // the server's FK per solution is slow in a debug build
+            }
+        }
+        // solutions that differ only by whole turns share their flags; the
+        // configurations differ
+        assert!(flags.len() >= 2, "{name}: {flags:?}");
+        // num_solutions = 1: the nearest
+        let one = ik
+            .solve_ik(pb::SolveIkRequest {
+                robot: named(name),
+                target: Some(pose_pb(&target)),
+                seed: q.clone(),
+                options: analytic(1),
+            })
+            .await
+            .unwrap()
+            .into_inner();
+        assert_eq!(one.solutions.len(), 1);
+        assert_eq!(one.solutions[0].joints, first.joints);
+    }
+}
+
+#[tokio::test]
+async fn describe_robot_names_the_family_and_refusals_name_the_reason() {
+    let server = start(ServerConfig::default()).await;
+    let mut ik = KinematicsServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    for (name, family) in [
+        ("kuka_kr210_r2700_extra", "spherical_wrist"),
+        ("kuka_kr120_r2500_pro", "spherical_wrist"),
+        ("abb_irb4600_60_205", "spherical_wrist"),
+        ("ur5", "three_parallel"),
+        // held at the middle of its limits (0), joint 3 leaves axes 2 and 4 parallel
+        ("kuka_lbr_iiwa14_r820", "spherical_wrist"),
+        ("franka_panda", ""),
+    ] {
+        let d = robots
+            .describe_robot(pb::DescribeRobotRequest {
+                robot: named(name),
+                ..Default::default()
+            })
+            .await
+            .unwrap()
+            .into_inner();
+        assert_eq!(d.analytic_family, family, "{name}");
+        assert_eq!(
+            d.analytic_reason.is_empty(),
+            !family.is_empty(),
+            "{name}: {}",
+            d.analytic_reason
+        );
+    }
+    // the iiwa with joint 3 held at the seed's value: every solution keeps it
+    let q = vec![0.3, 0.6, -0.4, -1.1, 0.5, 0.8, 0.2];
+    let target = fk(&mut robots, "kuka_lbr_iiwa14_r820", &q).await;
+    let reply = ik
+        .solve_ik(pb::SolveIkRequest {
+            robot: named("kuka_lbr_iiwa14_r820"),
+            target: Some(pose_pb(&target)),
+            seed: q.clone(),
+            options: analytic(1000),
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(reply.success);
+    assert!(
+        reply.solutions[0]
+            .joints
+            .iter()
+            .zip(&q)
+            .all(|(a, b)| (a - b).abs() < 1e-9)
+    );
+    for s in &reply.solutions {
+        assert_eq!(s.joints[2], q[2]);
+        let got = fk(&mut robots, "kuka_lbr_iiwa14_r820", &s.joints).await;
+        assert!((got.translation.vector - target.translation.vector).norm() < 1e-9);
+        assert!(got.rotation.angle_to(&target.rotation) < 1e-9);
+    }
+    // a 7-joint arm none of whose joints can be held: INVALID_ARGUMENT naming options.method and the reason
+    let q = vec![0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.8];
+    let target = fk(&mut robots, "franka_panda", &q).await;
+    let status = ik
+        .solve_ik(pb::SolveIkRequest {
+            robot: named("franka_panda"),
+            target: Some(pose_pb(&target)),
+            seed: vec![],
+            options: analytic(1),
+        })
+        .await
+        .unwrap_err();
+    assert_eq!(status.code(), Code::InvalidArgument);
+    assert!(
+        status.message().contains("chain is not analytic"),
+        "{}",
+        status.message()
+    );
+    assert!(
+        status.message().starts_with("options.method"),
+        "{}",
+        status.message()
+    );
+    // position-only targets cannot be served
+    let status = ik
+        .solve_ik(pb::SolveIkRequest {
+            robot: named("ur5"),
+            target: Some(pose_pb(&Isometry3::translation(0.4, 0.1, 0.3))),
+            seed: vec![],
+            options: Some(pb::IkOptions {
+                method: pb::IkMethod::Analytic as i32,
+                position_only: true,
+                ..Default::default()
+            }),
+        })
+        .await
+        .unwrap_err();
+    assert_eq!(status.code(), Code::InvalidArgument);
+    assert!(status.message().contains("full pose"), "{}", status.message());
+    // out of reach: no solution, a flagged least-squares best attempt, no NaN
+    let reply = ik
+        .solve_ik(pb::SolveIkRequest {
+            robot: named("ur5"),
+            target: Some(pose_pb(&Isometry3::translation(3.0, 0.0, 0.0))),
+            seed: vec![],
+            options: analytic(8),
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(!reply.success && reply.solutions.is_empty());
+    assert_eq!(reply.status, pb::IkStatus::MaxIterations as i32);
+    let best = reply.best_attempt.unwrap();
+    assert!(best.joints.iter().all(|v| v.is_finite()) && best.position_error > 1.0);
+}
+
+#[tokio::test]
+async fn stream_ik_analytic_keeps_one_configuration_along_s2s_circle() {
+    let server = start(ServerConfig::default()).await;
+    let mut ik = KinematicsServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    for (name, seed) in [
+        ("kuka_kr210_r2700_extra", vec![0.2, -1.6, 1.7, 0.3, 0.8, -0.2]),
+        ("ur5", vec![0.4, -1.1, 1.3, -0.6, 1.2, 0.3]),
+    ] {
+        let start = fk(&mut robots, name, &seed).await;
+        // S2: a 10 mm circle in steps of π/50 from the tool pose at the seed
+        let centre = start.translation.vector - Vector3::new(0.01, 0.0, 0.0);
+        let (tx, rx) = tokio::sync::mpsc::channel(8);
+        let mut answers = ik
+            .stream_ik(tokio_stream::wrappers::ReceiverStream::new(rx))
+            .await
+            .unwrap()
+            .into_inner();
+        let mut previous = seed.clone();
+        let mut config = None;
+        for k in 0..=100u64 {
+            let a = k as f64 * PI / 50.0;
+            let p = centre + Vector3::new(a.cos(), a.sin(), 0.0) * 0.01;
+            let target = Isometry3::from_parts(Translation3::from(p), start.rotation);
+            let first = k == 0;
+            tx.send(pb::StreamIkRequest {
+                sequence: k,
+                robot: if first { named(name) } else { None },
+                options: if first { analytic(1) } else { None },
+                seed: if first { seed.clone() } else { Vec::new() },
+                target: Some(pose_pb(&target)),
+            })
+            .await
+            .unwrap();
+            let result = answers.message().await.unwrap().unwrap().result.unwrap();
+            assert!(result.success, "{name} step {k}");
+            let s = &result.solutions[0];
+            assert!(s.position_error < 1e-9 && s.orientation_error < 1e-9);
+            let jump = s
+                .joints
+                .iter()
+                .zip(&previous)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(jump < 0.1, "{name} step {k}: joint jump {jump} rad");
+            let c = s.config.unwrap();
+            assert_eq!(
+                *config.get_or_insert(c),
+                c,
+                "{name} step {k}: configuration changed"
+            );
+            previous = s.joints.clone();
+        }
+        drop(tx);
+    }
+}
