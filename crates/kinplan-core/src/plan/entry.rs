@@ -325,6 +325,7 @@ pub fn plan<C: StateChecker + ?Sized>(
                 &goal,
                 n,
                 req.stomp.initial.for_algorithm(req.algorithm),
+                (req.algorithm == Algorithm::Ccstomp).then_some(&req.cartesian),
                 &req.rrt,
                 req.seed,
                 &clock,

@@ -7,6 +7,7 @@ mod cartesian;
 mod clock;
 mod column_scan;
 mod costs;
+mod detour;
 mod entry;
 mod error;
 mod initial;
