@@ -192,6 +192,17 @@ fn run(chain: &Chain, c: &SceneChecker, req: &PlanRequest, t: &mut Tally) {
     t.worst_rot.push(wr);
     let within = wt <= T_T && wr <= T_R;
     let free = path_free(c, &r.q, chain.dof());
+    if !ok && std::env::var("WHY").is_ok() {
+        println!(
+            "  {:?} seed {}: {:?}, cost {:.2} → {:.2} in {} iterations, worst e_t {wt:.3} e_r {wr:.3}, free {free}",
+            req.algorithm,
+            req.seed,
+            r.status,
+            r.cost_history.first().unwrap_or(&f64::NAN),
+            r.cost_history.last().unwrap_or(&f64::NAN),
+            r.iterations
+        );
+    }
     if ok && !(free && (within || req.algorithm != Algorithm::Ccstomp)) {
         println!("  !! {:?} seed {} succeeded but recomputed e_t {wt:.3} e_r {wr:.3} free {free}", req.algorithm, req.seed);
     }
@@ -282,12 +293,20 @@ fn problem(
 ) -> (Vec<f64>, Vec<f64>, SceneChecker) {
     let lim: Vec<(f64, f64)> = chain.limits().collect();
     let empty = checker(m, vec![]);
-    for _ in 0..100_000 {
+    let down = std::env::var("DOWN").ok().and_then(|v| v.parse::<f64>().ok());
+    for _ in 0..1_000_000 {
         let start: Vec<f64> = lim
             .iter()
             .map(|&(lo, hi)| rng.random_range(lo.max(-3.0) + 0.1..hi.min(3.0) - 0.1))
             .collect();
-        let p = chain.fk(&start).translation.vector;
+        let start_pose = chain.fk(&start);
+        let p = start_pose.translation.vector;
+        // `DOWN=<deg>`: the tool's z axis within that angle of straight down
+        if let Some(max) = down
+            && (start_pose.rotation * Vector3::z()).angle(&-Vector3::z()) > max.to_radians()
+        {
+            continue;
+        }
         let rxy = p.xy().norm();
         if !(f.reach.0..f.reach.1).contains(&rxy) || !(f.height.0..f.height.1).contains(&p.z) {
             continue;
@@ -324,7 +343,7 @@ fn problem(
             return (start, goal, c);
         }
     }
-    panic!("{}: no problem in 100,000 draws", f.name);
+    panic!("{}: no problem in 1,000,000 draws", f.name);
 }
 
 fn bench(problems: usize, n: usize) {
@@ -334,7 +353,8 @@ fn bench(problems: usize, n: usize) {
     println!("|---|---|---|---|---|---|---|---|---|");
     let (mut all_ok, mut all) = (0, 0);
     let mut all_times = Vec::new();
-    for f in &FAMILIES {
+    let only = std::env::var("ROBOT").ok();
+    for f in FAMILIES.iter().filter(|f| only.as_ref().is_none_or(|o| f.name.contains(o.as_str()))) {
         let chain = builtin_chain(f.name).unwrap();
         let m = model(&chain);
         let mut rng = ChaCha8Rng::seed_from_u64(2026);

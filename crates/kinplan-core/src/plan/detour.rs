@@ -9,6 +9,7 @@ use super::CartesianParams;
 use super::cartesian::CartesianLine;
 use super::clock::Clock;
 use super::costs::{interior_valid, resolution_of};
+use super::ladder::ladder_path;
 use crate::collision::StateChecker;
 use crate::ik::{IkParams, IkSolver, IkStatus, IkTarget};
 use crate::robot::Chain;
@@ -129,7 +130,7 @@ fn profile(i: usize, n: usize, lo: usize, hi: usize) -> f64 {
 /// other: `up` (world z with its component along `u` removed; world x when
 /// the line is vertical) and `u × up`. A zero-length line uses world z's
 /// complement as `u`.
-fn perpendicular_frame(u: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+pub(super) fn perpendicular_frame(u: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     let u = u.try_normalize(1e-9).unwrap_or_else(Vector3::x);
     let mut up = Vector3::z() - u * u.z;
     if up.norm() < 1e-6 {
@@ -220,7 +221,18 @@ pub(crate) fn tube_start<C: StateChecker + ?Sized>(
             }
         }
     }
-    None
+    ladder_path(
+        &mut solver,
+        checker,
+        &line,
+        tube.translation_tolerance,
+        start,
+        goal,
+        n,
+        &path_ik(),
+        MAX_CARTESIAN_STEP,
+        clock,
+    )
 }
 
 /// The pose inside the tube nearest `actual` (per part): its position pulled

@@ -12,6 +12,7 @@ mod entry;
 mod error;
 mod initial;
 mod kd_index;
+mod ladder;
 pub(crate) mod noise;
 mod params;
 mod rrt_connect;
