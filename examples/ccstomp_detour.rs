@@ -204,7 +204,10 @@ fn run(chain: &Chain, c: &SceneChecker, req: &PlanRequest, t: &mut Tally) {
         );
     }
     if ok && !(free && (within || req.algorithm != Algorithm::Ccstomp)) {
-        println!("  !! {:?} seed {} succeeded but recomputed e_t {wt:.3} e_r {wr:.3} free {free}", req.algorithm, req.seed);
+        println!(
+            "  !! {:?} seed {} succeeded but recomputed e_t {wt:.3} e_r {wr:.3} free {free}",
+            req.algorithm, req.seed
+        );
     }
     t.ok_recomputed += (within && free && req.algorithm == Algorithm::Ccstomp
         || free && req.algorithm != Algorithm::Ccstomp) as usize;
@@ -228,7 +231,10 @@ fn kr210(seeds: usize, n: usize) {
     let c = checker(&m, vec![cube(mid, 0.0, 0.15)]);
     assert!(c.is_valid(&start) && c.is_valid(&goal), "start/goal collide");
     if let Some(line) = line_joints(&chain, &start, &goal, n) {
-        println!("straight tool line by IK: collision-free {}", path_free(&c, &line, 6));
+        println!(
+            "straight tool line by IK: collision-free {}",
+            path_free(&c, &line, 6)
+        );
     }
     println!(
         "| algorithm | succeeded | recomputed | median ms | p95 ms | mean ms start / STOMP / re-check | p95 worst e_r rad | other statuses |"
@@ -354,11 +360,16 @@ fn bench(problems: usize, n: usize) {
     let (mut all_ok, mut all) = (0, 0);
     let mut all_times = Vec::new();
     let only = std::env::var("ROBOT").ok();
-    for f in FAMILIES.iter().filter(|f| only.as_ref().is_none_or(|o| f.name.contains(o.as_str()))) {
+    for f in FAMILIES
+        .iter()
+        .filter(|f| only.as_ref().is_none_or(|o| f.name.contains(o.as_str())))
+    {
         let chain = builtin_chain(f.name).unwrap();
         let m = model(&chain);
         let mut rng = ChaCha8Rng::seed_from_u64(2026);
-        let cases: Vec<_> = (0..problems).map(|_| problem(&chain, &m, f, &mut rng, n)).collect();
+        let cases: Vec<_> = (0..problems)
+            .map(|_| problem(&chain, &m, f, &mut rng, n))
+            .collect();
         let algs: &[Algorithm] = if std::env::var("ALL").is_ok() {
             &[Algorithm::Ccstomp, Algorithm::Stomp, Algorithm::RrtConnect]
         } else {

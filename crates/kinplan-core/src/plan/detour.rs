@@ -71,7 +71,13 @@ fn solve_tool_path<C: StateChecker + ?Sized>(
         }
         let prev = &out[(i - 1) * dof..i * dof];
         let r = solver
-            .solve(&IkTarget::Pose(pose(i)), Some(prev), &params, i as u64, clock.should_stop)
+            .solve(
+                &IkTarget::Pose(pose(i)),
+                Some(prev),
+                &params,
+                i as u64,
+                clock.should_stop,
+            )
             .map_err(|_| i)?;
         let q = match r.solutions.first() {
             Some(s) if r.stop_reason == IkStatus::Converged => &s.joints,
@@ -104,7 +110,14 @@ fn blocked_waypoints<C: StateChecker + ?Sized>(
         if bad[s] || bad[s + 1] {
             continue;
         }
-        if !interior_valid(checker, rows[s], rows[s + 1], resolution_of(checker), &mut buf, clock)? {
+        if !interior_valid(
+            checker,
+            rows[s],
+            rows[s + 1],
+            resolution_of(checker),
+            &mut buf,
+            clock,
+        )? {
             bad[s] = true;
             bad[s + 1] = true;
         }
@@ -247,7 +260,11 @@ fn nearest_in_tube(
 ) -> Isometry3<f64> {
     let dp = actual.translation.vector - reference.translation.vector;
     let max_t = margin * tube.translation_tolerance;
-    let dp = if dp.norm() > max_t { dp * (max_t / dp.norm()) } else { dp };
+    let dp = if dp.norm() > max_t {
+        dp * (max_t / dp.norm())
+    } else {
+        dp
+    };
     let rel = reference.rotation.inverse() * actual.rotation;
     let max_r = margin * tube.rotation_tolerance;
     let rel = match rel.axis_angle() {

@@ -21,7 +21,11 @@ const PARENTS_TRIED: usize = 2;
 /// `r` (0-based) in direction `d`. Returns (ring 0 = centre, 1-based rings;
 /// direction).
 fn ring_and_direction(k: usize) -> (usize, usize) {
-    if k == 0 { (0, 0) } else { (1 + (k - 1) / DIRECTIONS, (k - 1) % DIRECTIONS) }
+    if k == 0 {
+        (0, 0)
+    } else {
+        (1 + (k - 1) / DIRECTIONS, (k - 1) % DIRECTIONS)
+    }
 }
 
 /// Two nodes are neighbours when their rings differ by at most one and,
@@ -115,7 +119,11 @@ pub(crate) fn ladder_path<C: StateChecker + ?Sized>(
                 let Ok(r) = solver.solve(&target, Some(seed), ik, i as u64, clock.should_stop) else {
                     continue;
                 };
-                let Some(s) = r.solutions.first().filter(|_| r.stop_reason == IkStatus::Converged) else {
+                let Some(s) = r
+                    .solutions
+                    .first()
+                    .filter(|_| r.stop_reason == IkStatus::Converged)
+                else {
                     continue;
                 };
                 if step(seed, &s.joints) > max_step || !checker.is_valid(&s.joints) {
@@ -139,7 +147,8 @@ pub(crate) fn ladder_path<C: StateChecker + ?Sized>(
     order.sort_by(|&a, &b| cost[last * nodes + a].total_cmp(&cost[last * nodes + b]));
     let end = order.iter().copied().find(|&p| {
         let from = &q[(last * nodes + p) * dof..(last * nodes + p + 1) * dof];
-        step(from, goal) <= max_step && interior_valid(checker, from, goal, res, &mut buf, clock) == Some(true)
+        step(from, goal) <= max_step
+            && interior_valid(checker, from, goal, res, &mut buf, clock) == Some(true)
     })?;
     let mut out = vec![0.0; n * dof];
     out[(n - 1) * dof..].copy_from_slice(goal);
