@@ -115,6 +115,19 @@ fn path_free(c: &SceneChecker, q: &[f64], dof: usize) -> bool {
     rows.iter().all(|r| c.is_valid(r)) && rows.windows(2).all(|w| c.motion_valid(w[0], w[1]))
 }
 
+/// CPU time of every thread of this process so far (ns, from
+/// `/proc/self/task/*/schedstat`): a per-plan cost that a loaded machine
+/// does not inflate the way it inflates wall time.
+fn cpu_ns() -> u64 {
+    let Ok(dir) = std::fs::read_dir("/proc/self/task") else {
+        return 0;
+    };
+    dir.filter_map(|e| e.ok())
+        .filter_map(|e| std::fs::read_to_string(e.path().join("schedstat")).ok())
+        .filter_map(|s| s.split_whitespace().next().and_then(|v| v.parse::<u64>().ok()))
+        .sum()
+}
+
 fn percentile(v: &mut [f64], p: f64) -> f64 {
     v.sort_by(f64::total_cmp);
     if v.is_empty() {
@@ -126,6 +139,7 @@ fn percentile(v: &mut [f64], p: f64) -> f64 {
 #[derive(Default)]
 struct Tally {
     times: Vec<f64>,
+    cpu: Vec<f64>,
     ok: usize,
     ok_recomputed: usize,
     statuses: Vec<String>,
@@ -138,12 +152,14 @@ impl Tally {
     fn line(&mut self, label: &str, total: usize) -> String {
         let med = percentile(&mut self.times, 0.5);
         let p95 = percentile(&mut self.times, 0.95);
+        let cpu_med = percentile(&mut self.cpu, 0.5);
+        let cpu_p95 = percentile(&mut self.cpu, 0.95);
         let mut other = self.statuses.clone();
         other.sort();
         other.dedup();
         let per = |us: u64| us as f64 / total as f64 / 1e3;
         format!(
-            "| {label} | {}/{total} | {}/{total} | {med:.1} | {p95:.1} | {:.1} / {:.1} / {:.1} | {:.3} | {} |",
+            "| {label} | {}/{total} | {}/{total} | {med:.1} / {p95:.1} | {cpu_med:.1} / {cpu_p95:.1} | {:.1} / {:.1} / {:.1} | {:.3} | {} |",
             self.ok,
             self.ok_recomputed,
             per(self.phases[0]),
@@ -173,9 +189,10 @@ fn request(start: &[f64], goal: &[f64], alg: Algorithm, seed: u64, n: usize) -> 
 
 /// One plan: status, time (ms) and the FK-recomputed verdict.
 fn run(chain: &Chain, c: &SceneChecker, req: &PlanRequest, t: &mut Tally) {
-    let t0 = Instant::now();
+    let (t0, c0) = (Instant::now(), cpu_ns());
     let r = plan(chain, c, req, PlanControl::default()).expect("plan");
     t.times.push(t0.elapsed().as_secs_f64() * 1e3);
+    t.cpu.push((cpu_ns() - c0) as f64 / 1e6);
     let ok = r.status == PlanStatus::Succeeded;
     t.ok += ok as usize;
     let tm = r.timings;
@@ -237,7 +254,7 @@ fn kr210(seeds: usize, n: usize) {
         );
     }
     println!(
-        "| algorithm | succeeded | recomputed | median ms | p95 ms | mean ms start / STOMP / re-check | p95 worst e_r rad | other statuses |"
+        "| algorithm | succeeded | recomputed | wall ms median / p95 | CPU ms median / p95 | mean wall ms start / STOMP / re-check | p95 worst e_r rad | other statuses |"
     );
     println!("|---|---|---|---|---|---|---|---|");
     for alg in [Algorithm::Ccstomp, Algorithm::Stomp, Algorithm::RrtConnect] {
@@ -354,11 +371,12 @@ fn problem(
 
 fn bench(problems: usize, n: usize) {
     println!(
-        "| robot | algorithm | succeeded | within 1 m / 0.2 rad and free (recomputed) | median ms | p95 ms | mean ms start / STOMP / re-check | p95 worst e_r rad | other statuses |"
+        "| robot | algorithm | succeeded | within 1 m / 0.2 rad and free (recomputed) | wall ms median / p95 | CPU ms median / p95 | mean wall ms start / STOMP / re-check | p95 worst e_r rad | other statuses |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     let (mut all_ok, mut all) = (0, 0);
     let mut all_times = Vec::new();
+    let mut all_cpu = Vec::new();
     let only = std::env::var("ROBOT").ok();
     for f in FAMILIES
         .iter()
@@ -384,16 +402,19 @@ fn bench(problems: usize, n: usize) {
                 all_ok += t.ok_recomputed;
                 all += problems;
                 all_times.extend_from_slice(&t.times);
+                all_cpu.extend_from_slice(&t.cpu);
             }
             let short = f.name.split('_').take(2).collect::<Vec<_>>().join(" ");
             println!("{}", t.line(&format!("{short} | {alg:?}"), problems));
         }
     }
     println!(
-        "CCSTOMP overall: {all_ok}/{all} ({:.1} %) within the tolerances and free; median {:.1} ms, p95 {:.1} ms",
+        "CCSTOMP overall: {all_ok}/{all} ({:.1} %) within the tolerances and free; wall median {:.1} ms, p95 {:.1} ms; CPU median {:.1} ms, p95 {:.1} ms",
         100.0 * all_ok as f64 / all as f64,
         percentile(&mut all_times.clone(), 0.5),
-        percentile(&mut all_times, 0.95)
+        percentile(&mut all_times, 0.95),
+        percentile(&mut all_cpu.clone(), 0.5),
+        percentile(&mut all_cpu, 0.95)
     );
 }
 
