@@ -101,7 +101,7 @@ pub(crate) fn ladder_path<C: StateChecker + ?Sized>(
         }
         let pose = line.pose_at_waypoint(i, n);
         let reach_back = n - 1 - i; // layers left to come back to the line
-        for v in 0..nodes {
+        for (v, offset) in offsets.iter().enumerate() {
             let ring = ring_and_direction(v).0;
             if ring > i || ring > reach_back {
                 continue;
@@ -110,7 +110,7 @@ pub(crate) fn ladder_path<C: StateChecker + ?Sized>(
             order.extend((0..nodes).filter(|&p| cost[(i - 1) * nodes + p].is_finite() && adjacent(p, v)));
             order.sort_by(|&a, &b| cost[(i - 1) * nodes + a].total_cmp(&cost[(i - 1) * nodes + b]));
             let target = IkTarget::Pose(Isometry3::from_parts(
-                Translation3::from(pose.translation.vector + offsets[v]),
+                Translation3::from(pose.translation.vector + offset),
                 pose.rotation,
             ));
             for &p in order.iter().take(PARENTS_TRIED) {
@@ -133,7 +133,7 @@ pub(crate) fn ladder_path<C: StateChecker + ?Sized>(
                     continue;
                 }
                 let at = i * nodes + v;
-                cost[at] = cost[from] + offsets[v].norm();
+                cost[at] = cost[from] + offset.norm();
                 parent[at] = p;
                 q[at * dof..(at + 1) * dof].copy_from_slice(&s.joints);
                 break;
