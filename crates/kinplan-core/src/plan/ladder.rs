@@ -28,11 +28,11 @@ fn ring_and_direction(k: usize) -> (usize, usize) {
     }
 }
 
-/// Two nodes are neighbours when their rings differ by at most one and,
-/// off the centre, their directions by at most one step (cyclically).
-fn adjacent(a: usize, b: usize) -> bool {
+/// Two nodes are neighbours when their rings differ by at most `ring_step`
+/// and, off the centre, their directions by at most one step (cyclically).
+fn adjacent(a: usize, b: usize, ring_step: usize) -> bool {
     let ((ra, da), (rb, db)) = (ring_and_direction(a), ring_and_direction(b));
-    if ra.abs_diff(rb) > 1 {
+    if ra.abs_diff(rb) > ring_step {
         return false;
     }
     if ra == 0 || rb == 0 {
@@ -48,13 +48,15 @@ fn adjacent(a: usize, b: usize) -> bool {
 /// nodes are tool poses `PL_i` displaced perpendicular to the line by
 /// `0` or `ρ·t_t` (ρ ∈ {0.06, 0.12, 0.2, 0.3, 0.5, 0.9}) in one of 12 directions
 /// about it, at the slerped orientation. A node is reached from a
-/// neighbouring node (ring ±1, direction ±1) of the previous layer by IK
+/// neighbouring node (ring ±s, direction ±1) of the previous layer by IK
 /// warm-started at that node's joints (Levenberg–Marquardt, no restarts;
 /// the two cheapest parents are tried) when the step stays within
 /// `max_step` (rad or m, max-norm), the state is valid and so is the motion.
 /// A node's cost is its parent's plus its offset (m); rings beyond what the
 /// remaining waypoints can ramp down from are skipped. The chain ends at
-/// `goal` through a centre or first-ring node.
+/// `goal` through a node at most `s` rings out. The ring step
+/// `s = max(1, ⌈6 / ((n − 1)/2)⌉)` lets a short trajectory (S0's 10
+/// waypoints) reach the outer rings halfway along.
 ///
 /// Returns the cheapest chain (`n × dof`, row-major), or `None` when none
 /// reaches the goal or `clock` was interrupted (checked per layer).
@@ -93,6 +95,7 @@ pub(crate) fn ladder_path<C: StateChecker + ?Sized>(
     q[..dof].copy_from_slice(start);
     let mut buf = vec![0.0; dof];
     let mut order: Vec<usize> = Vec::with_capacity(nodes);
+    let ring_step = ((RINGS.len() as f64 / ((n - 1) as f64 / 2.0)).ceil() as usize).max(1);
     let step = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
     let res = resolution_of(checker);
     for i in 1..n - 1 {
@@ -103,11 +106,13 @@ pub(crate) fn ladder_path<C: StateChecker + ?Sized>(
         let reach_back = n - 1 - i; // layers left to come back to the line
         for (v, offset) in offsets.iter().enumerate() {
             let ring = ring_and_direction(v).0;
-            if ring > i || ring > reach_back {
+            if ring > i * ring_step || ring > reach_back * ring_step {
                 continue;
             }
             order.clear();
-            order.extend((0..nodes).filter(|&p| cost[(i - 1) * nodes + p].is_finite() && adjacent(p, v)));
+            order.extend(
+                (0..nodes).filter(|&p| cost[(i - 1) * nodes + p].is_finite() && adjacent(p, v, ring_step)),
+            );
             order.sort_by(|&a, &b| cost[(i - 1) * nodes + a].total_cmp(&cost[(i - 1) * nodes + b]));
             let target = IkTarget::Pose(Isometry3::from_parts(
                 Translation3::from(pose.translation.vector + offset),
@@ -140,10 +145,10 @@ pub(crate) fn ladder_path<C: StateChecker + ?Sized>(
             }
         }
     }
-    // the goal, reached from a centre or first-ring node of the last layer
+    // the goal, reached from a node at most `ring_step` rings out
     let last = n - 2;
     order.clear();
-    order.extend((0..nodes).filter(|&p| cost[last * nodes + p].is_finite() && adjacent(p, 0)));
+    order.extend((0..nodes).filter(|&p| cost[last * nodes + p].is_finite() && adjacent(p, 0, ring_step)));
     order.sort_by(|&a, &b| cost[last * nodes + a].total_cmp(&cost[last * nodes + b]));
     let end = order.iter().copied().find(|&p| {
         let from = &q[(last * nodes + p) * dof..(last * nodes + p + 1) * dof];
@@ -174,8 +179,12 @@ mod tests {
         assert_eq!(ring_and_direction(d), (1, d - 1));
         assert_eq!(ring_and_direction(d + 1), (2, 0));
         // the centre neighbours the first ring only; directions wrap around
-        assert!(adjacent(0, 5) && !adjacent(0, d + 1));
-        assert!(adjacent(1, d) && adjacent(1, d + 1) && adjacent(1, d + 2) && !adjacent(1, d + 3));
-        assert!(!adjacent(1, 2 * d + 1));
+        assert!(adjacent(0, 5, 1) && !adjacent(0, d + 1, 1));
+        assert!(
+            adjacent(1, d, 1) && adjacent(1, d + 1, 1) && adjacent(1, d + 2, 1) && !adjacent(1, d + 3, 1)
+        );
+        assert!(!adjacent(1, 2 * d + 1, 1));
+        // two rings per step: the centre reaches the second ring
+        assert!(adjacent(0, d + 1, 2) && adjacent(1, 2 * d + 1, 2) && !adjacent(0, 2 * d + 1, 2));
     }
 }
