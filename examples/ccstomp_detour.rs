@@ -180,6 +180,17 @@ fn request(start: &[f64], goal: &[f64], alg: Algorithm, seed: u64, n: usize) -> 
         ..Default::default()
     };
     req.stomp.timesteps = n;
+    // parameter probes: `SIGMA_T` (m), `SIGMA_R` (rad), `ITERS`
+    let get = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+    if let Some(v) = get("SIGMA_T") {
+        req.cartesian.translation_stddev = v;
+    }
+    if let Some(v) = get("SIGMA_R") {
+        req.cartesian.rotation_stddev = v;
+    }
+    if let Some(v) = get("ITERS") {
+        req.stomp.max_iterations = v as usize;
+    }
     if alg == Algorithm::Ccstomp && std::env::var("INIT").as_deref() == Ok("line") {
         // the code before the detour: straight line, else RRT-Connect
         req.stomp.initial = InitialTrajectory::RrtConnectIfBlocked;
