@@ -31,6 +31,11 @@ const DETOUR_ANGLES_DEG: [f64; 8] = [0.0, 90.0, -90.0, 45.0, -45.0, 135.0, -135.
 /// projected, so that the repaired waypoint is not left on the boundary.
 const PROJECTION_MARGIN: f64 = 0.8;
 
+/// Largest joint change between `a` and `b` (rad or m, max-norm).
+pub(super) fn joint_step(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
 /// IK of tool paths: Levenberg–Marquardt from the previous waypoint, no
 /// restarts (a restart would jump to another branch).
 fn path_ik() -> IkParams {
@@ -64,7 +69,7 @@ fn solve_tool_path<C: StateChecker + ?Sized>(
     let params = path_ik();
     out.clear();
     out.extend_from_slice(start);
-    let step = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    let step = joint_step;
     for i in 1..n - 1 {
         if clock.interrupted().is_some() {
             return Err(0);

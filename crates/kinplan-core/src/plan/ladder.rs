@@ -96,7 +96,7 @@ pub(crate) fn ladder_path<C: StateChecker + ?Sized>(
     let mut buf = vec![0.0; dof];
     let mut order: Vec<usize> = Vec::with_capacity(nodes);
     let ring_step = ((RINGS.len() as f64 / ((n - 1) as f64 / 2.0)).ceil() as usize).max(1);
-    let step = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+    let step = super::detour::joint_step;
     let res = resolution_of(checker);
     for i in 1..n - 1 {
         if clock.interrupted().is_some() {
