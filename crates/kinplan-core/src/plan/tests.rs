@@ -977,3 +977,39 @@ fn the_ladder_graph_finds_the_one_side_that_clears_the_circle() {
             .is_none()
     );
 }
+
+/// The detour search and the second pass look at the deadline: CCSTOMP on the
+/// blocked-line problem with a budget far below what the plan takes answers
+/// soon after it, as a timeout or a success.
+#[test]
+fn ccstomp_on_a_blocked_line_answers_by_its_deadline() {
+    let (chain, checker, start, goal) = kr210_box_on_the_line();
+    for budget_ms in [0, 2] {
+        let mut req = PlanRequest {
+            start: start.clone(),
+            goal: Goal::Joints(goal.clone()),
+            algorithm: Algorithm::Ccstomp,
+            ..Default::default()
+        };
+        // a 1 mm tube: no detour fits, so the search runs through the ladder
+        req.cartesian.translation_tolerance = 1e-3;
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let t0 = Instant::now();
+        let r = pool.install(|| {
+            let ctl = PlanControl {
+                deadline: Some(t0 + Duration::from_millis(budget_ms)),
+                ..Default::default()
+            };
+            plan(&chain, &checker, &req, ctl).unwrap()
+        });
+        let took = t0.elapsed();
+        // the margin is for a loaded CI host (one IK solve or state check
+        // past the deadline at most, then timing and scoring)
+        assert!(
+            took < Duration::from_millis(budget_ms + 150),
+            "{budget_ms} ms: {took:?}"
+        );
+        assert_eq!(r.status, PlanStatus::Timeout, "{budget_ms} ms");
+        assert!(!r.valid);
+    }
+}
