@@ -20,6 +20,23 @@ use crate::ik::{IkParams, IkTarget, solve_ik};
 use crate::robot::Chain;
 use crate::score::{Rows, ScoreInput, ScoreParams, Scores, TrajectoryData, score};
 
+/// Mixed into the seed of CCSTOMP's second pass, so that its rollouts
+/// differ from the first pass's.
+const RESTART_SEED: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// CCSTOMP's second pass, when the first ends without a valid trajectory:
+/// S0's noise generator at a tenth of the translation and half the rotation
+/// standard deviation (m, rad). S0's σ = 0.5 m suits its 2.7 m arm and a
+/// 1 m tube; near an obstacle or on a smaller arm most such samples leave
+/// the tube or collide, and the update learns nothing from them.
+fn finer_noise(c: &CartesianParams) -> CartesianParams {
+    CartesianParams {
+        translation_stddev: c.translation_stddev * 0.1,
+        rotation_stddev: c.rotation_stddev * 0.5,
+        ..*c
+    }
+}
+
 /// Which planner [`plan`] runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Algorithm {
@@ -318,6 +335,7 @@ pub fn plan<C: StateChecker + ?Sized>(
                 &goal,
                 n,
                 req.stomp.initial.for_algorithm(req.algorithm),
+                (req.algorithm == Algorithm::Ccstomp).then_some(&req.cartesian),
                 &req.rrt,
                 req.seed,
                 &clock,
@@ -325,9 +343,41 @@ pub fn plan<C: StateChecker + ?Sized>(
             timings.rrt_us = rrt_us;
             let t0 = Instant::now();
             let cart = (req.algorithm == Algorithm::Ccstomp).then_some(&req.cartesian);
-            let out = stomp_optimize(
+            let mut out = stomp_optimize(
                 chain, checker, &req.stomp, cart, &initial, req.seed, &clock, progress,
             );
+            if let Some(c) = cart
+                && !out.valid
+                && out.stop == StompStop::MaxIterations
+            {
+                // CCSTOMP's restart: a second pass from the best trajectory
+                // with finer Cartesian noise (docs/planning.md#ccstomp)
+                let finer = finer_noise(c);
+                let offset = out.iterations;
+                let mut shifted = |r: &IterationReport<'_>| {
+                    progress(&IterationReport {
+                        iteration: r.iteration + offset,
+                        ..*r
+                    })
+                };
+                let seed = req.seed ^ RESTART_SEED;
+                let again = stomp_optimize(
+                    chain,
+                    checker,
+                    &req.stomp,
+                    Some(&finer),
+                    &out.trajectory,
+                    seed,
+                    &clock,
+                    &mut shifted,
+                );
+                out.cost_history
+                    .extend_from_slice(again.cost_history.get(1..).unwrap_or(&[]));
+                out.iterations += again.iterations;
+                out.trajectory = again.trajectory;
+                out.valid = again.valid;
+                out.stop = again.stop;
+            }
             timings.stomp_us = t0.elapsed().as_micros() as u64;
             if matches!(out.stop, StompStop::Deadline | StompStop::Cancelled) {
                 interrupted_valid = Some(out.valid);

@@ -19,9 +19,12 @@ pub enum InitialTrajectory {
     RrtConnectIfBlocked,
     /// The tool's straight Cartesian line (lerp/slerp between the end poses)
     /// solved by IK waypoint after waypoint, warm-started, when that succeeds
-    /// without a branch jump (> 0.5 rad) and is valid; otherwise as
-    /// `RrtConnectIfBlocked`. Suits CCSTOMP, whose cost is measured against
-    /// that line.
+    /// without a branch jump (> 0.5 rad) and is valid. For CCSTOMP, when it is
+    /// blocked: a Cartesian detour inside the tolerance tube at the slerped
+    /// orientation (smooth detours, then a ladder graph), else RRT-Connect's
+    /// path projected into the tube (docs/planning.md#ccstomps-start-inside-the-tube).
+    /// For STOMP, when blocked: as `RrtConnectIfBlocked`. Suits CCSTOMP, whose
+    /// cost is measured against that line.
     CartesianLine,
 }
 
