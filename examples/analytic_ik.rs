@@ -230,7 +230,13 @@ fn main() {
                 })
                 .collect();
             let r = solver
-                .solve(&IkTarget::Pose(*t), Some(&seed), &lm, 0, kinplan_core::Deadline::none())
+                .solve(
+                    &IkTarget::Pose(*t),
+                    Some(&seed),
+                    &lm,
+                    0,
+                    kinplan_core::Deadline::none(),
+                )
                 .unwrap();
             if let Some(s) = r.solutions.first() {
                 lm_found += 1;

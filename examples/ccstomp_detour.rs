@@ -95,7 +95,15 @@ fn line_joints(chain: &Chain, start: &[f64], goal: &[f64], n: usize) -> Option<V
             a.rotation.slerp(&b.rotation, s),
         );
         let prev = out[(i - 1) * dof..i * dof].to_vec();
-        let r = solve_ik(chain, &IkTarget::Pose(pose), Some(&prev), &p, 0, kinplan_core::Deadline::none()).ok()?;
+        let r = solve_ik(
+            chain,
+            &IkTarget::Pose(pose),
+            Some(&prev),
+            &p,
+            0,
+            kinplan_core::Deadline::none(),
+        )
+        .ok()?;
         if r.stop_reason != IkStatus::Converged {
             return None;
         }

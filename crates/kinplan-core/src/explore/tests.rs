@@ -426,7 +426,12 @@ fn a_depth_image_from_the_simulated_camera_inserts_like_its_points() {
     // the points path: back-projected along each pixel's unit ray direction
     let mut by_points = Octree::new(0.05).unwrap();
     by_points
-        .insert_scan(&depth_to_points(&img, &cam, &pose, 1), &origin, &p, Deadline::none())
+        .insert_scan(
+            &depth_to_points(&img, &cam, &pose, 1),
+            &origin,
+            &p,
+            Deadline::none(),
+        )
         .unwrap();
     // the image path: pinhole intrinsics of the same camera
     let k = cam.intrinsics();
@@ -453,7 +458,12 @@ fn a_depth_image_from_the_simulated_camera_inserts_like_its_points() {
     };
     let mut by_mm_points = Octree::new(0.05).unwrap();
     by_mm_points
-        .insert_scan(&depth_to_points(&rounded, &cam, &pose, 1), &origin, &p, Deadline::none())
+        .insert_scan(
+            &depth_to_points(&rounded, &cam, &pose, 1),
+            &origin,
+            &p,
+            Deadline::none(),
+        )
         .unwrap();
     let depth = depth_from_millimetres(&mm, "depth_mm").unwrap();
     let mut by_mm = Octree::new(0.05).unwrap();

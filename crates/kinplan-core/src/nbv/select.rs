@@ -439,7 +439,15 @@ pub fn next_best_view(
                     if clock.interrupted().is_some() {
                         return None;
                     }
-                    Some(predict_view(tree, camera, &c.pose, vp, region_keys, ws, clock.deadline))
+                    Some(predict_view(
+                        tree,
+                        camera,
+                        &c.pose,
+                        vp,
+                        region_keys,
+                        ws,
+                        clock.deadline,
+                    ))
                 })
                 .collect();
             for (mut c, p) in batch.into_iter().zip(preds) {

@@ -361,7 +361,15 @@ fn numerical_search_finds_nothing_the_analytic_solver_missed() {
             arm.solve_into(&t, None, &nearest_params(), &mut out);
             for _ in 0..64 {
                 let seed = random_q(&chain, &mut rng);
-                let r = solve_ik(&chain, &IkTarget::Pose(t), Some(&seed), &lm, 0, crate::Deadline::none()).unwrap();
+                let r = solve_ik(
+                    &chain,
+                    &IkTarget::Pose(t),
+                    Some(&seed),
+                    &lm,
+                    0,
+                    crate::Deadline::none(),
+                )
+                .unwrap();
                 if let Some(s) = r.solutions.first() {
                     assert!(
                         out.iter().any(|a| same_angles(&a.joints, &s.joints, 1e-6)),
@@ -436,7 +444,15 @@ fn iiwa_with_joint_3_held_round_trips() {
         let t = chain.fk(&q);
         let reduced = analyse(&chain, &params.analytic, Some(&q)).unwrap();
         assert_eq!(reduced.held, Some((2, q[2])));
-        let r = solve_ik(&chain, &IkTarget::Pose(t), Some(&q), &params, 0, crate::Deadline::none()).unwrap();
+        let r = solve_ik(
+            &chain,
+            &IkTarget::Pose(t),
+            Some(&q),
+            &params,
+            0,
+            crate::Deadline::none(),
+        )
+        .unwrap();
         assert!(r.success(), "{q:?}");
         assert!(
             same_angles(&r.solutions[0].joints, &q, 1e-7),

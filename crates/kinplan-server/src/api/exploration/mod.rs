@@ -162,7 +162,8 @@ impl ExplorationService for ExplorationApi {
                         width,
                         height,
                         intrinsics,
-                    } => tree.insert_depth_image(depth, *width, *height, intrinsics, &sensor, &params, deadline),
+                    } => tree
+                        .insert_depth_image(depth, *width, *height, intrinsics, &sensor, &params, deadline),
                 }
                 .map_err(|e| octree_error("scan", e))?;
                 if stats.status == ScanStatus::Cancelled {
