@@ -9,6 +9,7 @@ mod hostile;
 mod kinematics;
 mod mobile;
 mod planning;
+mod poses;
 mod robot;
 mod scoring;
 mod security;

@@ -37,10 +37,8 @@ class Octree:
     @classmethod
     def from_bt(cls, content: bytes) -> "Octree":
         """A whole ``.bt`` file's bytes (header lines ``id``, ``res``, ``data``)."""
-        from .planning import OctreeObstacle
-
-        o = OctreeObstacle.from_bt_file_bytes(content)
-        return cls(data=o.data, resolution=o.resolution, binary=True, tree_id=o.tree_id)
+        tree_id, resolution, data = _split_header(content)
+        return cls(data=data, resolution=resolution, binary=True, tree_id=tree_id)
 
     @classmethod
     def from_file_bytes(cls, content: bytes) -> "Octree":

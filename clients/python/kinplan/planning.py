@@ -146,20 +146,10 @@ class OctreeObstacle:
     @classmethod
     def from_bt_file_bytes(cls, content: bytes, **kwargs: Any) -> "OctreeObstacle":
         """Splits a ``.bt`` file's header (``id``, ``res``, ``data`` lines) from its nodes."""
-        tree_id, resolution, offset = "OcTree", None, 0
-        while True:
-            end = content.index(b"\n", offset)
-            line = content[offset:end].decode("ascii", "replace").strip()
-            offset = end + 1
-            if line.startswith("id "):
-                tree_id = line[3:].strip()
-            elif line.startswith("res "):
-                resolution = float(line[4:])
-            elif line == "data":
-                break
-        if resolution is None:
-            raise ValueError("the .bt header has no 'res' line")
-        return cls(data=content[offset:], resolution=resolution, tree_id=tree_id, binary=True, **kwargs)
+        from .octree import _split_header
+
+        tree_id, resolution, data = _split_header(content)
+        return cls(data=data, resolution=resolution, tree_id=tree_id, binary=True, **kwargs)
 
     def to_proto(self) -> common_pb2.CollisionObject:
         return common_pb2.CollisionObject(
