@@ -1,0 +1,434 @@
+//! TOPP-RA: the time-optimal speed along a [`Curve`] within per-joint
+//! velocity and acceleration limits, by reachability analysis (Pham & Pham,
+//! "A New Approach to Time-Optimal Path Parameterization Based on
+//! Reachability Analysis", IEEE T-RO 34(3), 2018).
+
+use super::curve::Curve;
+
+/// Most grid points of one profile (memory: about 2·dof + 6 values each).
+pub const MAX_GRID_POINTS: usize = 1_000_000;
+/// Largest tangent turn between two grid points on a curved piece, rad.
+const MAX_TURN_STEP: f64 = 0.05;
+
+/// Why no profile came out.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ToppError {
+    /// The grid would exceed [`MAX_GRID_POINTS`] (it would have this many).
+    TooManyGridPoints(usize),
+    /// The start speed `ṡ₀²` exceeds the largest the path can stop from
+    /// within the limits (`max`, (rad/s)²).
+    StartTooFast { max: f64 },
+    /// `should_stop` returned true.
+    Interrupted,
+}
+
+/// The squared path speed `x = ṡ²` on a grid `s_0 < … < s_{N−1}`, the
+/// constant path acceleration `u_i = s̈` on each interval and the time of
+/// each grid point.
+#[derive(Debug, Clone)]
+pub struct SpeedProfile {
+    pub s: Vec<f64>,
+    /// The piece grid point `i` and the interval after it belong to.
+    pub piece: Vec<usize>,
+    pub x: Vec<f64>,
+    pub u: Vec<f64>,
+    pub t: Vec<f64>,
+}
+
+impl SpeedProfile {
+    /// Duration, s.
+    pub fn duration(&self) -> f64 {
+        self.t.last().copied().unwrap_or(0.0)
+    }
+
+    /// The same path `k` (≥ 1) times slower: `x/k²`, `u/k²`, `t·k`, which
+    /// divides every joint velocity by `k` and acceleration by `k²`.
+    pub fn slow_down(&mut self, k: f64) {
+        let f = 1.0 / (k * k);
+        self.x.iter_mut().for_each(|v| *v *= f);
+        self.u.iter_mut().for_each(|v| *v *= f);
+        self.t.iter_mut().for_each(|v| *v *= k);
+    }
+}
+
+/// Grid, derivatives at the grid points and the left limits at piece starts.
+struct Grid {
+    s: Vec<f64>,
+    piece: Vec<usize>,
+    /// `q'`, `q''` at each grid point on its own piece (`N × dof`).
+    d1: Vec<f64>,
+    d2: Vec<f64>,
+    /// `q'`, `q''` at the start of piece `k` seen from piece `k − 1`
+    /// (`pieces × dof`; row 0 unused).
+    l1: Vec<f64>,
+    l2: Vec<f64>,
+    /// Upper bound of `x` from the path itself (0 where it must stop).
+    cap: Vec<f64>,
+}
+
+fn build_grid<C: Curve + ?Sized>(curve: &C, step: f64) -> Result<Grid, ToppError> {
+    let (p, dof) = (curve.pieces(), curve.dof());
+    let counts: Vec<usize> = (0..p)
+        .map(|k| {
+            let (a, b) = curve.span(k);
+            let by_len = ((b - a) / step).ceil();
+            let by_turn = (curve.turn(k) / MAX_TURN_STEP).ceil();
+            by_len.max(by_turn).clamp(2.0, MAX_GRID_POINTS as f64 + 1.0) as usize
+        })
+        .collect();
+    let total = counts.iter().fold(1usize, |s, c| s.saturating_add(*c));
+    if total > MAX_GRID_POINTS {
+        return Err(ToppError::TooManyGridPoints(total));
+    }
+    let mut g = Grid {
+        s: Vec::with_capacity(total),
+        piece: Vec::with_capacity(total),
+        d1: vec![0.0; total * dof],
+        d2: vec![0.0; total * dof],
+        l1: vec![0.0; p * dof],
+        l2: vec![0.0; p * dof],
+        cap: vec![f64::INFINITY; total],
+    };
+    let mut q = vec![0.0; dof];
+    for (k, &n) in counts.iter().enumerate() {
+        let (a, b) = curve.span(k);
+        if k > 0 {
+            let (l1, l2) = (
+                &mut g.l1[k * dof..(k + 1) * dof],
+                &mut g.l2[k * dof..(k + 1) * dof],
+            );
+            curve.eval(k - 1, a, &mut q, l1, l2);
+            if curve.stop_after(k - 1) {
+                g.cap[g.s.len()] = 0.0;
+            }
+        }
+        for i in 0..n {
+            g.s.push(a + (b - a) * i as f64 / n as f64);
+            g.piece.push(k);
+        }
+    }
+    g.s.push(curve.span(p - 1).1);
+    g.piece.push(p - 1);
+    g.cap[total - 1] = 0.0;
+    for i in 0..total {
+        let r = i * dof..(i + 1) * dof;
+        curve.eval(g.piece[i], g.s[i], &mut q, &mut g.d1[r.clone()], &mut g.d2[r]);
+    }
+    Ok(g)
+}
+
+/// Lines `u ≥ α + βx` (lower) and `u ≤ α + βx` (upper) of the joint
+/// constraints `|q'_j u + q''_j x| ≤ a_j`, and the bound on `x` from
+/// `|q'_j| ṡ ≤ v_j` (and from `|q''_j| x ≤ a_j` where `q'_j = 0`).
+fn joint_lines(
+    d1: &[f64],
+    d2: &[f64],
+    v: &[f64],
+    a: &[f64],
+    lower: &mut Vec<(f64, f64)>,
+    upper: &mut Vec<(f64, f64)>,
+    cap: &mut f64,
+) {
+    for j in 0..d1.len() {
+        let (p, q) = (d1[j], d2[j]);
+        if p.abs() > 1e-12 {
+            *cap = cap.min((v[j] / p).powi(2));
+            let slope = -q / p;
+            let w = a[j] / p.abs();
+            lower.push((-w, slope));
+            upper.push((w, slope));
+        } else if q.abs() > 1e-12 {
+            *cap = cap.min(a[j] / q.abs());
+        }
+    }
+}
+
+/// The interval of `x ≥ 0`, `x ≤ cap`, for which some `u` lies above every
+/// lower line and below every upper line: each pair gives
+/// `(β_l − β_u) x ≤ α_u − α_l`.
+fn feasible(lower: &[(f64, f64)], upper: &[(f64, f64)], cap: f64) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (0.0f64, cap);
+    for &(al, bl) in lower {
+        for &(au, bu) in upper {
+            let c = bl - bu;
+            let r = au - al;
+            if c > 0.0 {
+                hi = hi.min(r / c);
+            } else if c < 0.0 {
+                lo = lo.max(r / c);
+            } else if r < 0.0 {
+                return None;
+            }
+        }
+    }
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// The time-optimal `x(s)` along `curve` from `ṡ² = x0` to rest.
+///
+/// Constraints at grid point `i` (`q'`, `q''` there; at a piece start also
+/// those of the piece before): `|q'_j| √x ≤ v_j` and
+/// `−a_j ≤ q'_j u + q''_j x ≤ a_j`, with `x_{i+1} = x_i + 2 Δ_i u_i`
+/// (Pham & Pham 2018, eqs. 5–8). A backward pass computes the controllable
+/// sets `K_i = [lo_i, hi_i]` — the `x_i` from which rest at the end remains
+/// reachable — each a two-variable LP solved exactly over line pairs; a
+/// forward pass then takes the largest `u_i` that keeps `x_{i+1}` in
+/// `K_{i+1}` (Theorem 3: this greedy choice is time-optimal on the grid).
+/// Interval times are `2Δ_i / (√x_i + √x_{i+1})`.
+///
+/// The limits are then checked at both ends of every interval (the
+/// derivatives change along an arc and jump between pieces); if the grid
+/// lets a limit be exceeded by a factor, `x` and `u` are divided by `k²`
+/// with `k = max(v ratio, √(a ratio))` — a uniform slow-down that makes every
+/// checked value feasible.
+pub fn topp_ra<C: Curve + ?Sized>(
+    curve: &C,
+    v: &[f64],
+    a: &[f64],
+    x0: f64,
+    step: f64,
+    should_stop: &dyn Fn() -> bool,
+) -> Result<SpeedProfile, ToppError> {
+    let dof = curve.dof();
+    let g = build_grid(curve, step)?;
+    let n = g.s.len();
+    let mut lower = Vec::with_capacity(2 * dof + 1);
+    let mut upper = Vec::with_capacity(2 * dof + 1);
+    // constraints at grid point i (without the transition lines)
+    let stage = |i: usize, lower: &mut Vec<(f64, f64)>, upper: &mut Vec<(f64, f64)>| -> f64 {
+        lower.clear();
+        upper.clear();
+        let mut cap = g.cap[i];
+        let r = i * dof..(i + 1) * dof;
+        joint_lines(&g.d1[r.clone()], &g.d2[r], v, a, lower, upper, &mut cap);
+        let k = g.piece[i];
+        if i > 0 && g.piece[i - 1] != k {
+            let r = k * dof..(k + 1) * dof;
+            joint_lines(&g.l1[r.clone()], &g.l2[r], v, a, lower, upper, &mut cap);
+        }
+        cap
+    };
+    let mut lo = vec![0.0; n];
+    let mut hi = vec![0.0; n];
+    for i in (0..n - 1).rev() {
+        if i % 4096 == 0 && should_stop() {
+            return Err(ToppError::Interrupted);
+        }
+        let cap = stage(i, &mut lower, &mut upper);
+        let w = 1.0 / (2.0 * (g.s[i + 1] - g.s[i]));
+        lower.push((lo[i + 1] * w, -w));
+        upper.push((hi[i + 1] * w, -w));
+        let (l, h) = feasible(&lower, &upper, cap).unwrap_or((0.0, 0.0));
+        lo[i] = l;
+        hi[i] = h;
+    }
+    if x0 > hi[0] * (1.0 + 1e-9) + 1e-12 {
+        return Err(ToppError::StartTooFast { max: hi[0] });
+    }
+    let mut x = vec![0.0; n];
+    let mut u = vec![0.0; n - 1];
+    x[0] = x0.min(hi[0]);
+    for i in 0..n - 1 {
+        stage(i, &mut lower, &mut upper);
+        let delta = g.s[i + 1] - g.s[i];
+        let joint_max = upper
+            .iter()
+            .map(|&(al, be)| al + be * x[i])
+            .fold(f64::INFINITY, f64::min);
+        let reach_max = (hi[i + 1] - x[i]) / (2.0 * delta);
+        let next = (x[i] + 2.0 * delta * joint_max.min(reach_max)).clamp(lo[i + 1], hi[i + 1]);
+        x[i + 1] = next.max(0.0);
+        u[i] = (x[i + 1] - x[i]) / (2.0 * delta);
+    }
+    // check both ends of every interval; slow down uniformly if needed
+    let mut worst = 1.0f64;
+    for i in 0..n - 1 {
+        let k = g.piece[i];
+        let here = i * dof..(i + 1) * dof;
+        let there = if g.piece[i + 1] == k || i + 1 == n - 1 {
+            (i + 1) * dof..(i + 2) * dof
+        } else {
+            (k + 1) * dof..(k + 2) * dof
+        };
+        let (e1, e2) = if g.piece[i + 1] == k || i + 1 == n - 1 {
+            (&g.d1[there.clone()], &g.d2[there])
+        } else {
+            (&g.l1[there.clone()], &g.l2[there])
+        };
+        for (d1, d2, xx) in [
+            (&g.d1[here.clone()], &g.d2[here.clone()], x[i]),
+            (e1, e2, x[i + 1]),
+        ] {
+            for j in 0..dof {
+                let rv = d1[j].abs() * xx.sqrt() / v[j];
+                let ra = (d1[j] * u[i] + d2[j] * xx).abs() / a[j];
+                worst = worst.max(rv).max(ra.sqrt());
+            }
+        }
+    }
+    if worst > 1.0 {
+        let f = 1.0 / (worst * worst * (1.0 + 1e-12));
+        x.iter_mut().for_each(|v| *v *= f);
+        u.iter_mut().for_each(|v| *v *= f);
+    }
+    let mut t = vec![0.0; n];
+    for i in 0..n - 1 {
+        let speed = x[i].sqrt() + x[i + 1].sqrt();
+        // both ends at rest means x_{i+1} = x_i + 2Δu = 0 with u = 0: the
+        // backward pass keeps every interior hi_i > 0 (braking to rest over
+        // one interval is always feasible), so only a rounding-level
+        // interval can get here, and it takes no time
+        let dt = if speed > 0.0 {
+            2.0 * (g.s[i + 1] - g.s[i]) / speed
+        } else {
+            0.0
+        };
+        t[i + 1] = t[i] + dt;
+    }
+    Ok(SpeedProfile {
+        s: g.s,
+        piece: g.piece,
+        x,
+        u,
+        t,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A circle of radius `r` in joints (0, 1), `laps` times around,
+    /// starting at angle 0: `q = r (cos(s/r), sin(s/r))`.
+    struct Circle {
+        r: f64,
+        laps: f64,
+    }
+
+    impl Curve for Circle {
+        fn dof(&self) -> usize {
+            2
+        }
+        fn pieces(&self) -> usize {
+            1
+        }
+        fn span(&self, _: usize) -> (f64, f64) {
+            (0.0, 2.0 * std::f64::consts::PI * self.r * self.laps)
+        }
+        fn turn(&self, _: usize) -> f64 {
+            2.0 * std::f64::consts::PI * self.laps
+        }
+        fn stop_after(&self, _: usize) -> bool {
+            false
+        }
+        fn eval(&self, _: usize, s: f64, q: &mut [f64], d1: &mut [f64], d2: &mut [f64]) {
+            let (sn, cs) = (s / self.r).sin_cos();
+            q.copy_from_slice(&[self.r * cs, self.r * sn]);
+            d1.copy_from_slice(&[-sn, cs]);
+            d2.copy_from_slice(&[-cs / self.r, -sn / self.r]);
+        }
+    }
+
+    #[test]
+    fn the_speed_on_a_circle_meets_the_closed_form_limit_curve() {
+        // With |q̈_j| ≤ a on a circle of radius r at angle θ, (s̈, ṡ²/r) is
+        // rotated onto the joints, so the largest feasible ṡ² is
+        // a r (|cos θ| + |sin θ|): a r at every quarter turn.
+        let (r, acc) = (0.5, 2.0);
+        let c = Circle { r, laps: 1.0 };
+        let p = topp_ra(&c, &[100.0, 100.0], &[acc, acc], 0.0, 1e-3, &|| false).unwrap();
+        for (s, x) in p.s.iter().zip(&p.x) {
+            let th = s / r;
+            let mvc = acc * r * (th.cos().abs() + th.sin().abs());
+            assert!(*x <= mvc * (1.0 + 1e-6), "s {s}: {x} > {mvc}");
+        }
+        // the optimal profile touches the curve's minima at a quarter, half
+        // and three quarters of the lap
+        for quarter in 1..=3 {
+            let s = quarter as f64 * std::f64::consts::FRAC_PI_2 * r;
+            let i = p.s.iter().position(|v| *v >= s - 1e-9).unwrap();
+            let rel = p.x[i] / (acc * r);
+            assert!((rel - 1.0).abs() < 0.01, "quarter {quarter}: x/(a r) = {rel}");
+        }
+    }
+
+    /// One straight joint-space segment of length `len` along `dir`.
+    struct Line {
+        dir: Vec<f64>,
+        len: f64,
+    }
+
+    impl Curve for Line {
+        fn dof(&self) -> usize {
+            self.dir.len()
+        }
+        fn pieces(&self) -> usize {
+            1
+        }
+        fn span(&self, _: usize) -> (f64, f64) {
+            (0.0, self.len)
+        }
+        fn turn(&self, _: usize) -> f64 {
+            0.0
+        }
+        fn stop_after(&self, _: usize) -> bool {
+            false
+        }
+        fn eval(&self, _: usize, s: f64, q: &mut [f64], d1: &mut [f64], d2: &mut [f64]) {
+            for j in 0..self.dir.len() {
+                q[j] = s * self.dir[j];
+                d1[j] = self.dir[j];
+                d2[j] = 0.0;
+            }
+        }
+    }
+
+    #[test]
+    fn a_straight_line_from_rest_to_rest_is_bang_bang() {
+        // joint 0 limits: path speed ≤ v/|d0|, path acceleration ≤ a/|d0|
+        let dir = vec![0.6, 0.8];
+        for (len, v, a) in [(2.0, [1.0, 1.0], [1.0, 1.0]), (0.3, [1.0, 1.0], [2.0, 2.0])] {
+            let p = topp_ra(
+                &Line {
+                    dir: dir.clone(),
+                    len,
+                },
+                &v,
+                &a,
+                0.0,
+                1e-3,
+                &|| false,
+            )
+            .unwrap();
+            // joint 1 (0.8) binds both: path limits v/0.8, a/0.8
+            let (vs, as_) = (v[1] / 0.8, a[1] / 0.8);
+            let expected = if len >= vs * vs / as_ {
+                len / vs + vs / as_ // trapezoid
+            } else {
+                2.0 * (len / as_).sqrt() // triangle
+            };
+            assert!(
+                (p.duration() - expected).abs() < 1e-3 * expected,
+                "len {len}: {} vs {expected}",
+                p.duration()
+            );
+            assert!(p.x.iter().all(|x| x.sqrt() <= vs * (1.0 + 1e-9)));
+            assert!(p.u.iter().all(|u| u.abs() <= as_ * (1.0 + 1e-9)));
+        }
+    }
+
+    #[test]
+    fn a_start_speed_too_high_to_stop_is_refused() {
+        let line = Line {
+            dir: vec![1.0],
+            len: 0.1,
+        };
+        // stopping from ṡ within 0.1 at a = 1 needs ṡ² ≤ 0.2
+        let p = topp_ra(&line, &[10.0], &[1.0], 0.19, 1e-3, &|| false).unwrap();
+        assert!((p.x[0] - 0.19).abs() < 1e-12);
+        match topp_ra(&line, &[10.0], &[1.0], 0.3, 1e-3, &|| false) {
+            Err(ToppError::StartTooFast { max }) => assert!((max - 0.2).abs() < 1e-9, "{max}"),
+            other => panic!("{other:?}"),
+        }
+    }
+}
