@@ -8,6 +8,7 @@ mod hostile;
 mod kinematics;
 mod mobile;
 mod planning;
+mod retime;
 mod robot;
 mod scoring;
 mod security;
