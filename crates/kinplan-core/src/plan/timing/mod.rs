@@ -221,9 +221,9 @@ fn time_optimal(
     let mut profile = profile;
     // Between grid points an arc turns the tangent a little further than the
     // grid's checks see; the samples are checked and, should one exceed a
-    // limit by a factor, the whole profile is slowed by it (rarely more than
-    // a few parts in 10⁴) and sampled again.
-    for _ in 0..3 {
+    // limit by a factor k, the whole profile is slowed by 2k − 1 (rarely
+    // more than a few parts in 10³) and sampled again.
+    for _ in 0..5 {
         let times = sample::sample_times(profile.duration(), params.sample_period, dof)
             .ok_or(too_many_samples(params.sample_period))?;
         let out =
@@ -232,7 +232,8 @@ fn time_optimal(
         if k <= 1.0 {
             return Ok(out);
         }
-        profile.slow_down(k * (1.0 + 1e-9));
+        // resampling moves the samples; overshoot so the next check passes
+        profile.slow_down(1.0 + 2.0 * (k - 1.0) + 1e-12);
     }
     Err(PlanError::InvalidParam {
         field: PlanField::GridStep,

@@ -143,6 +143,28 @@ fn joint_lines(
     }
 }
 
+/// The acceleration lines of [`joint_lines`] alone, for coefficients that
+/// are not a path tangent (no speed bound from them).
+fn accel_lines(
+    p: &[f64],
+    q: &[f64],
+    a: &[f64],
+    lower: &mut Vec<(f64, f64)>,
+    upper: &mut Vec<(f64, f64)>,
+    cap: &mut f64,
+) {
+    for j in 0..p.len() {
+        if p[j].abs() > 1e-12 {
+            let slope = -q[j] / p[j];
+            let w = a[j] / p[j].abs();
+            lower.push((-w, slope));
+            upper.push((w, slope));
+        } else if q[j].abs() > 1e-12 {
+            *cap = cap.min(a[j] / q[j].abs());
+        }
+    }
+}
+
 /// The interval of `x ≥ 0`, `x ≤ cap`, for which some `u` lies above every
 /// lower line and below every upper line: each pair gives
 /// `(β_l − β_u) x ≤ α_u − α_l`.
@@ -166,10 +188,11 @@ fn feasible(lower: &[(f64, f64)], upper: &[(f64, f64)], cap: f64) -> Option<(f64
 
 /// The time-optimal `x(s)` along `curve` from `ṡ² = x0` to rest.
 ///
-/// Constraints at grid point `i` (`q'`, `q''` there; at a piece start also
-/// those of the piece before): `|q'_j| √x ≤ v_j` and
+/// Constraints at grid point `i` (`q'`, `q''` there): `|q'_j| √x ≤ v_j` and
 /// `−a_j ≤ q'_j u + q''_j x ≤ a_j`, with `x_{i+1} = x_i + 2 Δ_i u_i`
-/// (Pham & Pham 2018, eqs. 5–8). A backward pass computes the controllable
+/// (Pham & Pham 2018, eqs. 5–8); on a curved piece the acceleration is
+/// also bounded where the interval ends (with `u_i` and `x_{i+1}`, written
+/// in `u_i`, `x_i`), so it holds on both sides of a junction. A backward pass computes the controllable
 /// sets `K_i = [lo_i, hi_i]` — the `x_i` from which rest at the end remains
 /// reachable — each a two-variable LP solved exactly over line pairs; a
 /// forward pass then takes the largest `u_i` that keeps `x_{i+1}` in
@@ -194,17 +217,36 @@ pub fn topp_ra<C: Curve + ?Sized>(
     let n = g.s.len();
     let mut lower = Vec::with_capacity(2 * dof + 1);
     let mut upper = Vec::with_capacity(2 * dof + 1);
-    // constraints at grid point i (without the transition lines)
-    let stage = |i: usize, lower: &mut Vec<(f64, f64)>, upper: &mut Vec<(f64, f64)>| -> f64 {
+    let mut end1 = vec![0.0; dof];
+    let mut end2 = vec![0.0; dof];
+    // q', q'' where interval i ends, on its own piece
+    let end_of = |i: usize| -> (&[f64], &[f64]) {
+        let k = g.piece[i];
+        if g.piece[i + 1] == k || i + 2 == n {
+            let r = (i + 1) * dof..(i + 2) * dof;
+            (&g.d1[r.clone()], &g.d2[r])
+        } else {
+            let r = (k + 1) * dof..(k + 2) * dof;
+            (&g.l1[r.clone()], &g.l2[r])
+        }
+    };
+    // Constraints of interval i on (u_i, x_i), without the transition lines:
+    // at its start, and on a curved piece also at its end, where
+    // q'_e u + q''_e (x + 2Δu) = (q'_e + 2Δ q''_e) u + q''_e x.
+    let mut stage = |i: usize, lower: &mut Vec<(f64, f64)>, upper: &mut Vec<(f64, f64)>| -> f64 {
         lower.clear();
         upper.clear();
         let mut cap = g.cap[i];
         let r = i * dof..(i + 1) * dof;
         joint_lines(&g.d1[r.clone()], &g.d2[r], v, a, lower, upper, &mut cap);
-        let k = g.piece[i];
-        if i > 0 && g.piece[i - 1] != k {
-            let r = k * dof..(k + 1) * dof;
-            joint_lines(&g.l1[r.clone()], &g.l2[r], v, a, lower, upper, &mut cap);
+        if curve.turn(g.piece[i]) > 0.0 {
+            let delta = g.s[i + 1] - g.s[i];
+            let (e1, e2) = end_of(i);
+            for j in 0..dof {
+                end1[j] = e1[j] + 2.0 * delta * e2[j];
+                end2[j] = e2[j];
+            }
+            accel_lines(&end1, &end2, a, lower, upper, &mut cap);
         }
         cap
     };
@@ -243,18 +285,8 @@ pub fn topp_ra<C: Curve + ?Sized>(
     // check both ends of every interval; slow down uniformly if needed
     let mut worst = 1.0f64;
     for i in 0..n - 1 {
-        let k = g.piece[i];
         let here = i * dof..(i + 1) * dof;
-        let there = if g.piece[i + 1] == k || i + 1 == n - 1 {
-            (i + 1) * dof..(i + 2) * dof
-        } else {
-            (k + 1) * dof..(k + 2) * dof
-        };
-        let (e1, e2) = if g.piece[i + 1] == k || i + 1 == n - 1 {
-            (&g.d1[there.clone()], &g.d2[there])
-        } else {
-            (&g.l1[there.clone()], &g.l2[there])
-        };
+        let (e1, e2) = end_of(i);
         for (d1, d2, xx) in [
             (&g.d1[here.clone()], &g.d2[here.clone()], x[i]),
             (e1, e2, x[i + 1]),
