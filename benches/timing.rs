@@ -33,6 +33,25 @@ fn random_walk(seed: u64) -> Vec<f64> {
     out
 }
 
+/// CPU time this thread has run, ns (`/proc/thread-self/schedstat`): on a
+/// machine shared with other builds, wall time counts the waits for a core.
+fn thread_cpu_ns() -> u64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0)
+}
+
+/// Mean on-CPU time of `f`, µs, over `iters` calls.
+fn cpu_us(iters: u32, mut f: impl FnMut()) -> f64 {
+    f();
+    let t0 = thread_cpu_ns();
+    for _ in 0..iters {
+        f();
+    }
+    (thread_cpu_ns() - t0) as f64 / 1e3 / iters as f64
+}
+
 fn bench(c: &mut Criterion) {
     let path = random_walk(1);
     let params = |method| TimingParams {
@@ -44,11 +63,31 @@ fn bench(c: &mut Criterion) {
     let optimal = params(TimingMethod::TimeOptimal);
     let jerk = params(TimingMethod::JerkLimited);
     let r = retime(&path, DOF, &V, &optimal, &|| false).unwrap();
+    let blended = BlendedPath::new(&path, DOF, optimal.path_tolerance);
+    let grid = topp_ra(&blended, &V, &A, 0.0, optimal.grid_step, &|| false)
+        .unwrap()
+        .s
+        .len();
     println!(
-        "time-optimal: {:.4} s, {} samples; jerk-limited: {:.4} s",
+        "time-optimal: {:.4} s, {} samples, {} grid points, {} path pieces; jerk-limited: {:.4} s",
         r.duration(),
         r.len(),
+        grid,
+        kinplan_core::plan::Curve::pieces(&blended),
         retime(&path, DOF, &V, &jerk, &|| false).unwrap().duration()
+    );
+    let blended_cpu = BlendedPath::new(&path, DOF, optimal.path_tolerance);
+    println!(
+        "on-CPU us per call (mean of 2000): time_optimal {:.1}, TOPP-RA alone {:.1}, jerk_limited {:.1}",
+        cpu_us(2000, || {
+            black_box(retime(black_box(&path), DOF, &V, &optimal, &|| false).unwrap());
+        }),
+        cpu_us(2000, || {
+            black_box(topp_ra(&blended_cpu, &V, &A, 0.0, optimal.grid_step, &|| false).unwrap());
+        }),
+        cpu_us(2000, || {
+            black_box(retime(black_box(&path), DOF, &V, &jerk, &|| false).unwrap());
+        }),
     );
     c.bench_function(
         "retime time_optimal 50x7 (blend + TOPP-RA + 10 ms samples)",

@@ -8,7 +8,7 @@ use super::curve::Curve;
 /// Most grid points of one profile (memory: about 2·dof + 6 values each).
 pub const MAX_GRID_POINTS: usize = 1_000_000;
 /// Largest tangent turn between two grid points on a curved piece, rad.
-const MAX_TURN_STEP: f64 = 0.05;
+const MAX_TURN_STEP: f64 = 0.1;
 
 /// Why no profile came out.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -165,25 +165,43 @@ fn accel_lines(
     }
 }
 
-/// The interval of `x ≥ 0`, `x ≤ cap`, for which some `u` lies above every
-/// lower line and below every upper line: each pair gives
-/// `(β_l − β_u) x ≤ α_u − α_l`.
-fn feasible(lower: &[(f64, f64)], upper: &[(f64, f64)], cap: f64) -> Option<(f64, f64)> {
-    let (mut lo, mut hi) = (0.0f64, cap);
-    for &(al, bl) in lower {
-        for &(au, bu) in upper {
-            let c = bl - bu;
-            let r = au - al;
-            if c > 0.0 {
-                hi = hi.min(r / c);
-            } else if c < 0.0 {
-                lo = lo.max(r / c);
-            } else if r < 0.0 {
-                return None;
+/// The largest `x` in `[0, cap]` for which some `u` lies above every lower
+/// line and below every upper line, given that `x = 0` is such a point.
+///
+/// `g(x) = min_m u_m(x) − max_l l_l(x)` is concave and piecewise linear with
+/// `g(0) ≥ 0`, so the feasible `x` form an interval `[0, x*]`. Newton's
+/// method on `g` from `x = cap` moves left monotonically (a concave
+/// function lies below its tangents) and lands on `x*` exactly after at most
+/// as many steps as `g` has pieces — usually one or two, each O(lines).
+fn largest_feasible(lower: &[(f64, f64)], upper: &[(f64, f64)], cap: f64) -> f64 {
+    let mut x = cap;
+    for _ in 0..64 {
+        let (mut lv, mut ls) = (f64::NEG_INFINITY, 0.0);
+        for &(a, b) in lower {
+            let y = a + b * x;
+            // ties: the smaller slope is the one active just left of x
+            if y > lv || (y == lv && b < ls) {
+                (lv, ls) = (y, b);
             }
         }
+        let (mut uv, mut us) = (f64::INFINITY, 0.0);
+        for &(a, b) in upper {
+            let y = a + b * x;
+            if y < uv || (y == uv && b > us) {
+                (uv, us) = (y, b);
+            }
+        }
+        let g = uv - lv;
+        if g >= -1e-12 * (1.0 + uv.abs().max(lv.abs())) {
+            return x;
+        }
+        let slope = us - ls;
+        if slope >= 0.0 {
+            return 0.0; // cannot happen for a concave g with g(0) ≥ 0
+        }
+        x = (x - g / slope).max(0.0);
     }
-    (lo <= hi).then_some((lo, hi))
+    x
 }
 
 /// The time-optimal `x(s)` along `curve` from `ṡ² = x0` to rest.
@@ -192,9 +210,10 @@ fn feasible(lower: &[(f64, f64)], upper: &[(f64, f64)], cap: f64) -> Option<(f64
 /// `−a_j ≤ q'_j u + q''_j x ≤ a_j`, with `x_{i+1} = x_i + 2 Δ_i u_i`
 /// (Pham & Pham 2018, eqs. 5–8); on a curved piece the acceleration is
 /// also bounded where the interval ends (with `u_i` and `x_{i+1}`, written
-/// in `u_i`, `x_i`), so it holds on both sides of a junction. A backward pass computes the controllable
-/// sets `K_i = [lo_i, hi_i]` — the `x_i` from which rest at the end remains
-/// reachable — each a two-variable LP solved exactly over line pairs; a
+/// in `u_i`, `x_i`), so it holds on both sides of a junction. A backward
+/// pass computes the controllable sets `K_i = [0, hi_i]` — the `x_i` from
+/// which rest at the end remains reachable — each a two-variable LP solved
+/// exactly ([`largest_feasible`]); a
 /// forward pass then takes the largest `u_i` that keeps `x_{i+1}` in
 /// `K_{i+1}` (Theorem 3: this greedy choice is time-optimal on the grid).
 /// Interval times are `2Δ_i / (√x_i + √x_{i+1})`.
@@ -250,7 +269,8 @@ pub fn topp_ra<C: Curve + ?Sized>(
         }
         cap
     };
-    let mut lo = vec![0.0; n];
+    // lo_i = 0 throughout: from x_i = 0, u_i = 0 stays at rest within
+    // every limit, and rest at the end stays reachable
     let mut hi = vec![0.0; n];
     for i in (0..n - 1).rev() {
         if i % 4096 == 0 && should_stop() {
@@ -258,11 +278,9 @@ pub fn topp_ra<C: Curve + ?Sized>(
         }
         let cap = stage(i, &mut lower, &mut upper);
         let w = 1.0 / (2.0 * (g.s[i + 1] - g.s[i]));
-        lower.push((lo[i + 1] * w, -w));
+        lower.push((0.0, -w));
         upper.push((hi[i + 1] * w, -w));
-        let (l, h) = feasible(&lower, &upper, cap).unwrap_or((0.0, 0.0));
-        lo[i] = l;
-        hi[i] = h;
+        hi[i] = largest_feasible(&lower, &upper, cap);
     }
     if x0 > hi[0] * (1.0 + 1e-9) + 1e-12 {
         return Err(ToppError::StartTooFast { max: hi[0] });
@@ -278,8 +296,7 @@ pub fn topp_ra<C: Curve + ?Sized>(
             .map(|&(al, be)| al + be * x[i])
             .fold(f64::INFINITY, f64::min);
         let reach_max = (hi[i + 1] - x[i]) / (2.0 * delta);
-        let next = (x[i] + 2.0 * delta * joint_max.min(reach_max)).clamp(lo[i + 1], hi[i + 1]);
-        x[i + 1] = next.max(0.0);
+        x[i + 1] = (x[i] + 2.0 * delta * joint_max.min(reach_max)).clamp(0.0, hi[i + 1]);
         u[i] = (x[i + 1] - x[i]) / (2.0 * delta);
     }
     // check both ends of every interval; slow down uniformly if needed
@@ -446,6 +463,37 @@ mod tests {
             );
             assert!(p.x.iter().all(|x| x.sqrt() <= vs * (1.0 + 1e-9)));
             assert!(p.u.iter().all(|u| u.abs() <= as_ * (1.0 + 1e-9)));
+        }
+    }
+
+    #[test]
+    fn newton_finds_the_same_bound_as_every_pair_of_lines() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for _ in 0..2000 {
+            let m = rng.random_range(1..9);
+            // lines through a feasible x = 0: lower α ≤ 0 ≤ upper α
+            let lower: Vec<(f64, f64)> = (0..m)
+                .map(|_| (-rng.random_range(0.0..3.0), rng.random_range(-5.0..5.0)))
+                .collect();
+            let upper: Vec<(f64, f64)> = (0..m)
+                .map(|_| (rng.random_range(0.0..3.0), rng.random_range(-5.0..5.0)))
+                .collect();
+            let cap: f64 = rng.random_range(0.1..10.0);
+            // each pair: (β_l − β_u) x ≤ α_u − α_l
+            let mut pairs = cap;
+            for &(al, bl) in &lower {
+                for &(au, bu) in &upper {
+                    if bl - bu > 0.0 {
+                        pairs = pairs.min((au - al) / (bl - bu));
+                    }
+                }
+            }
+            let newton = largest_feasible(&lower, &upper, cap);
+            assert!(
+                (newton - pairs).abs() <= 1e-9 * (1.0 + pairs),
+                "{newton} vs {pairs}"
+            );
         }
     }
 
