@@ -146,14 +146,14 @@ def test_jerk_limited_retime_keeps_every_limit_by_finite_differences_at_1_khz(ur
     assert one.duration == pytest.approx(1.7, abs=1e-9)
 
 
-def test_plan_exposes_velocities_and_accelerations(client, ur5):
-    plan = client.plan(ur5, start=START, goal=GOAL, algorithm="rrt_connect",
-                       timing={"method": "time_optimal", "max_velocity": V, "max_acceleration": A})
+def test_plan_exposes_velocities_and_accelerations(ur5):
+    plan = ur5.plan(START, GOAL, algorithm="rrt_connect",
+                    timing={"method": "time_optimal", "max_velocity": V, "max_acceleration": A})
     assert plan.success, plan.message
     assert plan.qd.shape == plan.q.shape == plan.qdd.shape
     assert np.all(np.abs(plan.qd) <= V * (1 + 1e-6)) and np.all(np.abs(plan.qdd) <= A * (1 + 1e-6))
     assert plan.duration == pytest.approx(plan.t[-1])
-    default = client.plan(ur5, start=START, goal=GOAL, algorithm="rrt_connect")
+    default = ur5.plan(START, GOAL, algorithm="rrt_connect")
     assert default.qd.shape == default.q.shape
     np.testing.assert_array_equal(default.qd[[0, -1]], 0.0)
 
