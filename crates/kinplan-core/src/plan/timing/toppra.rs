@@ -132,9 +132,10 @@ fn joint_lines(
     for j in 0..d1.len() {
         let (p, q) = (d1[j], d2[j]);
         if p.abs() > 1e-12 {
-            *cap = cap.min((v[j] / p).powi(2));
-            let slope = -q / p;
-            let w = a[j] / p.abs();
+            let ip = 1.0 / p;
+            *cap = cap.min((v[j] * ip).powi(2));
+            let slope = -q * ip;
+            let w = a[j] * ip.abs();
             lower.push((-w, slope));
             upper.push((w, slope));
         } else if q.abs() > 1e-12 {
@@ -155,8 +156,9 @@ fn accel_lines(
 ) {
     for j in 0..p.len() {
         if p[j].abs() > 1e-12 {
-            let slope = -q[j] / p[j];
-            let w = a[j] / p[j].abs();
+            let ip = 1.0 / p[j];
+            let slope = -q[j] * ip;
+            let w = a[j] * ip.abs();
             lower.push((-w, slope));
             upper.push((w, slope));
         } else if q[j].abs() > 1e-12 {
@@ -218,8 +220,8 @@ fn largest_feasible(lower: &[(f64, f64)], upper: &[(f64, f64)], cap: f64) -> f64
 /// `K_{i+1}` (Theorem 3: this greedy choice is time-optimal on the grid).
 /// Interval times are `2Δ_i / (√x_i + √x_{i+1})`.
 ///
-/// The limits are then checked at both ends of every interval (the
-/// derivatives change along an arc and jump between pieces); if the grid
+/// The limits are then checked at both ends of every interval and in the
+/// middle of curved ones (the derivatives change along an arc); if the grid
 /// lets a limit be exceeded by a factor, `x` and `u` are divided by `k²`
 /// with `k = max(v ratio, √(a ratio))` — a uniform slow-down that makes every
 /// checked value feasible.
@@ -271,13 +273,47 @@ pub fn topp_ra<C: Curve + ?Sized>(
     };
     // lo_i = 0 throughout: from x_i = 0, u_i = 0 stays at rest within
     // every limit, and rest at the end stays reachable
+    // A straight piece has constant constraints: |u| ≤ A_k, x ≤ C_k
+    // (A_k = min_j a_j/|q'_j|, C_k = min_j (v_j/q'_j)²), so its controllable
+    // sets follow hi_i = min(C_k, hi_{i+1} + 2Δ A_k) in O(1) per point.
+    let pieces = curve.pieces();
+    let mut line_acc = vec![f64::INFINITY; pieces];
+    let mut line_cap = vec![f64::INFINITY; pieces];
+    let mut first = 0;
+    for k in 0..pieces {
+        while g.piece[first] != k {
+            first += 1;
+        }
+        if curve.turn(k) == 0.0 {
+            for j in 0..dof {
+                let p = g.d1[first * dof + j].abs();
+                if p > 1e-12 {
+                    line_acc[k] = line_acc[k].min(a[j] / p);
+                    line_cap[k] = line_cap[k].min((v[j] / p).powi(2));
+                }
+            }
+        }
+    }
+    // the joint lines of curved stages, kept for the forward pass
+    let mut kept_upper: Vec<(f64, f64)> = Vec::with_capacity(n * 2 * dof);
+    let mut kept_at = vec![(0u32, 0u32); n];
     let mut hi = vec![0.0; n];
     for i in (0..n - 1).rev() {
         if i % 4096 == 0 && should_stop() {
             return Err(ToppError::Interrupted);
         }
+        let k = g.piece[i];
+        let delta = g.s[i + 1] - g.s[i];
+        if curve.turn(k) == 0.0 {
+            hi[i] = g.cap[i]
+                .min(line_cap[k])
+                .min(hi[i + 1] + 2.0 * delta * line_acc[k]);
+            continue;
+        }
         let cap = stage(i, &mut lower, &mut upper);
-        let w = 1.0 / (2.0 * (g.s[i + 1] - g.s[i]));
+        kept_at[i] = (kept_upper.len() as u32, (kept_upper.len() + upper.len()) as u32);
+        kept_upper.extend_from_slice(&upper);
+        let w = 1.0 / (2.0 * delta);
         lower.push((0.0, -w));
         upper.push((hi[i + 1] * w, -w));
         hi[i] = largest_feasible(&lower, &upper, cap);
@@ -289,32 +325,50 @@ pub fn topp_ra<C: Curve + ?Sized>(
     let mut u = vec![0.0; n - 1];
     x[0] = x0.min(hi[0]);
     for i in 0..n - 1 {
-        stage(i, &mut lower, &mut upper);
+        let k = g.piece[i];
         let delta = g.s[i + 1] - g.s[i];
-        let joint_max = upper
-            .iter()
-            .map(|&(al, be)| al + be * x[i])
-            .fold(f64::INFINITY, f64::min);
+        let joint_max = if curve.turn(k) == 0.0 {
+            line_acc[k]
+        } else {
+            let (from, to) = kept_at[i];
+            kept_upper[from as usize..to as usize]
+                .iter()
+                .map(|&(al, be)| al + be * x[i])
+                .fold(f64::INFINITY, f64::min)
+        };
         let reach_max = (hi[i + 1] - x[i]) / (2.0 * delta);
         x[i + 1] = (x[i] + 2.0 * delta * joint_max.min(reach_max)).clamp(0.0, hi[i + 1]);
         u[i] = (x[i + 1] - x[i]) / (2.0 * delta);
     }
-    // check both ends of every interval; slow down uniformly if needed
-    let mut worst = 1.0f64;
+    // check both ends of every interval and the middle of curved ones;
+    // slow down uniformly if needed
+    let (mut worst_v, mut worst_a) = (1.0f64, 1.0f64);
+    let inv_v: Vec<f64> = v.iter().map(|x| 1.0 / x).collect();
+    let inv_a: Vec<f64> = a.iter().map(|x| 1.0 / x).collect();
+    let (mut q, mut m1, mut m2) = (vec![0.0; dof], vec![0.0; dof], vec![0.0; dof]);
     for i in 0..n - 1 {
         let here = i * dof..(i + 1) * dof;
         let (e1, e2) = end_of(i);
-        for (d1, d2, xx) in [
-            (&g.d1[here.clone()], &g.d2[here.clone()], x[i]),
+        let k = g.piece[i];
+        let curved = curve.turn(k) > 0.0;
+        if curved {
+            curve.eval(k, (g.s[i] + g.s[i + 1]) / 2.0, &mut q, &mut m1, &mut m2);
+        }
+        let x_mid = (x[i] + x[i + 1]) / 2.0;
+        let checks = [
+            (&g.d1[here.clone()], &g.d2[here], x[i]),
             (e1, e2, x[i + 1]),
-        ] {
+            (&m1[..], &m2[..], x_mid),
+        ];
+        for &(d1, d2, xx) in &checks[..if curved { 3 } else { 2 }] {
+            let sd = xx.sqrt();
             for j in 0..dof {
-                let rv = d1[j].abs() * xx.sqrt() / v[j];
-                let ra = (d1[j] * u[i] + d2[j] * xx).abs() / a[j];
-                worst = worst.max(rv).max(ra.sqrt());
+                worst_v = worst_v.max(d1[j].abs() * sd * inv_v[j]);
+                worst_a = worst_a.max((d1[j] * u[i] + d2[j] * xx).abs() * inv_a[j]);
             }
         }
     }
+    let worst = worst_v.max(worst_a.sqrt());
     if worst > 1.0 {
         let f = 1.0 / (worst * worst * (1.0 + 1e-12));
         x.iter_mut().for_each(|v| *v *= f);
