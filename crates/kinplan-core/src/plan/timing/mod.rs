@@ -103,7 +103,7 @@ pub fn retime(
         return Err(PlanError::EmptyChain);
     }
     let n = waypoints.len() / dof;
-    if n == 0 || waypoints.len() % dof != 0 {
+    if n == 0 || !waypoints.len().is_multiple_of(dof) {
         return Err(PlanError::WrongLength {
             field: PlanField::Waypoints,
             expected: dof * n.max(1),

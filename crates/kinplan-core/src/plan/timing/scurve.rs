@@ -85,13 +85,13 @@ impl SCurve {
     /// `[0, duration]`).
     pub fn at(&self, t: f64) -> (f64, f64, f64, f64) {
         let mut rest = t.max(0.0);
-        for k in 0..7 {
-            if rest <= self.phases[k] || k == 6 {
-                let jk = SIGNS[k] * self.jerk;
-                let [p, v, a] = advance(self.starts[k], jk, rest.min(self.phases[k]));
+        for (k, (&len, &sign)) in self.phases.iter().zip(&SIGNS).enumerate() {
+            if rest <= len || k == 6 {
+                let jk = sign * self.jerk;
+                let [p, v, a] = advance(self.starts[k], jk, rest.min(len));
                 return (p, v, a, jk);
             }
-            rest -= self.phases[k];
+            rest -= len;
         }
         unreachable!("the loop returns at the last phase")
     }

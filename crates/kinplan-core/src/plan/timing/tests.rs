@@ -108,11 +108,11 @@ fn time_optimal_trajectories_keep_every_limit_and_stay_near_the_path() {
         // differences over the uniform samples)
         let h = p.sample_period;
         for i in 1..r.len().saturating_sub(2) {
-            for j in 0..dof {
+            for (j, aj) in a.iter().enumerate() {
                 let fd = (r.q[(i + 1) * dof + j] - r.q[(i - 1) * dof + j]) / (2.0 * h);
                 let err = (fd - r.qd[i * dof + j]).abs();
                 assert!(
-                    err <= a[j] * h * 1.01 + 1e-9,
+                    err <= aj * h * 1.01 + 1e-9,
                     "case {case}: qd {} vs fd {fd}",
                     r.qd[i * dof + j]
                 );
@@ -265,8 +265,10 @@ fn bad_requests_are_refused_by_field_and_a_stop_interrupts() {
         ),
         "{e}"
     );
-    let mut off = TimingParams::default();
-    off.start_velocity = Some(vec![1.0]);
+    let off = TimingParams {
+        start_velocity: Some(vec![1.0]),
+        ..Default::default()
+    };
     assert!(off.validate(1).is_err());
     // a single waypoint is one sample at rest
     let r = retime(&[0.25], 1, &[1.0], &p, &|| false).unwrap();
