@@ -12,7 +12,7 @@ use super::error::{PlanError, PlanField, check_vector};
 use super::initial::initial_trajectory;
 use super::rrt_connect::{RrtStop, rrt_connect_path};
 use super::stomp::{IterationReport, StompStop, stomp_optimize};
-use super::timing::{TimedTrajectory, TimingParams, retime, time_parameterize};
+use super::timing::{TimedTrajectory, TimingMethod, TimingParams, retime, time_parameterize};
 use super::{CartesianParams, RrtParams, StompParams};
 use crate::collision::StateChecker;
 use crate::ik::{IkParams, IkTarget, solve_ik};
@@ -208,9 +208,11 @@ fn validate(chain: &Chain, checker_dof: usize, req: &PlanRequest) -> Result<(), 
 ///    joint line; Cartesian line by IK; RRT-Connect when the line is blocked)
 ///    optimised by STOMP.
 /// 4. The result is re-checked state by state and motion by motion at the
-///    checker's resolution (skipped after an interruption),
-///    timed by [`time_parameterize`] and scored (S0 criteria, unit joint
-///    weights).
+///    checker's resolution (skipped after an interruption), timed by
+///    [`retime`] with `timing.method` (a time-optimal trajectory, whose
+///    blends leave the checked polyline, is checked again sample to sample)
+///    and scored on the timed points (S0 criteria, unit joint weights, jerk
+///    on the real time axis).
 ///
 /// ```
 /// use kinplan_core::collision::StateChecker;
@@ -384,7 +386,17 @@ pub fn plan<C: StateChecker + ?Sized>(
             time_parameterize(&result.q, dof, &v, req.timing.acceleration_limits.as_deref());
         let stop = || clock.interrupted().is_some();
         match retime(&result.q, dof, &v, &req.timing, &stop) {
-            Ok(t) => result.trajectory = t,
+            Ok(t) => {
+                // the blends cut the corners the re-check above proved: the
+                // timed trajectory itself is checked, sample to sample
+                if req.timing.method == TimingMethod::TimeOptimal && result.valid {
+                    let t0 = Instant::now();
+                    result.valid =
+                        path_valid(checker, &t.q, dof, resolution_of(checker), &clock) == Some(true);
+                    timings.verify_us += t0.elapsed().as_micros() as u64;
+                }
+                result.trajectory = t;
+            }
             Err(PlanError::Interrupted) => {
                 // no executable timed trajectory: reported as the interruption
                 result.valid = false;
