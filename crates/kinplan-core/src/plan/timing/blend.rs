@@ -1,6 +1,6 @@
 //! The waypoint polyline with its corners rounded by circular arcs of bounded
 //! deviation (Kunz & Stilman, "Time-Optimal Trajectory Generation for Path
-//! Following with Bounded Acceleration and Velocity", RSS 2012, §IV), as a
+//! Following with Bounded Acceleration and Velocity", RSS 2012), as a
 //! [`Curve`] parameterised by joint-space arc length.
 
 use super::curve::Curve;
@@ -45,7 +45,7 @@ struct Piece {
 /// ```
 ///
 /// so the arc is tangent to both segments and passes `r(1/cos(α/2) − 1) ≤ δ`
-/// from the waypoint (Kunz & Stilman 2012, eqs. 3–8). Consecutive equal
+/// from the waypoint (Kunz & Stilman 2012). Consecutive equal
 /// waypoints are merged; a reversal (α ≈ π) is not rounded and the path
 /// stops there.
 #[derive(Debug, Clone)]

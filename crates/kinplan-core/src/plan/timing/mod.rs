@@ -221,8 +221,8 @@ fn time_optimal(
     let mut profile = profile;
     // Between grid points an arc turns the tangent a little further than the
     // grid's checks see; the samples are checked and, should one exceed a
-    // limit by a factor k, the whole profile is slowed by 2k − 1 (rarely
-    // more than a few parts in 10³) and sampled again.
+    // limit by a factor k, the whole profile is slowed by 2k − 1 and
+    // sampled again.
     for _ in 0..5 {
         let times = sample::sample_times(profile.duration(), params.sample_period, dof)
             .ok_or(too_many_samples(params.sample_period))?;

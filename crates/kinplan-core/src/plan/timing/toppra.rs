@@ -210,14 +210,15 @@ fn largest_feasible(lower: &[(f64, f64)], upper: &[(f64, f64)], cap: f64) -> f64
 ///
 /// Constraints at grid point `i` (`q'`, `q''` there): `|q'_j| √x ≤ v_j` and
 /// `−a_j ≤ q'_j u + q''_j x ≤ a_j`, with `x_{i+1} = x_i + 2 Δ_i u_i`
-/// (Pham & Pham 2018, eqs. 5–8); on a curved piece the acceleration is
+/// (Pham & Pham 2018); on a curved piece the acceleration is
 /// also bounded where the interval ends (with `u_i` and `x_{i+1}`, written
 /// in `u_i`, `x_i`), so it holds on both sides of a junction. A backward
 /// pass computes the controllable sets `K_i = [0, hi_i]` — the `x_i` from
 /// which rest at the end remains reachable — each a two-variable LP solved
 /// exactly ([`largest_feasible`]); a
 /// forward pass then takes the largest `u_i` that keeps `x_{i+1}` in
-/// `K_{i+1}` (Theorem 3: this greedy choice is time-optimal on the grid).
+/// `K_{i+1}` (the paper shows this greedy choice is time-optimal on the
+/// grid).
 /// Interval times are `2Δ_i / (√x_i + √x_{i+1})`.
 ///
 /// The limits are then checked at both ends of every interval and in the
