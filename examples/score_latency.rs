@@ -34,6 +34,7 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
                     -0.4 * s,
                 ],
                 time_from_start: 0.0,
+                ..Default::default()
             }
         })
         .collect();

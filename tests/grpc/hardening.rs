@@ -681,6 +681,7 @@ async fn scoring_limits_are_checked_up_front() {
             .map(|(k, q)| pb::JointPoint {
                 positions: q.clone(),
                 time_from_start: times.map_or(0.0, |dt| dt * k as f64),
+                ..Default::default()
             })
             .collect(),
         ..Default::default()
@@ -729,6 +730,7 @@ async fn scoring_limits_are_checked_up_front() {
                 .map(|k| pb::JointPoint {
                     positions: vec![0.001 * k as f64],
                     time_from_start: 0.0,
+                    ..Default::default()
                 })
                 .collect(),
             ..Default::default()

@@ -295,6 +295,7 @@ async fn every_rpc(v: Values) -> Result<(), TestCaseError> {
             .map(|k| pb::JointPoint {
                 positions: joints.iter().map(|q| q + 0.01 * k as f64).collect(),
                 time_from_start: f[23] * k as f64,
+                ..Default::default()
             })
             .collect()
     };

@@ -10,6 +10,7 @@ mod kinematics;
 mod mobile;
 mod planning;
 mod poses;
+mod retime;
 mod robot;
 mod scoring;
 mod security;

@@ -23,6 +23,7 @@ fn trajectory(rows: &[Vec<f64>]) -> pb::JointTrajectory {
             .map(|q| pb::JointPoint {
                 positions: q.clone(),
                 time_from_start: 0.0,
+                ..Default::default()
             })
             .collect(),
     }

@@ -25,7 +25,7 @@ from .exploration_loop import ExploreStep, ExploreSummary, ReferenceScene
 from .kinematics import ConfigFlags, IkBatchResult, IkOptions, IkResult, IkSolution, LinearSolution, TrackResult
 from .robot import IkStream, Robot
 from .mobile import Mobile, MobileRun, StepResult, WheelKinematics
-from .planning import Box, Capsule, Cylinder, Mesh, OctreeObstacle, Plan, Sphere, StateChecks
+from .planning import Box, Capsule, Cylinder, Mesh, OctreeObstacle, Plan, Sphere, StateChecks, TimedTrajectory
 from .scoring import Comparison, Scores
 
 __all__ = [
@@ -43,6 +43,7 @@ __all__ = [
     "Plan",
     "Sphere",
     "StateChecks",
+    "TimedTrajectory",
     "Comparison",
     "IkBatchResult",
     "IkOptions",

@@ -9,7 +9,7 @@ robot's base frame; units are metres and radians (proto/kinplan/v1/planning.prot
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -180,10 +180,77 @@ def scene_to_proto(scene: Optional[Sequence[Obstacle]]) -> common_pb2.Scene:
     return common_pb2.Scene(objects=objects)
 
 
+#: Timing method names accepted by ``timing={"method": ...}`` and ``retime(method=...)``.
+TIMING_METHODS = {
+    "waypoint": planning_pb2.TIMING_METHOD_WAYPOINT,
+    "time_optimal": planning_pb2.TIMING_METHOD_TIME_OPTIMAL,
+    "jerk_limited": planning_pb2.TIMING_METHOD_JERK_LIMITED,
+}
+
+
+def timing_options(timing: Optional[Mapping[str, Any]]) -> planning_pb2.TimingOptions:
+    """``TimingOptions`` from a mapping of its fields; ``method`` may be a name
+    of :data:`TIMING_METHODS` (or the enum value)."""
+    fields = dict(timing or {})
+    method = fields.get("method")
+    if isinstance(method, str):
+        if method not in TIMING_METHODS:
+            raise ValueError(f"timing method must be one of {sorted(TIMING_METHODS)}, got {method!r}")
+        fields["method"] = TIMING_METHODS[method]
+    return planning_pb2.TimingOptions(**fields)
+
+
+def _rates(points: Any, name: str, dof: int) -> np.ndarray:
+    """``velocities`` or ``accelerations`` of every point as n x dof (NaN where a point has none)."""
+    rows = [list(getattr(p, name)) or [np.nan] * dof for p in points]
+    return np.array(rows, dtype=float).reshape(len(rows), dof)
+
+
+@dataclass
+class TimedTrajectory:
+    """A timed joint trajectory from ``robot.retime``: ``t`` (s), ``q``
+    (rad, or m for prismatic joints), ``qd`` (rad/s) and ``qdd`` (rad/s^2),
+    n x dof each; ``duration`` (s); ``scores`` the S0 criteria of its points
+    with the jerk on the real time axis ("JJ_time", "JMJ_time" rad/s^3,
+    "CJ_time", "CMJ_time" m/s^3); ``compute_time`` the server's time for the
+    timing alone (s)."""
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    duration: float
+    scores: Dict[str, float]
+    compute_time: float
+    raw: Any = field(default=None, repr=False)
+
+    def __repr__(self) -> str:
+        return f"TimedTrajectory(points={len(self.t)}, duration={self.duration:.3f} s)"
+
+    @classmethod
+    def from_proto(cls, r: planning_pb2.RetimeResponse) -> "TimedTrajectory":
+        points = r.trajectory.points
+        dof = len(points[0].positions) if points else 0
+        return cls(
+            t=np.array([p.time_from_start for p in points], dtype=float),
+            q=np.array([list(p.positions) for p in points], dtype=float).reshape(len(points), dof),
+            qd=_rates(points, "velocities", dof),
+            qdd=_rates(points, "accelerations", dof),
+            duration=r.duration,
+            scores=dict(r.criteria),
+            compute_time=r.compute_time,
+            raw=r,
+        )
+
+
 @dataclass
 class Plan:
     """A planned trajectory. ``q`` is n x dof (rad, or m for prismatic
-    joints), ``t`` the time of each waypoint (s) within the velocity limits.
+    joints), ``t`` the time of each point (s), ``qd`` and ``qdd`` the joint
+    velocities (rad/s) and accelerations (rad/s^2) there, all timed by
+    ``timing={"method": ...}`` within the limits: one point per waypoint for
+    "waypoint" (the default), points every ``sample_period`` for
+    "time_optimal" and "jerk_limited".
     ``status`` is one of SUCCEEDED, NO_VALID_TRAJECTORY, INVALID_START,
     INVALID_GOAL, GOAL_UNREACHABLE, TIMEOUT, CANCELLED; ``valid`` says the
     trajectory is collision-free (and, for CCSTOMP, within the Cartesian
@@ -195,6 +262,8 @@ class Plan:
     message: str
     q: np.ndarray
     t: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
     valid: bool
     cost_history: np.ndarray
     deviation: np.ndarray
@@ -232,6 +301,8 @@ class Plan:
             message=r.message,
             q=q,
             t=np.array([p.time_from_start for p in points], dtype=float),
+            qd=_rates(points, "velocities", q.shape[1]),
+            qdd=_rates(points, "accelerations", q.shape[1]),
             valid=r.valid,
             cost_history=np.array(r.cost_history, dtype=float),
             deviation=np.column_stack(
@@ -292,7 +363,7 @@ def _vec(v: Any, present: bool) -> List[float]:
 
 
 __all__ = ["ALGORITHMS", "Box", "Capsule", "Cylinder", "Mesh", "Obstacle", "OctreeObstacle", "Plan", "Sphere",
-           "StateChecks", "scene_to_proto"]
+           "StateChecks", "TIMING_METHODS", "TimedTrajectory", "scene_to_proto", "timing_options"]
 
 
 def __getattr__(name: str) -> Any:

@@ -26,7 +26,7 @@ from .description import JointLimits, RobotDescription
 from .errors import KinplanError
 from .kinematics import (IkBatchResult, IkMethodName, IkOptions, IkResult, LinearSolverName, TrackResult,
                          resolve_ik_args)
-from .planning import Obstacle, Plan, StateChecks
+from .planning import Obstacle, Plan, StateChecks, TimedTrajectory
 from .scoring import Comparison, Scores, Trajectory, _check_trajectory_limits
 from .v1 import common_pb2, kinematics_pb2
 
@@ -361,6 +361,25 @@ class Robot(RobotRefs):
         collisions, joint limits, the closest pair and its witness points
         (clearances capped at ``max_distance``, m)."""
         out: StateChecks = self._run(_planning.check(qs, scene, max_distance), timeout)
+        return out
+
+    def retime(self, path: Any, *, method: str = "time_optimal", max_velocity: Optional[Sequence[float]] = None,
+               max_acceleration: Optional[Sequence[float]] = None, max_jerk: Optional[Sequence[float]] = None,
+               path_tolerance: Optional[float] = None, start_velocity: Optional[Sequence[float]] = None,
+               sample_period: Optional[float] = None, grid_step: Optional[float] = None,
+               velocity_scale: Optional[float] = None, timeout: Optional[float] = None) -> TimedTrajectory:
+        """Times a joint path (n x dof, from any planner) within the joint
+        limits: ``method`` "time_optimal" (circular blends at most
+        ``path_tolerance`` from the waypoints, TOPP-RA; needs
+        ``max_acceleration``), "jerk_limited" (straight segments, an S-curve
+        each, stopping at every waypoint; needs ``max_acceleration`` and
+        ``max_jerk``) or "waypoint". Limits per joint in rad/s, rad/s^2,
+        rad/s^3 (``max_velocity`` defaults to the model's). Returns a
+        :class:`TimedTrajectory` sampled every ``sample_period`` s."""
+        timing = dict(method=method, max_velocity=max_velocity, max_acceleration=max_acceleration,
+                      max_jerk=max_jerk, path_tolerance=path_tolerance, start_velocity=start_velocity,
+                      sample_period=sample_period, grid_step=grid_step, velocity_scale=velocity_scale)
+        out: TimedTrajectory = self._run(_planning.retime(path, timing), timeout)
         return out
 
     # ---- ScoringService ------------------------------------------------------------------------------------------

@@ -104,6 +104,25 @@ def test_plans_and_state_checks(server_address):
     assert checks.valid.all() and not blocked.valid[0]
 
 
+def test_retime_a_line_from_rest_to_rest(server_address):
+    start = np.array([-1.2, -1.3, 1.4, -1.6, -1.57, 0.0])
+    line = np.array([start, start + [1.0, 0, 0, 0, 0, 0]])
+    v, a = [1.0] * 6, [2.0] * 6
+
+    async def main():
+        async with kinplan.aio.Client(server_address, timeout=20) as c:
+            ur5 = c.robot("ur5")
+            optimal = await ur5.retime(line, max_velocity=v, max_acceleration=a)
+            smooth = await ur5.retime(line, method="jerk_limited", max_velocity=v, max_acceleration=a,
+                                      max_jerk=[10.0] * 6)
+            return optimal, smooth
+
+    optimal, smooth = run(main())
+    # trapezoid 1/1 + 1/2 s; S-curve with T_j = 0.2, T_a = 0.3 and 0.3 s of cruise: 1.7 s
+    assert abs(optimal.duration - 1.5) < 2e-3 and abs(smooth.duration - 1.7) < 1e-9
+    assert smooth.qd.shape == smooth.q.shape and np.all(np.abs(smooth.qdd) <= 2.0 + 1e-9)
+
+
 def test_errors_are_the_blocking_clients(server_address):
     async def main():
         async with kinplan.aio.Client(server_address, timeout=10) as c:

@@ -108,3 +108,58 @@ def test_bad_input_is_named(client, ur5):
         client.plan(ur5, start=START)
     with pytest.raises(ValueError):
         client.plan(ur5, start=START, goal=GOAL, algorithm="prm")
+
+
+V = np.array([1.0, 1.2, 1.5, 2.0, 2.0, 2.5])
+A = np.array([2.0, 2.5, 3.0, 4.0, 4.0, 5.0])
+J = np.array([10.0, 12.0, 15.0, 20.0, 20.0, 25.0])
+PATH = np.array([START, [-0.4, -1.0, 1.0, -1.2, -1.2, 0.3], [0.5, -1.4, 1.3, -1.5, -1.5, 0.1], GOAL])
+
+
+def test_retime_a_line_takes_the_bang_bang_time_and_a_path_keeps_the_limits(ur5):
+    line = np.array([START, START + [1.0, 0, 0, 0, 0, 0]])
+    # 1 rad at v = 1, a = 2 from rest to rest: 1/1 + 1/2 s
+    tr = ur5.retime(line, max_velocity=V, max_acceleration=A)
+    assert tr.duration == pytest.approx(1.5, abs=2e-3)
+    tr = ur5.retime(PATH, max_velocity=V, max_acceleration=A, path_tolerance=0.05)
+    assert tr.q.shape == tr.qd.shape == tr.qdd.shape == (len(tr.t), 6)
+    assert np.all(np.abs(tr.qd) <= V * (1 + 1e-6)) and np.all(np.abs(tr.qdd) <= A * (1 + 1e-6))
+    np.testing.assert_allclose(tr.q[[0, -1]], PATH[[0, -1]], atol=1e-9)
+    # the velocities are the positions' derivative (central differences, 10 ms)
+    h = 0.01
+    fd = (tr.q[2:-1] - tr.q[:-3]) / (2 * h)
+    assert np.all(np.abs(fd - tr.qd[1:-2]) <= A * h + 1e-9)
+    assert {"JJ_time", "CMJ_time", "CD"} <= set(tr.scores)
+
+
+def test_jerk_limited_retime_keeps_every_limit_by_finite_differences_at_1_khz(ur5):
+    tr = ur5.retime(PATH, method="jerk_limited", max_velocity=V, max_acceleration=A, max_jerk=J,
+                    sample_period=1e-3)
+    q = tr.q[:-1]  # the last point may be closer than 1 ms
+    h = 1e-3
+    assert np.all(np.abs(np.diff(q, 1, axis=0)) / h <= V * (1 + 1e-9))
+    assert np.all(np.abs(np.diff(q, 2, axis=0)) / h**2 <= A * (1 + 1e-6))
+    assert np.all(np.abs(np.diff(q, 3, axis=0)) / h**3 <= J * (1 + 1e-3))
+    one = ur5.retime(np.array([START, START + [1.0, 0, 0, 0, 0, 0]]), method="jerk_limited", max_velocity=V,
+                     max_acceleration=A, max_jerk=J)
+    # hand-derived S-curve: T_j = a/j = 0.2, T_a = v/a - a/j = 0.3, cruise 0.3
+    assert one.duration == pytest.approx(1.7, abs=1e-9)
+
+
+def test_plan_exposes_velocities_and_accelerations(ur5):
+    plan = ur5.plan(START, GOAL, algorithm="rrt_connect",
+                    timing={"method": "time_optimal", "max_velocity": V, "max_acceleration": A})
+    assert plan.success, plan.message
+    assert plan.qd.shape == plan.q.shape == plan.qdd.shape
+    assert np.all(np.abs(plan.qd) <= V * (1 + 1e-6)) and np.all(np.abs(plan.qdd) <= A * (1 + 1e-6))
+    assert plan.duration == pytest.approx(plan.t[-1])
+    default = ur5.plan(START, GOAL, algorithm="rrt_connect")
+    assert default.qd.shape == default.q.shape
+    np.testing.assert_array_equal(default.qd[[0, -1]], 0.0)
+
+
+def test_retime_errors_name_the_field(ur5):
+    with pytest.raises(kinplan.KinplanError, match="timing.max_jerk"):
+        ur5.retime(PATH, method="jerk_limited", max_acceleration=A)
+    with pytest.raises(ValueError, match="timing method"):
+        ur5.retime(PATH, method="fastest")

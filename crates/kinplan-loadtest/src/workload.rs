@@ -80,6 +80,7 @@ pub fn build_pool(rpc: Rpc, robot: &str, count: usize, seed: u64) -> Result<Vec<
                             pb::JointPoint {
                                 positions: q.iter().zip(&end).map(|(a, b)| a + t * (b - a)).collect(),
                                 time_from_start: 0.0,
+                                ..Default::default()
                             }
                         })
                         .collect();

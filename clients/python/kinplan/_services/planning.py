@@ -7,7 +7,7 @@ from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Union
 import numpy as np
 
 from .._codec import joints
-from ..planning import ALGORITHMS, Obstacle, Plan, StateChecks, _pose, scene_to_proto
+from ..planning import ALGORITHMS, Obstacle, Plan, StateChecks, TimedTrajectory, _pose, scene_to_proto, timing_options
 from ..v1 import common_pb2, planning_pb2
 from . import Call
 
@@ -37,7 +37,7 @@ def _plan_build(
         stomp=planning_pb2.StompOptions(**dict(stomp or {})),
         cartesian=planning_pb2.CartesianOptions(**dict(cartesian or {})),
         rrt_connect=planning_pb2.RrtConnectOptions(**dict(rrt_connect or {})),
-        timing=planning_pb2.TimingOptions(**dict(timing or {})),
+        timing=timing_options(timing),
         return_cost_history=return_cost_history,
     )
     if time_budget is not None:
@@ -115,3 +115,18 @@ def check(qs: Any, scene: Optional[Sequence[Obstacle]], max_distance: float) -> 
             max_distance=float(max_distance))
 
     return Call("planning", "CheckState", StateChecks.from_proto, build=build)
+
+
+def retime(path: Any, timing: Mapping[str, Any]) -> Call[TimedTrajectory]:
+    """Retime: the joint path ``path`` (n x dof) timed by ``timing`` (TimingOptions fields)."""
+    arr = np.asarray(path, dtype=float)
+    if arr.ndim != 2:
+        raise ValueError(f"path must be n x dof, got shape {arr.shape}")
+    options = timing_options({k: v for k, v in timing.items() if v is not None})
+    rows = arr.tolist()
+
+    def build(ref: common_pb2.RobotRef) -> planning_pb2.RetimeRequest:
+        return planning_pb2.RetimeRequest(
+            robot=ref, waypoints=[planning_pb2.JointState(positions=row) for row in rows], timing=options)
+
+    return Call("planning", "Retime", TimedTrajectory.from_proto, build=build)

@@ -23,7 +23,7 @@ from ..description import JointLimits, RobotDescription
 from ..errors import KinplanError, error_for
 from ..kinematics import (IkBatchResult, IkMethodName, IkOptions, IkResult, LinearSolverName, TrackResult,
                           resolve_ik_args)
-from ..planning import Obstacle, Plan, StateChecks
+from ..planning import Obstacle, Plan, StateChecks, TimedTrajectory
 from ..scoring import Comparison, Scores, Trajectory, _check_trajectory_limits
 from ..v1 import common_pb2, kinematics_pb2
 
@@ -198,6 +198,19 @@ class AsyncRobot(RobotRefs):
                     timeout: Optional[float] = None) -> StateChecks:
         """As :meth:`kinplan.Robot.check`."""
         out: StateChecks = await self._run(_planning.check(qs, scene, max_distance), timeout)
+        return out
+
+    async def retime(self, path: Any, *, method: str = "time_optimal",
+                     max_velocity: Optional[Sequence[float]] = None,
+                     max_acceleration: Optional[Sequence[float]] = None, max_jerk: Optional[Sequence[float]] = None,
+                     path_tolerance: Optional[float] = None, start_velocity: Optional[Sequence[float]] = None,
+                     sample_period: Optional[float] = None, grid_step: Optional[float] = None,
+                     velocity_scale: Optional[float] = None, timeout: Optional[float] = None) -> TimedTrajectory:
+        """As :meth:`kinplan.Robot.retime`."""
+        timing = dict(method=method, max_velocity=max_velocity, max_acceleration=max_acceleration,
+                      max_jerk=max_jerk, path_tolerance=path_tolerance, start_velocity=start_velocity,
+                      sample_period=sample_period, grid_step=grid_step, velocity_scale=velocity_scale)
+        out: TimedTrajectory = await self._run(_planning.retime(path, timing), timeout)
         return out
 
     async def score(self, q: Trajectory, timestamps: Optional[Iterable[float]] = None,

@@ -74,12 +74,16 @@ class MeshFile(_message.Message):
     def __init__(self, uri: _Optional[str] = ..., data: _Optional[bytes] = ...) -> None: ...
 
 class JointPoint(_message.Message):
-    __slots__ = ("positions", "time_from_start")
+    __slots__ = ("positions", "time_from_start", "velocities", "accelerations")
     POSITIONS_FIELD_NUMBER: _ClassVar[int]
     TIME_FROM_START_FIELD_NUMBER: _ClassVar[int]
+    VELOCITIES_FIELD_NUMBER: _ClassVar[int]
+    ACCELERATIONS_FIELD_NUMBER: _ClassVar[int]
     positions: _containers.RepeatedScalarFieldContainer[float]
     time_from_start: float
-    def __init__(self, positions: _Optional[_Iterable[float]] = ..., time_from_start: _Optional[float] = ...) -> None: ...
+    velocities: _containers.RepeatedScalarFieldContainer[float]
+    accelerations: _containers.RepeatedScalarFieldContainer[float]
+    def __init__(self, positions: _Optional[_Iterable[float]] = ..., time_from_start: _Optional[float] = ..., velocities: _Optional[_Iterable[float]] = ..., accelerations: _Optional[_Iterable[float]] = ...) -> None: ...
 
 class JointTrajectory(_message.Message):
     __slots__ = ("joint_names", "points")

@@ -32,6 +32,13 @@ class InitialTrajectory(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
     INITIAL_TRAJECTORY_STRAIGHT_LINE: _ClassVar[InitialTrajectory]
     INITIAL_TRAJECTORY_RRT_CONNECT_IF_BLOCKED: _ClassVar[InitialTrajectory]
     INITIAL_TRAJECTORY_CARTESIAN_LINE: _ClassVar[InitialTrajectory]
+
+class TimingMethod(int, metaclass=_enum_type_wrapper.EnumTypeWrapper):
+    __slots__ = ()
+    TIMING_METHOD_UNSPECIFIED: _ClassVar[TimingMethod]
+    TIMING_METHOD_WAYPOINT: _ClassVar[TimingMethod]
+    TIMING_METHOD_TIME_OPTIMAL: _ClassVar[TimingMethod]
+    TIMING_METHOD_JERK_LIMITED: _ClassVar[TimingMethod]
 PLAN_ALGORITHM_UNSPECIFIED: PlanAlgorithm
 PLAN_ALGORITHM_STOMP: PlanAlgorithm
 PLAN_ALGORITHM_CCSTOMP: PlanAlgorithm
@@ -48,6 +55,10 @@ INITIAL_TRAJECTORY_UNSPECIFIED: InitialTrajectory
 INITIAL_TRAJECTORY_STRAIGHT_LINE: InitialTrajectory
 INITIAL_TRAJECTORY_RRT_CONNECT_IF_BLOCKED: InitialTrajectory
 INITIAL_TRAJECTORY_CARTESIAN_LINE: InitialTrajectory
+TIMING_METHOD_UNSPECIFIED: TimingMethod
+TIMING_METHOD_WAYPOINT: TimingMethod
+TIMING_METHOD_TIME_OPTIMAL: TimingMethod
+TIMING_METHOD_JERK_LIMITED: TimingMethod
 
 class StompOptions(_message.Message):
     __slots__ = ("timesteps", "rollouts", "max_rollouts", "max_iterations", "iterations_after_valid", "noise_stddev", "cost_sensitivity", "control_cost_weight", "collision_penalty", "kernel_half_width", "clearance_distance", "clearance_weight", "joint_limit_weight", "straight_line_start", "initial_trajectory")
@@ -114,16 +125,28 @@ class RrtConnectOptions(_message.Message):
     def __init__(self, range: _Optional[float] = ..., max_samples: _Optional[int] = ..., shortcut_attempts: _Optional[int] = ...) -> None: ...
 
 class TimingOptions(_message.Message):
-    __slots__ = ("max_velocity", "max_acceleration", "default_velocity", "velocity_scale")
+    __slots__ = ("max_velocity", "max_acceleration", "default_velocity", "velocity_scale", "method", "max_jerk", "path_tolerance", "start_velocity", "sample_period", "grid_step")
     MAX_VELOCITY_FIELD_NUMBER: _ClassVar[int]
     MAX_ACCELERATION_FIELD_NUMBER: _ClassVar[int]
     DEFAULT_VELOCITY_FIELD_NUMBER: _ClassVar[int]
     VELOCITY_SCALE_FIELD_NUMBER: _ClassVar[int]
+    METHOD_FIELD_NUMBER: _ClassVar[int]
+    MAX_JERK_FIELD_NUMBER: _ClassVar[int]
+    PATH_TOLERANCE_FIELD_NUMBER: _ClassVar[int]
+    START_VELOCITY_FIELD_NUMBER: _ClassVar[int]
+    SAMPLE_PERIOD_FIELD_NUMBER: _ClassVar[int]
+    GRID_STEP_FIELD_NUMBER: _ClassVar[int]
     max_velocity: _containers.RepeatedScalarFieldContainer[float]
     max_acceleration: _containers.RepeatedScalarFieldContainer[float]
     default_velocity: float
     velocity_scale: float
-    def __init__(self, max_velocity: _Optional[_Iterable[float]] = ..., max_acceleration: _Optional[_Iterable[float]] = ..., default_velocity: _Optional[float] = ..., velocity_scale: _Optional[float] = ...) -> None: ...
+    method: TimingMethod
+    max_jerk: _containers.RepeatedScalarFieldContainer[float]
+    path_tolerance: float
+    start_velocity: _containers.RepeatedScalarFieldContainer[float]
+    sample_period: float
+    grid_step: float
+    def __init__(self, max_velocity: _Optional[_Iterable[float]] = ..., max_acceleration: _Optional[_Iterable[float]] = ..., default_velocity: _Optional[float] = ..., velocity_scale: _Optional[float] = ..., method: _Optional[_Union[TimingMethod, str]] = ..., max_jerk: _Optional[_Iterable[float]] = ..., path_tolerance: _Optional[float] = ..., start_velocity: _Optional[_Iterable[float]] = ..., sample_period: _Optional[float] = ..., grid_step: _Optional[float] = ...) -> None: ...
 
 class PlanOptions(_message.Message):
     __slots__ = ("stomp", "cartesian", "rrt_connect", "timing", "motion_resolution", "time_budget", "return_cost_history", "padded_motion")
@@ -281,3 +304,32 @@ class CheckStateResponse(_message.Message):
     STATES_FIELD_NUMBER: _ClassVar[int]
     states: _containers.RepeatedCompositeFieldContainer[StateCheck]
     def __init__(self, states: _Optional[_Iterable[_Union[StateCheck, _Mapping]]] = ...) -> None: ...
+
+class RetimeRequest(_message.Message):
+    __slots__ = ("robot", "waypoints", "timing")
+    ROBOT_FIELD_NUMBER: _ClassVar[int]
+    WAYPOINTS_FIELD_NUMBER: _ClassVar[int]
+    TIMING_FIELD_NUMBER: _ClassVar[int]
+    robot: _common_pb2.RobotRef
+    waypoints: _containers.RepeatedCompositeFieldContainer[JointState]
+    timing: TimingOptions
+    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., waypoints: _Optional[_Iterable[_Union[JointState, _Mapping]]] = ..., timing: _Optional[_Union[TimingOptions, _Mapping]] = ...) -> None: ...
+
+class RetimeResponse(_message.Message):
+    __slots__ = ("trajectory", "duration", "criteria", "compute_time")
+    class CriteriaEntry(_message.Message):
+        __slots__ = ("key", "value")
+        KEY_FIELD_NUMBER: _ClassVar[int]
+        VALUE_FIELD_NUMBER: _ClassVar[int]
+        key: str
+        value: float
+        def __init__(self, key: _Optional[str] = ..., value: _Optional[float] = ...) -> None: ...
+    TRAJECTORY_FIELD_NUMBER: _ClassVar[int]
+    DURATION_FIELD_NUMBER: _ClassVar[int]
+    CRITERIA_FIELD_NUMBER: _ClassVar[int]
+    COMPUTE_TIME_FIELD_NUMBER: _ClassVar[int]
+    trajectory: _common_pb2.JointTrajectory
+    duration: float
+    criteria: _containers.ScalarMap[str, float]
+    compute_time: float
+    def __init__(self, trajectory: _Optional[_Union[_common_pb2.JointTrajectory, _Mapping]] = ..., duration: _Optional[float] = ..., criteria: _Optional[_Mapping[str, float]] = ..., compute_time: _Optional[float] = ...) -> None: ...

@@ -49,6 +49,11 @@ class PlanningServiceStub:
                 request_serializer=kinplan_dot_v1_dot_planning__pb2.CheckStateRequest.SerializeToString,
                 response_deserializer=kinplan_dot_v1_dot_planning__pb2.CheckStateResponse.FromString,
                 _registered_method=True)
+        self.Retime = channel.unary_unary(
+                '/kinplan.v1.PlanningService/Retime',
+                request_serializer=kinplan_dot_v1_dot_planning__pb2.RetimeRequest.SerializeToString,
+                response_deserializer=kinplan_dot_v1_dot_planning__pb2.RetimeResponse.FromString,
+                _registered_method=True)
 
 
 class PlanningServiceServicer:
@@ -86,6 +91,17 @@ class PlanningServiceServicer:
         context.set_details('Method not implemented!')
         raise NotImplementedError('Method not implemented!')
 
+    def Retime(self, request, context):
+        """Times a client's own joint path (from any planner) within the robot's
+        joint limits: positions, velocities and accelerations at every point.
+        At most 100,000 waypoints; memory linear in the waypoints, the grid
+        (path length / grid_step, at most 1,000,000 points) and the samples
+        (at most 2,000,000 values).
+        """
+        context.set_code(grpc.StatusCode.UNIMPLEMENTED)
+        context.set_details('Method not implemented!')
+        raise NotImplementedError('Method not implemented!')
+
 
 def add_PlanningServiceServicer_to_server(servicer, server):
     rpc_method_handlers = {
@@ -103,6 +119,11 @@ def add_PlanningServiceServicer_to_server(servicer, server):
                     servicer.CheckState,
                     request_deserializer=kinplan_dot_v1_dot_planning__pb2.CheckStateRequest.FromString,
                     response_serializer=kinplan_dot_v1_dot_planning__pb2.CheckStateResponse.SerializeToString,
+            ),
+            'Retime': grpc.unary_unary_rpc_method_handler(
+                    servicer.Retime,
+                    request_deserializer=kinplan_dot_v1_dot_planning__pb2.RetimeRequest.FromString,
+                    response_serializer=kinplan_dot_v1_dot_planning__pb2.RetimeResponse.SerializeToString,
             ),
     }
     generic_handler = grpc.method_handlers_generic_handler(
@@ -186,6 +207,33 @@ class PlanningService:
             '/kinplan.v1.PlanningService/CheckState',
             kinplan_dot_v1_dot_planning__pb2.CheckStateRequest.SerializeToString,
             kinplan_dot_v1_dot_planning__pb2.CheckStateResponse.FromString,
+            options,
+            channel_credentials,
+            insecure,
+            call_credentials,
+            compression,
+            wait_for_ready,
+            timeout,
+            metadata,
+            _registered_method=True)
+
+    @staticmethod
+    def Retime(request,
+            target,
+            options=(),
+            channel_credentials=None,
+            call_credentials=None,
+            insecure=False,
+            compression=None,
+            wait_for_ready=None,
+            timeout=None,
+            metadata=None):
+        return grpc.experimental.unary_unary(
+            request,
+            target,
+            '/kinplan.v1.PlanningService/Retime',
+            kinplan_dot_v1_dot_planning__pb2.RetimeRequest.SerializeToString,
+            kinplan_dot_v1_dot_planning__pb2.RetimeResponse.FromString,
             options,
             channel_credentials,
             insecure,

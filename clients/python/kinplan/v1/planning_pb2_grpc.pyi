@@ -58,6 +58,13 @@ class PlanningServiceStub:
     100,000 states; memory linear in the states and the scene. A fault
     confined to one state is that state's answer (StateCheck.error).
     """
+    Retime: _grpc.UnaryUnaryMultiCallable[_planning_pb2.RetimeRequest, _planning_pb2.RetimeResponse]
+    """Times a client's own joint path (from any planner) within the robot's
+    joint limits: positions, velocities and accelerations at every point.
+    At most 100,000 waypoints; memory linear in the waypoints, the grid
+    (path length / grid_step, at most 1,000,000 points) and the samples
+    (at most 2,000,000 values).
+    """
 
 @_typing.type_check_only
 class PlanningServiceAsyncStub(PlanningServiceStub):
@@ -81,6 +88,13 @@ class PlanningServiceAsyncStub(PlanningServiceStub):
     client can check a plan without a collision library of its own. At most
     100,000 states; memory linear in the states and the scene. A fault
     confined to one state is that state's answer (StateCheck.error).
+    """
+    Retime: _aio.UnaryUnaryMultiCallable[_planning_pb2.RetimeRequest, _planning_pb2.RetimeResponse]  # type: ignore[assignment]
+    """Times a client's own joint path (from any planner) within the robot's
+    joint limits: positions, velocities and accelerations at every point.
+    At most 100,000 waypoints; memory linear in the waypoints, the grid
+    (path length / grid_step, at most 1,000,000 points) and the samples
+    (at most 2,000,000 values).
     """
 
 class PlanningServiceServicer(metaclass=_abc_1.ABCMeta):
@@ -120,6 +134,19 @@ class PlanningServiceServicer(metaclass=_abc_1.ABCMeta):
         client can check a plan without a collision library of its own. At most
         100,000 states; memory linear in the states and the scene. A fault
         confined to one state is that state's answer (StateCheck.error).
+        """
+
+    @_abc_1.abstractmethod
+    def Retime(
+        self,
+        request: _planning_pb2.RetimeRequest,
+        context: _ServicerContext,
+    ) -> _typing.Union[_planning_pb2.RetimeResponse, _abc.Awaitable[_planning_pb2.RetimeResponse]]:
+        """Times a client's own joint path (from any planner) within the robot's
+        joint limits: positions, velocities and accelerations at every point.
+        At most 100,000 waypoints; memory linear in the waypoints, the grid
+        (path length / grid_step, at most 1,000,000 points) and the samples
+        (at most 2,000,000 values).
         """
 
 def add_PlanningServiceServicer_to_server(servicer: PlanningServiceServicer, server: _typing.Union[_grpc.Server, _aio.Server]) -> None: ...

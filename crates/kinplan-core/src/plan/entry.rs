@@ -12,7 +12,7 @@ use super::error::{PlanError, PlanField, check_vector};
 use super::initial::initial_trajectory;
 use super::rrt_connect::{RrtStop, rrt_connect_path};
 use super::stomp::{IterationReport, StompStop, stomp_optimize};
-use super::timing::{TimingParams, time_parameterize};
+use super::timing::{TimedTrajectory, TimingMethod, TimingParams, retime, time_parameterize};
 use super::{CartesianParams, RrtParams, StompParams};
 use crate::Deadline;
 use crate::collision::StateChecker;
@@ -136,9 +136,16 @@ pub struct PlanResult {
     pub status: PlanStatus,
     /// Waypoints, `n × dof` row-major (empty for invalid start/goal).
     pub q: Vec<f64>,
-    /// Time of each waypoint from the start (s), within the velocity and
-    /// acceleration limits of [`TimingParams`].
+    /// Time of each waypoint from the start (s) by the waypoint method
+    /// ([`time_parameterize`]), within the velocity and acceleration limits
+    /// of [`TimingParams`], whatever `timing.method` is.
     pub time_from_start: Vec<f64>,
+    /// The trajectory to execute, timed by `timing.method`: for the waypoint
+    /// method one sample per waypoint, otherwise samples every
+    /// `sample_period` along the blended (time-optimal) or straight
+    /// (jerk-limited) path. Empty without waypoints, or when the deadline
+    /// or a cancellation cut the timing short.
+    pub trajectory: TimedTrajectory,
     pub dof: usize,
     /// Every state and motion valid per the checker (re-checked here) and,
     /// for CCSTOMP, every waypoint within the Cartesian tolerances: true
@@ -211,9 +218,11 @@ fn validate(chain: &Chain, checker_dof: usize, req: &PlanRequest) -> Result<(), 
 ///    joint line; Cartesian line by IK; RRT-Connect when the line is blocked)
 ///    optimised by STOMP.
 /// 4. The result is re-checked state by state and motion by motion at the
-///    checker's resolution (skipped after an interruption),
-///    timed by [`time_parameterize`] and scored (S0 criteria, unit joint
-///    weights).
+///    checker's resolution (skipped after an interruption), timed by
+///    [`retime`] with `timing.method` (a time-optimal trajectory, whose
+///    blends leave the checked polyline, is checked again sample to sample)
+///    and scored on the timed points (S0 criteria, unit joint weights, jerk
+///    on the real time axis).
 ///
 /// ```
 /// use kinplan_core::collision::StateChecker;
@@ -253,6 +262,7 @@ pub fn plan<C: StateChecker + ?Sized>(
         status: PlanStatus::NoValidTrajectory,
         q: Vec::new(),
         time_from_start: Vec::new(),
+        trajectory: TimedTrajectory::default(),
         dof,
         valid: false,
         violates_tolerance: false,
@@ -417,14 +427,36 @@ pub fn plan<C: StateChecker + ?Sized>(
         let v = req.timing.velocities(chain);
         result.time_from_start =
             time_parameterize(&result.q, dof, &v, req.timing.acceleration_limits.as_deref());
-        let poses: Vec<Isometry3<f64>> = result.q.chunks_exact(dof).map(|q| chain.fk(q)).collect();
-        let mut input = ScoreInput::new(TrajectoryData::new(
+        match retime(&result.q, dof, &v, &req.timing, clock.deadline) {
+            Ok(t) => {
+                // the blends cut the corners the re-check above proved: the
+                // timed trajectory itself is checked, sample to sample
+                if req.timing.method == TimingMethod::TimeOptimal && result.valid {
+                    let t0 = Instant::now();
+                    result.valid =
+                        path_valid(checker, &t.q, dof, resolution_of(checker), &clock) == Some(true);
+                    timings.verify_us += t0.elapsed().as_micros() as u64;
+                }
+                result.trajectory = t;
+            }
+            Err(PlanError::Interrupted) => {
+                // no executable timed trajectory: reported as the interruption
+                result.valid = false;
+                interrupted = clock.interrupted().or(Some(Interrupt::Deadline));
+            }
+            Err(e) => return Err(e),
+        }
+        let traj = &result.trajectory;
+        let poses: Vec<Isometry3<f64>> = traj.q.chunks_exact(dof).map(|q| chain.fk(q)).collect();
+        let mut data = TrajectoryData::new(
             Rows::Flat {
-                values: &result.q,
+                values: &traj.q,
                 width: dof,
             },
             &poses,
-        ));
+        );
+        data.timestamps = Some(&traj.t);
+        let mut input = ScoreInput::new(data);
         input.dof = Some(dof);
         result.criteria = score(&input, &ScoreParams::default()).ok().map(|r| r.scores);
     }

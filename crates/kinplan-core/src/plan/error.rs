@@ -38,6 +38,13 @@ pub enum PlanField {
     VelocityLimits,
     AccelerationLimits,
     VelocityScale,
+    JerkLimits,
+    PathTolerance,
+    StartVelocity,
+    SamplePeriod,
+    GridStep,
+    /// The waypoints of a path to time.
+    Waypoints,
 }
 
 impl PlanField {
@@ -75,6 +82,12 @@ impl PlanField {
             PlanField::VelocityLimits => "timing.velocity_limits",
             PlanField::AccelerationLimits => "timing.acceleration_limits",
             PlanField::VelocityScale => "timing.velocity_scale",
+            PlanField::JerkLimits => "timing.jerk_limits",
+            PlanField::PathTolerance => "timing.path_tolerance",
+            PlanField::StartVelocity => "timing.start_velocity",
+            PlanField::SamplePeriod => "timing.sample_period",
+            PlanField::GridStep => "timing.grid_step",
+            PlanField::Waypoints => "waypoints",
         }
     }
 }
@@ -106,6 +119,8 @@ pub enum PlanError {
         value: f64,
         reason: &'static str,
     },
+    #[error("the deadline passed or the caller cancelled while timing the path")]
+    Interrupted,
     #[error("goal IK parameters: {0}")]
     GoalIk(#[from] crate::ik::IkError),
 }

@@ -30,7 +30,11 @@ pub use stomp::{IterationReport, StompOutcome, StompStop};
 pub use stomp_matrices::{
     ACCELERATION_STENCIL, MatricesError, PADDING, StompMatrices, finite_difference_matrix,
 };
-pub use timing::{MIN_SEGMENT_TIME, TimingParams, time_parameterize};
+pub use timing::{
+    BlendedPath, Curve, MAX_GRID_POINTS, MAX_SAMPLE_VALUES, MIN_SEGMENT_TIME, SCurve, SpeedProfile,
+    TimedTrajectory, TimingMethod, TimingParams, ToppError, retime, time_parameterize, topp_ra,
+    waypoint_rates,
+};
 
 #[cfg(test)]
 mod tests;

@@ -103,6 +103,42 @@ fn rrt_connect_threads_a_narrow_joint_space_passage() {
 }
 
 #[test]
+fn a_blend_cutting_into_the_wall_makes_the_time_optimal_plan_invalid() {
+    // the narrow passage above: with corners rounded by up to 0.5 rad the
+    // timed trajectory enters the wall (checked here state by state at
+    // 0.001 rad), and the plan must not call it valid
+    let wall = |lo1: f64, hi1: f64| (vec![0.4, lo1, -10.0], vec![0.6, hi1, 10.0]);
+    let w = JointBoxes {
+        dof: 3,
+        limit: std::f64::consts::PI,
+        boxes: vec![wall(-10.0, 0.5), wall(0.6, 10.0)],
+    };
+    let chain = planar3();
+    let mut req = PlanRequest {
+        start: vec![0.0, -1.0, 0.0],
+        goal: Goal::Joints(vec![1.0, 1.0, 0.3]),
+        algorithm: Algorithm::RrtConnect,
+        seed: 3,
+        ..Default::default()
+    };
+    req.timing.method = TimingMethod::TimeOptimal;
+    req.timing.acceleration_limits = Some(vec![2.0; 3]);
+    req.timing.path_tolerance = 1e-3;
+    // the tight blends stay as clear of the wall as the polyline (which may
+    // graze it between the states checked at 0.02 rad)
+    let tight = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert!(fine_valid(&w.shrunk(0.01), &tight.trajectory.q, 3, 0.001));
+    req.timing.path_tolerance = 0.5;
+    let loose = plan(&chain, &w, &req, PlanControl::default()).unwrap();
+    assert_eq!(loose.q, tight.q, "the same planned waypoints");
+    assert!(
+        !fine_valid(&w, &loose.trajectory.q, 3, 0.001),
+        "the loose blends should cut into the wall"
+    );
+    assert!(!loose.valid && loose.status == PlanStatus::NoValidTrajectory);
+}
+
+#[test]
 fn the_same_seed_gives_the_same_trajectory_on_any_pool() {
     let chain = planar3();
     let w = PlanarWorld::planar3_blocked();

@@ -41,22 +41,43 @@ pub fn plan_field(field: PlanField) -> &'static str {
         PlanField::VelocityLimits => "options.timing.max_velocity",
         PlanField::AccelerationLimits => "options.timing.max_acceleration",
         PlanField::VelocityScale => "options.timing.velocity_scale",
+        PlanField::JerkLimits => "options.timing.max_jerk",
+        PlanField::PathTolerance => "options.timing.path_tolerance",
+        PlanField::StartVelocity => "options.timing.start_velocity",
+        PlanField::SamplePeriod => "options.timing.sample_period",
+        PlanField::GridStep => "options.timing.grid_step",
+        PlanField::Waypoints => "waypoints",
     }
 }
 
 /// INVALID_ARGUMENT naming the request field behind a refused plan; INTERNAL
-/// for what the service itself built wrong.
+/// for what the service itself built wrong; DEADLINE_EXCEEDED when the
+/// timing was cut short.
 pub fn plan_error(err: PlanError) -> Status {
+    error_at(err, |f| plan_field(f).to_owned())
+}
+
+/// As [`plan_error`] for a `RetimeRequest`, whose timing options sit at
+/// `timing` instead of `options.timing`.
+pub fn retime_error(err: PlanError) -> Status {
+    error_at(err, |f| {
+        let name = plan_field(f);
+        name.strip_prefix("options.").unwrap_or(name).to_owned()
+    })
+}
+
+fn error_at(err: PlanError, name: impl Fn(PlanField) -> String) -> Status {
     let text = err.to_string();
     match err {
         PlanError::EmptyChain => invalid("robot", text),
         PlanError::WrongLength { field, .. } | PlanError::InvalidParam { field, .. } => {
-            invalid(plan_field(field), text)
+            invalid(name(field), text)
         }
         PlanError::NonFinite { field, index } => match field {
-            PlanField::GoalPose => invalid(plan_field(field), text),
-            _ => invalid(format!("{}[{index}]", plan_field(field)), text),
+            PlanField::GoalPose => invalid(name(field), text),
+            _ => invalid(format!("{}[{index}]", name(field)), text),
         },
+        PlanError::Interrupted => Status::deadline_exceeded(text),
         PlanError::CheckerDof { .. } | PlanError::GoalIk(_) => {
             tracing::error!(error = %text, "planning rejected service-built input");
             Status::internal(format!("planning failed on service-built input: {text}"))

@@ -9,8 +9,12 @@ use crate::api::convert::{finite, optional_seconds, pose_in};
 use crate::pb;
 use crate::status::invalid;
 use kinplan_core::collision::{CheckerParams, Part, StateReport};
-use kinplan_core::plan::{Algorithm, Goal, InitialTrajectory, PlanRequest, PlanResult, PlanStatus};
+use kinplan_core::plan::{
+    Algorithm, Goal, InitialTrajectory, PlanRequest, PlanResult, PlanStatus, TimedTrajectory, TimingMethod,
+    TimingParams,
+};
 use kinplan_core::robot::Chain;
+use kinplan_core::score::Scores;
 
 /// Largest RRT-Connect sample budget (each sample may add a tree node).
 pub const MAX_RRT_SAMPLES: usize = 1_000_000;
@@ -157,24 +161,7 @@ pub fn plan_input(req: &pb::PlanRequest) -> Result<PlanInput, Status> {
     r.max_samples = count(rrt.max_samples, r.max_samples);
     r.shortcut_attempts = count(rrt.shortcut_attempts, r.shortcut_attempts);
 
-    let timing = options.timing.unwrap_or_default();
-    let t = &mut request.timing;
-    if !timing.max_velocity.is_empty() {
-        t.velocity_limits = Some(timing.max_velocity.clone());
-    }
-    if !timing.max_acceleration.is_empty() {
-        t.acceleration_limits = Some(timing.max_acceleration.clone());
-    }
-    t.default_velocity = number(
-        "options.timing.default_velocity",
-        timing.default_velocity,
-        t.default_velocity,
-    )?;
-    t.velocity_scale = number(
-        "options.timing.velocity_scale",
-        timing.velocity_scale,
-        t.velocity_scale,
-    )?;
+    request.timing = timing_in("options.timing", &options.timing.unwrap_or_default())?;
 
     // Memory bounds a small request could otherwise break (time is bounded by
     // the deadline): RRT trees grow a node per sample, STOMP keeps
@@ -217,6 +204,47 @@ pub fn plan_input(req: &pb::PlanRequest) -> Result<PlanInput, Status> {
         time_budget,
         return_cost_history: options.return_cost_history,
     })
+}
+
+/// `TimingOptions` → [`TimingParams`] (unset fields: the domain's
+/// defaults); `prefix` is where the message sits in the request. Ranges are
+/// the domain's `validate` to check.
+pub fn timing_in(prefix: &str, timing: &pb::TimingOptions) -> Result<TimingParams, Status> {
+    let mut t = TimingParams::default();
+    if !timing.max_velocity.is_empty() {
+        t.velocity_limits = Some(timing.max_velocity.clone());
+    }
+    if !timing.max_acceleration.is_empty() {
+        t.acceleration_limits = Some(timing.max_acceleration.clone());
+    }
+    if !timing.max_jerk.is_empty() {
+        t.jerk_limits = Some(timing.max_jerk.clone());
+    }
+    if !timing.start_velocity.is_empty() {
+        t.start_velocity = Some(timing.start_velocity.clone());
+    }
+    let field = |name: &str| format!("{prefix}.{name}");
+    t.default_velocity = number(
+        &field("default_velocity"),
+        timing.default_velocity,
+        t.default_velocity,
+    )?;
+    t.velocity_scale = number(&field("velocity_scale"), timing.velocity_scale, t.velocity_scale)?;
+    t.path_tolerance = number(&field("path_tolerance"), timing.path_tolerance, t.path_tolerance)?;
+    t.sample_period = number(&field("sample_period"), timing.sample_period, t.sample_period)?;
+    t.grid_step = number(&field("grid_step"), timing.grid_step, t.grid_step)?;
+    t.method = match pb::TimingMethod::try_from(timing.method) {
+        Ok(pb::TimingMethod::Unspecified | pb::TimingMethod::Waypoint) => TimingMethod::Waypoint,
+        Ok(pb::TimingMethod::TimeOptimal) => TimingMethod::TimeOptimal,
+        Ok(pb::TimingMethod::JerkLimited) => TimingMethod::JerkLimited,
+        Err(_) => {
+            return Err(invalid(
+                field("method"),
+                format!("unknown value {}", timing.method),
+            ));
+        }
+    };
+    Ok(t)
 }
 
 fn status_out(s: PlanStatus) -> pb::PlanStatus {
@@ -274,9 +302,43 @@ pub fn trajectory_out(chain: &Chain, q: &[f64], dof: usize, times: &[f64]) -> pb
             .map(|(i, row)| pb::JointPoint {
                 positions: row.to_vec(),
                 time_from_start: times.get(i).copied().unwrap_or(0.0),
+                ..Default::default()
             })
             .collect(),
     }
+}
+
+/// A timed trajectory with velocities and accelerations at every point.
+pub fn timed_out(chain: &Chain, tr: &TimedTrajectory) -> pb::JointTrajectory {
+    let dof = tr.dof.max(1);
+    pb::JointTrajectory {
+        joint_names: chain.joints().iter().map(|j| j.name.clone()).collect(),
+        points: (0..tr.len())
+            .map(|i| {
+                let r = i * dof..(i + 1) * dof;
+                pb::JointPoint {
+                    positions: tr.q[r.clone()].to_vec(),
+                    time_from_start: tr.t[i],
+                    velocities: tr.qd[r.clone()].to_vec(),
+                    accelerations: tr.qdd[r].to_vec(),
+                }
+            })
+            .collect(),
+    }
+}
+
+/// The criteria map of a response: the S0 criteria by name and the
+/// time-scaled jerk as "JJ_time", "CJ_time", "JMJ_time", "CMJ_time".
+pub fn criteria_out(s: &Scores) -> std::collections::HashMap<String, f64> {
+    let mut out: std::collections::HashMap<String, f64> =
+        s.iter().map(|(c, v)| (c.name().to_owned(), v)).collect();
+    if let Some(t) = s.time_scaled {
+        out.insert("JJ_time".into(), t.jj);
+        out.insert("CJ_time".into(), t.cj);
+        out.insert("JMJ_time".into(), t.jmj);
+        out.insert("CMJ_time".into(), t.cmj);
+    }
+    out
 }
 
 /// The reply for a finished plan; `report` explains an invalid start or goal.
@@ -292,7 +354,7 @@ pub fn plan_response(
         status: status_out(r.status) as i32,
         message: status_message(r.status, report.as_ref()),
         colliding: report.as_ref().map(colliding_out).unwrap_or_default(),
-        trajectory: Some(trajectory_out(chain, &r.q, r.dof, &r.time_from_start)),
+        trajectory: Some(timed_out(chain, &r.trajectory)),
         valid: r.valid,
         cost_history: if with_history { r.cost_history } else { Vec::new() },
         deviation: Some(pb::CartesianDeviation {
@@ -300,12 +362,9 @@ pub fn plan_response(
             rotation: r.deviation.iter().map(|d| d.rotation).collect(),
             violates_tolerance: r.violates_tolerance,
         }),
-        criteria: r
-            .criteria
-            .map(|s| s.iter().map(|(c, v)| (c.name().to_owned(), v)).collect())
-            .unwrap_or_default(),
+        criteria: r.criteria.as_ref().map(criteria_out).unwrap_or_default(),
         iterations: r.iterations.min(u32::MAX as usize) as u32,
-        duration: r.time_from_start.last().copied().unwrap_or(0.0),
+        duration: r.trajectory.duration(),
         goal: r.goal.unwrap_or_default(),
         timings: Some(pb::PlanTimings {
             goal_ik: us(r.timings.goal_ik_us),

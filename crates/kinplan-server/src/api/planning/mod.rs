@@ -1,5 +1,5 @@
-//! `PlanningService`: Plan, PlanStream and CheckState over the plan and
-//! collision rooms.
+//! `PlanningService`: Plan, PlanStream, CheckState and Retime over the plan
+//! and collision rooms.
 //!
 //! Per request: admission and the robot (cached), the scene converted and
 //! validated, the robot's collision setup (cached per chain), then on the
@@ -26,8 +26,10 @@ use convert::{PlanInput, colliding_out, pair_name, plan_input, plan_response, tr
 use kinplan_core::Deadline;
 use kinplan_core::collision::{CheckerParams, SceneChecker, SceneGeometry, SceneLimits};
 use kinplan_core::plan::{Goal, IterationReport, PlanControl, PlanStatus, plan};
+use retime::{retime_input, retime_reply};
 
 pub(crate) mod convert;
+mod retime;
 
 /// Most states one CheckState request may ask about.
 const MAX_CHECKED_STATES: usize = 100_000;
@@ -239,6 +241,24 @@ impl PlanningService for PlanningApi {
             })
             .await??;
         Ok(Response::new(pb::CheckStateResponse { states }))
+    }
+
+    async fn retime(
+        &self,
+        request: Request<pb::RetimeRequest>,
+    ) -> Result<Response<pb::RetimeResponse>, Status> {
+        let (_permit, budget, robot) = self
+            .shared
+            .admit_robot(&request, request.get_ref().robot.as_ref())
+            .await?;
+        let input = retime_input(request.get_ref(), robot.chain.dof())?;
+        let chain = robot.chain.clone();
+        let reply = self
+            .shared
+            .compute
+            .run(&budget, move |b| retime_reply(&chain, &input, b.deadline()))
+            .await??;
+        Ok(Response::new(reply))
     }
 }
 

@@ -70,6 +70,7 @@ pub(super) async fn unary(
         "MobileService" / "Navigate" => mobile.navigate via MobileService,
         "PlanningService" / "Plan" => planning.plan via PlanningService,
         "PlanningService" / "CheckState" => planning.check_state via PlanningService,
+        "PlanningService" / "Retime" => planning.retime via PlanningService,
         "ExplorationService" / "NextBestView" => exploration.next_best_view via ExplorationService,
         "ExplorationService" / "InsertScan" => exploration.insert_scan via ExplorationService,
         "ExplorationService" / "OctreeInfo" => exploration.octree_info via ExplorationService,

@@ -350,7 +350,7 @@ mod tests {
     }
 
     /// Every unary kinplan method, as the proto declares them.
-    const UNARY_PATHS: [&str; 21] = [
+    const UNARY_PATHS: [&str; 22] = [
         "/kinplan.v1.RobotService/ListRobots",
         "/kinplan.v1.RobotService/DescribeRobot",
         "/kinplan.v1.RobotService/ForwardKinematics",
@@ -368,6 +368,7 @@ mod tests {
         "/kinplan.v1.MobileService/Navigate",
         "/kinplan.v1.PlanningService/Plan",
         "/kinplan.v1.PlanningService/CheckState",
+        "/kinplan.v1.PlanningService/Retime",
         "/kinplan.v1.ExplorationService/NextBestView",
         "/kinplan.v1.ExplorationService/InsertScan",
         "/kinplan.v1.ExplorationService/OctreeInfo",

@@ -1,104 +1,6 @@
-//! Time parameterisation: timestamps for a joint-space waypoint path within
-//! per-joint velocity (and optionally acceleration) limits.
-
-use super::error::{PlanError, PlanField, require};
-use crate::robot::Chain;
-
-/// Options of [`time_parameterize`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct TimingParams {
-    /// Speed limit per joint (rad/s or m/s, finite, > 0). `None`: the
-    /// chain's `max_velocity`, and `default_velocity` where it has none.
-    pub velocity_limits: Option<Vec<f64>>,
-    /// Acceleration limit per joint (rad/s² or m/s², > 0; `+∞` = none).
-    /// `None`: velocity limits only. Default `None`.
-    pub acceleration_limits: Option<Vec<f64>>,
-    /// Speed for joints the model gives none (rad/s or m/s, > 0). Default 1.
-    pub default_velocity: f64,
-    /// Fraction of the velocity limits used (0 < s ≤ 1). Default 1.
-    pub velocity_scale: f64,
-}
-
-impl Default for TimingParams {
-    fn default() -> Self {
-        Self {
-            velocity_limits: None,
-            acceleration_limits: None,
-            default_velocity: 1.0,
-            velocity_scale: 1.0,
-        }
-    }
-}
-
-impl TimingParams {
-    /// Checks the ranges; `dof` sizes the limit vectors.
-    pub fn validate(&self, dof: usize) -> Result<(), PlanError> {
-        let s = self.velocity_scale;
-        require(
-            s.is_finite() && s > 0.0 && s <= 1.0,
-            PlanField::VelocityScale,
-            s,
-            "must be in (0, 1]",
-        )?;
-        let d = self.default_velocity;
-        require(
-            d.is_finite() && d > 0.0,
-            PlanField::VelocityLimits,
-            d,
-            "must be finite and > 0",
-        )?;
-        if let Some(v) = &self.velocity_limits {
-            require(
-                v.len() == dof,
-                PlanField::VelocityLimits,
-                v.len() as f64,
-                "needs one value per joint",
-            )?;
-            for &x in v {
-                require(
-                    x.is_finite() && x > 0.0,
-                    PlanField::VelocityLimits,
-                    x,
-                    "must be finite and > 0",
-                )?;
-            }
-        }
-        if let Some(a) = &self.acceleration_limits {
-            require(
-                a.len() == dof,
-                PlanField::AccelerationLimits,
-                a.len() as f64,
-                "needs one value per joint",
-            )?;
-            for &x in a {
-                require(
-                    x > 0.0,
-                    PlanField::AccelerationLimits,
-                    x,
-                    "must be > 0 (+inf allowed)",
-                )?;
-            }
-        }
-        Ok(())
-    }
-
-    /// Effective speed limits for `chain` (scaled).
-    pub fn velocities(&self, chain: &Chain) -> Vec<f64> {
-        let base: Vec<f64> = match &self.velocity_limits {
-            Some(v) => v.clone(),
-            None => chain
-                .joints()
-                .iter()
-                .map(|j| {
-                    j.max_velocity
-                        .filter(|v| v.is_finite() && *v > 0.0)
-                        .unwrap_or(self.default_velocity)
-                })
-                .collect(),
-        };
-        base.iter().map(|v| v * self.velocity_scale).collect()
-    }
-}
+//! The waypoint method: timestamps for the waypoints of a path followed as
+//! straight joint segments, within per-joint velocity (and optionally
+//! acceleration) limits.
 
 /// Shortest segment duration (s), so timestamps strictly increase.
 pub const MIN_SEGMENT_TIME: f64 = 1e-6;
@@ -188,4 +90,42 @@ pub fn time_parameterize(waypoints: &[f64], dof: usize, v_max: &[f64], a_max: Op
         t.push(last + d);
     }
     t
+}
+
+/// Velocities and accelerations at the waypoints of a path timed by
+/// [`time_parameterize`] (`n × dof` each, row-major).
+///
+/// With segment velocities `v_s = Δq_s / T_s` (rest before the first and
+/// after the last waypoint), waypoint `i` gets the mean of the adjacent
+/// segment velocities, `q̇_i = (v_{i−1} + v_i)/2`, and the acceleration the
+/// method bounds, `q̈_i = (v_i − v_{i−1}) / ((T_{i−1} + T_i)/2)` (one half
+/// segment at either end). Both are within the limits `time_parameterize`
+/// was given: a mean of two speeds within a limit is within it.
+pub fn waypoint_rates(waypoints: &[f64], dof: usize, t: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let n = t.len();
+    let mut qd = vec![0.0; n * dof];
+    let mut qdd = vec![0.0; n * dof];
+    if n < 2 {
+        return (qd, qdd);
+    }
+    let seg_v =
+        |s: usize, j: usize| (waypoints[(s + 1) * dof + j] - waypoints[s * dof + j]) / (t[s + 1] - t[s]);
+    for i in 0..n {
+        let span = if i == 0 {
+            (t[1] - t[0]) / 2.0
+        } else if i + 1 == n {
+            (t[n - 1] - t[n - 2]) / 2.0
+        } else {
+            (t[i + 1] - t[i - 1]) / 2.0
+        };
+        for j in 0..dof {
+            let v_in = if i > 0 { seg_v(i - 1, j) } else { 0.0 };
+            let v_out = if i + 1 < n { seg_v(i, j) } else { 0.0 };
+            if i > 0 && i + 1 < n {
+                qd[i * dof + j] = (v_in + v_out) / 2.0;
+            }
+            qdd[i * dof + j] = (v_out - v_in) / span;
+        }
+    }
+    (qd, qdd)
 }

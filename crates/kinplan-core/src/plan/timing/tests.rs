@@ -1,0 +1,287 @@
+//! `retime` end to end: closed forms, limits at every sample and by finite
+//! differences, path tolerance, start velocities, refusals.
+
+use crate::Deadline;
+use rand::{Rng, SeedableRng};
+
+use super::*;
+
+fn params(method: TimingMethod, a: &[f64], j: Option<&[f64]>) -> TimingParams {
+    TimingParams {
+        method,
+        acceleration_limits: Some(a.to_vec()),
+        jerk_limits: j.map(<[f64]>::to_vec),
+        ..Default::default()
+    }
+}
+
+fn random_path(rng: &mut rand_chacha::ChaCha8Rng, n: usize, dof: usize) -> Vec<f64> {
+    let mut q = vec![0.0; dof];
+    let mut out = Vec::with_capacity(n * dof);
+    for _ in 0..n {
+        out.extend_from_slice(&q);
+        for v in q.iter_mut() {
+            *v += rng.random_range(-0.6..0.6);
+        }
+    }
+    out
+}
+
+/// Distance from `p` to the polyline through `w` (`dof` columns).
+fn polyline_distance(w: &[f64], dof: usize, p: &[f64]) -> f64 {
+    let rows: Vec<&[f64]> = w.chunks_exact(dof).collect();
+    let mut best = f64::INFINITY;
+    for s in rows.windows(2) {
+        let d: Vec<f64> = (0..dof).map(|j| s[1][j] - s[0][j]).collect();
+        let dd: f64 = d.iter().map(|x| x * x).sum();
+        let t = if dd > 0.0 {
+            ((0..dof).map(|j| (p[j] - s[0][j]) * d[j]).sum::<f64>() / dd).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let e = (0..dof)
+            .map(|j| (s[0][j] + t * d[j] - p[j]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        best = best.min(e);
+    }
+    best
+}
+
+#[test]
+fn a_multi_joint_straight_line_takes_the_bang_bang_time_of_its_slowest_joint() {
+    // joint 1 moves 1.5 rad with v = 0.8, a = 1: trapezoid 1.5/0.8 + 0.8/1;
+    // joint 0 moves 0.5 rad at far looser limits
+    let p = params(TimingMethod::TimeOptimal, &[5.0, 1.0], None);
+    let r = retime(&[0.0, 0.0, 0.5, 1.5], 2, &[3.0, 0.8], &p, Deadline::none()).unwrap();
+    let expected = 1.5 / 0.8 + 0.8;
+    assert!((r.duration() - expected).abs() < 2e-3, "{}", r.duration());
+    // triangle: 0.2 rad at a = 1 never reaches 0.8 rad/s: 2·√(0.2/1)
+    let r = retime(&[0.0, 0.0, 0.0, 0.2], 2, &[3.0, 0.8], &p, Deadline::none()).unwrap();
+    assert!(
+        (r.duration() - 2.0 * 0.2f64.sqrt()).abs() < 2e-3,
+        "{}",
+        r.duration()
+    );
+    let peak = r.qd.chunks_exact(2).map(|v| v[1]).fold(0.0, f64::max);
+    assert!((peak - 0.2f64.sqrt()).abs() < 0.02, "{peak}");
+}
+
+#[test]
+fn time_optimal_trajectories_keep_every_limit_and_stay_near_the_path() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    for case in 0..20 {
+        let dof = rng.random_range(1..8);
+        let n = rng.random_range(2..12);
+        let w = random_path(&mut rng, n, dof);
+        let v: Vec<f64> = (0..dof).map(|_| rng.random_range(0.5..3.0)).collect();
+        let a: Vec<f64> = (0..dof).map(|_| rng.random_range(1.0..10.0)).collect();
+        let mut p = params(TimingMethod::TimeOptimal, &a, None);
+        p.path_tolerance = 0.05;
+        let r = retime(&w, dof, &v, &p, Deadline::none()).unwrap();
+        assert!(r.t.windows(2).all(|t| t[1] > t[0]), "case {case}");
+        for i in 0..r.len() {
+            for j in 0..dof {
+                let k = i * dof + j;
+                assert!(
+                    r.qd[k].abs() <= v[j] * (1.0 + 1e-6),
+                    "case {case} v {} {} at {}/{}",
+                    r.qd[k],
+                    v[j],
+                    i,
+                    r.len()
+                );
+                assert!(r.qdd[k].abs() <= a[j] * (1.0 + 1e-6), "case {case} a");
+            }
+            let e = polyline_distance(&w, dof, &r.q[i * dof..(i + 1) * dof]);
+            assert!(e <= 0.05 + 1e-9, "case {case}: {e} from the path");
+        }
+        assert!(r.qd[..dof].iter().all(|x| *x == 0.0));
+        assert!(r.qd[r.qd.len() - dof..].iter().all(|x| x.abs() < 1e-9));
+        assert_eq!(&r.q[..dof], &w[..dof]);
+        let end = &r.q[r.q.len() - dof..];
+        assert!(
+            end.iter()
+                .zip(&w[w.len() - dof..])
+                .all(|(x, y)| (x - y).abs() < 1e-9)
+        );
+        // the velocities are the derivative of the positions (central
+        // differences over the uniform samples)
+        let h = p.sample_period;
+        for i in 1..r.len().saturating_sub(2) {
+            for (j, aj) in a.iter().enumerate() {
+                let fd = (r.q[(i + 1) * dof + j] - r.q[(i - 1) * dof + j]) / (2.0 * h);
+                let err = (fd - r.qd[i * dof + j]).abs();
+                assert!(
+                    err <= aj * h * 1.01 + 1e-9,
+                    "case {case}: qd {} vs fd {fd}",
+                    r.qd[i * dof + j]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn jerk_limited_trajectories_match_the_s_curve_and_keep_every_limit_at_1_khz() {
+    // one joint, 1 rad at v = 1, a = 2, j = 10: 1.7 s (see SCurve)
+    let mut p = params(TimingMethod::JerkLimited, &[2.0], Some(&[10.0]));
+    p.sample_period = 1e-3;
+    let r = retime(&[0.0, 1.0], 1, &[1.0], &p, Deadline::none()).unwrap();
+    assert!((r.duration() - 1.7).abs() < 1e-12);
+    // two segments: rest at the waypoint between them, durations add
+    let r = retime(&[0.0, 1.0, 0.5], 1, &[1.0], &p, Deadline::none()).unwrap();
+    let second = SCurve::rest_to_rest(0.5, 1.0, 2.0, 10.0).duration();
+    assert!((r.duration() - 1.7 - second).abs() < 1e-12);
+
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    for case in 0..10 {
+        let dof = rng.random_range(1..8);
+        let n = rng.random_range(2..6);
+        let w = random_path(&mut rng, n, dof);
+        let v: Vec<f64> = (0..dof).map(|_| rng.random_range(0.5..3.0)).collect();
+        let a: Vec<f64> = (0..dof).map(|_| rng.random_range(1.0..10.0)).collect();
+        let j: Vec<f64> = (0..dof).map(|_| rng.random_range(5.0..50.0)).collect();
+        let mut p = params(TimingMethod::JerkLimited, &a, Some(&j));
+        p.sample_period = 1e-3;
+        let r = retime(&w, dof, &v, &p, Deadline::none()).unwrap();
+        let h = 1e-3;
+        let uniform = r.len() - 1; // the last sample may be closer
+        for i in 0..uniform.saturating_sub(3) {
+            for k in 0..dof {
+                let x = |m: usize| r.q[(i + m) * dof + k];
+                let vel = (x(1) - x(0)) / h;
+                let acc = (x(2) - 2.0 * x(1) + x(0)) / (h * h);
+                let jerk = (x(3) - 3.0 * x(2) + 3.0 * x(1) - x(0)) / (h * h * h);
+                assert!(vel.abs() <= v[k] * (1.0 + 1e-9), "case {case}: v {vel}");
+                assert!(acc.abs() <= a[k] * (1.0 + 1e-6), "case {case}: a {acc}");
+                assert!(jerk.abs() <= j[k] * (1.0 + 1e-3), "case {case}: j {jerk}");
+            }
+        }
+        // every sample lies on the polyline
+        for q in r.q.chunks_exact(dof) {
+            assert!(polyline_distance(&w, dof, q) < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn a_start_velocity_along_the_path_is_kept_and_one_across_it_is_refused() {
+    let mut p = params(TimingMethod::TimeOptimal, &[1.0, 1.0], None);
+    p.start_velocity = Some(vec![0.3, 0.4]);
+    let w = [0.0, 0.0, 3.0, 4.0];
+    let r = retime(&w, 2, &[1.0, 1.0], &p, Deadline::none()).unwrap();
+    assert!((r.qd[0] - 0.3).abs() < 1e-12 && (r.qd[1] - 0.4).abs() < 1e-12);
+    // joint 1 (0.8 of the direction) binds: path speed ≤ 1.25, path
+    // acceleration ≤ 1.25; from ṡ = 0.5 up to 1.25, cruise, brake to rest
+    let rest = retime(
+        &w,
+        2,
+        &[1.0, 1.0],
+        &params(TimingMethod::TimeOptimal, &[1.0, 1.0], None),
+        Deadline::none(),
+    )
+    .unwrap();
+    assert!(r.duration() < rest.duration());
+    let vs = 1.25;
+    let acc = 1.25;
+    let expected =
+        (vs - 0.5) / acc + vs / acc + (5.0 - (vs * vs - 0.25) / (2.0 * acc) - vs * vs / (2.0 * acc)) / vs;
+    assert!(
+        (r.duration() - expected).abs() < 2e-3,
+        "{} vs {expected}",
+        r.duration()
+    );
+    p.start_velocity = Some(vec![0.4, 0.3]);
+    let e = retime(&w, 2, &[1.0, 1.0], &p, Deadline::none()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PlanError::InvalidParam {
+                field: PlanField::StartVelocity,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    // too fast to stop within 0.05 rad
+    p.start_velocity = Some(vec![0.6, 0.8]);
+    let e = retime(&[0.0, 0.0, 0.03, 0.04], 2, &[1.0, 1.0], &p, Deadline::none()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PlanError::InvalidParam {
+                field: PlanField::StartVelocity,
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn bad_requests_are_refused_by_field_and_a_stop_interrupts() {
+    let p = params(TimingMethod::TimeOptimal, &[1.0], None);
+    let e = retime(&[], 1, &[1.0], &p, Deadline::none()).unwrap_err();
+    assert!(matches!(
+        e,
+        PlanError::WrongLength {
+            field: PlanField::Waypoints,
+            ..
+        }
+    ));
+    let e = retime(&[0.0, f64::NAN], 1, &[1.0], &p, Deadline::none()).unwrap_err();
+    assert!(matches!(
+        e,
+        PlanError::NonFinite {
+            field: PlanField::Waypoints,
+            index: 1
+        }
+    ));
+    let mut fine = p.clone();
+    fine.sample_period = 1e-4;
+    let e = retime(&[0.0, 1e4], 1, &[1.0], &fine, Deadline::none()).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PlanError::InvalidParam {
+                field: PlanField::SamplePeriod,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let e = retime(
+        &[0.0, 1.0],
+        1,
+        &[1.0],
+        &p,
+        Deadline::none().with_cancel(&std::sync::atomic::AtomicBool::new(true)),
+    )
+    .unwrap_err();
+    assert_eq!(e, PlanError::Interrupted);
+    let mut no_jerk = p.clone();
+    no_jerk.method = TimingMethod::JerkLimited;
+    let e = no_jerk.validate(1).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            PlanError::InvalidParam {
+                field: PlanField::JerkLimits,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let off = TimingParams {
+        start_velocity: Some(vec![1.0]),
+        ..Default::default()
+    };
+    assert!(off.validate(1).is_err());
+    // a single waypoint is one sample at rest
+    let r = retime(&[0.25], 1, &[1.0], &p, Deadline::none()).unwrap();
+    assert_eq!(
+        (r.t.clone(), r.q.clone(), r.qd.clone()),
+        (vec![0.0], vec![0.25], vec![0.0])
+    );
+}
