@@ -247,7 +247,8 @@ class TimedTrajectory:
 class Plan:
     """A planned trajectory. ``q`` is n x dof (rad, or m for prismatic
     joints), ``t`` the time of each point (s), ``qd`` and ``qdd`` the joint
-    velocities (rad/s) and accelerations (rad/s^2) there, all timed by
+    velocities (rad/s) and accelerations (rad/s^2) there (None in a Plan
+    built by hand), all timed by
     ``timing={"method": ...}`` within the limits: one point per waypoint for
     "waypoint" (the default), points every ``sample_period`` for
     "time_optimal" and "jerk_limited".
@@ -262,8 +263,6 @@ class Plan:
     message: str
     q: np.ndarray
     t: np.ndarray
-    qd: np.ndarray
-    qdd: np.ndarray
     valid: bool
     cost_history: np.ndarray
     deviation: np.ndarray
@@ -274,6 +273,8 @@ class Plan:
     iterations: int
     duration: float
     timings: Dict[str, float]
+    qd: Optional[np.ndarray] = None
+    qdd: Optional[np.ndarray] = None
     raw: Any = field(default=None, repr=False)
 
     @property
