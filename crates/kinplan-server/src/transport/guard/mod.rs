@@ -583,7 +583,7 @@ mod tests {
                 let body = response.into_body();
                 tokio::time::sleep(Duration::from_millis(40)).await;
                 drop(body);
-                // OK written 40 ms into a 20 ms call: the client saw its deadline.
+                // OK written 40 ms into a 20 ms call: kept as sent, counted as late.
                 let late = layer.layer(tower::service_fn(|_req: http::Request<Body>| async {
                     let body = LateOk(Box::pin(tokio::time::sleep(Duration::from_millis(40))));
                     Ok::<_, std::convert::Infallible>(http::Response::new(Body::new(body)))
