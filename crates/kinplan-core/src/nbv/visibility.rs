@@ -80,8 +80,8 @@ impl VisibilityParams {
                 "must lie in [1, 64]",
             );
         }
-        if self.lookahead == 0 || self.lookahead > 1000 {
-            return bad("visibility.lookahead", self.lookahead, "must lie in [1, 1000]");
+        if self.lookahead == 0 || self.lookahead > 64 {
+            return bad("visibility.lookahead", self.lookahead, "must lie in [1, 64]");
         }
         if self.min_new_cells == 0 {
             return bad("visibility.min_new_cells", 0, "must be at least 1");
@@ -121,6 +121,9 @@ fn in_keys(k: &OcKey, keys: &Option<(OcKey, OcKey)>) -> bool {
         .is_none_or(|(a, b)| (0..3).all(|i| k[i] >= a[i] && k[i] <= b[i]))
 }
 
+/// Length at which a key list is first compacted.
+const COMPACT_MIN: usize = 1 << 16;
+
 /// Predicts what `camera` at `pose` (optical frame → map) reveals of `tree` (module
 /// docs): the rays through every `pixel_stride`-th pixel (the pixel grid of the
 /// simulated sensor at the same stride) are walked by a 3-D DDA from the camera centre
@@ -142,6 +145,10 @@ pub fn predict_view(
     ws.first.clear();
     ws.reached.clear();
     let mut out = ViewPrediction::default();
+    // The key lists are compacted (sorted, deduplicated) whenever they have
+    // doubled since the last compaction: memory stays within twice the
+    // distinct cells, not rays × lookahead.
+    let mut compact_at = [COMPACT_MIN; 2];
     'rows: for v in (0..camera.height).step_by(stride) {
         for u in (0..camera.width).step_by(stride) {
             if out.rays % 64 == 63 && deadline.expired() {
@@ -174,6 +181,13 @@ pub fn predict_view(
                     }
                 },
             );
+            for (list, at) in [&mut ws.first, &mut ws.reached].into_iter().zip(&mut compact_at) {
+                if list.len() >= *at {
+                    list.sort_unstable();
+                    list.dedup();
+                    *at = (2 * list.len()).max(COMPACT_MIN);
+                }
+            }
         }
     }
     for v in [&mut ws.first, &mut ws.reached] {
