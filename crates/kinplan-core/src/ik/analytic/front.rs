@@ -48,16 +48,21 @@ pub(crate) fn solve_with(
 ) -> IkResult {
     // validate_request refuses position targets for this method; answer one with
     // nothing rather than panic should a caller skip it
-    let IkTarget::Pose(pose) = target else {
-        return IkResult {
-            solutions: Vec::new(),
-            best_attempt: None,
-            stop_reason: IkStatus::MaxIterations,
-            attempts: 0,
-            total_iterations: 0,
-            elapsed_us: clock.elapsed_us(),
-        };
+    let nothing = |stop_reason| IkResult {
+        solutions: Vec::new(),
+        best_attempt: None,
+        stop_reason,
+        attempts: 0,
+        total_iterations: 0,
+        elapsed_us: clock.elapsed_us(),
     };
+    let IkTarget::Pose(pose) = target else {
+        return nothing(IkStatus::MaxIterations);
+    };
+    // a path of many steps (TrackPath, StreamIk) ends here once the deadline passes
+    if let Some(stop) = clock.interrupted() {
+        return nothing(stop);
+    }
     let arm = &reduced.arm;
     let seed_q: Vec<f64> = seed.map_or_else(|| chain.mid_limits(), <[f64]>::to_vec);
     let seed6 = reduced.reduce(&seed_q);
@@ -72,8 +77,16 @@ pub(crate) fn solve_with(
         ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
     });
     let mut solutions = Vec::new();
-    for s in &raw {
+    let mut interrupted = None;
+    for (k, s) in raw.iter().enumerate() {
         if solutions.len() >= params.num_solutions {
+            break;
+        }
+        // whole turns of wide joints can give thousands of candidates
+        if k % 256 == 255
+            && let Some(stop) = clock.interrupted()
+        {
+            interrupted = Some(stop);
             break;
         }
         let sol = solution(chain, reduced, target, s, clock);
@@ -82,6 +95,11 @@ pub(crate) fn solve_with(
         {
             solutions.push(sol);
         }
+    }
+    if solutions.is_empty()
+        && let Some(stop) = interrupted
+    {
+        return nothing(stop);
     }
     let best_attempt = if solutions.is_empty() {
         arm.nearest(pose, Some(&seed6), &params.analytic, &mut raw);

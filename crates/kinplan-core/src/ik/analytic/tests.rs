@@ -523,3 +523,37 @@ fn analytic_start_puts_lm_on_the_nearest_closed_form_solution() {
     .unwrap();
     assert!(plain.solutions.first().is_none_or(|s| s.iterations > 0));
 }
+
+/// The analytic method looks at the deadline: a passed one or a raised
+/// cancellation answers as such, with no solution, where a live one solves.
+#[test]
+fn the_analytic_method_stops_at_the_deadline_and_on_cancellation() {
+    use crate::Deadline;
+    use crate::ik::IkStatus;
+    let chain = builtin_chain("kuka_kr210_r2700_extra").unwrap();
+    let q = [0.2, -1.2, 1.1, 0.3, 0.4, -0.5];
+    let target = IkTarget::Pose(chain.fk(&q));
+    let params = IkParams {
+        method: IkMethod::Analytic,
+        num_solutions: 8,
+        ..IkParams::default()
+    };
+    let live = solve_ik(&chain, &target, Some(&q), &params, 0, Deadline::none()).unwrap();
+    assert_eq!(live.stop_reason, IkStatus::Converged);
+    assert!(!live.solutions.is_empty());
+    let past = std::time::Instant::now() - std::time::Duration::from_millis(1);
+    let late = solve_ik(&chain, &target, Some(&q), &params, 0, Deadline::at(past)).unwrap();
+    assert_eq!(late.stop_reason, IkStatus::TimeBudget);
+    assert!(late.solutions.is_empty());
+    let gone = std::sync::atomic::AtomicBool::new(true);
+    let cancelled = solve_ik(
+        &chain,
+        &target,
+        Some(&q),
+        &params,
+        0,
+        Deadline::none().with_cancel(&gone),
+    )
+    .unwrap();
+    assert_eq!(cancelled.stop_reason, IkStatus::Cancelled);
+}
