@@ -294,9 +294,21 @@ async fn bad_retime_input_is_named_by_field() {
         }),
         ..Default::default()
     };
-    let err = planning.plan(plan).await.unwrap_err();
+    let err = planning.plan(plan.clone()).await.unwrap_err();
     assert!(
         err.message().starts_with("options.timing.path_tolerance:"),
+        "{}",
+        err.message()
+    );
+    // a plan starts at rest: a start velocity is refused before any planning
+    let mut moving = plan;
+    let timing = moving.options.as_mut().unwrap().timing.as_mut().unwrap();
+    timing.path_tolerance = None;
+    timing.start_velocity = vec![0.1, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let err = planning.plan(moving).await.unwrap_err();
+    assert_eq!(err.code(), Code::InvalidArgument, "{}", err.message());
+    assert!(
+        err.message().starts_with("options.timing.start_velocity:"),
         "{}",
         err.message()
     );

@@ -8,7 +8,7 @@ use nalgebra::Isometry3;
 use super::cartesian::{CartesianLine, Deviation, deviation, violates};
 use super::clock::{Clock, Interrupt};
 use super::costs::{path_valid, resolution_of};
-use super::error::{PlanError, PlanField, check_vector};
+use super::error::{PlanError, PlanField, check_vector, require};
 use super::initial::initial_trajectory;
 use super::rrt_connect::{RrtStop, rrt_connect_path};
 use super::stomp::{IterationReport, StompStop, stomp_optimize};
@@ -203,7 +203,23 @@ fn validate(chain: &Chain, checker_dof: usize, req: &PlanRequest) -> Result<(), 
     req.stomp.validate(dof)?;
     req.cartesian.validate()?;
     req.rrt.validate()?;
-    req.timing.validate(dof)
+    req.timing.validate(dof)?;
+    // a start velocity must point along the path's first segment, which a
+    // client cannot know before the plan: only Retime takes one
+    let moving = req
+        .timing
+        .start_velocity
+        .as_deref()
+        .and_then(|v| v.iter().copied().find(|x| *x != 0.0));
+    match moving {
+        Some(v) => require(
+            false,
+            PlanField::StartVelocity,
+            v,
+            "a plan starts at rest; time a path from a moving start with Retime",
+        ),
+        None => Ok(()),
+    }
 }
 
 /// Plans a trajectory for `chain` from `req.start` to `req.goal` in the world
