@@ -202,6 +202,14 @@ async fn bad_exploration_requests_are_named_by_field() {
             });
             r
         }),
+        ("nbv.visibility", {
+            let mut r = request();
+            r.nbv = Some(pb::NbvOptions {
+                visibility: Some(pb::VisibilityCheck::default()),
+                ..Default::default()
+            });
+            r
+        }),
     ];
     for (field, req) in cases {
         let Err(err) = client.explore(req).await else {

@@ -33,6 +33,14 @@ pub fn explore_params_in(
     if let Some(m) = &req.camera_mount {
         p.camera_mount = pose_in("camera_mount", Some(m))?;
     }
+    // the loop's own visibility check is ExploreRequest.visibility (or
+    // no_visibility_check); one given inside nbv would be silently replaced
+    if req.nbv.as_ref().is_some_and(|n| n.visibility.is_some()) {
+        return Err(crate::status::invalid(
+            "nbv.visibility",
+            "the exploration loop takes its visibility check from ExploreRequest.visibility",
+        ));
+    }
     // NBV options through NextBestView's converter; the loop sets the rest.
     let nbv_req = pb::NextBestViewRequest {
         robot: req.robot.clone(),
