@@ -13,7 +13,6 @@ streams the client cancels. Exit status 1 when any series disagrees.
 """
 import argparse
 import collections
-import math
 import random
 import re
 import socket

@@ -9,27 +9,25 @@
 
 use std::time::{Duration, Instant};
 
+use kinplan_loadtest::LatencyReport;
 use kinplan_proto as pb;
 use pb::kinematics_service_client::KinematicsServiceClient;
 use pb::robot_service_client::RobotServiceClient;
 use tonic::transport::{Channel, Endpoint};
 
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    let rank = ((p / 100.0) * (sorted.len() - 1) as f64).round() as usize;
-    sorted[rank.min(sorted.len() - 1)]
+/// p50 and p99 (ms, nearest rank, as the load test reports them) of latencies in ms.
+fn p50_p99(ms: &[f64]) -> (f64, f64) {
+    let mut ns: Vec<u64> = ms.iter().map(|m| (m * 1e6) as u64).collect();
+    let at = |r: &LatencyReport, p| r.at(p).map_or(f64::NAN, |v| v as f64 / 1e6);
+    LatencyReport::from_latencies(&mut ns).map_or((f64::NAN, f64::NAN), |r| (at(&r, 50.0), at(&r, 99.0)))
 }
 
-fn summary(what: &str, mut shed_ms: Vec<f64>, others: usize) {
-    shed_ms.sort_by(f64::total_cmp);
+fn summary(what: &str, shed_ms: &[f64], others: usize) {
+    let (p50, p99) = p50_p99(shed_ms);
+    let max = shed_ms.iter().copied().fold(f64::NAN, f64::max);
     println!(
-        "{what}: {} shed, {others} other answers; shed latency p50 {:.3} ms, p99 {:.3} ms, max {:.3} ms",
+        "{what}: {} shed, {others} other answers; shed latency p50 {p50:.3} ms, p99 {p99:.3} ms, max {max:.3} ms",
         shed_ms.len(),
-        percentile(&shed_ms, 50.0),
-        percentile(&shed_ms, 99.0),
-        shed_ms.last().copied().unwrap_or(f64::NAN),
     );
 }
 
@@ -55,12 +53,14 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
         .nth(1)
         .ok_or("usage: shed_burst <path to the kinplan binary>")?;
     let port = free_port();
-    let mut server = std::process::Command::new(&binary)
-        .args(["serve", "--listen", &format!("127.0.0.1:{port}")])
-        .args(["--cpu-threads", "2", "--concurrency-limit", "4"])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()?;
+    let _server = KillOnDrop(
+        std::process::Command::new(&binary)
+            .args(["serve", "--listen", &format!("127.0.0.1:{port}")])
+            .args(["--cpu-threads", "2", "--concurrency-limit", "4"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()?,
+    );
     let endpoint = Endpoint::from_shared(format!("http://127.0.0.1:{port}"))?.tcp_nodelay(true);
     let mut channel = None;
     for _ in 0..100 {
@@ -78,13 +78,9 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     // The floor: the same burst answered (not shed) by an idle server.
     let idle = futures_join(robots.clone(), 200).await;
-    let mut answered: Vec<f64> = idle.iter().filter(|(_, s)| !*s).map(|(ms, _)| *ms).collect();
-    answered.sort_by(f64::total_cmp);
-    println!(
-        "200 calls at once, idle server (answered): p50 {:.3} ms, p99 {:.3} ms",
-        percentile(&answered, 50.0),
-        percentile(&answered, 99.0)
-    );
+    let answered: Vec<f64> = idle.iter().filter(|(_, s)| !*s).map(|(ms, _)| *ms).collect();
+    let (p50, p99) = p50_p99(&answered);
+    println!("200 calls at once, idle server (answered): p50 {p50:.3} ms, p99 {p99:.3} ms");
     // Four calls that run for seconds: a target 10 m away, unlimited restarts.
     let far = pb::SolveIkRequest {
         robot: Some(pb::RobotRef {
@@ -119,7 +115,7 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     let shed: Vec<f64> = burst.iter().filter(|(_, s)| *s).map(|(ms, _)| *ms).collect();
     summary(
         "200 calls at once",
-        shed,
+        &shed,
         burst.iter().filter(|(_, s)| !*s).count(),
     );
 
@@ -133,14 +129,22 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
             others += 1;
         }
     }
-    summary("200 calls one after another", sequential, others);
+    summary("200 calls one after another", &sequential, others);
 
     for call in busy {
         let _ = call.await;
     }
-    let _ = server.kill();
-    let _ = server.wait();
     Ok(())
+}
+
+/// The server process, stopped however `main` returns.
+struct KillOnDrop(std::process::Child);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
 }
 
 /// `n` ListRobots calls started together, each timed from its own start.
