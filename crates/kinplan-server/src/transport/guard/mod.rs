@@ -259,10 +259,11 @@ where
 }
 
 /// A call not yet answered; dropped so, it is recorded as abandoned.
-struct Unanswered(Option<CallLabels>);
+pub(crate) struct Unanswered(pub(crate) Option<CallLabels>);
 
 impl Unanswered {
-    fn answered(mut self) -> CallLabels {
+    /// The call's labels, now that it is answered (no longer recorded on drop).
+    pub(crate) fn answered(mut self) -> CallLabels {
         self.0
             .take()
             .unwrap_or_else(|| CallLabels::for_path("/unknown/unknown"))

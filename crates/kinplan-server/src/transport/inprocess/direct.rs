@@ -22,10 +22,10 @@ use crate::pb::planning_service_server::PlanningService;
 use crate::pb::robot_service_server::RobotService;
 use crate::pb::scoring_service_server::ScoringService;
 use crate::runtime::catch_unwind;
-use crate::runtime::deadline::{RequestDeadline, call_deadline};
+use crate::runtime::deadline::{RequestDeadline, call_deadline, effective_timeout};
 use crate::status::code_name;
 use crate::transport::finite;
-use crate::transport::guard::{CallLabels, deadline_status, non_finite_status, panic_status};
+use crate::transport::guard::{CallLabels, Unanswered, deadline_status, non_finite_status, panic_status};
 
 /// What a direct call needs besides the handler: the server's limits.
 pub(super) struct Limits {
@@ -78,7 +78,10 @@ pub(super) async fn unary(
     }
 }
 
-/// One direct call, recorded in the metrics with the status it answers.
+/// One direct call, recorded in the metrics with the status it answers —
+/// or, when the caller drops it before the answer (an asyncio task
+/// cancelled, a timeout around it), as abandoned: DEADLINE_EXCEEDED at the
+/// call's timeout, CANCELLED before, as the guard records a reset stream.
 async fn call<Req, Resp, Fut>(
     limits: &Limits,
     path: &str,
@@ -91,7 +94,8 @@ where
     Resp: Message,
     Fut: Future<Output = Result<tonic::Response<Resp>, Status>>,
 {
-    let labels = CallLabels::for_path(path);
+    let labels = CallLabels::for_path(path).with_timeout(effective_timeout(timeout, limits.default_timeout));
+    let waiting = Unanswered(Some(labels.clone()));
     let answer: Result<Bytes, Status> = async {
         let deadline = call_deadline(timeout, limits.default_timeout);
         within_limit("request", message.len(), limits.max_message_bytes)?;
@@ -119,7 +123,7 @@ where
         Ok(Bytes::from(encoded))
     }
     .await;
-    labels.record(match &answer {
+    waiting.answered().record(match &answer {
         Ok(_) => "OK",
         Err(status) => code_name(status.code() as i32),
     });

@@ -490,6 +490,56 @@ mod tests {
         assert_eq!(status.code(), tonic::Code::OutOfRange, "{status:?}");
     }
 
+    /// A direct call its caller drops before the answer (an asyncio task
+    /// cancelled) is counted, as CANCELLED, as the guard counts a reset call.
+    #[test]
+    fn a_direct_call_dropped_before_its_answer_is_recorded_as_cancelled() {
+        let recorder = metrics_exporter_prometheus::PrometheusBuilder::new().build_recorder();
+        let handle = recorder.handle();
+        let runtime = tokio::runtime::Builder::new_current_thread()
+            .enable_all()
+            .build()
+            .unwrap();
+        let batch = pb::ForwardKinematicsBatchRequest {
+            robot: kr210(),
+            joint_positions: Some(pb::Matrix {
+                rows: 200_000,
+                cols: 6,
+                data: vec![0.1; 1_200_000],
+            }),
+            ..Default::default()
+        }
+        .encode_to_vec();
+        let config = ServerConfig {
+            max_message_bytes: 16 << 20,
+            ..ServerConfig::default()
+        };
+        metrics::with_local_recorder(&recorder, || {
+            runtime.block_on(async {
+                let local = InProcess::new(&config);
+                let call = local.unary(
+                    "/kinplan.v1.RobotService/ForwardKinematicsBatch",
+                    &batch,
+                    Some(Duration::from_secs(30)),
+                );
+                assert!(
+                    tokio::time::timeout(Duration::from_millis(2), call)
+                        .await
+                        .is_err(),
+                    "200,000 FK states are not answered within 2 ms"
+                );
+            })
+        });
+        let text = handle.render();
+        let cancelled = text.lines().any(|l| {
+            l.starts_with("grpc_server_handled_total")
+                && l.contains("grpc_method=\"ForwardKinematicsBatch\"")
+                && l.contains("grpc_code=\"CANCELLED\"")
+                && l.ends_with(" 1")
+        });
+        assert!(cancelled, "{text}");
+    }
+
     #[tokio::test]
     async fn a_bidirectional_stream_answers_each_message_in_order() {
         let local = InProcess::new(&ServerConfig::default());
