@@ -64,6 +64,24 @@ impl Tokens {
     }
 }
 
+/// Whether `request` passes authentication: no tokens configured, an open
+/// path, or a configured token. The guard asks this too, so that a caller
+/// without a token is told UNAUTHENTICATED, never RESOURCE_EXHAUSTED.
+pub(crate) fn admits<B>(tokens: Option<&Tokens>, request: &http::Request<B>) -> bool {
+    let Some(tokens) = tokens else {
+        return true;
+    };
+    let path = request.uri().path();
+    if OPEN_PREFIXES.iter().any(|p| path.starts_with(p)) {
+        return true;
+    }
+    let header = request
+        .headers()
+        .get(http::header::AUTHORIZATION)
+        .map(|v| v.as_bytes());
+    tokens.accepts(header)
+}
+
 /// The layer: pass-through when `tokens` is `None`.
 #[derive(Clone)]
 pub struct AuthLayer {
@@ -109,20 +127,12 @@ where
     }
 
     fn call(&mut self, request: http::Request<B>) -> Self::Future {
-        if let Some(tokens) = &self.tokens {
-            let path = request.uri().path();
-            let open = OPEN_PREFIXES.iter().any(|p| path.starts_with(p));
-            let header = request
-                .headers()
-                .get(http::header::AUTHORIZATION)
-                .map(|v| v.as_bytes());
-            if !open && !tokens.accepts(header) {
-                metrics::counter!("kinplan_unauthenticated_total").increment(1);
-                let status = Status::unauthenticated(
-                    "this server requires `authorization: Bearer <token>` with a configured token",
-                );
-                return Box::pin(async move { Ok(status.into_http()) });
-            }
+        if !admits(self.tokens.as_ref(), &request) {
+            metrics::counter!("kinplan_unauthenticated_total").increment(1);
+            let status = Status::unauthenticated(
+                "this server requires `authorization: Bearer <token>` with a configured token",
+            );
+            return Box::pin(async move { Ok(status.into_http()) });
         }
         Box::pin(self.inner.call(request))
     }

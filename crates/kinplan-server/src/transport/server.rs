@@ -185,7 +185,8 @@ pub async fn serve(
     let router = builder
         .layer(
             GuardLayer::new(cut_rx, config.request_timeout)
-                .shedding_when(Arc::new(move || compute.saturated())),
+                .shedding_when(Arc::new(move || compute.saturated()))
+                .authenticating_with(config.auth_tokens.clone()),
         )
         .layer(AuthLayer::new(config.auth_tokens.clone()))
         .add_routes(routes)

@@ -23,6 +23,7 @@ use crate::runtime::deadline::{
     RequestDeadline, answer_reserve, call_deadline, effective_timeout, grpc_timeout,
 };
 use crate::status::code_name;
+use crate::transport::auth::{Tokens, admits};
 
 /// Histogram bucket bounds, seconds: 50 µs to 10 s.
 pub const HANDLING_BUCKETS: &[f64] = &[
@@ -40,6 +41,7 @@ pub struct GuardLayer {
     cut: watch::Receiver<bool>,
     default_timeout: Option<Duration>,
     saturated: Option<Saturated>,
+    tokens: Option<Tokens>,
 }
 
 impl GuardLayer {
@@ -48,6 +50,7 @@ impl GuardLayer {
             cut,
             default_timeout,
             saturated: None,
+            tokens: None,
         }
     }
 
@@ -56,6 +59,13 @@ impl GuardLayer {
     /// only answers a burst's extra calls without reading them).
     pub fn shedding_when(mut self, saturated: Saturated) -> Self {
         self.saturated = Some(saturated);
+        self
+    }
+
+    /// Sheds only calls that pass authentication with `tokens` (the
+    /// authentication layer inside answers the others UNAUTHENTICATED).
+    pub fn authenticating_with(mut self, tokens: Option<Tokens>) -> Self {
+        self.tokens = tokens;
         self
     }
 }
@@ -68,6 +78,7 @@ impl<S> tower::Layer<S> for GuardLayer {
             cut: self.cut.clone(),
             default_timeout: self.default_timeout,
             saturated: self.saturated.clone(),
+            tokens: self.tokens.clone(),
         }
     }
 }
@@ -78,6 +89,7 @@ pub struct Guard<S> {
     cut: watch::Receiver<bool>,
     default_timeout: Option<Duration>,
     saturated: Option<Saturated>,
+    tokens: Option<Tokens>,
 }
 
 /// The calls admitted stream by stream (their messages are admitted one by
@@ -217,6 +229,7 @@ where
         if reply_type.is_some()
             && !ADMITTED_PER_MESSAGE.contains(&request.uri().path())
             && self.saturated.as_ref().is_some_and(|busy| busy())
+            && admits(self.tokens.as_ref(), &request)
         {
             metrics::counter!("kinplan_requests_shed_total").increment(1);
             let status = crate::runtime::compute::shed_status();
@@ -356,6 +369,47 @@ mod tests {
             call(passes).await.unwrap();
         }
         assert_eq!(reached.load(std::sync::atomic::Ordering::SeqCst), 2);
+    }
+
+    /// With tokens configured, a saturated server sheds only authenticated
+    /// calls: a caller without a valid token reaches the authentication
+    /// layer and is told UNAUTHENTICATED, not RESOURCE_EXHAUSTED.
+    #[tokio::test]
+    async fn a_saturated_pool_sheds_only_authenticated_calls() {
+        let (_tx, layer) = layer();
+        let tokens = Tokens::new(["secret".to_string()]);
+        let guard = layer
+            .shedding_when(Arc::new(|| true))
+            .authenticating_with(tokens.clone());
+        let svc = guard.layer(
+            crate::transport::auth::AuthLayer::new(tokens).layer(tower::service_fn(
+                |_req: http::Request<Body>| {
+                    std::future::ready(Ok::<_, std::convert::Infallible>(http::Response::new(
+                        Body::empty(),
+                    )))
+                },
+            )),
+        );
+        let call = |token: Option<&str>| {
+            let mut request = http::Request::new(Body::empty());
+            *request.uri_mut() = "/kinplan.v1.RobotService/ForwardKinematics".parse().unwrap();
+            if let Some(t) = token {
+                request
+                    .headers_mut()
+                    .insert(http::header::AUTHORIZATION, t.parse().unwrap());
+            }
+            svc.clone().oneshot(request)
+        };
+        for anonymous in [None, Some("Bearer wrong")] {
+            let answer = call(anonymous).await.unwrap();
+            assert_eq!(
+                status_of(&answer),
+                Some(tonic::Code::Unauthenticated as i32),
+                "{anonymous:?}"
+            );
+        }
+        let shed = call(Some("Bearer secret")).await.unwrap();
+        assert_eq!(status_of(&shed), Some(tonic::Code::ResourceExhausted as i32));
     }
 
     struct PanickingBody;
