@@ -427,6 +427,53 @@ async fn work_stops_soon_after_a_missed_deadline() {
     assert_idle("SolveIkBatch", idle_after(&running).await);
 }
 
+/// Regression: building a robot's collision model (its bodies and the
+/// sampled allowed-collision matrix, up to two million pair tests) ignored
+/// the deadline and ran on the pool for seconds after the answer, for every
+/// new URDF or held-joint value a client sent. The build now stops at the
+/// call's deadline and is not cached half-done.
+#[tokio::test]
+async fn a_collision_model_build_stops_at_the_deadline() {
+    let running = Arc::new(AtomicUsize::new(0));
+    let server = start(ServerConfig {
+        running_jobs: running.clone(),
+        ..ServerConfig::default()
+    })
+    .await;
+    // 30 links, each a cylinder: 435 body pairs, about 4,600 sampled states
+    let links = 30;
+    let mut urdf = String::from(r#"<robot name="snake"><link name="l0"/>"#);
+    for k in 1..=links {
+        urdf += &format!(
+            r#"<link name="l{k}"><collision><origin xyz="0 0 0.05"/><geometry><cylinder radius="0.05" length="0.1"/></geometry></collision></link>
+            <joint name="j{k}" type="revolute"><parent link="l{}"/><child link="l{k}"/><origin xyz="0 0 0.1"/>
+              <axis xyz="{}"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>"#,
+            k - 1,
+            if k % 2 == 0 { "0 1 0" } else { "1 0 0" }
+        );
+    }
+    urdf += "</robot>";
+    let mut planning = pb::planning_service_client::PlanningServiceClient::new(server.channel.clone());
+    let check = pb::CheckStateRequest {
+        robot: Some(pb::RobotRef {
+            source: Some(pb::robot_ref::Source::Urdf(urdf)),
+            ..Default::default()
+        }),
+        states: vec![pb::JointState {
+            positions: vec![0.3; links],
+        }],
+        ..Default::default()
+    };
+    let (request, deadline) = with_deadline(check, 150);
+    let answer = planning.check_state(request).await;
+    let err = answer.as_ref().err().map(|e| e.message().to_string());
+    deadline.in_time(answer);
+    if let Some(message) = err.filter(|m| m.contains("collision model")) {
+        assert!(message.contains("longer deadline"), "{message}");
+    }
+    assert_idle("CheckState (collision model build)", idle_after(&running).await);
+}
+
 /// Health answers within 10 ms while every pool thread is busy (measured with
 /// the release binary, see the report; the assertion here allows for a debug
 /// build on a loaded 2-core machine, yet fails if health waits for the pool).
@@ -714,7 +761,8 @@ async fn scoring_limits_are_checked_up_front() {
     );
 
     // 1,000 boxes (the model limit) × 8 vertices × 2,000 waypoints: refused up front.
-    let boxes = r#"<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>"#.repeat(1000);
+    let boxes =
+        r#"<collision><geometry><cylinder radius="0.05" length="0.1"/></geometry></collision>"#.repeat(1000);
     let urdf = format!(
         r#"<robot name="b"><link name="a"/><link name="b">{boxes}</link>
         <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>

@@ -21,6 +21,7 @@ use rayon::prelude::*;
 use super::CollisionError;
 use super::model::{MAX_BODIES, RobotModel};
 use super::narrow::body_body_intersect;
+use crate::Deadline;
 use nalgebra::Isometry3;
 
 /// Why a pair of bodies is not checked.
@@ -131,6 +132,16 @@ impl AllowedCollisions {
     /// Adjacent pairs plus the default, always and never pairs found by
     /// sampling (see the module doc). Samples are checked on the rayon pool.
     pub fn sampled(model: &RobotModel, params: &AcmParams) -> Result<Self, CollisionError> {
+        Self::sampled_until(model, params, Deadline::none())
+    }
+
+    /// [`Self::sampled`], stopping with [`CollisionError::Stopped`] once
+    /// `deadline` says so (polled before every sample).
+    pub fn sampled_until(
+        model: &RobotModel,
+        params: &AcmParams,
+        deadline: Deadline<'_>,
+    ) -> Result<Self, CollisionError> {
         params.validate()?;
         let mut acm = Self::adjacent(model);
         let chain = model.chain();
@@ -172,17 +183,24 @@ impl AllowedCollisions {
             .map(|block| {
                 let mut c = vec![0u32; pairs.len()];
                 for q in block.chunks(dof.max(1)) {
+                    if let Some(stop) = deadline.stop() {
+                        return Err(stop);
+                    }
                     colliding(q, &mut c);
                 }
-                c
+                Ok(c)
             })
-            .reduce(
+            .try_reduce(
                 || vec![0u32; pairs.len()],
                 |mut x, y| {
                     x.iter_mut().zip(y).for_each(|(a, b)| *a += b);
-                    x
+                    Ok(x)
                 },
-            );
+            )
+            .map_err(|stop| CollisionError::Stopped {
+                what: "sampling the allowed-collision matrix".into(),
+                stop,
+            })?;
         let always = (params.always_fraction * params.samples as f64).ceil() as u32;
         for (k, &(a, b)) in pairs.iter().enumerate() {
             if at_default[k] > 0 {

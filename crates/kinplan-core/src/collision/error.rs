@@ -47,6 +47,11 @@ pub enum CollisionError {
          can move its links arbitrarily far"
     )]
     CannotPad,
+    #[error("{what} stopped before it finished: {}", match stop {
+        crate::Stop::Deadline => "the deadline passed",
+        crate::Stop::Cancelled => "the call was cancelled",
+    })]
+    Stopped { what: String, stop: crate::Stop },
     #[error("{field} = {value} is outside [{lower}, {upper}]")]
     OutOfRange {
         field: String,

@@ -11,6 +11,7 @@ use std::sync::{Arc, Mutex, Weak};
 use kinplan_core::collision::{
     AcmParams, AllowReason, AllowedCollisions, CollisionError, MeshFileLimits, RobotModel, read_mesh_file,
 };
+use kinplan_core::{Deadline, Stop};
 
 use crate::runtime::models::{HeldJoints, ModelSource};
 use kinplan_core::robot::Chain;
@@ -28,11 +29,24 @@ impl CollisionSetup {
     /// matrix: `acm_samples` states, fewer when the model has so many body
     /// pairs that the tests would exceed the domain's bound
     /// ([`AcmParams::samples_within`]).
+    ///
+    /// Stops with [`CollisionError::Stopped`] once `deadline` says so: it is
+    /// polled before every mesh file, after the bodies are built and during
+    /// the sampling.
     pub fn build(
         chain: Arc<Chain>,
         model: Option<(&ModelSource, &[(String, f64)])>,
         acm_samples: usize,
+        deadline: Deadline<'_>,
     ) -> Result<Self, CollisionError> {
+        let stopped = |what: &str| {
+            deadline.stop().map_or(Ok(()), |stop| {
+                Err(CollisionError::Stopped {
+                    what: what.into(),
+                    stop,
+                })
+            })
+        };
         let source = model.map(|(s, _)| s);
         let held: Vec<(&str, f64)> = model
             .map(|(_, h)| h.iter().map(|(n, v)| (n.as_str(), *v)).collect())
@@ -43,24 +57,29 @@ impl CollisionSetup {
                 let meshes = source
                     .meshes
                     .iter()
-                    .map(|(uri, data)| read_mesh_file(uri, data, &limits))
+                    .map(|(uri, data)| {
+                        stopped("reading the robot's mesh files")?;
+                        read_mesh_file(uri, data, &limits)
+                    })
                     .collect::<Result<Vec<_>, _>>()?;
                 RobotModel::of_urdf(chain, &source.urdf, &held, &meshes)?
             }
             None => RobotModel::new(chain)?,
         });
+        stopped("building the robot's collision bodies")?;
         // MoveIt's disable_collisions pairs (by link name; pairs of links the
         // model does not hold are left out)
         let disabled: &[(String, String)] = match source.and_then(|s| s.srdf.as_deref()) {
             Some(srdf) => &srdf.parsed.disabled_collisions,
             None => &[],
         };
-        let mut acm = AllowedCollisions::sampled(
+        let mut acm = AllowedCollisions::sampled_until(
             &model,
             &AcmParams {
                 samples: AcmParams::samples_within(model.body_count(), acm_samples),
                 ..AcmParams::default()
             },
+            deadline,
         )?;
         let index: std::collections::HashMap<&str, usize> =
             model.body_names().enumerate().map(|(i, n)| (n, i)).collect();
@@ -121,8 +140,10 @@ impl CollisionModels {
     }
 }
 
-/// The chain's collision setup: cached, or built on the CPU pool (and cached
-/// even if this request's deadline passes meanwhile).
+/// The chain's collision setup: cached, or built on the CPU pool within the
+/// call's deadline. A build the deadline stops is not cached, so its cost is
+/// bounded by the call that asked for it; DEADLINE_EXCEEDED then says that
+/// the first call for a robot must allow for the build.
 pub async fn collision_setup(
     shared: &crate::runtime::Shared,
     robot: &crate::runtime::models::Resolved,
@@ -137,17 +158,33 @@ pub async fn collision_setup(
     let held = robot.held.clone();
     shared
         .compute
-        .run(budget, move |_| {
+        .run(budget, move |budget| {
             let setup = Arc::new(CollisionSetup::build(
                 chain.clone(),
                 Some((&source, &held[..])),
                 cache.acm_samples,
+                budget.deadline(),
             )?);
             cache.insert(&chain, &held, setup.clone());
             Ok(setup)
         })
         .await?
-        .map_err(|e: CollisionError| crate::status::collision::collision_error("robot", e))
+        .map_err(|e: CollisionError| match e {
+            CollisionError::Stopped { what, stop } => stopped_status(&what, stop),
+            e => crate::status::collision::collision_error("robot", e),
+        })
+}
+
+/// DEADLINE_EXCEEDED (or CANCELLED) for a build stopped while `what`.
+fn stopped_status(what: &str, stop: Stop) -> tonic::Status {
+    match stop {
+        Stop::Cancelled => tonic::Status::cancelled(format!("the call was cancelled while {what}")),
+        Stop::Deadline => tonic::Status::deadline_exceeded(format!(
+            "the deadline passed while {what}: the robot's collision model (mesh hulls and \
+             allowed-collision matrix) is built on the first call for a robot and cached \
+             afterwards; give that call a longer deadline"
+        )),
+    }
 }
 
 #[cfg(test)]
@@ -160,7 +197,7 @@ mod tests {
         let cache = CollisionModels::new(2, 50);
         let none: HeldJoints = Arc::from(Vec::new());
         let ur5 = builtin_chain("ur5").unwrap();
-        let setup = Arc::new(CollisionSetup::build(ur5.clone(), None, 50).unwrap());
+        let setup = Arc::new(CollisionSetup::build(ur5.clone(), None, 50, Deadline::none()).unwrap());
         cache.insert(&ur5, &none, setup.clone());
         assert!(Arc::ptr_eq(&cache.get(&ur5, &none).unwrap(), &setup));
         // other held values are another model
@@ -172,7 +209,7 @@ mod tests {
         cache.insert(
             &copy,
             &none,
-            Arc::new(CollisionSetup::build(copy.clone(), None, 50).unwrap()),
+            Arc::new(CollisionSetup::build(copy.clone(), None, 50, Deadline::none()).unwrap()),
         );
         drop(copy);
         // The dead entry is dropped on the next insert; capacity holds.
@@ -180,7 +217,7 @@ mod tests {
         cache.insert(
             &panda,
             &none,
-            Arc::new(CollisionSetup::build(panda.clone(), None, 50).unwrap()),
+            Arc::new(CollisionSetup::build(panda.clone(), None, 50, Deadline::none()).unwrap()),
         );
         assert_eq!(cache.entries.lock().unwrap().len(), 2);
     }

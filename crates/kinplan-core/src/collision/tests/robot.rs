@@ -69,6 +69,31 @@ fn sampled_acm_keeps_adjacency_is_deterministic_and_keeps_reachable_pairs_checke
 }
 
 #[test]
+fn sampling_the_acm_stops_when_its_deadline_says_so() {
+    use std::sync::atomic::AtomicBool;
+    let model = RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap();
+    let params = AcmParams::default();
+    let past = crate::Deadline::at(std::time::Instant::now());
+    assert_eq!(
+        AllowedCollisions::sampled_until(&model, &params, past),
+        Err(CollisionError::Stopped {
+            what: "sampling the allowed-collision matrix".into(),
+            stop: crate::Stop::Deadline
+        })
+    );
+    let cancelled = AtomicBool::new(true);
+    let err =
+        AllowedCollisions::sampled_until(&model, &params, crate::Deadline::none().with_cancel(&cancelled))
+            .unwrap_err();
+    assert!(err.to_string().contains("the call was cancelled"), "{err}");
+    // no limit: the same matrix as without one
+    assert_eq!(
+        AllowedCollisions::sampled_until(&model, &params, crate::Deadline::none()),
+        AllowedCollisions::sampled(&model, &params)
+    );
+}
+
+#[test]
 fn malformed_meshes_are_rejected_naming_the_field() {
     let (v, i) = box_mesh(Vector3::new(0.1, 0.1, 0.1));
     let scene = |vertices: Vec<Point3<f64>>, indices: Vec<u32>| {
