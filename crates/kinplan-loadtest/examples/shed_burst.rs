@@ -3,7 +3,11 @@
 //! sends 200 ListRobots calls at once (and 200 one after another) and reports
 //! each shed call's latency from the moment it was sent, with a Rust client
 //! (so the figure is the server's, not a slow client's). The same burst
-//! answered by the idle server first gives the transport's floor.
+//! answered by the idle server first gives the transport's floor. Then the
+//! burst spread over eight connections, and the CPU time the server's I/O
+//! threads spend per shed call over `SHED_ROUNDS` (default 200) such bursts:
+//! a 200-call burst cannot be answered sooner than 200 times that, divided
+//! by the I/O threads.
 //!
 //! `cargo run --release -p kinplan-loadtest --example shed_burst -- target/release/kinplan`
 
@@ -61,6 +65,7 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
             .stderr(std::process::Stdio::null())
             .spawn()?,
     );
+    let server_pid = _server.0.id();
     let endpoint = Endpoint::from_shared(format!("http://127.0.0.1:{port}"))?.tcp_nodelay(true);
     let mut channel = None;
     for _ in 0..100 {
@@ -119,6 +124,43 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
         burst.iter().filter(|(_, s)| !*s).count(),
     );
 
+    // The same burst spread over eight connections (eight clients at once),
+    // then the CPU time the server's I/O threads spend per shed call over
+    // many such bursts.
+    let mut channels = Vec::new();
+    for _ in 0..8 {
+        channels.push(RobotServiceClient::new(endpoint.connect().await?));
+    }
+    for c in &channels {
+        let _ = list(c.clone()).await;
+    }
+    let spread = spread_join(&channels, 200).await;
+    let shed: Vec<f64> = spread.iter().filter(|(_, s)| *s).map(|(ms, _)| *ms).collect();
+    summary(
+        "200 calls at once over 8 connections",
+        &shed,
+        spread.iter().filter(|(_, s)| !*s).count(),
+    );
+    let before = io_cpu_seconds(server_pid);
+    let rounds: usize = std::env::var("SHED_ROUNDS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(200);
+    let mut shed_calls = 0;
+    for _ in 0..rounds {
+        shed_calls += spread_join(&channels, 200)
+            .await
+            .iter()
+            .filter(|(_, s)| *s)
+            .count();
+    }
+    if let (Some(a), Some(b)) = (before, io_cpu_seconds(server_pid)) {
+        println!(
+            "server I/O threads' CPU per shed call over {rounds} such bursts: {:.1} us ({shed_calls} shed)",
+            (b - a) * 1e6 / shed_calls.max(1) as f64
+        );
+    }
+
     let mut sequential = Vec::new();
     let mut others = 0;
     for _ in 0..200 {
@@ -145,6 +187,41 @@ impl Drop for KillOnDrop {
         let _ = self.0.kill();
         let _ = self.0.wait();
     }
+}
+
+/// `n` ListRobots calls started together over `channels` in turn, each
+/// timed from its own start.
+async fn spread_join(channels: &[RobotServiceClient<Channel>], n: usize) -> Vec<(f64, bool)> {
+    let calls: Vec<_> = (0..n)
+        .map(|k| tokio::spawn(list(channels[k % channels.len()].clone())))
+        .collect();
+    let mut out = Vec::with_capacity(n);
+    for call in calls {
+        if let Ok(result) = call.await {
+            out.push(result);
+        }
+    }
+    out
+}
+
+/// User plus system CPU time of the server's I/O threads (named
+/// `kinplan-io-*`; the CPU pool, busy with the long calls, is left out),
+/// seconds, from Linux `/proc`.
+fn io_cpu_seconds(pid: u32) -> Option<f64> {
+    let mut ticks = 0.0;
+    for task in std::fs::read_dir(format!("/proc/{pid}/task")).ok()?.flatten() {
+        let comm = std::fs::read_to_string(task.path().join("comm")).unwrap_or_default();
+        if !comm.starts_with("kinplan-io") {
+            continue;
+        }
+        let stat = std::fs::read_to_string(task.path().join("stat")).ok()?;
+        // fields after the command's closing parenthesis; utime and stime are 14 and 15
+        let rest = &stat[stat.rfind(')')? + 2..];
+        let fields: Vec<&str> = rest.split_whitespace().collect();
+        ticks += fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
+    }
+    // USER_HZ is 100 on Linux
+    Some(ticks / 100.0)
 }
 
 /// `n` ListRobots calls started together, each timed from its own start.
