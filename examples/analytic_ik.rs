@@ -25,10 +25,10 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
+use kinplan_core::Deadline;
 use kinplan_core::ik::analytic::{
     AnalyticArm, AnalyticParams, AnalyticSolution, Family, Turns, ZeroAxes, analyse, wrap,
 };
-use kinplan_core::Deadline;
 use kinplan_core::ik::{IkMethod, IkParams, IkSolver, IkTarget};
 use kinplan_core::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 use nalgebra::Isometry3;
@@ -108,7 +108,8 @@ fn best_of_5(mut pass: impl FnMut()) -> f64 {
 /// joint. (3) Searched: each pose's joints with the held joint moved 0.4 rad
 /// and the others up to 0.05 rad as the seed; `search_redundant` against
 /// Levenberg–Marquardt from the same seed (default restarts), both through
-/// `IkSolver`, with the squared joint distance of the answer to the seed.
+/// `IkSolver`, with the squared joint distance of the answer to the seed
+/// (`SAMPLES`: the search's `redundant_samples`, default 24).
 fn redundant(label: &str, chain: &Chain, n: usize, out_dir: Option<&String>) {
     let mut rng = ChaCha8Rng::seed_from_u64(2026);
     let configs: Vec<Vec<f64>> = (0..n).map(|_| random_7(chain, &mut rng)).collect();
@@ -136,6 +137,9 @@ fn redundant(label: &str, chain: &Chain, n: usize, out_dir: Option<&String>) {
         let full: Vec<Vec<f64>> = out.iter().map(|s| r.expand(&s.joints)).collect();
         if !full.iter().any(|s| same(s, q, 1e-7)) {
             missing += 1;
+            if missing <= 3 {
+                eprintln!("{label}: {q:?} not among {full:?}");
+            }
         }
         for s in &full {
             let f = chain.fk(s);
@@ -243,6 +247,7 @@ fn redundant(label: &str, chain: &Chain, n: usize, out_dir: Option<&String>) {
         num_solutions: 1,
         analytic: AnalyticParams {
             search_redundant: true,
+            redundant_samples: std::env::var("SAMPLES").map_or(24, |s| s.parse().expect("SAMPLES")),
             ..AnalyticParams::default()
         },
         ..IkParams::default()
@@ -253,7 +258,9 @@ fn redundant(label: &str, chain: &Chain, n: usize, out_dir: Option<&String>) {
         let us = best_of_5(|| {
             (sum, solved, as_near) = (0.0, 0, 0);
             for ((q, t), s) in configs.iter().zip(&poses).zip(&seeds) {
-                let r = solver.solve(&IkTarget::Pose(*t), Some(s), p, 0, Deadline::none()).unwrap();
+                let r = solver
+                    .solve(&IkTarget::Pose(*t), Some(s), p, 0, Deadline::none())
+                    .unwrap();
                 if let Some(best) = r.solutions.first() {
                     let d = dist2(&best.joints, s);
                     solved += 1;

@@ -39,7 +39,7 @@ pub struct AnalyticParams {
     pub search_redundant: bool,
     /// Evenly spaced held values (count, ≥ 2) the search starts from; the
     /// search can miss a nearer solution only in a gap between two samples.
-    /// Default 32.
+    /// Default 24.
     pub redundant_samples: usize,
 }
 
@@ -52,7 +52,7 @@ impl Default for AnalyticParams {
             hold_configuration: false,
             redundant_joint: None,
             search_redundant: false,
-            redundant_samples: 32,
+            redundant_samples: 24,
         }
     }
 }

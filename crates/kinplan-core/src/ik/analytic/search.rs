@@ -7,14 +7,19 @@ use super::family::AnalyticArm;
 use super::params::{AnalyticParams, Turns};
 use super::redundant::{ChainAxes, ChainModel, ReducedArm, hold_at};
 use super::solve::AnalyticSolution;
-use crate::ik::IkTarget;
 use crate::ik::attempt::Clock;
+use crate::ik::{IkMethod, IkParams, IkSolver, IkTarget};
 use crate::robot::Chain;
 
 /// Brent's minimiser stops when the bracket is this narrow (rad).
-const X_TOLERANCE: f64 = 1e-8;
+const X_TOLERANCE: f64 = 1e-6;
+/// The relaxed objective is refined only this far (rad): it only points
+/// at a valley, which the exact objective then refines.
+const G_TOLERANCE: f64 = 1e-4;
 /// … or after this many evaluations (the compass search too).
 const MAX_REFINE: usize = 80;
+/// First step (rad) of the compass search around a proposed held value.
+const PROPOSAL_STEP: f64 = 0.01;
 /// The deadline and cancellation are looked at every this many evaluations.
 const POLL_EVERY: usize = 8;
 
@@ -118,14 +123,17 @@ impl Objective<'_> {
 /// penalty, see `Objective`) are evaluated at `params.redundant_samples`
 /// evenly spaced values across joint `j`'s limits (`seed ± π` when unlimited)
 /// and at the seed's own value. The best sample of `f` is refined within its
-/// neighbouring samples, to 1e-8 rad, by Brent's minimiser (parabolic
+/// neighbouring samples, to 1e-6 rad, by Brent's minimiser (parabolic
 /// interpolation with golden-section steps; R. P. Brent, *Algorithms for
 /// Minimization without Derivatives*, 1973, ch. 5) when the neighbours
 /// bracket it, else by a compass search (step halved on failure) that copes
-/// with held values where the limits leave no solution (`f = ∞`). When the
-/// best sample of `g` lies elsewhere (a branch the limits allow on a stretch
-/// shorter than the sample spacing), `g` is refined there too and then `f`
-/// next to it; the nearer of the two answers wins. Each configuration's
+/// with held values where the limits leave no solution (`f = ∞`) — unless a
+/// proposal is given (the caller's Levenberg–Marquardt solve from the seed: a
+/// local answer, usually on the seed's own branch) and `f` refined next to
+/// its held value is already below the best sample's value. When the best sample of `g` lies elsewhere and is lower
+/// than the best `f` so far (a branch the limits allow on a stretch shorter
+/// than the sample spacing), `g` is refined there to 1e-4 rad and then `f`
+/// next to it. The nearest answer wins. Each configuration's
 /// solution moves continuously with `v` away from singular poses, so both
 /// refinements converge to local minima.
 ///
@@ -133,14 +141,16 @@ impl Objective<'_> {
 /// seed's own value and at every sample. The global nearest can be missed when
 /// it lies in a dip of `f` (and of `g`) narrower than the sample spacing
 /// `(upper − lower)/(samples − 1)` that no sample falls in; more samples narrow
-/// that gap, at one closed-form solve each. Cost: `samples + 1` solves plus at
-/// most 2 × (2 + 80) + 80 for the refinements. The deadline and cancellation
+/// that gap, at one closed-form solve each (the proposal closes it for the
+/// branch the seed's local answer lies on). Cost: `samples + 1` solves plus at
+/// most 2 × (2 + 80) + 2 × 80 for the refinements, and one LM attempt. The deadline and cancellation
 /// end the search early with the best value so far.
 pub(crate) fn search_held(
     axes: &ChainAxes,
     j: usize,
     target: &Isometry3<f64>,
     seed: &[f64],
+    proposal: Option<f64>,
     params: &AnalyticParams,
     clock: &Clock<'_>,
 ) -> f64 {
@@ -192,8 +202,17 @@ pub(crate) fn search_held(
             best_g = (v, gv, Some(k));
         }
     }
+    // the held value of a local numerical answer from the seed, when given
     let mut best = (best_f.0, best_f.1);
-    if best.1.is_finite() {
+    if let Some(v) = proposal.filter(|v| (lo..=hi).contains(v)) {
+        let r = local(&mut f, (lo, hi), v, PROPOSAL_STEP, clock);
+        if r.1 < best.1 {
+            best = r;
+        }
+    }
+    // the best sample's valley, unless the proposal's answer is nearer than
+    // that sample already
+    if best_f.1.is_finite() && best_f.1 <= best.1 {
         let r = refine(
             &mut f,
             (lo, hi),
@@ -201,15 +220,17 @@ pub(crate) fn search_held(
             (best_f.0, best_f.1),
             best_f.2,
             v_seed,
+            X_TOLERANCE,
             clock,
         );
         if r.1 < best.1 {
             best = r;
         }
     }
-    // the relaxed valley, when it lies elsewhere: its bottom, then the
-    // nearest values the limits allow (its bottom may lie a little outside)
-    if best_g.1.is_finite() && best_g.2 != best_f.2 {
+    // the relaxed valley, when it lies elsewhere and promises a nearer
+    // solution: its bottom, then the nearest values the limits allow there
+    // (its bottom may lie a little outside them)
+    if best_g.1 < best.1 && best_g.2 != best_f.2 {
         f.relaxed = true;
         let (x, _) = refine(
             &mut f,
@@ -218,11 +239,11 @@ pub(crate) fn search_held(
             (best_g.0, best_g.1),
             best_g.2,
             v_seed,
+            G_TOLERANCE,
             clock,
         );
         f.relaxed = false;
-        let start = (x, f.eval(x));
-        let r = compass(&mut f, (lo, hi), start, (0.25 * step).min(0.05), clock);
+        let r = local(&mut f, (lo, hi), x, (0.25 * step).min(0.05), clock);
         if r.1 < best.1 {
             best = r;
         }
@@ -242,6 +263,7 @@ fn refine(
     best: (f64, f64),
     k: Option<usize>,
     v_seed: f64,
+    xtol: f64,
     clock: &Clock<'_>,
 ) -> (f64, f64) {
     let (a, b) = match k {
@@ -255,10 +277,27 @@ fn refine(
     let bracketed =
         a < best.0 && best.0 < b && fa.is_finite() && fb.is_finite() && fa >= best.1 && fb >= best.1;
     if bracketed {
-        brent(f, a, b, best, clock)
+        brent(f, a, b, best, xtol, clock)
     } else {
-        compass(f, (lo, hi), best, 0.5 * step, clock)
+        compass(f, (lo, hi), best, 0.5 * step, xtol, clock)
     }
+}
+
+/// `f`'s local minimum next to `v`: Brent's minimiser on `[v − h, v + h]`
+/// when that brackets one, else a compass search from the best of the three.
+fn local(f: &mut Objective<'_>, (lo, hi): (f64, f64), v: f64, h: f64, clock: &Clock<'_>) -> (f64, f64) {
+    let (a, b) = ((v - h).max(lo), (v + h).min(hi));
+    let (fa, fv, fb) = (f.eval(a), f.eval(v), f.eval(b));
+    if a < v && v < b && fv.is_finite() && fa >= fv && fb >= fv && fa.is_finite() && fb.is_finite() {
+        return brent(f, a, b, (v, fv), X_TOLERANCE, clock);
+    }
+    let start = [(a, fa), (v, fv), (b, fb)]
+        .into_iter()
+        .fold((v, fv), |m, x| if x.1 < m.1 { x } else { m });
+    if !start.1.is_finite() {
+        return start;
+    }
+    compass(f, (lo, hi), start, 0.5 * h, X_TOLERANCE, clock)
 }
 
 /// Compass search on `[lo, hi]` from `start`: try `x ± h`, move to the first
@@ -268,12 +307,13 @@ fn compass(
     (lo, hi): (f64, f64),
     start: (f64, f64),
     step: f64,
+    xtol: f64,
     clock: &Clock<'_>,
 ) -> (f64, f64) {
     let (mut x, mut fx) = start;
     let mut h = step;
     let mut evaluations = 0;
-    while h > X_TOLERANCE && evaluations < MAX_REFINE {
+    while h > xtol && evaluations < MAX_REFINE {
         if clock.interrupted().is_some() {
             break;
         }
@@ -299,7 +339,14 @@ fn compass(
 
 /// Brent's localmin on `[a, b]` starting from the known point `start` inside
 /// it (its golden-section point is used when `start` lies outside).
-fn brent(f: &mut Objective<'_>, mut a: f64, mut b: f64, start: (f64, f64), clock: &Clock<'_>) -> (f64, f64) {
+fn brent(
+    f: &mut Objective<'_>,
+    mut a: f64,
+    mut b: f64,
+    start: (f64, f64),
+    xtol: f64,
+    clock: &Clock<'_>,
+) -> (f64, f64) {
     const GOLD: f64 = 0.381_966_011_250_105_1; // (3 − √5)/2
     let (mut x, mut fx) = if start.0 > a && start.0 < b {
         start
@@ -314,7 +361,7 @@ fn brent(f: &mut Objective<'_>, mut a: f64, mut b: f64, start: (f64, f64), clock
             break;
         }
         let m = 0.5 * (a + b);
-        let tol1 = 1e-12 * x.abs() + X_TOLERANCE / 3.0;
+        let tol1 = 1e-12 * x.abs() + xtol / 3.0;
         let tol2 = 2.0 * tol1;
         if (x - m).abs() <= tol2 - 0.5 * (b - a) {
             break;
@@ -394,6 +441,20 @@ pub(crate) fn searched(
         return reduced;
     };
     let seed_q = seed.map_or_else(|| chain.mid_limits(), <[f64]>::to_vec);
-    let v = search_held(axes, j, pose, &seed_q, params, clock);
+    // Levenberg–Marquardt from the seed (one attempt, no restarts) lands on a
+    // solution near it; its held value is one more start for the search
+    let lm = IkParams {
+        method: IkMethod::LevenbergMarquardt,
+        max_restarts: 0,
+        num_solutions: 1,
+        analytic_start: false,
+        ..IkParams::default()
+    };
+    let proposal = IkSolver::new(chain)
+        .solve_validated(target, Some(&seed_q), &lm, 0, clock)
+        .solutions
+        .first()
+        .map(|s| s.joints[j]);
+    let v = search_held(axes, j, pose, &seed_q, proposal, params, clock);
     hold_at(axes, j, v, params.geometry_tolerance).unwrap_or(reduced)
 }
