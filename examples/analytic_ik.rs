@@ -150,6 +150,46 @@ fn redundant(label: &str, chain: &Chain, n: usize, out_dir: Option<&String>) {
             }
         }
     }
+    // numerical cross-check on the held chains: LM from LM_SEEDS random seeds
+    // (default 64) on the first LM_POSES7 poses (default 500) finds no
+    // solution the closed form (every branch, no limits) missed
+    let lm_seeds: usize = std::env::var("LM_SEEDS").map_or(64, |s| s.parse().unwrap());
+    let lm_poses: usize = std::env::var("LM_POSES7").map_or(500, |s| s.parse().unwrap());
+    let lm_check = IkParams {
+        max_restarts: 0,
+        position_tolerance: 1e-10,
+        orientation_tolerance: 1e-10,
+        ..IkParams::default()
+    };
+    let (mut lm_found, mut lm_missed) = (0usize, 0usize);
+    for (q, t) in configs.iter().zip(&poses).take(lm_poses) {
+        let r = analyse(chain, &params, Some(q)).unwrap();
+        let (hj, hv) = r.held.unwrap();
+        let six = chain.with_joint_fixed(hj, hv).unwrap();
+        let mut ours = Vec::new();
+        r.arm.nearest(t, None, &params, &mut ours);
+        ours.retain(|s| s.exact);
+        let mut lm_solver = IkSolver::new(&six);
+        for _ in 0..lm_seeds {
+            let seed: Vec<f64> = six
+                .joints()
+                .iter()
+                .map(|j| rng.random_range(j.lower..=j.upper))
+                .collect();
+            let res = lm_solver
+                .solve(&IkTarget::Pose(*t), Some(&seed), &lm_check, 0, Deadline::none())
+                .unwrap();
+            if let Some(s) = res.solutions.first() {
+                lm_found += 1;
+                if !ours.iter().any(|a| same(&a.joints, &s.joints, 1e-6)) {
+                    lm_missed += 1;
+                    if lm_missed <= 3 {
+                        eprintln!("{label}: LM found {:?}, not among {:?}", s.joints, ours);
+                    }
+                }
+            }
+        }
+    }
     let held_us = best_of_5(|| {
         for (q, t) in configs.iter().zip(&poses) {
             let r = analyse(chain, &params, Some(black_box(q))).unwrap();
@@ -282,7 +322,8 @@ fn redundant(label: &str, chain: &Chain, n: usize, out_dir: Option<&String>) {
          {held_us:.3}, through IkSolver (FK check, ranking) {service_us:.3}; held at {v_fix}: {:.2}/pose, \
          {fixed_us:.3} µs; searched: {search_us:.2} µs, solved {search_solved}/{n}, as near as the pose's joints \
          {search_near}/{n}, mean squared distance {search_d:.4}; LM from the seed: {lm_us:.2} µs, solved \
-         {lm_solved}/{n}, as near {lm_near}/{n}, mean squared distance {lm_d:.4}",
+         {lm_solved}/{n}, as near {lm_near}/{n}, mean squared distance {lm_d:.4}; LM {lm_seeds} seeds × \
+         {lm_poses} poses on the held chain: {lm_found} converged, {lm_missed} not among ours",
         j + 1,
         if reversed { " (read from the tool end)" } else { "" },
         total as f64 / n as f64,

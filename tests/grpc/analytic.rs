@@ -222,7 +222,7 @@ async fn describe_robot_names_the_family_and_refusals_name_the_reason() {
 #[tokio::test]
 async fn panda_analytic_holds_or_searches_joint_7() {
     let server = start(ServerConfig::default()).await;
-    let mut ik = KinematicsServiceClient::new(server.channel.clone());
+    let ik = KinematicsServiceClient::new(server.channel.clone());
     let mut robots = RobotServiceClient::new(server.channel.clone());
     let q = vec![0.2, -0.4, 0.3, -2.1, 0.4, 1.8, 0.5];
     let target = fk(&mut robots, "franka_panda", &q).await;
@@ -230,7 +230,7 @@ async fn panda_analytic_holds_or_searches_joint_7() {
     let mut seed = q.clone();
     seed[6] += 0.4;
     let dist = |a: &[f64]| a.iter().zip(&seed).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
-    let mut solve = |options: pb::IkOptions| {
+    let solve = |options: pb::IkOptions| {
         let request = pb::SolveIkRequest {
             robot: named("franka_panda"),
             target: Some(pose_pb(&target)),

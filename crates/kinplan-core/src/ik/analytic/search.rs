@@ -189,6 +189,7 @@ pub(crate) fn search_held(
     let (mut best_f, mut best_g) = ((v_seed, f0, None), (v_seed, g0, None));
     let n = params.redundant_samples.max(2);
     let step = (hi - lo) / (n - 1) as f64;
+    let grid = Grid { lo, hi, step, v_seed };
     for k in 0..n {
         if k % POLL_EVERY == POLL_EVERY - 1 && clock.interrupted().is_some() {
             return best_f.0;
@@ -213,16 +214,7 @@ pub(crate) fn search_held(
     // the best sample's valley, unless the proposal's answer is nearer than
     // that sample already
     if best_f.1.is_finite() && best_f.1 <= best.1 {
-        let r = refine(
-            &mut f,
-            (lo, hi),
-            step,
-            (best_f.0, best_f.1),
-            best_f.2,
-            v_seed,
-            X_TOLERANCE,
-            clock,
-        );
+        let r = refine(&mut f, &grid, (best_f.0, best_f.1), best_f.2, X_TOLERANCE, clock);
         if r.1 < best.1 {
             best = r;
         }
@@ -232,16 +224,7 @@ pub(crate) fn search_held(
     // (its bottom may lie a little outside them)
     if best_g.1 < best.1 && best_g.2 != best_f.2 {
         f.relaxed = true;
-        let (x, _) = refine(
-            &mut f,
-            (lo, hi),
-            step,
-            (best_g.0, best_g.1),
-            best_g.2,
-            v_seed,
-            G_TOLERANCE,
-            clock,
-        );
+        let (x, _) = refine(&mut f, &grid, (best_g.0, best_g.1), best_g.2, G_TOLERANCE, clock);
         f.relaxed = false;
         let r = local(&mut f, (lo, hi), x, (0.25 * step).min(0.05), clock);
         if r.1 < best.1 {
@@ -251,6 +234,16 @@ pub(crate) fn search_held(
     if best.1.is_finite() { best.0 } else { v_seed }
 }
 
+/// The held values searched: `[lo, hi]` (rad), the sample spacing, and the
+/// seed's value.
+#[derive(Clone, Copy)]
+struct Grid {
+    lo: f64,
+    hi: f64,
+    step: f64,
+    v_seed: f64,
+}
+
 /// Refines the sample `best` (index `k`, or the seed's value `v_seed` when
 /// `None`) between its neighbouring samples: Brent's minimiser when they
 /// bracket it (both finite and higher), else (a neighbour without a solution
@@ -258,14 +251,13 @@ pub(crate) fn search_held(
 /// that never steps where the objective is infinite.
 fn refine(
     f: &mut Objective<'_>,
-    (lo, hi): (f64, f64),
-    step: f64,
+    grid: &Grid,
     best: (f64, f64),
     k: Option<usize>,
-    v_seed: f64,
     xtol: f64,
     clock: &Clock<'_>,
 ) -> (f64, f64) {
+    let Grid { lo, hi, step, v_seed } = *grid;
     let (a, b) = match k {
         Some(k) => (
             lo + step * k.saturating_sub(1) as f64,
