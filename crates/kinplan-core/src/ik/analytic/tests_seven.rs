@@ -354,3 +354,30 @@ fn reversed_arm_config_flags_and_refusals() {
     let e = bad.validate().unwrap_err().to_string();
     assert!(e.contains("redundant_samples"), "{e}");
 }
+
+/// The search looks at the deadline: a passed one answers as such, quickly.
+#[test]
+fn the_search_stops_at_the_deadline() {
+    use crate::Deadline;
+    use crate::ik::IkStatus;
+    let panda = builtin_chain("franka_panda").unwrap();
+    let q = [0.2, -0.4, 0.3, -2.1, 0.4, 1.8, 0.5];
+    let target = IkTarget::Pose(panda.fk(&q));
+    let params = analytic(
+        8,
+        AnalyticParams {
+            search_redundant: true,
+            redundant_samples: 4096,
+            ..AnalyticParams::default()
+        },
+    );
+    let past = std::time::Instant::now() - std::time::Duration::from_millis(1);
+    let t0 = std::time::Instant::now();
+    let late = solve_ik(&panda, &target, Some(&q), &params, 0, Deadline::at(past)).unwrap();
+    assert_eq!(late.stop_reason, IkStatus::TimeBudget);
+    assert!(late.solutions.is_empty());
+    // 4096 samples would take far longer than the few polled before stopping
+    assert!(t0.elapsed() < std::time::Duration::from_millis(500));
+    let live = solve_ik(&panda, &target, Some(&q), &params, 0, Deadline::none()).unwrap();
+    assert!(live.success());
+}
