@@ -142,9 +142,9 @@ impl Objective<'_> {
 /// it lies in a dip of `f` (and of `g`) narrower than the sample spacing
 /// `(upper − lower)/(samples − 1)` that no sample falls in; more samples narrow
 /// that gap, at one closed-form solve each (the proposal closes it for the
-/// branch the seed's local answer lies on). Cost: `samples + 1` solves plus at
-/// most 2 × (2 + 80) + 2 × 80 for the refinements, and one LM attempt. The deadline and cancellation
-/// end the search early with the best value so far.
+/// branch the seed's local answer lies on). Cost: `samples + 1` solves, one LM
+/// attempt, and at most four refinements of at most 83 solves each. The
+/// deadline and cancellation end the search early with the best value so far.
 pub(crate) fn search_held(
     axes: &ChainAxes,
     j: usize,
