@@ -143,7 +143,7 @@ impl Objective<'_> {
 /// `(upper − lower)/(samples − 1)` that no sample falls in; more samples narrow
 /// that gap, at one closed-form solve each (the proposal closes it for the
 /// branch the seed's local answer lies on). Cost: `samples + 1` solves, one LM
-/// attempt, and at most four refinements of at most 83 solves each. The
+/// attempt, and at most four refinements of at most 85 solves each. The
 /// deadline and cancellation end the search early with the best value so far.
 pub(crate) fn search_held(
     axes: &ChainAxes,
