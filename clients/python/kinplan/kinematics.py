@@ -245,7 +245,7 @@ class IkOptions:
 
     ``method``: "lm" (Levenberg-Marquardt), "jacobian_inverse", "newton",
     "ccd", "fabrik", "length_relaxation", "analytic" (closed form: every
-    solution, 6-joint arms of the families ``RobotDescription.analytic_family``
+    solution, 6- and 7-joint arms of the families ``RobotDescription.analytic_family``
     names); ``linear_solver`` (Jacobian
     methods): "svd", "angle_relaxation", "angle_relaxation_safeguarded";
     tolerances in m and rad; ``max_restarts`` random restarts drawn from
