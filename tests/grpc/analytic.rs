@@ -110,7 +110,9 @@ async fn describe_robot_names_the_family_and_refusals_name_the_reason() {
         ("ur5", "three_parallel"),
         // held at the middle of its limits (0), joint 3 leaves axes 2 and 4 parallel
         ("kuka_lbr_iiwa14_r820", "spherical_wrist"),
-        ("franka_panda", ""),
+        // joint 7 held, read from the tool end
+        ("franka_panda", "spherical_two_intersecting"),
+        ("planar_7", ""),
     ] {
         let d = robots
             .describe_robot(pb::DescribeRobotRequest {
@@ -127,6 +129,10 @@ async fn describe_robot_names_the_family_and_refusals_name_the_reason() {
             "{name}: {}",
             d.analytic_reason
         );
+        assert_eq!(d.analytic_reversed, name == "franka_panda", "{name}");
+        if name == "franka_panda" {
+            assert_eq!(d.analytic_held_joint, 6);
+        }
     }
     // the iiwa with joint 3 held at the seed's value: every solution keeps it
     let q = vec![0.3, 0.6, -0.4, -1.1, 0.5, 0.8, 0.2];
@@ -156,11 +162,11 @@ async fn describe_robot_names_the_family_and_refusals_name_the_reason() {
         assert!(got.rotation.angle_to(&target.rotation) < 1e-9);
     }
     // a 7-joint arm none of whose joints can be held: INVALID_ARGUMENT naming options.method and the reason
-    let q = vec![0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.8];
-    let target = fk(&mut robots, "franka_panda", &q).await;
+    let q = vec![0.1; 7];
+    let target = fk(&mut robots, "planar_7", &q).await;
     let status = ik
         .solve_ik(pb::SolveIkRequest {
-            robot: named("franka_panda"),
+            robot: named("planar_7"),
             target: Some(pose_pb(&target)),
             seed: vec![],
             options: analytic(1),
@@ -209,6 +215,67 @@ async fn describe_robot_names_the_family_and_refusals_name_the_reason() {
     assert_eq!(reply.status, pb::IkStatus::MaxIterations as i32);
     let best = reply.best_attempt.unwrap();
     assert!(best.joints.iter().all(|v| v.is_finite()) && best.position_error > 1.0);
+}
+
+/// The Panda with joint 7 held at the seed's value, and searched for the
+/// solution nearest the seed; a bad sample count is refused by name.
+#[tokio::test]
+async fn panda_analytic_holds_or_searches_joint_7() {
+    let server = start(ServerConfig::default()).await;
+    let ik = KinematicsServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let q = vec![0.2, -0.4, 0.3, -2.1, 0.4, 1.8, 0.5];
+    let target = fk(&mut robots, "franka_panda", &q).await;
+    // the seed: the pose's joints with joint 7 moved by 0.4 rad
+    let mut seed = q.clone();
+    seed[6] += 0.4;
+    let dist = |a: &[f64]| a.iter().zip(&seed).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
+    let solve = |options: pb::IkOptions| {
+        let request = pb::SolveIkRequest {
+            robot: named("franka_panda"),
+            target: Some(pose_pb(&target)),
+            seed: seed.clone(),
+            options: Some(options),
+        };
+        let mut ik = ik.clone();
+        async move { ik.solve_ik(request).await }
+    };
+    let held = solve(analytic(1000).unwrap()).await.unwrap().into_inner();
+    assert!(held.success);
+    for s in &held.solutions {
+        assert_eq!(s.joints[6], seed[6]);
+        let got = fk(&mut robots, "franka_panda", &s.joints).await;
+        assert!((got.translation.vector - target.translation.vector).norm() < 1e-9);
+        assert!(got.rotation.angle_to(&target.rotation) < 1e-9);
+    }
+    let searched = solve(pb::IkOptions {
+        search_redundant: true,
+        ..analytic(1000).unwrap()
+    })
+    .await
+    .unwrap()
+    .into_inner();
+    assert!(searched.success);
+    let best = &searched.solutions[0].joints;
+    let got = fk(&mut robots, "franka_panda", best).await;
+    assert!((got.translation.vector - target.translation.vector).norm() < 1e-9);
+    // at least as near as the pose's own joints (0.4 rad away), nearer than holding
+    assert!(dist(best) <= dist(&q) + 1e-12, "{best:?}");
+    assert!(dist(best) <= dist(&held.solutions[0].joints) + 1e-12);
+    let status = solve(pb::IkOptions {
+        search_redundant: true,
+        redundant_samples: Some(1),
+        ..analytic(1).unwrap()
+    })
+    .await
+    .unwrap_err();
+    assert_eq!(status.code(), Code::InvalidArgument);
+    assert!(
+        status.message().starts_with("options.redundant_samples"),
+        "{}",
+        status.message()
+    );
+    drop(ik);
 }
 
 #[tokio::test]

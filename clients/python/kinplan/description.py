@@ -44,7 +44,7 @@ class RobotDescription:
     @property
     def analytic_family(self) -> str:
         """The chain's closed-form IK family ("spherical_wrist",
-        "three_parallel"), or "" when ``method="analytic"`` does not apply
+        "three_parallel", "spherical_two_intersecting"), or "" when ``method="analytic"`` does not apply
         (then :attr:`analytic_reason` says why)."""
         return "" if self.raw is None else str(self.raw.analytic_family)
 
@@ -53,6 +53,14 @@ class RobotDescription:
         """7-joint arms: the joint (0-based) the analytic method holds at the
         seed's value by default; -1 otherwise."""
         return -1 if self.raw is None else int(self.raw.analytic_held_joint)
+
+    @property
+    def analytic_reversed(self) -> bool:
+        """The analytic family holds for the chain read from the tool end
+        (the Panda with joint 7 held): the solver inverts the pose and reverses
+        the joints, and the solutions' ``config`` flags name the reversed
+        chain's shoulder, elbow and wrist."""
+        return False if self.raw is None else bool(self.raw.analytic_reversed)
 
     @property
     def analytic_reason(self) -> str:

@@ -155,6 +155,8 @@ def ik_options(
     nearest_turn_only: bool = False,
     redundant_joint: Optional[int] = None,
     analytic_start: bool = False,
+    search_redundant: bool = False,
+    redundant_samples: Optional[int] = None,
 ) -> kinematics_pb2.IkOptions:
     """IkOptions from Python values; ``None`` means the server's documented
     default. Values are checked by the server, which names a bad field.
@@ -162,7 +164,7 @@ def ik_options(
     key: Any = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
            damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
            max_step, distinct_tolerance, rlxa_max_iterations, history, hold_configuration, nearest_turn_only,
-           redundant_joint, analytic_start)
+           redundant_joint, analytic_start, search_redundant, redundant_samples)
     try:
         cached = _IK_OPTIONS_CACHE.get(key)
     except TypeError:  # an unhashable argument: build without the cache
@@ -174,7 +176,8 @@ def ik_options(
     o = _build_ik_options(method, linear_solver, position_tolerance, orientation_tolerance, position_only,
                           max_iterations, damping, max_restarts, num_solutions, rng_seed, joint_limits,
                           time_budget, adaptive_damping, max_step, distinct_tolerance, rlxa_max_iterations, history,
-                          hold_configuration, nearest_turn_only, redundant_joint, analytic_start)
+                          hold_configuration, nearest_turn_only, redundant_joint, analytic_start,
+                          search_redundant, redundant_samples)
     if key is not None and len(_IK_OPTIONS_CACHE) < 256:
         _IK_OPTIONS_CACHE[key] = kinematics_pb2.IkOptions()
         _IK_OPTIONS_CACHE[key].CopyFrom(o)
@@ -189,7 +192,8 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
                       num_solutions: Any, rng_seed: Any, joint_limits: Any, time_budget: Any,
                       adaptive_damping: Any, max_step: Any, distinct_tolerance: Any, rlxa_max_iterations: Any,
                       history: Any, hold_configuration: Any = None, nearest_turn_only: Any = False,
-                      redundant_joint: Any = None, analytic_start: Any = False) -> kinematics_pb2.IkOptions:
+                      redundant_joint: Any = None, analytic_start: Any = False, search_redundant: Any = False,
+                      redundant_samples: Any = None) -> kinematics_pb2.IkOptions:
     o = kinematics_pb2.IkOptions(
         method=_choice(METHODS, method, "method"),
         linear_solver=_choice(LINEAR_SOLVERS, linear_solver, "linear_solver"),
@@ -201,6 +205,7 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
         return_history=bool(history),
         nearest_turn_only=bool(nearest_turn_only),
         analytic_start=bool(analytic_start),
+        search_redundant=bool(search_redundant),
     )
     for name, value, kind in (
         ("position_tolerance", position_tolerance, float),
@@ -214,6 +219,7 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
         ("rlxa_max_iterations", rlxa_max_iterations, int),
         ("hold_configuration", hold_configuration, bool),
         ("redundant_joint", redundant_joint, int),
+        ("redundant_samples", redundant_samples, int),
     ):
         if value is not None:
             setattr(o, name, kind(value))
@@ -225,7 +231,8 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
 IK_OPTION_FIELDS = ("method", "linear_solver", "position_tolerance", "orientation_tolerance", "position_only",
                     "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits",
                     "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations",
-                    "return_history", "hold_configuration", "nearest_turn_only", "redundant_joint", "analytic_start")
+                    "return_history", "hold_configuration", "nearest_turn_only", "redundant_joint", "analytic_start",
+                    "search_redundant", "redundant_samples")
 #: The keyword shortcuts of ``robot.ik`` and friends, in the same order.
 IK_SHORTCUTS = tuple("history" if f == "return_history" else f for f in IK_OPTION_FIELDS)
 
@@ -238,7 +245,7 @@ class IkOptions:
 
     ``method``: "lm" (Levenberg-Marquardt), "jacobian_inverse", "newton",
     "ccd", "fabrik", "length_relaxation", "analytic" (closed form: every
-    solution, 6-joint arms of the families ``RobotDescription.analytic_family``
+    solution, 6- and 7-joint arms of the families ``RobotDescription.analytic_family``
     names); ``linear_solver`` (Jacobian
     methods): "svd", "angle_relaxation", "angle_relaxation_safeguarded";
     tolerances in m and rad; ``max_restarts`` random restarts drawn from
@@ -251,8 +258,10 @@ class IkOptions:
     ``hold_configuration``, ``nearest_turn_only`` and ``redundant_joint``
     steer ``method="analytic"`` (the seed's configuration first; one
     whole-turn variant per joint; the joint of a 7-joint arm held at the
-    seed's value); ``analytic_start`` starts the iterative methods from the
-    closed-form solution nearest the seed.
+    seed's value); ``search_redundant`` searches that joint's value (within
+    its limits, ``redundant_samples`` samples then a refinement) for the
+    solution nearest the seed instead; ``analytic_start`` starts the
+    iterative methods from the closed-form solution nearest the seed.
 
     Pass it as ``robot.ik(T, options=IkOptions(...))`` (also ``ik_batch``,
     ``track``, ``stream_ik``); a keyword shortcut given beside it
@@ -281,6 +290,8 @@ class IkOptions:
     nearest_turn_only: bool = False
     redundant_joint: Optional[int] = None
     analytic_start: bool = False
+    search_redundant: bool = False
+    redundant_samples: Optional[int] = None
 
     def __post_init__(self) -> None:
         _choice(METHODS, self.method, "method")

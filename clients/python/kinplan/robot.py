@@ -207,6 +207,8 @@ class Robot(RobotRefs):
         nearest_turn_only: bool = False,
         redundant_joint: Optional[int] = None,
         analytic_start: bool = False,
+        search_redundant: bool = False,
+        redundant_samples: Optional[int] = None,
         timeout: Optional[float] = None,
     ) -> IkResult:
         """Joints that put the tool at ``T`` (4x4, or (position, quaternion
@@ -220,8 +222,11 @@ class Robot(RobotRefs):
         default. ``method``: "lm" (default), "jacobian_inverse", "newton",
         "ccd", "fabrik", "length_relaxation", "analytic" (closed form:
         with ``num_solutions=1000`` every solution inside the limits, each
-        solution's ``config`` flags set; 6-joint arms whose
-        ``describe().analytic_family`` is not empty); ``linear_solver`` (Jacobian
+        solution's ``config`` flags set; 6- and 7-joint arms whose
+        ``describe().analytic_family`` is not empty; a 7-joint arm's
+        redundant joint is held at the seed's value, or with
+        ``search_redundant=True`` searched for the solution nearest the
+        seed); ``linear_solver`` (Jacobian
         methods): "svd" (default), "angle_relaxation",
         "angle_relaxation_safeguarded". Tolerances in m and rad (default
         1e-5); ``max_restarts`` (default 200) random restarts from
@@ -235,7 +240,7 @@ class Robot(RobotRefs):
         args = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
                 damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
                 max_step, distinct_tolerance, rlxa_max_iterations, history, hold_configuration, nearest_turn_only,
-                redundant_joint, analytic_start)
+                redundant_joint, analytic_start, search_redundant, redundant_samples)
         if options is not None:
             args = resolve_ik_args(options, args)
         if not matrix:

@@ -283,13 +283,36 @@ def test_analytic_ik_returns_every_solution_with_flags(client, name):
 
 
 def test_analytic_ik_refuses_a_7_joint_arm_naming_why(client):
-    robot = client.robot("franka_panda")
+    robot = client.robot("planar_7")
     assert robot.describe().analytic_family == ""
-    assert "7 joints" in robot.describe().analytic_reason
-    T = robot.fk([0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.8])
+    assert "holding any one of them" in robot.describe().analytic_reason
+    T = robot.fk([0.1] * 7)
     with pytest.raises(kinplan.InvalidArgument) as e:
         robot.ik(T, method="analytic")
     assert "chain is not analytic" in str(e.value)
+
+
+def test_analytic_ik_panda_with_joint_7_held_or_searched(client):
+    robot = client.robot("franka_panda")
+    d = robot.describe()
+    assert d.analytic_family == "spherical_two_intersecting" and d.analytic_reversed
+    assert d.analytic_held_joint == 6
+    q = np.array([0.2, -0.4, 0.3, -2.1, 0.4, 1.8, 0.5])
+    T = robot.fk(q)
+    seed = q.copy()
+    seed[6] += 0.4
+    held = robot.ik(T, seed=seed, method="analytic", num_solutions=1000)
+    assert held.success and all(s.q[6] == seed[6] for s in held.solutions)
+    for s in held.solutions:  # each checked by the server's forward kinematics
+        assert np.allclose(robot.fk(s.q), T, atol=1e-9)
+    searched = robot.ik(T, seed=seed, method="analytic", search_redundant=True, redundant_samples=64)
+    best = searched.solutions[0].q
+    assert np.allclose(robot.fk(best), T, atol=1e-9)
+    # at least as near the seed as the pose's own joints, which lie 0.4 rad away
+    assert np.sum((best - seed) ** 2) <= np.sum((q - seed) ** 2) + 1e-12
+    with pytest.raises(kinplan.InvalidArgument) as e:
+        robot.ik(T, seed=seed, method="analytic", search_redundant=True, redundant_samples=1)
+    assert "redundant_samples" in str(e.value)
 
 
 def test_analytic_options_hold_turns_and_start(client):

@@ -102,7 +102,7 @@ class LinkInfo(_message.Message):
     def __init__(self, name: _Optional[str] = ..., parent_joint: _Optional[int] = ..., offset: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., collision: _Optional[_Iterable[_Union[CollisionGeometry, _Mapping]]] = ...) -> None: ...
 
 class DescribeRobotResponse(_message.Message):
-    __slots__ = ("name", "model_id", "base_link", "tip_link", "joints", "links", "tip_offset", "urdf", "collision_bodies", "named_states", "analytic_family", "analytic_reason", "analytic_held_joint")
+    __slots__ = ("name", "model_id", "base_link", "tip_link", "joints", "links", "tip_offset", "urdf", "collision_bodies", "named_states", "analytic_family", "analytic_reason", "analytic_held_joint", "analytic_reversed")
     NAME_FIELD_NUMBER: _ClassVar[int]
     MODEL_ID_FIELD_NUMBER: _ClassVar[int]
     BASE_LINK_FIELD_NUMBER: _ClassVar[int]
@@ -116,6 +116,7 @@ class DescribeRobotResponse(_message.Message):
     ANALYTIC_FAMILY_FIELD_NUMBER: _ClassVar[int]
     ANALYTIC_REASON_FIELD_NUMBER: _ClassVar[int]
     ANALYTIC_HELD_JOINT_FIELD_NUMBER: _ClassVar[int]
+    ANALYTIC_REVERSED_FIELD_NUMBER: _ClassVar[int]
     name: str
     model_id: bytes
     base_link: str
@@ -129,7 +130,8 @@ class DescribeRobotResponse(_message.Message):
     analytic_family: str
     analytic_reason: str
     analytic_held_joint: int
-    def __init__(self, name: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., joints: _Optional[_Iterable[_Union[JointInfo, _Mapping]]] = ..., links: _Optional[_Iterable[_Union[LinkInfo, _Mapping]]] = ..., tip_offset: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., urdf: _Optional[str] = ..., collision_bodies: _Optional[_Iterable[_Union[CollisionBodyInfo, _Mapping]]] = ..., named_states: _Optional[_Iterable[_Union[NamedState, _Mapping]]] = ..., analytic_family: _Optional[str] = ..., analytic_reason: _Optional[str] = ..., analytic_held_joint: _Optional[int] = ...) -> None: ...
+    analytic_reversed: bool
+    def __init__(self, name: _Optional[str] = ..., model_id: _Optional[bytes] = ..., base_link: _Optional[str] = ..., tip_link: _Optional[str] = ..., joints: _Optional[_Iterable[_Union[JointInfo, _Mapping]]] = ..., links: _Optional[_Iterable[_Union[LinkInfo, _Mapping]]] = ..., tip_offset: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., urdf: _Optional[str] = ..., collision_bodies: _Optional[_Iterable[_Union[CollisionBodyInfo, _Mapping]]] = ..., named_states: _Optional[_Iterable[_Union[NamedState, _Mapping]]] = ..., analytic_family: _Optional[str] = ..., analytic_reason: _Optional[str] = ..., analytic_held_joint: _Optional[int] = ..., analytic_reversed: _Optional[bool] = ...) -> None: ...
 
 class NamedState(_message.Message):
     __slots__ = ("name", "group", "joint_names", "positions")

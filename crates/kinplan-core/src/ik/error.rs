@@ -31,6 +31,8 @@ pub enum IkParam {
     GeometryTolerance,
     /// `AnalyticParams::solve_tolerance`.
     SolveTolerance,
+    /// `AnalyticParams::redundant_samples`.
+    RedundantSamples,
 }
 
 /// A parameter of a sampled path ([`line_path`](super::line_path),
@@ -67,6 +69,7 @@ impl IkParam {
             IkParam::TimeBudget => "time_budget",
             IkParam::Lengths => "lengths",
             IkParam::GeometryTolerance => "geometry_tolerance",
+            IkParam::RedundantSamples => "redundant_samples",
             IkParam::SolveTolerance => "solve_tolerance",
         }
     }

@@ -209,6 +209,7 @@ impl<'c> IkSolver<'c> {
         if params.method == IkMethod::Analytic {
             // validated: the chain is analytic
             if let Ok(arm) = analyse(chain, &params.analytic, seed) {
+                let arm = super::analytic::searched(chain, arm, target, seed, &params.analytic, clock);
                 return super::analytic::front::solve_with(chain, &arm, target, seed, params, clock);
             }
         }

@@ -2,7 +2,10 @@
 
 use nalgebra::{Isometry3, Matrix6xX, Translation3, Unit, UnitQuaternion, Vector3};
 
+use std::sync::OnceLock;
+
 use super::{LinkCollision, RobotError};
+use crate::ik::analytic::ChainModel;
 
 /// How a joint moves its child link.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -81,6 +84,9 @@ pub struct Chain {
     pub(super) tip_offset: Isometry3<f64>,
     pub(super) links: Vec<LinkFrame>,
     pub(super) collision: Vec<LinkCollision>,
+    /// The analytic IK method's reading of the chain, made on first use and
+    /// kept with the model (empty in a changed copy).
+    pub(super) analytic: OnceLock<ChainModel>,
 }
 
 impl Chain {
@@ -112,6 +118,10 @@ impl Chain {
     /// Collision shapes of the links on the chain.
     pub fn collision(&self) -> &[LinkCollision] {
         &self.collision
+    }
+    /// Where the analytic IK method keeps its reading of this chain.
+    pub(crate) fn analytic_cache(&self) -> &OnceLock<ChainModel> {
+        &self.analytic
     }
 
     /// Lower and upper limits, in joint order.
@@ -252,6 +262,7 @@ impl Chain {
         let removed = self.joints.get(index)?;
         let fold = removed.origin * removed.motion(value);
         let mut out = self.clone();
+        out.analytic = OnceLock::new();
         out.joints.remove(index);
         match out.joints.get_mut(index) {
             Some(next) => next.origin = fold * next.origin,

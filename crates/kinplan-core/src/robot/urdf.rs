@@ -375,6 +375,7 @@ impl<'a> Tree<'a> {
             tip_offset: pending,
             links,
             collision,
+            analytic: Default::default(),
         })
     }
 }

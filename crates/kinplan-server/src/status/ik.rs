@@ -66,6 +66,7 @@ pub fn param_field(param: IkParam) -> &'static str {
         IkParam::DistinctTolerance => "options.distinct_tolerance",
         IkParam::TimeBudget => "options.time_budget",
         IkParam::Lengths => "robot",
+        IkParam::RedundantSamples => "options.redundant_samples",
         // not settable on the wire (the service uses the domain defaults)
         IkParam::GeometryTolerance | IkParam::SolveTolerance => "options.method",
     }

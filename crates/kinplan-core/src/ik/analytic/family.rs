@@ -3,7 +3,7 @@
 
 use std::fmt;
 
-use nalgebra::{Isometry3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::subproblems::sp1;
 use crate::robot::{Chain, JointKind};
@@ -144,8 +144,44 @@ pub struct AnalyticArm {
     /// `±1`: `h₃·h₂` and `h₄·h₂` signs (three parallel only).
     pub(super) s3: f64,
     pub(super) s4: f64,
+    /// Limits and whether each joint is continuous, in chain order (also when
+    /// the arm is solved reversed).
     pub(super) limits: [(f64, f64); 6],
     pub(super) continuous: [bool; 6],
+    /// The family is that of the chain read from the tool end (see
+    /// [`Axes6::reversed`]): the solvers invert the pose and reverse the joints.
+    pub(super) reversed: bool,
+}
+
+/// The six joints an analytic arm solves for: unit axes `h`, points `p` on
+/// them and the tool pose `m`, in the zero configuration and base frame, with
+/// the joints' limits (rad) and whether each is continuous.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Axes6 {
+    pub h: [Vector3<f64>; 6],
+    pub p: [Vector3<f64>; 6],
+    pub m: Isometry3<f64>,
+    pub limits: [(f64, f64); 6],
+    pub continuous: [bool; 6],
+}
+
+impl Axes6 {
+    /// The same arm read from the tool end. With `T(q) = E₁(q₁)⋯E₆(q₆) M`,
+    /// `T⁻¹ = M⁻¹ E₆(−q₆)⋯E₁(−q₁) = E′₁(q₆)⋯E′₆(q₁) M⁻¹`, where `E′ₖ` turns
+    /// about `h′ₖ = −R_Mᵀ h₇₋ₖ` through `p′ₖ = M⁻¹ p₇₋ₖ` (conjugation by `M`
+    /// moves a screw axis; the sign makes the angle the original joint's).
+    /// So the reversed arm, with tool pose `M⁻¹`, reaches `T⁻¹` at the joint
+    /// values of `T` in reverse order.
+    pub fn reversed(&self) -> Self {
+        let mi = self.m.inverse();
+        Self {
+            h: std::array::from_fn(|k| -(mi.rotation * self.h[5 - k])),
+            p: std::array::from_fn(|k| (mi * Point3::from(self.p[5 - k])).coords),
+            m: mi,
+            limits: std::array::from_fn(|k| self.limits[5 - k]),
+            continuous: std::array::from_fn(|k| self.continuous[5 - k]),
+        }
+    }
 }
 
 fn normal_to(h: &Vector3<f64>) -> Vector3<f64> {
@@ -184,8 +220,48 @@ impl AnalyticArm {
             return Err(not(format!("joint {} is prismatic", j.name)));
         }
         let z = ZeroAxes::of(chain);
-        let h: [Vector3<f64>; 6] = std::array::from_fn(|i| z.h[i].normalize());
-        let p: [Vector3<f64>; 6] = std::array::from_fn(|i| z.p[i]);
+        let axes = Axes6 {
+            h: std::array::from_fn(|i| z.h[i].normalize()),
+            p: std::array::from_fn(|i| z.p[i]),
+            m: z.m,
+            limits: std::array::from_fn(|i| {
+                let j = &chain.joints()[i];
+                (j.lower, j.upper)
+            }),
+            continuous: std::array::from_fn(|i| {
+                let j = &chain.joints()[i];
+                j.kind == JointKind::Continuous || !(j.upper - j.lower).is_finite()
+            }),
+        };
+        Self::from_axes(&axes, tol)
+    }
+
+    /// The family of six revolute joints given by their axes: read from the
+    /// base, or else from the tool end ([`Axes6::reversed`]; the Panda with
+    /// joint 7 held is a spherical shoulder at the base and two meeting axes
+    /// near the tool, i.e. `spherical_two_intersecting` reversed).
+    pub(crate) fn from_axes(axes: &Axes6, tol: f64) -> Result<Self, NotAnalytic> {
+        let forward = match Self::classify(axes, tol) {
+            Ok(arm) => return Ok(arm),
+            Err(e) => e,
+        };
+        match Self::classify(&axes.reversed(), tol) {
+            Ok(mut arm) => {
+                arm.reversed = true;
+                arm.limits = axes.limits;
+                arm.continuous = axes.continuous;
+                Ok(arm)
+            }
+            Err(back) if back.reason == forward.reason => Err(forward),
+            Err(back) => Err(not(format!(
+                "{}; read from the tool end, {}",
+                forward.reason, back.reason
+            ))),
+        }
+    }
+
+    fn classify(a: &Axes6, tol: f64) -> Result<Self, NotAnalytic> {
+        let (h, p) = (a.h, a.p);
         if parallel(&h[0], &h[1], tol) {
             return Err(not("axes 1 and 2 are parallel"));
         }
@@ -257,19 +333,11 @@ impl AnalyticArm {
             Family::ThreeParallel => h[1],
         };
         let q5_singular = sp1(&h[4], &h[5], &singular_with, 1.0).angles[0];
-        let limits: [(f64, f64); 6] = std::array::from_fn(|i| {
-            let j = &chain.joints()[i];
-            (j.lower, j.upper)
-        });
-        let continuous: [bool; 6] = std::array::from_fn(|i| {
-            let j = &chain.joints()[i];
-            j.kind == JointKind::Continuous || !(j.upper - j.lower).is_finite()
-        });
         Ok(Self {
             family,
             h,
             p,
-            m_inv: z.m.inverse(),
+            m_inv: a.m.inverse(),
             wrist,
             shoulder,
             forward,
@@ -279,8 +347,9 @@ impl AnalyticArm {
             x2: normal_to(&h[1]),
             s3: h[2].dot(&h[1]).signum(),
             s4: h[3].dot(&h[1]).signum(),
-            limits,
-            continuous,
+            limits: a.limits,
+            continuous: a.continuous,
+            reversed: false,
         })
     }
 
@@ -290,8 +359,21 @@ impl AnalyticArm {
     }
 
     /// Base frame, zero configuration (m): the wrist centre (spherical wrist) or
-    /// the point where axes 5 and 6 meet (three parallel).
+    /// the point where axes 5 and 6 meet (three parallel); for a reversed arm,
+    /// that point of the reversed chain (where the chain's first axes meet).
     pub fn wrist_point(&self) -> Vector3<f64> {
-        self.wrist
+        if self.reversed {
+            // the reversed arm's frame is the tool frame at zero; its m_inv is M
+            (self.m_inv * Point3::from(self.wrist)).coords
+        } else {
+            self.wrist
+        }
+    }
+
+    /// True when the family holds for the chain read from the tool end: the
+    /// configuration flags then name the reversed chain's shoulder, elbow and
+    /// wrist (the chain's wrist, elbow and shoulder).
+    pub fn is_reversed(&self) -> bool {
+        self.reversed
     }
 }

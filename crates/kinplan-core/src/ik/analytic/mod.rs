@@ -6,15 +6,19 @@ mod family;
 pub(crate) mod front;
 mod params;
 mod redundant;
+mod search;
 mod solve;
 mod subproblems;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_seven;
 
 pub use family::{AnalyticArm, Family, NotAnalytic, ZeroAxes};
 pub use front::solve_analytic;
 pub use params::{AnalyticParams, Turns};
-pub use redundant::{ReducedArm, analyse};
+pub use redundant::{ChainModel, ReducedArm, analyse};
+pub(crate) use search::searched;
 pub use solve::{AnalyticSolution, ConfigFlags, MAX_TURNS};
 pub use subproblems::{Angles, DEGENERATE, Pairs, rot, sp1, sp2, sp3, sp4, wrap};

@@ -30,8 +30,17 @@ pub struct AnalyticParams {
     pub hold_configuration: bool,
     /// 7-joint chains: the joint (0-based chain index) held at the seed's value
     /// so that the other six are solved in closed form; `None` = the first of
-    /// joints 3, 4, 5, 2, 6, 1, 7 that leaves a covered arm. Default none.
+    /// joints 3, 4, 5, 7, 1, 2, 6 that leaves a covered arm. Default none.
     pub redundant_joint: Option<usize>,
+    /// 7-joint chains: false = the held joint takes the seed's value; true =
+    /// its value is searched for the solution nearest the seed (see
+    /// `search_held`: samples across its limits, then Brent's minimiser), and
+    /// every solution at the value found is returned. Default false.
+    pub search_redundant: bool,
+    /// Evenly spaced held values (count, ≥ 2) the search starts from; the
+    /// search can miss a nearer solution only in a gap between two samples.
+    /// Default 24.
+    pub redundant_samples: usize,
 }
 
 impl Default for AnalyticParams {
@@ -42,6 +51,8 @@ impl Default for AnalyticParams {
             turns: Turns::All,
             hold_configuration: false,
             redundant_joint: None,
+            search_redundant: false,
+            redundant_samples: 24,
         }
     }
 }
@@ -61,6 +72,16 @@ impl AnalyticParams {
                 });
             }
         }
+        if !(2..=MAX_SAMPLES).contains(&self.redundant_samples) {
+            return Err(IkError::InvalidParam {
+                field: IkParam::RedundantSamples,
+                value: self.redundant_samples as f64,
+                reason: "must be at least 2 and at most 4096",
+            });
+        }
         Ok(())
     }
 }
+
+/// Most held values [`AnalyticParams::redundant_samples`] may ask for.
+pub const MAX_SAMPLES: usize = 4096;

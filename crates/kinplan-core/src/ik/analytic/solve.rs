@@ -97,6 +97,11 @@ impl AnalyticArm {
     /// assert_eq!(same.config, arm.config_of(&q));
     /// ```
     pub fn config_of(&self, q: &[f64]) -> ConfigFlags {
+        let q: [f64; 6] = if self.reversed {
+            std::array::from_fn(|i| q[5 - i])
+        } else {
+            std::array::from_fn(|i| q[i])
+        };
         let last = match self.family {
             Family::SphericalWrist | Family::SphericalTwoIntersecting => 2,
             Family::ThreeParallel => 3,
@@ -130,6 +135,9 @@ impl AnalyticArm {
     /// gives `q₃` (subproblem 3) and `q₂` (subproblem 1). Source: Elias & Wen,
     /// IK-Geo (2025), the "spherical, two parallel" and "three parallel, two
     /// intersecting" decompositions; our own derivation and code.
+    ///
+    /// A reversed arm ([`AnalyticArm::is_reversed`]) solves `T⁻¹` for the chain
+    /// read from the tool end and reverses each answer's joints.
     pub fn solve_into(
         &self,
         target: &Isometry3<f64>,
@@ -138,7 +146,7 @@ impl AnalyticArm {
         out: &mut Vec<AnalyticSolution>,
     ) {
         out.clear();
-        let base = self.base(target, seed, false, params.solve_tolerance);
+        let base = self.base_in_order(target, seed, false, params.solve_tolerance);
         for s in &base.sols[..base.n] {
             self.push_turns(s, seed, params.turns, out);
         }
@@ -154,8 +162,35 @@ impl AnalyticArm {
         out: &mut Vec<AnalyticSolution>,
     ) {
         out.clear();
-        let base = self.base(target, seed, true, params.solve_tolerance);
+        let base = self.base_in_order(target, seed, true, params.solve_tolerance);
         out.extend_from_slice(&base.sols[..base.n]);
+    }
+
+    /// The base solutions in chain order (a reversed arm solves the inverse
+    /// pose with the seed reversed, then reverses each answer).
+    fn base_in_order(
+        &self,
+        target: &Isometry3<f64>,
+        seed: Option<&[f64]>,
+        keep_inexact: bool,
+        tol: f64,
+    ) -> Base {
+        if !self.reversed {
+            return self.base(target, seed, keep_inexact, tol);
+        }
+        let rseed: Option<[f64; 6]> = seed
+            .filter(|s| s.len() == 6)
+            .map(|s| std::array::from_fn(|i| s[5 - i]));
+        let mut base = self.base(
+            &target.inverse(),
+            rseed.as_ref().map(|s| &s[..]),
+            keep_inexact,
+            tol,
+        );
+        for s in &mut base.sols[..base.n] {
+            s.joints.reverse();
+        }
+        base
     }
 
     fn base(&self, target: &Isometry3<f64>, seed: Option<&[f64]>, keep_inexact: bool, tol: f64) -> Base {

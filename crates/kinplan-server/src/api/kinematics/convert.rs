@@ -148,6 +148,11 @@ impl Options {
                     Turns::All
                 },
                 redundant_joint: o.redundant_joint.map(|j| j as usize),
+                search_redundant: o.search_redundant,
+                redundant_samples: match o.redundant_samples {
+                    None | Some(0) => d.analytic.redundant_samples,
+                    Some(n) => n as usize,
+                },
                 ..d.analytic
             },
             ..d

@@ -63,6 +63,7 @@ pub(super) fn describe(chain: &Chain, model_id: Vec<u8>) -> pb::DescribeRobotRes
             .ok()
             .and_then(|a| a.held)
             .map_or(-1, |(j, _)| j as i32),
+        analytic_reversed: analytic.as_ref().is_ok_and(|a| a.arm.is_reversed()),
         analytic_reason: analytic.err().map_or_else(String::new, |e| e.reason),
     }
 }
