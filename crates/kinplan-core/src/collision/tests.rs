@@ -13,6 +13,7 @@ use super::*;
 use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
 mod robot;
+mod spheres;
 mod sweep;
 
 /// URDF of the xyz probe whose link carries `geometry` (URDF XML).
