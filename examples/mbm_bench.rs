@@ -7,8 +7,15 @@
 //! tar xjf ../shared/bench/mbm/panda_problems.tar.bz2 -C target/mbm
 //! cargo build --release -p kinplan-core --example mbm_bench
 //! target/release/examples/mbm_bench target/mbm/problems [--passes 10] [--stomp 10]
-//!     [--clamp-fingers] [--padded] [--set NAME] [--problems 3,17,42] [--out target/mbm_bench]
+//!     [--clamp-fingers] [--padded] [--set NAME] [--problems 3,17,42] [--state-cost N]
+//!     [--out target/mbm_bench]
 //! ```
+//!
+//! `--state-cost N` also times the state check alone in every scene: `N`
+//! states drawn uniformly within the joint limits (ChaCha8, seed = problem
+//! number), `is_valid` on each (limits, forward kinematics, scene and self
+//! pairs), the whole loop timed once; reported as ns per state, median over
+//! the scenes of a set, with the fraction of valid states.
 //!
 //! `--problems` keeps only the listed problem numbers (say the band around a
 //! set's median, to profile what the median measures).
@@ -54,6 +61,8 @@ use kinplan_core::plan::{
     Algorithm, Goal, PlanControl, PlanRequest, PlanStatus, RrtOutcome, RrtParams, RrtStop, plan, rrt_connect,
 };
 use kinplan_core::robot::{Chain, builtin_chain};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use serde_json::json;
 
 const FINE: f64 = 0.01;
@@ -146,6 +155,10 @@ struct Row {
     waypoints: usize,
     length: f64,
     stop: String,
+    /// `is_valid` alone on random states: ns per state (NaN when not timed).
+    state_ns: f64,
+    /// Fraction of those states valid.
+    state_valid: f64,
 }
 
 struct StompRow {
@@ -173,11 +186,13 @@ struct Args {
     only_set: Option<String>,
     /// Only these problem numbers (`None`: all), e.g. a median band to profile.
     only_problems: Option<Vec<usize>>,
+    /// Random states per scene for the state-check timing (0: none).
+    state_cost: usize,
     out: PathBuf,
 }
 
 fn args() -> Result<Args, String> {
-    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--problems N,N,...] [--out PREFIX]";
+    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--problems N,N,...] [--state-cost N] [--out PREFIX]";
     let mut it = std::env::args().skip(1);
     let mut a = Args {
         root: PathBuf::new(),
@@ -190,6 +205,7 @@ fn args() -> Result<Args, String> {
         shortcut_attempts: None,
         only_set: None,
         only_problems: None,
+        state_cost: 0,
         out: PathBuf::from("target/mbm_bench"),
     };
     let mut root = None;
@@ -202,6 +218,7 @@ fn args() -> Result<Args, String> {
         match x.as_str() {
             "--passes" => a.passes = num("--passes")?.max(1),
             "--stomp" => a.stomp = num("--stomp")?,
+            "--state-cost" => a.state_cost = num("--state-cost")?,
             "--clamp-fingers" => a.clamp = true,
             "--padded" => a.padded = true,
             "--shortcut-attempts" => a.shortcut_attempts = Some(num("--shortcut-attempts")?),
@@ -367,8 +384,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 build_us,
                 start_ok: checker.is_valid(&start),
                 goal_ok: checker.is_valid(&goal),
+                state_ns: f64::NAN,
                 ..Row::default()
             };
+            if a.state_cost > 0 {
+                let mut rng = ChaCha8Rng::seed_from_u64(k as u64);
+                let states: Vec<f64> = (0..a.state_cost)
+                    .flat_map(|_| {
+                        chain
+                            .joints()
+                            .iter()
+                            .map(|j| rng.random_range(j.lower..=j.upper))
+                            .collect::<Vec<_>>()
+                    })
+                    .collect();
+                let t = Instant::now();
+                let valid = states.chunks_exact(dof).filter(|q| checker.is_valid(q)).count();
+                row.state_ns = t.elapsed().as_secs_f64() * 1e9 / a.state_cost as f64;
+                row.state_valid = valid as f64 / a.state_cost as f64;
+            }
             if row.start_ok && row.goal_ok {
                 let seed = k as u64;
                 // The counted run is an extra one, not timed: the counter's
@@ -560,6 +594,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "states_checked_median": median(&solved.iter().map(|r| r.states as f64).collect::<Vec<_>>()),
                 "us_per_state_median": median(&solved.iter().map(|r| (r.search_us + r.shortcut_us) / r.states.max(1) as f64).collect::<Vec<_>>()),
                 "samples_median": median(&solved.iter().map(|r| r.samples as f64).collect::<Vec<_>>()),
+                "state_ns_median": median(&rows.iter().map(|r| r.state_ns).filter(|v| v.is_finite()).collect::<Vec<_>>()),
+                "state_valid_median": median(&rows.iter().filter(|r| r.state_ns.is_finite()).map(|r| r.state_valid).collect::<Vec<_>>()),
             }),
         );
     }

@@ -45,6 +45,7 @@ mod octree_cells;
 mod padded;
 mod scene;
 mod scene_checker;
+mod spheres;
 mod sweep;
 mod trig;
 mod world;
@@ -61,6 +62,7 @@ pub(crate) use padded::bisection_order;
 pub use padded::{MAX_CHECKS_PER_PIECE, MIN_PIECE, PaddedMotion, padded_motion, padded_motion_valid};
 pub use scene::{Geometry, Obstacle, Scene, SceneLimits};
 pub use scene_checker::{CheckerParams, Part, Proximity, SceneChecker, StateReport};
+pub use spheres::{Sphere, SphereModel, SphereParams};
 pub use sweep::SweepBound;
 pub use world::SceneGeometry;
 

@@ -269,34 +269,25 @@ impl RobotModel {
         self.bodies[a].parent == Some(b) || self.bodies[b].parent == Some(a)
     }
 
-    /// Poses (base frame) of every body at `q`, written into `out[..body_count()]`.
+    /// Poses (base frame) of every body at `q`, written into `out[..body_count()]`
+    /// (`out` holds at least [`RobotModel::body_count`] entries).
     /// `q` must hold `dof()` values (missing ones read as 0).
     ///
     /// Link poses follow [`Chain::link_frames_into`]:
     /// `T_link = Π_{joints before it} (O_i · M_i(q_i)) · offset_link`; a body's
     /// pose is `T_link · offset_body`.
-    pub(crate) fn body_poses(&self, q: &[f64], out: &mut [Isometry3<f64>; MAX_BODIES]) {
+    pub(crate) fn body_poses(&self, q: &[f64], out: &mut [Isometry3<f64>]) {
         self.pose_bodies(q, out, None);
     }
 
     /// [`RobotModel::body_poses`], plus every joint's axis (a point on it
     /// and its unit direction, base frame) into `axes[..dof]`: the axis of
     /// joint `i` is `axis_i` in the frame `Π_{k<i} (O_k · M_k(q_k)) · O_i`.
-    pub(crate) fn body_poses_and_axes(
-        &self,
-        q: &[f64],
-        out: &mut [Isometry3<f64>; MAX_BODIES],
-        axes: &mut [JointAxis],
-    ) {
+    pub(crate) fn body_poses_and_axes(&self, q: &[f64], out: &mut [Isometry3<f64>], axes: &mut [JointAxis]) {
         self.pose_bodies(q, out, Some(axes));
     }
 
-    fn pose_bodies(
-        &self,
-        q: &[f64],
-        out: &mut [Isometry3<f64>; MAX_BODIES],
-        mut axes: Option<&mut [JointAxis]>,
-    ) {
+    fn pose_bodies(&self, q: &[f64], out: &mut [Isometry3<f64>], mut axes: Option<&mut [JointAxis]>) {
         let steps = &self.steps;
         let links = self.chain.links();
         let mut t = Isometry3::identity();

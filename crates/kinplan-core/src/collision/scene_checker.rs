@@ -29,6 +29,10 @@ use crate::robot::JointKind;
 
 /// Joints of the chains whose padded checks keep their axes in a small buffer.
 const SMALL_CHAIN: usize = 16;
+/// Bodies of the models whose state checks keep poses, centres and pads in
+/// buffers of this size instead of [`MAX_BODIES`]: an arm with a gripper
+/// has about a dozen, and every check would otherwise fill four arrays of 63.
+const SMALL_MODEL: usize = 16;
 
 /// Options of a [`SceneChecker`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -228,22 +232,29 @@ impl SceneChecker {
     /// True when some body overlaps an obstacle or a checked body (limits
     /// not considered). `q` must hold `dof` finite values.
     pub fn in_collision(&self, q: &[f64]) -> bool {
-        let mut poses = [Isometry3::identity(); MAX_BODIES];
-        self.model.body_poses(q, &mut poses);
-        self.hits(&poses)
+        if self.model.body_count() <= SMALL_MODEL {
+            let mut poses = [Isometry3::identity(); SMALL_MODEL];
+            self.model.body_poses(q, &mut poses);
+            self.hits(&poses)
+        } else {
+            let mut poses = [Isometry3::identity(); MAX_BODIES];
+            self.model.body_poses(q, &mut poses);
+            self.hits(&poses)
+        }
     }
 
-    /// The bodies' bounding-sphere centres at `poses`.
-    fn centers(&self, poses: &[Isometry3<f64>; MAX_BODIES]) -> [Vector3<f64>; MAX_BODIES] {
-        let mut centers = [Vector3::zeros(); MAX_BODIES];
+    /// The bodies' bounding-sphere centres at `poses` (`N` ≥ the body count).
+    fn centers<const N: usize>(&self, poses: &[Isometry3<f64>; N]) -> [Vector3<f64>; N] {
+        let mut centers = [Vector3::zeros(); N];
         for (b, body) in self.model.bodies.iter().enumerate() {
             centers[b] = sphere_center(body, &poses[b]);
         }
         centers
     }
 
-    /// [`SceneChecker::in_collision`] on bodies already posed.
-    fn hits(&self, poses: &[Isometry3<f64>; MAX_BODIES]) -> bool {
+    /// [`SceneChecker::in_collision`] on bodies already posed (`N` ≥ the
+    /// body count).
+    fn hits<const N: usize>(&self, poses: &[Isometry3<f64>; N]) -> bool {
         let bodies = &self.model.bodies;
         let centers = self.centers(poses);
         for &b in &self.scene_bodies {
@@ -290,17 +301,17 @@ impl SceneChecker {
     /// [`SELF_PAIRS`] every self pair. What this check proves is added:
     /// after a body is found near something the other bodies are still
     /// checked, so that the halves of the piece check only what is left.
-    fn hits_padded(
+    fn hits_padded<const N: usize>(
         &self,
-        poses: &[Isometry3<f64>; MAX_BODIES],
-        coarse: &[f64; MAX_BODIES],
+        poses: &[Isometry3<f64>; N],
+        coarse: &[f64; N],
         mut fine: impl FnMut(usize) -> f64,
         proved: &mut u64,
     ) -> PadHit {
         let bodies = &self.model.bodies;
         // A zero pad still counts touching: growing by a hair keeps `≤ 0` a hit.
         let margin = |pad: f64| pad.max(f64::MIN_POSITIVE);
-        let mut fine_pads = [f64::NAN; MAX_BODIES];
+        let mut fine_pads = [f64::NAN; N];
         let mut fine_pad = |b: usize| {
             if fine_pads[b].is_nan() {
                 fine_pads[b] = margin(fine(b));
@@ -636,11 +647,36 @@ impl StateChecker for SceneChecker {
     /// `SceneChecker::hits_padded`: bit `b` the scene around body `b`,
     /// `SELF_PAIRS` (bit 63) all self pairs.
     fn padded_verdict_sparing(&self, q: &[f64], half_step: &[f64], proved: &mut u64) -> Option<PadVerdict> {
+        if self.model.body_count() <= SMALL_MODEL {
+            self.padded_verdict_in::<SMALL_MODEL>(q, half_step, proved)
+        } else {
+            self.padded_verdict_in::<MAX_BODIES>(q, half_step, proved)
+        }
+    }
+
+    fn motion_check(&self) -> MotionCheck {
+        let resolution = self.params.motion_resolution;
+        match self.params.padded_motion {
+            false => MotionCheck::Interpolated { resolution },
+            true => MotionCheck::Padded { resolution },
+        }
+    }
+}
+
+impl SceneChecker {
+    /// [`StateChecker::padded_verdict_sparing`] with poses and pads in
+    /// buffers of `N` ≥ the body count.
+    fn padded_verdict_in<const N: usize>(
+        &self,
+        q: &[f64],
+        half_step: &[f64],
+        proved: &mut u64,
+    ) -> Option<PadVerdict> {
         let sweep = self.sweep.as_ref()?;
         if !self.within_limits(q) || half_step.len() != q.len() {
             return Some(PadVerdict::Collides);
         }
-        let mut poses = [Isometry3::identity(); MAX_BODIES];
+        let mut poses = [Isometry3::identity(); N];
         // Axes on the stack, sized for the usual arm: a 96-joint buffer would
         // be zeroed on every check for chains that are almost always ≤ 16.
         let (mut small, mut large);
@@ -652,7 +688,7 @@ impl StateChecker for SceneChecker {
             large.get_mut(..q.len())?
         };
         self.model.body_poses_and_axes(q, &mut poses, axes);
-        let mut coarse = [0.0; MAX_BODIES];
+        let mut coarse = [0.0; N];
         sweep.pads(half_step, &mut coarse);
         // the piece's prefix sums, once, when a first body needs its tight pad
         let mut sums = None;
@@ -668,13 +704,5 @@ impl StateChecker for SceneChecker {
             PadHit::Touches => PadVerdict::Collides,
             PadHit::Near => PadVerdict::Unproved,
         })
-    }
-
-    fn motion_check(&self) -> MotionCheck {
-        let resolution = self.params.motion_resolution;
-        match self.params.padded_motion {
-            false => MotionCheck::Interpolated { resolution },
-            true => MotionCheck::Padded { resolution },
-        }
     }
 }

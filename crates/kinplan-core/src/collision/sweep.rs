@@ -60,7 +60,9 @@
 
 use nalgebra::{Isometry3, Point3, Vector3};
 
-use super::model::{JointAxis, MAX_BODIES, RobotModel};
+#[cfg(test)]
+use super::model::MAX_BODIES;
+use super::model::{JointAxis, RobotModel};
 use crate::robot::JointKind;
 
 /// The lever arms `L_{j,b}` of a robot model (see the module doc).
@@ -134,7 +136,7 @@ impl SweepBound {
 
     /// `δ_b(Δq)` for every body into `pads[..bodies]`, with `Δq = step`
     /// (absolute values are taken).
-    pub fn pads(&self, step: &[f64], pads: &mut [f64; MAX_BODIES]) {
+    pub fn pads(&self, step: &[f64], pads: &mut [f64]) {
         if self.dof == 0 {
             pads.fill(0.0);
             return;

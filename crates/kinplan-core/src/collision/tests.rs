@@ -13,6 +13,7 @@ use super::*;
 use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
 mod robot;
+mod spheres;
 mod sweep;
 
 /// URDF of the xyz probe whose link carries `geometry` (URDF XML).
@@ -388,6 +389,67 @@ fn bodies_out_of_reach_of_every_obstacle_are_skipped_without_changing_a_verdict(
     assert!(
         valid > 100 && invalid > 30,
         "valid {valid}, hitting the box {invalid}"
+    );
+}
+
+#[test]
+fn a_model_of_more_bodies_than_the_small_buffers_gets_the_report_verdicts() {
+    // A 20-link snake of 0.1 m links turning about z, a 4 cm sphere at each
+    // link's end, beside a box: the checks of models beyond the small pose
+    // buffers must agree with the report (every body, every obstacle) and
+    // the padded check with the padded test on the full buffers.
+    let mut urdf = String::from(r#"<robot name="snake"><link name="l0"/>"#);
+    for i in 1..=20 {
+        urdf += &format!(
+            r#"<link name="l{i}"><collision><origin xyz="0.1 0 0"/><geometry><sphere radius="0.04"/></geometry></collision></link>
+               <joint name="j{i}" type="revolute"><parent link="l{}"/><child link="l{i}"/><origin xyz="{}"/>
+               <axis xyz="0 0 1"/><limit lower="-0.6" upper="0.6" effort="0" velocity="1"/></joint>"#,
+            i - 1,
+            if i == 1 { "0 0 0" } else { "0.1 0 0" }
+        );
+    }
+    urdf += "</robot>";
+    let block = Obstacle::new(
+        "block",
+        Isometry3::translation(1.2, 0.4, 0.0),
+        Geometry::Box {
+            half_extents: Vector3::new(0.2, 0.1, 0.1),
+        },
+    );
+    let chain = Arc::new(parse_chain(&urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
+    let model = Arc::new(RobotModel::new(chain.clone()).unwrap());
+    assert_eq!(model.body_count(), 20);
+    let acm = AllowedCollisions::adjacent(&model);
+    let world =
+        Arc::new(SceneGeometry::build(&Scene::new(vec![block], &SceneLimits::default()).unwrap()).unwrap());
+    let checker = SceneChecker::new(model, &acm, world, CheckerParams::default()).unwrap();
+    let sweep = SweepBound::new(checker.model()).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(20);
+    let (mut valid, mut invalid, mut proved) = (0, 0, 0);
+    for _ in 0..2000 {
+        let q: Vec<f64> = (0..20).map(|_| rng.random_range(-0.3..0.3)).collect();
+        let expected = checker.report(&q).unwrap().is_valid();
+        assert_eq!(checker.is_valid(&q), expected, "{q:?}");
+        let half: Vec<f64> = (0..20).map(|_| rng.random_range(-0.01..0.01)).collect();
+        let mut pads = [0.0; MAX_BODIES];
+        sweep.pads(&half, &mut pads);
+        if checker.padded_valid(&q, &half) == Some(true) {
+            // the tight pads are within the global ones: free with them too
+            assert!(expected);
+            proved += 1;
+        }
+        if !checker.in_collision_padded(&q, &pads) {
+            assert_eq!(checker.padded_valid(&q, &half), Some(true), "{q:?}");
+        }
+        if expected {
+            valid += 1;
+        } else {
+            invalid += 1;
+        }
+    }
+    assert!(
+        valid > 100 && invalid > 100 && proved > 100,
+        "{valid} {invalid} {proved}"
     );
 }
 

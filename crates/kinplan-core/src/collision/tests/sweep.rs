@@ -83,6 +83,68 @@ fn sphere_points(body: &super::super::model::Body) -> Vec<Point3<f64>> {
     points
 }
 
+/// Points of a body's own shapes (body frame): a capsule's or sphere's ends
+/// and the points at its radius from them in 14 directions, a box's corners
+/// and centre, the bounding-sphere points of anything else.
+fn shape_points(body: &super::super::model::Body) -> Vec<Point3<f64>> {
+    use super::super::fast::RobotFast;
+    let mut points = Vec::new();
+    let mut directions: Vec<Vector3<f64>> = (0..3)
+        .flat_map(|k| [-1.0, 1.0].map(|s| Vector3::ith(k, s)))
+        .collect();
+    for corner in 0..8 {
+        let sign = |k: usize| if corner & (1 << k) == 0 { -1.0 } else { 1.0 };
+        directions.push(Vector3::new(sign(0), sign(1), sign(2)) / 3f64.sqrt());
+    }
+    for shape in &body.shapes {
+        match shape.fast {
+            RobotFast::Swept { a, b, r } => {
+                for end in [a, b] {
+                    points.push(end);
+                    points.extend(directions.iter().map(|u| end + u * r));
+                }
+            }
+            RobotFast::Box { offset, half } => {
+                points.push(offset * Point3::origin());
+                for corner in 0..8 {
+                    let sign = |k: usize| if corner & (1 << k) == 0 { -1.0 } else { 1.0 };
+                    points.push(offset * Point3::new(sign(0) * half.x, sign(1) * half.y, sign(2) * half.z));
+                }
+            }
+            RobotFast::None => points.extend(sphere_points(body)),
+        }
+    }
+    points
+}
+
+/// Asserts that no point of any body's shapes ([`shape_points`]) moves
+/// farther than `pads[b]` from its place in `from` when the robot is at `q`.
+fn assert_shapes_within_pads(
+    model: &RobotModel,
+    from: &[Isometry3<f64>; MAX_BODIES],
+    q: &[f64],
+    pads: &[f64],
+    context: &str,
+) -> f64 {
+    let mut at = [Isometry3::identity(); MAX_BODIES];
+    model.body_poses(q, &mut at);
+    let mut tightest = 0.0f64;
+    for (b, body) in model.bodies.iter().enumerate() {
+        for p in shape_points(body) {
+            let moved = (at[b] * p - from[b] * p).norm();
+            assert!(
+                moved <= pads[b] + 1e-12,
+                "{context}, body {b}: moved {moved} > pad {}",
+                pads[b]
+            );
+            if pads[b] > 0.0 {
+                tightest = tightest.max(moved / pads[b]);
+            }
+        }
+    }
+    tightest
+}
+
 /// Asserts that no bounding-sphere point (centre and poles) of any body
 /// moves farther than `pads[b]` from its place in `from` when the robot is
 /// at `q`.
@@ -666,6 +728,40 @@ fn the_bound_along_a_piece_holds_for_its_states_and_is_tighter_than_the_box() {
     let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
     eprintln!("segment / box bound on 0.05 rad pieces: mean {mean:.3}");
     assert!(mean < 0.8, "the segment bound is no tighter: mean ratio {mean}");
+}
+
+#[test]
+fn the_bound_along_a_piece_holds_for_the_corners_of_the_hand_and_fingers() {
+    // The Panda with its hand (a box) and fingers (boxes) held open: every
+    // corner and every capsule point sampled along random pieces stays
+    // within the bound taken over the shapes' extreme points.
+    let chain = builtin_chain("franka_panda_hand").unwrap();
+    let urdf = crate::robot::builtin_urdf("franka_panda_hand").unwrap();
+    let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
+    let model = RobotModel::of_urdf(chain, urdf, &fingers, &[]).unwrap();
+    let sweep = SweepBound::new(&model).unwrap();
+    let joints = model.chain().joints().to_vec();
+    let mut rng = ChaCha8Rng::seed_from_u64(29);
+    let mut at_m = [Isometry3::identity(); MAX_BODIES];
+    let mut axes = [JointAxis::default(); 7];
+    let mut tightest = 0.0f64;
+    for k in 0..300 {
+        let m = random_state(&joints, &mut rng);
+        let span = [0.025, 0.1, 0.4][k % 3];
+        let d: Vec<f64> = (0..7).map(|_| rng.random_range(-span..span)).collect();
+        model.body_poses_and_axes(&m, &mut at_m, &mut axes);
+        let along: Vec<f64> = (0..model.body_count())
+            .map(|b| sweep.pad_along(&model, b, &at_m[b], &axes, &d))
+            .collect();
+        for i in -10..=10 {
+            let s = f64::from(i) / 10.0;
+            let q: Vec<f64> = m.iter().zip(&d).map(|(x, dj)| x + s * dj).collect();
+            let t = assert_shapes_within_pads(&model, &at_m, &q, &along, &format!("hand, s = {s}"));
+            tightest = tightest.max(t);
+        }
+    }
+    // not vacuous: some point moves most of its pad
+    assert!(tightest > 0.8, "tightest ratio {tightest}");
 }
 
 #[test]
