@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use nalgebra::{Isometry3, Point3};
+use nalgebra::Isometry3;
 use rayon::prelude::*;
 
 use super::batch::BatchUpdate;
@@ -135,10 +135,14 @@ pub struct PinholeIntrinsics {
 /// Free cells, end-point cells (Morton codes) and skipped points of one chunk of beams.
 type ChunkKeys = (Vec<u64>, Vec<u64>, usize);
 
-/// A scan's cells to update: bits over the key box (with the map from a bit to its
-/// key) or sorted Morton codes.
+/// A scan's cells to update: bits over the key box starting at `lo` with `dims`
+/// cells per axis (x fastest), or sorted Morton codes.
 enum CellSet {
-    Dense(Vec<u64>, Box<dyn Fn(usize) -> OcKey>),
+    Dense {
+        bits: Vec<u64>,
+        lo: OcKey,
+        dims: [usize; 3],
+    },
     Sorted(Vec<u64>),
 }
 
@@ -146,16 +150,25 @@ impl CellSet {
     /// The keys in ascending bit or Morton order.
     fn iter(&self) -> Box<dyn Iterator<Item = OcKey> + '_> {
         match self {
-            CellSet::Dense(bits, key_of) => Box::new(bits.iter().enumerate().flat_map(move |(w, &word)| {
-                let mut b = word;
-                std::iter::from_fn(move || {
-                    (b != 0).then(|| {
-                        let i = w * 64 + b.trailing_zeros() as usize;
-                        b &= b - 1;
-                        key_of(i)
+            CellSet::Dense { bits, lo, dims } => {
+                let (lo, dx, dy) = (*lo, dims[0], dims[1]);
+                // the row (y, z) of the last bit: a division only when the row changes
+                let mut row = (usize::MAX, 0u16, 0u16);
+                Box::new(bits.iter().enumerate().flat_map(move |(w, &word)| {
+                    let mut b = word;
+                    std::iter::from_fn(move || {
+                        (b != 0).then(|| {
+                            let i = w * 64 + b.trailing_zeros() as usize;
+                            b &= b - 1;
+                            if i < row.0 || i >= row.0 + dx {
+                                let r = i / dx;
+                                row = (r * dx, lo[1] + (r % dy) as u16, lo[2] + (r / dy) as u16);
+                            }
+                            [lo[0] + (i - row.0) as u16, row.1, row.2]
+                        })
                     })
-                })
-            })),
+                }))
+            }
             CellSet::Sorted(codes) => Box::new(codes.iter().map(|&m| unmorton(m))),
         }
     }
@@ -513,15 +526,9 @@ impl Octree {
         for (f, o) in free.iter_mut().zip(&occ) {
             *f &= !o;
         }
-        let key_of = move |i: usize| {
-            let x = i % dims[0];
-            let y = (i / dims[0]) % dims[1];
-            let z = i / (dims[0] * dims[1]);
-            [lo[0] + x as u16, lo[1] + y as u16, lo[2] + z as u16]
-        };
         Some(ScanCells {
-            free: CellSet::Dense(free, Box::new(key_of)),
-            occupied: CellSet::Dense(occ, Box::new(key_of)),
+            free: CellSet::Dense { bits: free, lo, dims },
+            occupied: CellSet::Dense { bits: occ, lo, dims },
             skipped,
         })
     }
@@ -640,37 +647,36 @@ impl Octree {
         deadline: Deadline<'_>,
     ) -> Result<ScanStats, OctreeError> {
         params.validate()?;
-        let pts = depth_image_points(depth, width, height, intrinsics, camera_pose)?;
         let o = camera_pose.translation.vector;
         let origin = [o.x as f32, o.y as f32, o.z as f32];
         if params.near_ray_spacing <= 0.0 || origin.iter().any(|v| !v.is_finite()) {
+            let pts = depth_image_points(depth, width, height, intrinsics, camera_pose)?;
             return self.insert_scan(&pts, &origin, params, deadline);
         }
-        let mut next = 0u32;
-        let beams: Vec<PixelBeam> = depth
-            .iter()
-            .map(|&z| {
-                if !(z.is_finite() && z > 0.0) {
-                    return PixelBeam {
-                        covered: 0.0,
-                        point: u32::MAX,
-                    };
-                }
-                let p = &pts[next as usize];
-                let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-                let range = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
-                let covered = match self.key_of_f32(p) {
-                    _ if params.max_range > 0.0 && range > params.max_range => params.max_range,
-                    Some(_) if p.iter().all(|v| v.is_finite()) => range,
-                    _ => 0.0,
-                };
-                next += 1;
-                PixelBeam {
-                    covered: covered as f32,
-                    point: next - 1,
-                }
-            })
-            .collect();
+        let mut pts = Vec::with_capacity(depth.len());
+        let mut beams = vec![
+            PixelBeam {
+                covered: 0.0,
+                point: u32::MAX,
+            };
+            depth.len()
+        ];
+        back_project(depth, width, height, intrinsics, camera_pose, |i, p| {
+            let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+            let range = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
+            let covered = if params.max_range > 0.0 && range > params.max_range {
+                params.max_range
+            } else if p.iter().all(|v| v.is_finite()) && self.key_of_f32(&p).is_some() {
+                range
+            } else {
+                0.0
+            };
+            beams[i] = PixelBeam {
+                covered: covered as f32,
+                point: pts.len() as u32,
+            };
+            pts.push(p);
+        })?;
         let starts = near_field_starts(
             &beams,
             width,
@@ -710,6 +716,23 @@ pub fn depth_image_points(
     k: &PinholeIntrinsics,
     camera_pose: &Isometry3<f64>,
 ) -> Result<Vec<[f32; 3]>, OctreeError> {
+    let mut out = Vec::with_capacity(depth.len());
+    back_project(depth, width, height, k, camera_pose, |_, p| out.push(p))?;
+    Ok(out)
+}
+
+/// Checks the image and hands each pixel with a return to `each` as
+/// `(row-major pixel index, map-frame point)`, in pixel order: `z > 0` finite,
+/// `p_c = (a_u·z, b_v·z, z)` with `a_u = (u − cx)/fx`, `b_v = (v − cy)/fy`, and
+/// `p = R·p_c + t` for the pose's rotation matrix `R` and translation `t`.
+pub(crate) fn back_project(
+    depth: &[f32],
+    width: usize,
+    height: usize,
+    k: &PinholeIntrinsics,
+    camera_pose: &Isometry3<f64>,
+    mut each: impl FnMut(usize, [f32; 3]),
+) -> Result<(), OctreeError> {
     let expected = width.checked_mul(height).ok_or(OctreeError::InvalidParam {
         field: "width",
         value: width as f64,
@@ -736,17 +759,21 @@ pub fn depth_image_points(
             field: "principal point",
         });
     }
-    let mut out = Vec::with_capacity(expected);
+    let r = *camera_pose.rotation.to_rotation_matrix().matrix();
+    let t = camera_pose.translation.vector;
+    let a: Vec<f64> = (0..width).map(|u| (u as f64 - k.cx) / k.fx).collect();
     for v in 0..height {
-        for u in 0..width {
-            let z = depth[v * width + u] as f64;
+        let b = (v as f64 - k.cy) / k.fy;
+        let row = &depth[v * width..(v + 1) * width];
+        for (u, (&z, &a)) in row.iter().zip(&a).enumerate() {
+            let z = z as f64;
             if !(z.is_finite() && z > 0.0) {
                 continue;
             }
-            let pc = Point3::new((u as f64 - k.cx) * z / k.fx, (v as f64 - k.cy) * z / k.fy, z);
-            let pm = camera_pose * pc;
-            out.push([pm.x as f32, pm.y as f32, pm.z as f32]);
+            let (x, y) = (a * z, b * z);
+            let p = [0, 1, 2].map(|i| (r[(i, 0)] * x + r[(i, 1)] * y + r[(i, 2)] * z + t[i]) as f32);
+            each(v * width + u, p);
         }
     }
-    Ok(out)
+    Ok(())
 }
