@@ -33,6 +33,7 @@ fn scan_request(octree: Option<pb::Octree>, xyz: Vec<f32>) -> pb::InsertScanRequ
         max_range: None,
         discretize: false,
         full: false,
+        near_ray_spacing: 0.0,
     }
 }
 

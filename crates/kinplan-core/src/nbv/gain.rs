@@ -6,7 +6,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use super::camera::{CameraModel, Frustum};
 use super::count::FrustumCounter;
 use crate::Deadline;
-use crate::octree::{CellState, OcKey, Octree, SearchCache};
+use crate::octree::{CellState, OcKey, Octree, SearchCache, morton};
 
 /// How the gain of a view is computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -160,11 +160,6 @@ pub fn ray_gain(
         ig: total / c_max,
         ray_steps: steps,
     }
-}
-
-#[inline]
-fn morton(k: &OcKey) -> u64 {
-    (k[0] as u64) | (k[1] as u64) << 16 | (k[2] as u64) << 32
 }
 
 /// Walks the cells a ray `o + t·dir` (unit `dir`, m) crosses for `t ∈ [t0, t1]` with a

@@ -29,7 +29,7 @@ use super::NbvError;
 use super::camera::CameraModel;
 use super::gain::walk;
 use crate::Deadline;
-use crate::octree::{CellState, OcKey, Octree};
+use crate::octree::{CellState, OcKey, Octree, morton};
 
 /// Options of the visibility check of [`next_best_view`](super::next_best_view).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,11 +108,6 @@ pub struct ViewPrediction {
 pub struct PredictWorkspace {
     first: Vec<u64>,
     reached: Vec<u64>,
-}
-
-#[inline]
-fn morton(k: &OcKey) -> u64 {
-    (k[0] as u64) | (k[1] as u64) << 16 | (k[2] as u64) << 32
 }
 
 #[inline]
