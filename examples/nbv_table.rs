@@ -3,7 +3,7 @@
 //! 0.05–0.15 m and on geb079.bt; then NBV end to end with 1,000 frontier candidates at
 //! 5 cm. Seeded; prints Markdown.
 //!
-//! cargo run --release -p kinplan-core --example nbv_table [-- --no-rays | --nbv-only] [--write-bt PATH]
+//! cargo run --release -p kinplan-core --example nbv_table [-- --no-rays | --nbv-only] [--config I] [--write-bt PATH]
 
 use std::time::Instant;
 
@@ -220,8 +220,14 @@ fn main() {
             },
         ),
     ];
-    for (name, p) in cfgs {
-        if no_rays && !matches!(p.gain, GainMethod::Intersection) {
+    // `--config I`: only the I-th row
+    let only: Option<usize> = args
+        .iter()
+        .position(|a| a == "--config")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok());
+    for (i, (name, p)) in cfgs.into_iter().enumerate() {
+        if no_rays && !matches!(p.gain, GainMethod::Intersection) || only.is_some_and(|o| o != i) {
             continue;
         }
         let s = Instant::now();

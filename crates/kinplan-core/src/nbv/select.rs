@@ -14,7 +14,7 @@ use super::count::FrustumCounter;
 use super::frontier::{candidate_pose, frontier_cells, potential_field, unknown_needed};
 use super::gain::{GainMethod, GainWorkspace, ray_gain};
 use super::grid::{Ball, MAX_CELLS, StateGrid};
-use super::visibility::{PredictWorkspace, ViewPrediction, predict_view};
+use super::visibility::{PredictWorkspace, ViewPrediction, predict_view_in};
 use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
 use crate::octree::{CellState, Octree};
@@ -429,6 +429,8 @@ pub fn next_best_view(
         };
         let mut kept: Vec<NbvCandidate> = Vec::with_capacity(params.max_results);
         let mut rest = scored.into_iter();
+        // one workspace per candidate of a batch, kept from batch to batch
+        let mut workspaces: Vec<PredictWorkspace> = Vec::new();
         loop {
             let batch: Vec<NbvCandidate> = rest.by_ref().take(vp.batch).collect();
             if batch.is_empty() {
@@ -438,14 +440,19 @@ pub fn next_best_view(
                 status = s;
                 break;
             }
+            if workspaces.len() < batch.len() {
+                workspaces.resize_with(batch.len(), PredictWorkspace::default);
+            }
             let preds: Vec<Option<ViewPrediction>> = batch
                 .par_iter()
-                .map_init(PredictWorkspace::default, |ws, c| {
+                .zip(workspaces.par_iter_mut())
+                .map(|(c, ws)| {
                     if clock.interrupted().is_some() {
                         return None;
                     }
-                    Some(predict_view(
+                    Some(predict_view_in(
                         tree,
+                        grid.as_ref(),
                         camera,
                         &c.pose,
                         vp,
