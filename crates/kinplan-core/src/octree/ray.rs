@@ -165,7 +165,8 @@ impl Octree {
     /// `t_max_i = (border_i − o_i)/d̂_i` — the value the walk from the origin reaches
     /// by summing `t_delta_i`, up to rounding — so the cells after `t_start` are those
     /// of the whole walk (a cell can differ only where two borders lie within rounding
-    /// of each other). `t_start ≤ 0` is the whole walk.
+    /// of each other). `t_start ≤ 0` is the whole walk; with `t_start > 0` the origin's
+    /// cell is not looked up (the caller has checked it lies in the tree).
     #[inline]
     pub(crate) fn visit_ray_cells_from(
         &self,
@@ -181,12 +182,9 @@ impl Octree {
         if t_start > 0.0 && t_start >= length as f64 {
             return true;
         }
-        let (Some(ko), Some(ke)) = (self.key_of_f32(origin), self.key_of_f32(end)) else {
+        let Some(ke) = self.key_of_f32(end) else {
             return false;
         };
-        if ko == ke {
-            return true;
-        }
         for v in dir.iter_mut() {
             *v /= length;
         }
@@ -218,6 +216,14 @@ impl Octree {
             }
             (ks, dda)
         } else {
+            // a start inside the segment lies in the end cell when the origin does
+            // (cells are convex), so only the whole walk checks the origin's cell
+            let Some(ko) = self.key_of_f32(origin) else {
+                return false;
+            };
+            if ko == ke {
+                return true;
+            }
             (ko, Dda::new(&ko, origin, &dir, self.resolution, true))
         };
         let mut idx = index_of(&ks);
