@@ -4,12 +4,14 @@
 //!
 //! - `write`: renders the frame from the room's first scan pose and writes its points
 //!   (after the depth image's back-projection) to `target/frame_points.bin`.
-//! - `compare OT [runs]`: times `Octree::insert_depth_image` of the same frame into
+//! - `compare OT [runs [exact|discretize|near]]`: times `Octree::insert_depth_image` of the same frame into
 //!   fresh trees (median and minimum over `runs`, default 7; set `RAYON_NUM_THREADS=1`
 //!   for one core) and compares every cell of the room's key box with OctoMap's tree
 //!   read from `OT`: same state (unknown / free / occupied) or not. Then the same with
 //!   `ScanParams::discretize` (end points merged per cell and cast from the cell's
-//!   centre, OctoMap's `discretize`), against the same OctoMap tree (not discretized).
+//!   centre, OctoMap's `discretize`), against the same OctoMap tree (not discretized),
+//!   and with the shared near field (`ScanParams::near_ray_spacing` at
+//!   `NEAR_RAY_SPACING`).
 //!
 //! Run by hand (not in CI):
 //!
@@ -24,11 +26,13 @@
 use std::time::Instant;
 
 use kinplan_core::nbv::{CameraModel, look_along};
-use kinplan_core::octree::{Octree, OctreeLimits, ScanParams, depth_image_points};
+use kinplan_core::octree::{NEAR_RAY_SPACING, Octree, OctreeLimits, ScanParams, depth_image_points};
 use nalgebra::{Isometry3, Point3, Vector3};
 
 #[path = "common/room_scene.rs"]
 mod room_scene;
+#[path = "common/sched.rs"]
+mod sched;
 
 const RES: f64 = 0.05;
 
@@ -36,7 +40,12 @@ const RES: f64 = 0.05;
 /// room's first scan pose, every pixel a return (the room is closed).
 fn frame() -> (CameraModel, Isometry3<f64>, Vec<f32>) {
     let cam = CameraModel::default();
-    let (o, yaw, pitch) = room_scene::scan_poses()[0];
+    // `FRAME_POSE=i` takes the room's i-th scan pose instead of the first
+    let i = std::env::var("FRAME_POSE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
+    let (o, yaw, pitch) = room_scene::scan_poses()[i];
     let dir = Vector3::new(yaw.cos() * pitch.cos(), yaw.sin() * pitch.cos(), pitch.sin());
     let pose = look_along(&Point3::from(o), &dir).unwrap();
     let origin = Point3::from(o);
@@ -69,14 +78,30 @@ fn write() {
     println!("{} points written to target/frame_points.bin", pts.len());
 }
 
-fn compare(ot: &str, runs: usize, discretize: bool) {
+/// How our insert is run.
+#[derive(Clone, Copy, Debug)]
+enum Mode {
+    Exact,
+    Discretize,
+    /// The shared near field at `NEAR_RAY_SPACING`.
+    NearField,
+}
+
+fn compare(ot: &str, runs: usize, mode: Mode) {
     let (cam, pose, depth) = frame();
     let k = cam.intrinsics();
+    // `NEAR_RAY_SPACING=0.9 depth_frame compare …` tries another spacing (cells)
+    let spacing = std::env::var("NEAR_RAY_SPACING")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(NEAR_RAY_SPACING);
     let mut ms = Vec::new();
+    let mut cpu_ms = Vec::new();
     let mut split = (0u64, 0u64);
     let mut ours = Octree::new(RES).unwrap();
     for _ in 0..runs.max(1) {
         ours = Octree::new(RES).unwrap();
+        let c0 = sched::sched_ns();
         let t = Instant::now();
         let stats = ours
             .insert_depth_image(
@@ -86,25 +111,41 @@ fn compare(ot: &str, runs: usize, discretize: bool) {
                 &k,
                 &pose,
                 &ScanParams {
-                    discretize,
+                    discretize: matches!(mode, Mode::Discretize),
+                    near_ray_spacing: if matches!(mode, Mode::NearField) {
+                        spacing
+                    } else {
+                        0.0
+                    },
                     ..ScanParams::default()
                 },
                 kinplan_core::Deadline::none(),
             )
             .unwrap();
         ms.push(t.elapsed().as_secs_f64() * 1e3);
+        if let (Some(a), Some(b)) = (c0, sched::sched_ns()) {
+            cpu_ms.push((b.0 - a.0) as f64 / 1e6);
+        }
         split = (stats.trace_us, stats.update_us);
     }
     let mut sorted = ms.clone();
     sorted.sort_by(f64::total_cmp);
+    cpu_ms.sort_by(f64::total_cmp);
     println!(
-        "kinplan insert_depth_image (discretize {discretize}): {} pixels, res {RES}, median {:.1} ms, min {:.1} ms over {} runs, threads {}",
+        "kinplan insert_depth_image ({mode:?}, near_ray_spacing {spacing} if NearField): {} pixels, res {RES}, median {:.1} ms, min {:.1} ms over {} runs, threads {}",
         depth.len(),
         sorted[sorted.len() / 2],
         sorted[0],
         ms.len(),
         rayon::current_num_threads()
     );
+    if !cpu_ms.is_empty() {
+        println!(
+            "  CPU time, all threads: median {:.1} ms, min {:.1} ms",
+            cpu_ms[cpu_ms.len() / 2],
+            cpu_ms[0]
+        );
+    }
     println!(
         "  last run: trace {:.1} ms, update {:.1} ms",
         split.0 as f64 / 1e3,
@@ -148,14 +189,20 @@ fn main() {
     match args.first().map(String::as_str) {
         Some("write") => write(),
         Some("compare") => {
-            for discretize in [false, true] {
+            let modes = match args.get(3).map(String::as_str) {
+                Some("exact") => vec![Mode::Exact],
+                Some("discretize") => vec![Mode::Discretize],
+                Some("near") => vec![Mode::NearField],
+                _ => vec![Mode::Exact, Mode::Discretize, Mode::NearField],
+            };
+            for mode in modes {
                 compare(
                     args.get(1).expect("the OctoMap .ot path"),
                     args.get(2).map_or(7, |v| v.parse().expect("runs")),
-                    discretize,
+                    mode,
                 );
             }
         }
-        _ => eprintln!("usage: depth_frame write | compare OT [runs]"),
+        _ => eprintln!("usage: depth_frame write | compare OT [runs [exact|discretize|near]]"),
     }
 }

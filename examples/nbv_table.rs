@@ -3,7 +3,7 @@
 //! 0.05–0.15 m and on geb079.bt; then NBV end to end with 1,000 frontier candidates at
 //! 5 cm. Seeded; prints Markdown.
 //!
-//! cargo run --release -p kinplan-core --example nbv_table [-- --no-rays | --nbv-only] [--write-bt PATH]
+//! cargo run --release -p kinplan-core --example nbv_table [-- --no-rays | --nbv-only] [--config I] [--write-bt PATH]
 
 use std::time::Instant;
 
@@ -18,23 +18,11 @@ use rand_chacha::ChaCha8Rng;
 
 #[path = "common/room_scene.rs"]
 mod room_scene;
+#[path = "common/sched.rs"]
+mod sched;
+use sched::sched_ns;
 
 const VIEWS: usize = 8;
-
-/// CPU time on a core and time waiting in the run queue (ns), summed over the threads
-/// of this process (Linux `/proc/self/task/*/schedstat`); `None` elsewhere. The wait
-/// shows how much of a wall time the machine's other load took.
-fn sched_ns() -> Option<(u64, u64)> {
-    let mut on = 0u64;
-    let mut wait = 0u64;
-    for t in std::fs::read_dir("/proc/self/task").ok()? {
-        let s = std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok()?;
-        let mut f = s.split_whitespace().map(|v| v.parse::<u64>().unwrap_or(0));
-        on += f.next()?;
-        wait += f.next()?;
-    }
-    Some((on, wait))
-}
 
 fn room_tree(res: f64) -> Octree {
     let mut t = Octree::new(res).unwrap();
@@ -232,8 +220,14 @@ fn main() {
             },
         ),
     ];
-    for (name, p) in cfgs {
-        if no_rays && !matches!(p.gain, GainMethod::Intersection) {
+    // `--config I`: only the I-th row
+    let only: Option<usize> = args
+        .iter()
+        .position(|a| a == "--config")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok());
+    for (i, (name, p)) in cfgs.into_iter().enumerate() {
+        if no_rays && !matches!(p.gain, GainMethod::Intersection) || only.is_some_and(|o| o != i) {
             continue;
         }
         let s = Instant::now();

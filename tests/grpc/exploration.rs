@@ -33,6 +33,7 @@ fn scan_request(octree: Option<pb::Octree>, xyz: Vec<f32>) -> pb::InsertScanRequ
         max_range: None,
         discretize: false,
         full: false,
+        near_ray_spacing: 0.0,
     }
 }
 
@@ -322,5 +323,60 @@ async fn depth_images_in_metres_millimetres_or_with_a_camera_model_insert_like_t
             .unwrap_err();
         assert_eq!(err.code(), Code::InvalidArgument, "{}", err.message());
         assert!(err.message().starts_with(field), "{field}: {}", err.message());
+    }
+}
+
+#[tokio::test]
+async fn a_shared_near_field_keeps_every_end_point_and_refuses_bad_spacings_by_name() {
+    let server = start(ServerConfig::default()).await;
+    let mut exploration = ExplorationServiceClient::new(server.channel.clone());
+    // 64 × 48 pixels, f = 40 px, of a plane tilted away from the camera (2–4.5 m)
+    let (w, h) = (64u32, 48u32);
+    let depth: Vec<f32> = (0..w * h)
+        .map(|i| 2.0 + 2.5 * (i % w) as f32 / w as f32)
+        .collect();
+    let image = pb::DepthImage {
+        width: w,
+        height: h,
+        depth,
+        fx: 40.0,
+        fy: 40.0,
+        cx: 31.5,
+        cy: 23.5,
+        ..Default::default()
+    };
+    let with = |spacing: f64, discretize: bool| pb::InsertScanRequest {
+        scan: Some(Scan::DepthImage(image.clone())),
+        near_ray_spacing: spacing,
+        discretize,
+        ..scan_request(None, Vec::new())
+    };
+    let exact = exploration
+        .insert_scan(with(0.0, false))
+        .await
+        .unwrap()
+        .into_inner();
+    let fast = exploration
+        .insert_scan(with(0.7, false))
+        .await
+        .unwrap()
+        .into_inner();
+    // every end point is still occupied; the free cells are those of the exact beams
+    // after each beam's start, so at most as many, and all but a few of them
+    assert_eq!(fast.occupied_cells, exact.occupied_cells);
+    assert!(fast.free_cells <= exact.free_cells);
+    assert!(
+        fast.free_cells * 100 >= exact.free_cells * 99,
+        "{} of {} free cells",
+        fast.free_cells,
+        exact.free_cells
+    );
+    for (spacing, discretize) in [(1.5, false), (-0.1, false), (f64::NAN, false), (0.5, true)] {
+        let err = exploration
+            .insert_scan(with(spacing, discretize))
+            .await
+            .unwrap_err();
+        assert_eq!(err.code(), Code::InvalidArgument, "{}", err.message());
+        assert!(err.message().starts_with("near_ray_spacing"), "{}", err.message());
     }
 }

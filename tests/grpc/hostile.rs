@@ -620,6 +620,7 @@ async fn planning_and_exploration(v: Values) -> Result<(), TestCaseError> {
         max_range: Some(h.at(17, -1.0)),
         discretize: v.n[4].is_multiple_of(2),
         full: false,
+        near_ray_spacing: 0.0,
     };
     let bad = h.any_absurd(8..11) || h.absurd_at(17) || (v.n[2].is_multiple_of(2) && bad_tree);
     judge_refused("InsertScan", t, bad, exploration.insert_scan(scan).await)?;

@@ -329,6 +329,7 @@ class Client:
         resolution: float = 0.05,
         max_range: Optional[float] = None,
         discretize: bool = False,
+        near_ray_spacing: float = 0.0,
         timeout: Optional[float] = None,
     ) -> Octree:
         """Inserts ``points`` (n x 3, world frame, metres) seen from ``origin``
@@ -340,9 +341,12 @@ class Client:
         metres, 0 / NaN = no return) taken from ``origin``, the camera's
         optical frame (4x4: x right, y down, z forward), with
         ``intrinsics=(fx, fy, cx, cy)`` in pixels or ``camera=`` a camera
-        model dict (its width and height those of the image)."""
+        model dict (its width and height those of the image).
+        ``near_ray_spacing`` (cells, in [0, 1]; depth images only): trace
+        only a pixel lattice this dense close to the camera, 0.7 being the
+        suggested value; 0 (default) gives OctoMap's tree exactly."""
         out: Octree = self._run(_exploration.insert_scan(octree, points, origin, resolution, max_range, discretize,
-                                                         depth, intrinsics, camera),
+                                                         depth, intrinsics, camera, near_ray_spacing),
                                 timeout)
         return out
 

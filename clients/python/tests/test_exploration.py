@@ -142,3 +142,22 @@ def test_a_depth_image_inserts_like_its_hand_back_projected_points(client):
     with pytest.raises(kinplan.KinplanError) as e:
         client.insert_scan(None, origin=pose, depth=np.full((4, 6), 2.0), camera={"width": 5, "height": 4})
     assert "depth_image.camera.width" in str(e.value)
+
+
+def test_a_shared_near_field_keeps_the_end_points_and_refuses_bad_spacings(client):
+    # 48 x 36 pixels of a plane tilted from 2 m to 4 m, f = 30 px
+    pose = np.eye(4)
+    depth = np.tile(2.0 + 2.0 * np.arange(48) / 48, (36, 1))
+    k = (30.0, 30.0, 23.5, 17.5)
+    exact = client.insert_scan(None, origin=pose, depth=depth, intrinsics=k, resolution=0.1)
+    fast = client.insert_scan(None, origin=pose, depth=depth, intrinsics=k, resolution=0.1, near_ray_spacing=0.7)
+    ie, fa = client.octree_info(exact), client.octree_info(fast)
+    # every end point is occupied in both; the near field leaves out at most a few free cells
+    np.testing.assert_array_equal(np.sort(exact.occupied_cells(), axis=0), np.sort(fast.occupied_cells(), axis=0))
+    assert ie["occupied_leaves"] == fa["occupied_leaves"]
+    assert fa["free_volume"] <= ie["free_volume"] + 1e-9
+    assert fa["free_volume"] >= 0.99 * ie["free_volume"]
+    for bad in (1.5, -0.5):
+        with pytest.raises(kinplan.KinplanError) as e:
+            client.insert_scan(None, origin=pose, depth=depth, intrinsics=k, near_ray_spacing=bad)
+        assert "near_ray_spacing" in str(e.value)

@@ -128,7 +128,8 @@ def _views(reply: exploration_pb2.NextBestViewResponse) -> Views:
 def insert_scan(octree: Any, points: Any, origin: Any, resolution: float,
                 max_range: Optional[float], discretize: bool, depth: Any = None,
                 intrinsics: Optional[Sequence[float]] = None,
-                camera: Optional[Dict[str, Any]] = None) -> Call[Octree]:
+                camera: Optional[Dict[str, Any]] = None,
+                near_ray_spacing: float = 0.0) -> Call[Octree]:
     """InsertScan: ``points`` seen from ``origin``, or a ``depth`` image taken
     from the sensor pose ``origin``, into ``octree`` (any form
     :meth:`Octree.read` takes; a new tree when None)."""
@@ -136,6 +137,7 @@ def insert_scan(octree: Any, points: Any, origin: Any, resolution: float,
         resolution=float(resolution),
         sensor_pose=_pose(origin),
         discretize=discretize,
+        near_ray_spacing=float(near_ray_spacing),
     )
     if (points is None) == (depth is None):
         raise ValueError("give points or depth, not both")

@@ -227,10 +227,11 @@ class Client:
                           depth: Any = None, intrinsics: Optional[Sequence[float]] = None,
                           camera: Optional[Dict[str, Any]] = None,
                           resolution: float = 0.05, max_range: Optional[float] = None, discretize: bool = False,
+                          near_ray_spacing: float = 0.0,
                           timeout: Optional[float] = None) -> Octree:
         """As :meth:`kinplan.Client.insert_scan`."""
         call = _exploration.insert_scan(octree, points, origin, resolution, max_range, discretize,
-                                        depth, intrinsics, camera)
+                                        depth, intrinsics, camera, near_ray_spacing)
         out: Octree = await self._run(call, timeout)
         return out
 

@@ -305,7 +305,7 @@ class DepthImage(_message.Message):
     def __init__(self, width: _Optional[int] = ..., height: _Optional[int] = ..., depth: _Optional[_Iterable[float]] = ..., fx: _Optional[float] = ..., fy: _Optional[float] = ..., cx: _Optional[float] = ..., cy: _Optional[float] = ..., depth_mm: _Optional[bytes] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ...) -> None: ...
 
 class InsertScanRequest(_message.Message):
-    __slots__ = ("octree", "resolution", "sensor_pose", "points", "depth_image", "max_range", "discretize", "full")
+    __slots__ = ("octree", "resolution", "sensor_pose", "points", "depth_image", "max_range", "discretize", "full", "near_ray_spacing")
     OCTREE_FIELD_NUMBER: _ClassVar[int]
     RESOLUTION_FIELD_NUMBER: _ClassVar[int]
     SENSOR_POSE_FIELD_NUMBER: _ClassVar[int]
@@ -314,6 +314,7 @@ class InsertScanRequest(_message.Message):
     MAX_RANGE_FIELD_NUMBER: _ClassVar[int]
     DISCRETIZE_FIELD_NUMBER: _ClassVar[int]
     FULL_FIELD_NUMBER: _ClassVar[int]
+    NEAR_RAY_SPACING_FIELD_NUMBER: _ClassVar[int]
     octree: _common_pb2.Octree
     resolution: float
     sensor_pose: _common_pb2.Pose
@@ -322,7 +323,8 @@ class InsertScanRequest(_message.Message):
     max_range: float
     discretize: bool
     full: bool
-    def __init__(self, octree: _Optional[_Union[_common_pb2.Octree, _Mapping]] = ..., resolution: _Optional[float] = ..., sensor_pose: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., points: _Optional[_Union[PointCloud, _Mapping]] = ..., depth_image: _Optional[_Union[DepthImage, _Mapping]] = ..., max_range: _Optional[float] = ..., discretize: _Optional[bool] = ..., full: _Optional[bool] = ...) -> None: ...
+    near_ray_spacing: float
+    def __init__(self, octree: _Optional[_Union[_common_pb2.Octree, _Mapping]] = ..., resolution: _Optional[float] = ..., sensor_pose: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., points: _Optional[_Union[PointCloud, _Mapping]] = ..., depth_image: _Optional[_Union[DepthImage, _Mapping]] = ..., max_range: _Optional[float] = ..., discretize: _Optional[bool] = ..., full: _Optional[bool] = ..., near_ray_spacing: _Optional[float] = ...) -> None: ...
 
 class PointCloud(_message.Message):
     __slots__ = ("xyz",)

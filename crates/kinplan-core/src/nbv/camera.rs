@@ -58,7 +58,7 @@ impl CameraModel {
         if self.height == 0 {
             return bad("height", 0.0, "must be at least 1");
         }
-        if self.width.saturating_mul(self.height) > 1 << 24 {
+        if self.width.saturating_mul(self.height) > crate::octree::MAX_DEPTH_PIXELS {
             return bad("width", self.width as f64, "width · height must be at most 2^24");
         }
         Ok(())

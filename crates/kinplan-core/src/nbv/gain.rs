@@ -6,7 +6,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use super::camera::{CameraModel, Frustum};
 use super::count::FrustumCounter;
 use crate::Deadline;
-use crate::octree::{CellState, OcKey, Octree, SearchCache};
+use crate::octree::{CellState, OcKey, Octree, SearchCache, morton};
 
 /// How the gain of a view is computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -162,11 +162,6 @@ pub fn ray_gain(
     }
 }
 
-#[inline]
-fn morton(k: &OcKey) -> u64 {
-    (k[0] as u64) | (k[1] as u64) << 16 | (k[2] as u64) << 32
-}
-
 /// Walks the cells a ray `o + t·dir` (unit `dir`, m) crosses for `t ∈ [t0, t1]` with a
 /// 3-D DDA (Amanatides & Woo), calling `visit(key, state, log_odds)` per cell until it
 /// returns false; returns the steps taken.
@@ -176,6 +171,37 @@ pub fn walk(
     dir: &Vector3<f64>,
     t0: f64,
     t1: f64,
+    visit: impl FnMut(&OcKey, CellState, Option<f32>) -> bool,
+) -> u64 {
+    let mut cache = SearchCache::default();
+    walk_with(tree, o, dir, t0, t1, |k| tree_state(tree, k, &mut cache), visit)
+}
+
+/// State and log-odds of the depth-16 cell `key` of `tree` (`None` where unknown).
+#[inline]
+pub(crate) fn tree_state(tree: &Octree, key: &OcKey, cache: &mut SearchCache) -> (CellState, Option<f32>) {
+    match tree.search_key_cached(key, cache) {
+        None => (CellState::Unknown, None),
+        Some((v, _)) => (
+            if v > tree.threshold_log_odds() {
+                CellState::Occupied
+            } else {
+                CellState::Free
+            },
+            Some(v),
+        ),
+    }
+}
+
+/// [`walk`] reading each cell's state and log-odds from `lookup` instead of the tree
+/// (the tree gives the resolution and the key space).
+pub(crate) fn walk_with(
+    tree: &Octree,
+    o: &Point3<f64>,
+    dir: &Vector3<f64>,
+    t0: f64,
+    t1: f64,
+    mut lookup: impl FnMut(&OcKey) -> (CellState, Option<f32>),
     mut visit: impl FnMut(&OcKey, CellState, Option<f32>) -> bool,
 ) -> u64 {
     let res = tree.resolution();
@@ -194,20 +220,9 @@ pub fn walk(
         }
     }
     let mut steps = 0u64;
-    let mut cache = SearchCache::default();
     loop {
         steps += 1;
-        let (state, v) = match tree.search_key_cached(&k, &mut cache) {
-            None => (CellState::Unknown, None),
-            Some((v, _)) => (
-                if v > tree.threshold_log_odds() {
-                    CellState::Occupied
-                } else {
-                    CellState::Free
-                },
-                Some(v),
-            ),
-        };
+        let (state, v) = lookup(&k);
         if !visit(&k, state, v) {
             return steps;
         }

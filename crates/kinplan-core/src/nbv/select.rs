@@ -14,7 +14,7 @@ use super::count::FrustumCounter;
 use super::frontier::{candidate_pose, frontier_cells, potential_field, unknown_needed};
 use super::gain::{GainMethod, GainWorkspace, ray_gain};
 use super::grid::{Ball, MAX_CELLS, StateGrid};
-use super::visibility::{PredictWorkspace, ViewPrediction, predict_view};
+use super::visibility::{PredictWorkspace, ViewPrediction, predict_view_in};
 use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
 use crate::octree::{CellState, Octree};
@@ -118,6 +118,12 @@ impl Clock<'_> {
 
 fn us(t: Instant) -> u64 {
     t.elapsed().as_micros() as u64
+}
+
+/// S0's utility `f = w_d·D + w_r·R + w_i·Ig − penalty·failures` of a scored candidate
+/// (`failures` is 0 unless failures are counted).
+fn utility(w: &Weights, c: &NbvCandidate, failure_penalty: f64) -> f64 {
+    w.w_d * c.distance_term + w.w_r * c.rotation_term + w.w_i * c.ig - failure_penalty * c.failures as f64
 }
 
 /// Largest tool distance from the base over 2,000 seeded joint samples inside the
@@ -397,7 +403,6 @@ pub fn next_best_view(
     for c in scored.iter_mut() {
         c.distance_term = 1.0 - (c.pose.translation.vector - pc).norm() / (2.0 * d_max);
         c.rotation_term = 1.0 - current_pose.rotation.angle_to(&c.pose.rotation) / std::f64::consts::PI;
-        c.utility = w.w_d * c.distance_term + w.w_r * c.rotation_term + w.w_i * c.ig;
         if params.count_failures {
             let pos = Point3::from(c.pose.translation.vector);
             c.failures = params
@@ -406,8 +411,8 @@ pub fn next_best_view(
                 .filter(|(p, _)| (p - pos).norm() <= params.position_threshold)
                 .map(|(_, n)| *n)
                 .sum();
-            c.utility -= params.failure_penalty * c.failures as f64;
         }
+        c.utility = utility(&w, c, params.failure_penalty);
     }
     let rank = |v: &mut Vec<NbvCandidate>| v.sort_by(|a, b| b.utility.total_cmp(&a.utility));
     rank(&mut scored);
@@ -424,6 +429,8 @@ pub fn next_best_view(
         };
         let mut kept: Vec<NbvCandidate> = Vec::with_capacity(params.max_results);
         let mut rest = scored.into_iter();
+        // one workspace per candidate of a batch, kept from batch to batch
+        let mut workspaces: Vec<PredictWorkspace> = Vec::new();
         loop {
             let batch: Vec<NbvCandidate> = rest.by_ref().take(vp.batch).collect();
             if batch.is_empty() {
@@ -433,14 +440,19 @@ pub fn next_best_view(
                 status = s;
                 break;
             }
+            if workspaces.len() < batch.len() {
+                workspaces.resize_with(batch.len(), PredictWorkspace::default);
+            }
             let preds: Vec<Option<ViewPrediction>> = batch
                 .par_iter()
-                .map_init(PredictWorkspace::default, |ws, c| {
+                .zip(workspaces.par_iter_mut())
+                .map(|(c, ws)| {
                     if clock.interrupted().is_some() {
                         return None;
                     }
-                    Some(predict_view(
+                    Some(predict_view_in(
                         tree,
+                        grid.as_ref(),
                         camera,
                         &c.pose,
                         vp,
@@ -486,9 +498,7 @@ pub fn next_best_view(
             let reached = c.predicted.map_or(0, |p| p.reached) as f64;
             c.ig = reached / best;
             c.unknown_cells = reached;
-            // failures are counted only with count_failures (0 otherwise)
-            c.utility = w.w_d * c.distance_term + w.w_r * c.rotation_term + w.w_i * c.ig
-                - params.failure_penalty * c.failures as f64;
+            c.utility = utility(&w, c, params.failure_penalty);
         }
         st.after_visibility = kept.len();
         scored = kept;
@@ -542,7 +552,7 @@ pub fn next_best_view(
                 c.reachable = Some(false);
                 if params.count_failures {
                     c.failures += 1;
-                    c.utility -= params.failure_penalty;
+                    c.utility = utility(&w, &c, params.failure_penalty);
                     out.push(c);
                 }
             }

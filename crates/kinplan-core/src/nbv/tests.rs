@@ -384,6 +384,18 @@ fn predicted_cells_stop_at_occupied_cells_and_count_the_first_unknown_one_as_cer
     t3.update_key(&[32780, 32768, 32768], hit);
     let p = predict_view(&t3, &cam, &pose, &vp, None, &mut ws, Deadline::none());
     assert_eq!((p.first, p.reached), (1, 2));
+    // the same hand counts reading the states from a byte grid that covers the ray up
+    // to cell 32779 (the tree beyond it)
+    let on_grid = |t: &Octree| {
+        let g = grid::StateGrid::new(t, [32760, 32760, 32760], [32779, 32775, 32775], 1 << 20).unwrap();
+        let mut ws = PredictWorkspace::default();
+        let p = visibility::predict_view_in(t, Some(&g), &cam, &pose, &vp, None, &mut ws, Deadline::none());
+        (p.first, p.reached)
+    };
+    let (t, _, _) = corridor();
+    assert_eq!(on_grid(&t), (1, 3));
+    assert_eq!(on_grid(&t2), (0, 0));
+    assert_eq!(on_grid(&t3), (1, 2));
 }
 
 #[test]

@@ -27,9 +27,10 @@ use nalgebra::{Isometry3, Point3};
 
 use super::NbvError;
 use super::camera::CameraModel;
-use super::gain::walk;
+use super::gain::{tree_state, walk_with};
+use super::grid::{FREE, OCCUPIED, StateGrid, UNKNOWN};
 use crate::Deadline;
-use crate::octree::{CellState, OcKey, Octree};
+use crate::octree::{CellState, OcKey, Octree, SearchCache, morton};
 
 /// Options of the visibility check of [`next_best_view`](super::next_best_view).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -111,11 +112,6 @@ pub struct PredictWorkspace {
 }
 
 #[inline]
-fn morton(k: &OcKey) -> u64 {
-    (k[0] as u64) | (k[1] as u64) << 16 | (k[2] as u64) << 32
-}
-
-#[inline]
 fn in_keys(k: &OcKey, keys: &Option<(OcKey, OcKey)>) -> bool {
     keys.as_ref()
         .is_none_or(|(a, b)| (0..3).all(|i| k[i] >= a[i] && k[i] <= b[i]))
@@ -140,6 +136,29 @@ pub fn predict_view(
     ws: &mut PredictWorkspace,
     deadline: Deadline<'_>,
 ) -> ViewPrediction {
+    predict_view_in(tree, None, camera, pose, params, region_keys, ws, deadline)
+}
+
+/// [`predict_view`] reading cell states from `grid` (the tree's states over a key box,
+/// one byte per cell) where it covers the key, from the tree elsewhere.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn predict_view_in(
+    tree: &Octree,
+    grid: Option<&StateGrid>,
+    camera: &CameraModel,
+    pose: &Isometry3<f64>,
+    params: &VisibilityParams,
+    region_keys: Option<(OcKey, OcKey)>,
+    ws: &mut PredictWorkspace,
+    deadline: Deadline<'_>,
+) -> ViewPrediction {
+    let mut cache = SearchCache::default();
+    let mut lookup = |k: &OcKey| match grid.and_then(|g| g.index_of(k).map(|i| g.cells[i])) {
+        Some(UNKNOWN) => (CellState::Unknown, None),
+        Some(FREE) => (CellState::Free, None),
+        Some(OCCUPIED) => (CellState::Occupied, None),
+        _ => tree_state(tree, k, &mut cache),
+    };
     let stride = params.pixel_stride.max(1);
     let origin = Point3::from(pose.translation.vector);
     ws.first.clear();
@@ -158,12 +177,13 @@ pub fn predict_view(
             let local = camera.ray_direction(u, v);
             let dir = pose.rotation * local;
             let mut unknown = 0usize;
-            out.steps += walk(
+            out.steps += walk_with(
                 tree,
                 &origin,
                 &dir,
                 0.0,
                 camera.far / local.z,
+                &mut lookup,
                 |k, state, _| match state {
                     CellState::Occupied => false,
                     CellState::Free => true,

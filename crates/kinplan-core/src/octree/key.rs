@@ -21,11 +21,15 @@ pub fn child_index(key: &OcKey, depth: u8) -> usize {
 /// with `f = 1/res` in f64; `None` outside `[0, 65536)`.
 #[inline]
 pub fn coord_to_key_axis(c: f64, resolution_factor: f64) -> Option<u16> {
-    let s = (c * resolution_factor).floor();
+    let s = c * resolution_factor;
+    // ⌊s⌋ ∈ [−32768, 32768) ⇔ s ∈ [−32768, 32768); NaN fails both
     if !(s >= -(TREE_MAX_VAL as f64) && s < TREE_MAX_VAL as f64) {
         return None;
     }
-    Some((s as i32 + TREE_MAX_VAL) as u16)
+    // ⌊s⌋ by truncation, one less for a negative non-integer (no libm call)
+    let t = s as i32;
+    let floor = if (t as f64) > s { t - 1 } else { t };
+    Some((floor + TREE_MAX_VAL) as u16)
 }
 
 /// Centre of a depth-16 key along one axis (m): `(k − 32768 + ½) · res`.
@@ -89,6 +93,38 @@ pub fn probability(l: f32) -> f64 {
     1.0 - 1.0 / (1.0 + (l as f64).exp())
 }
 
+/// Morton code of a key (x in bit 0): sorting by it makes successive updates share
+/// their path from the root.
+#[inline]
+pub(crate) fn morton(k: &OcKey) -> u64 {
+    #[inline]
+    fn spread(v: u16) -> u64 {
+        let mut x = v as u64;
+        x = (x | (x << 32)) & 0x001F_0000_0000_FFFF;
+        x = (x | (x << 16)) & 0x001F_0000_FF00_00FF;
+        x = (x | (x << 8)) & 0x100F_00F0_0F00_F00F;
+        x = (x | (x << 4)) & 0x10C3_0C30_C30C_30C3;
+        x = (x | (x << 2)) & 0x1249_2492_4924_9249;
+        x
+    }
+    spread(k[0]) | (spread(k[1]) << 1) | (spread(k[2]) << 2)
+}
+
+#[inline]
+pub(crate) fn unmorton(m: u64) -> OcKey {
+    #[inline]
+    fn squeeze(mut x: u64) -> u16 {
+        x &= 0x1249_2492_4924_9249;
+        x = (x ^ (x >> 2)) & 0x10C3_0C30_C30C_30C3;
+        x = (x ^ (x >> 4)) & 0x100F_00F0_0F00_F00F;
+        x = (x ^ (x >> 8)) & 0x001F_0000_FF00_00FF;
+        x = (x ^ (x >> 16)) & 0x001F_0000_0000_FFFF;
+        x = (x ^ (x >> 32)) & 0x001F_FFFF;
+        x as u16
+    }
+    [squeeze(m), squeeze(m >> 1), squeeze(m >> 2)]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -130,5 +166,20 @@ mod tests {
     fn logodds_of_defaults() {
         assert!((logodds(0.7) - 0.847_297_9).abs() < 1e-6);
         assert!((probability(logodds(0.4)) - 0.4).abs() < 1e-6);
+    }
+
+    #[test]
+    fn morton_round_trips() {
+        for k in [[0u16, 0, 0], [65535, 1, 32768], [12345, 54321, 7]] {
+            assert_eq!(unmorton(morton(&k)), k);
+        }
+        assert_eq!(morton(&[1, 0, 0]), 1);
+        assert_eq!(morton(&[0, 1, 0]), 2);
+        assert_eq!(morton(&[0, 0, 1]), 4);
+        assert_eq!(morton(&[2, 0, 0]), 8);
+        assert_eq!(
+            morton(&[0xffff, 0, 0]),
+            0x1249_2492_4924_9249 & ((1u64 << 48) - 1)
+        );
     }
 }

@@ -154,32 +154,83 @@ impl Octree {
         end: &[f32; 3],
         lo: &OcKey,
         strides: [usize; 3],
+        visit: impl FnMut(&OcKey, usize),
+    ) -> bool {
+        self.visit_ray_cells_from(origin, end, 0.0, lo, strides, visit)
+    }
+
+    /// [`visit_ray_cells`](Self::visit_ray_cells) from the ray parameter `t_start`
+    /// (m from `origin`) on: the cells before it are left out. The walk starts in the
+    /// cell holding `o + t_start·d̂` with the DDA state in closed form,
+    /// `t_max_i = (border_i − o_i)/d̂_i` — the value the walk from the origin reaches
+    /// by summing `t_delta_i`, up to rounding — so the cells after `t_start` are those
+    /// of the whole walk (a cell can differ only where two borders lie within rounding
+    /// of each other). `t_start ≤ 0` is the whole walk; with `t_start > 0` the origin's
+    /// cell is not looked up (the caller has checked it lies in the tree).
+    #[inline]
+    pub(crate) fn visit_ray_cells_from(
+        &self,
+        origin: &[f32; 3],
+        end: &[f32; 3],
+        t_start: f64,
+        lo: &OcKey,
+        strides: [usize; 3],
         mut visit: impl FnMut(&OcKey, usize),
     ) -> bool {
-        let (Some(ko), Some(ke)) = (self.key_of_f32(origin), self.key_of_f32(end)) else {
-            return false;
-        };
-        if ko == ke {
-            return true;
-        }
-        let mut idx = (0..3).fold(0usize, |a, i| {
-            a.wrapping_add(
-                (ko[i] as usize)
-                    .wrapping_sub(lo[i] as usize)
-                    .wrapping_mul(strides[i]),
-            )
-        });
-        visit(&ko, idx);
         let mut dir = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
         let length = f32_norm(&dir) as f32;
+        if t_start > 0.0 && t_start >= length as f64 {
+            return true;
+        }
+        let Some(ke) = self.key_of_f32(end) else {
+            return false;
+        };
         for v in dir.iter_mut() {
             *v /= length;
         }
-        let dda = Dda::new(&ko, origin, &dir, self.resolution, true);
         let length = length as f64;
+        let index_of = |k: &OcKey| {
+            (0..3).fold(0usize, |a, i| {
+                a.wrapping_add(
+                    (k[i] as usize)
+                        .wrapping_sub(lo[i] as usize)
+                        .wrapping_mul(strides[i]),
+                )
+            })
+        };
+        let (ks, dda) = if t_start > 0.0 {
+            let f = self.resolution_factor;
+            let at = |i: usize| coord_to_key_axis(origin[i] as f64 + t_start * dir[i] as f64, f);
+            let (Some(x), Some(y), Some(z)) = (at(0), at(1), at(2)) else {
+                return true;
+            };
+            let ks = [x, y, z];
+            if ks == ke {
+                return true;
+            }
+            let dda = Dda::new(&ks, origin, &dir, self.resolution, true);
+            // the whole walk visits this cell only when it leaves it before the end
+            let exit = dda.t_max[0].min(dda.t_max[1]).min(dda.t_max[2]);
+            if exit > length {
+                return true;
+            }
+            (ks, dda)
+        } else {
+            // a start inside the segment lies in the end cell when the origin does
+            // (cells are convex), so only the whole walk checks the origin's cell
+            let Some(ko) = self.key_of_f32(origin) else {
+                return false;
+            };
+            if ko == ke {
+                return true;
+            }
+            (ko, Dda::new(&ko, origin, &dir, self.resolution, true))
+        };
+        let mut idx = index_of(&ks);
+        visit(&ks, idx);
         // the DDA state in scalar locals (registers): an array indexed by the axis made
         // each step wait on a partial store-to-load forward of the key
-        let [mut kx, mut ky, mut kz] = ko;
+        let [mut kx, mut ky, mut kz] = ks;
         let [mut tx, mut ty, mut tz] = dda.t_max;
         let [dx, dy, dz] = dda.t_delta;
         let [sx, sy, sz] = dda.step.map(|s| s as u16); // ±1 as a wrapping u16 step

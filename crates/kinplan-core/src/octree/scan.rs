@@ -4,10 +4,12 @@
 
 use std::time::Instant;
 
-use nalgebra::{Isometry3, Point3};
+use nalgebra::Isometry3;
 use rayon::prelude::*;
 
-use super::key::OcKey;
+use super::batch::BatchUpdate;
+use super::frame::{PixelBeam, near_field_starts};
+use super::key::{OcKey, morton, unmorton};
 use super::{Octree, OctreeError, OctreeLimits};
 use crate::Deadline;
 
@@ -35,7 +37,18 @@ pub struct ScanParams {
     /// stops with [`OctreeError::TreeGrewTooLarge`] once the tree grows past it.
     /// Default [`OctreeLimits::default`]'s `max_nodes`.
     pub max_nodes: usize,
+    /// Depth images only: the near field of the image's beams is shared
+    /// (docs/octree.md#whole-frame-insertion): close to the camera only a pixel
+    /// lattice whose neighbouring beams are at most this far apart is traced, in cells
+    /// (multiples of the resolution), in [0, 1]; 0 traces every beam from the camera
+    /// (the exact `insertPointCloud` result). [`NEAR_RAY_SPACING`] is the suggested
+    /// value. Not with `discretize`. Default 0.
+    pub near_ray_spacing: f64,
 }
+
+/// Suggested [`ScanParams::near_ray_spacing`] (cells): a lattice of this spacing
+/// crosses the inscribed ball of every cell in its fan (`s/√2 < ½`).
+pub const NEAR_RAY_SPACING: f64 = 0.7;
 
 impl Default for ScanParams {
     fn default() -> Self {
@@ -45,15 +58,32 @@ impl Default for ScanParams {
             dense_limit_cells: 1 << 27,
             max_traced_cells: 1 << 28,
             max_nodes: OctreeLimits::default().max_nodes,
+            near_ray_spacing: 0.0,
         }
     }
 }
 
 impl ScanParams {
-    /// Checks `max_range` is not NaN.
+    /// Checks `max_range` is not NaN and `near_ray_spacing` lies in [0, 1] without
+    /// `discretize`.
     pub fn validate(&self) -> Result<(), OctreeError> {
         if self.max_range.is_nan() {
             return Err(OctreeError::NonFinite { field: "max_range" });
+        }
+        let s = self.near_ray_spacing;
+        if !(0.0..=1.0).contains(&s) {
+            return Err(OctreeError::InvalidParam {
+                field: "near_ray_spacing",
+                value: s,
+                reason: "must lie in [0, 1] cells",
+            });
+        }
+        if s > 0.0 && self.discretize {
+            return Err(OctreeError::InvalidParam {
+                field: "near_ray_spacing",
+                value: s,
+                reason: "cannot be combined with discretize",
+            });
         }
         Ok(())
     }
@@ -90,6 +120,9 @@ pub struct ScanStats {
     pub update_us: u64,
 }
 
+/// Most pixels a depth image or a camera model may have (`width · height`): 2^24.
+pub const MAX_DEPTH_PIXELS: usize = 1 << 24;
+
 /// Pinhole intrinsics of a depth camera (pixels).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PinholeIntrinsics {
@@ -102,10 +135,14 @@ pub struct PinholeIntrinsics {
 /// Free cells, end-point cells (Morton codes) and skipped points of one chunk of beams.
 type ChunkKeys = (Vec<u64>, Vec<u64>, usize);
 
-/// A scan's cells to update: bits over the key box (with the map from a bit to its
-/// key) or sorted Morton codes.
+/// A scan's cells to update: bits over the key box starting at `lo` with `dims`
+/// cells per axis (x fastest), or sorted Morton codes.
 enum CellSet {
-    Dense(Vec<u64>, Box<dyn Fn(usize) -> OcKey>),
+    Dense {
+        bits: Vec<u64>,
+        lo: OcKey,
+        dims: [usize; 3],
+    },
     Sorted(Vec<u64>),
 }
 
@@ -113,16 +150,25 @@ impl CellSet {
     /// The keys in ascending bit or Morton order.
     fn iter(&self) -> Box<dyn Iterator<Item = OcKey> + '_> {
         match self {
-            CellSet::Dense(bits, key_of) => Box::new(bits.iter().enumerate().flat_map(move |(w, &word)| {
-                let mut b = word;
-                std::iter::from_fn(move || {
-                    (b != 0).then(|| {
-                        let i = w * 64 + b.trailing_zeros() as usize;
-                        b &= b - 1;
-                        key_of(i)
+            CellSet::Dense { bits, lo, dims } => {
+                let (lo, dx, dy) = (*lo, dims[0], dims[1]);
+                // the row (y, z) of the last bit: a division only when the row changes
+                let mut row = (usize::MAX, 0u16, 0u16);
+                Box::new(bits.iter().enumerate().flat_map(move |(w, &word)| {
+                    let mut b = word;
+                    std::iter::from_fn(move || {
+                        (b != 0).then(|| {
+                            let i = w * 64 + b.trailing_zeros() as usize;
+                            b &= b - 1;
+                            if i < row.0 || i >= row.0 + dx {
+                                let r = i / dx;
+                                row = (r * dx, lo[1] + (r % dy) as u16, lo[2] + (r / dy) as u16);
+                            }
+                            [lo[0] + (i - row.0) as u16, row.1, row.2]
+                        })
                     })
-                })
-            })),
+                }))
+            }
             CellSet::Sorted(codes) => Box::new(codes.iter().map(|&m| unmorton(m))),
         }
     }
@@ -159,38 +205,6 @@ fn merge_sorted(a: &[u64], b: &[u64]) -> Vec<u64> {
     out.extend_from_slice(&a[i..]);
     out.extend_from_slice(&b[j..]);
     out
-}
-
-/// Morton code of a key (x in bit 0): sorting by it makes successive updates share
-/// their path from the root.
-#[inline]
-fn morton(k: &OcKey) -> u64 {
-    #[inline]
-    fn spread(v: u16) -> u64 {
-        let mut x = v as u64;
-        x = (x | (x << 32)) & 0x001F_0000_0000_FFFF;
-        x = (x | (x << 16)) & 0x001F_0000_FF00_00FF;
-        x = (x | (x << 8)) & 0x100F_00F0_0F00_F00F;
-        x = (x | (x << 4)) & 0x10C3_0C30_C30C_30C3;
-        x = (x | (x << 2)) & 0x1249_2492_4924_9249;
-        x
-    }
-    spread(k[0]) | (spread(k[1]) << 1) | (spread(k[2]) << 2)
-}
-
-#[inline]
-fn unmorton(m: u64) -> OcKey {
-    #[inline]
-    fn squeeze(mut x: u64) -> u16 {
-        x &= 0x1249_2492_4924_9249;
-        x = (x ^ (x >> 2)) & 0x10C3_0C30_C30C_30C3;
-        x = (x ^ (x >> 4)) & 0x100F_00F0_0F00_F00F;
-        x = (x ^ (x >> 8)) & 0x001F_0000_FF00_00FF;
-        x = (x ^ (x >> 16)) & 0x001F_0000_0000_FFFF;
-        x = (x ^ (x >> 32)) & 0x001F_FFFF;
-        x as u16
-    }
-    [squeeze(m), squeeze(m >> 1), squeeze(m >> 2)]
 }
 
 /// Cells traced between two looks at the stop flag (a chunk of beams), so a
@@ -255,7 +269,22 @@ impl Octree {
         params: &ScanParams,
         deadline: Deadline<'_>,
     ) -> Result<ScanStats, OctreeError> {
+        self.insert_beams(points, origin, None, params, deadline)
+    }
+
+    /// [`insert_scan`](Self::insert_scan) with, optionally, the ray parameter (m) at
+    /// which each beam's free cells start (one per point; the end point is always
+    /// occupied).
+    fn insert_beams(
+        &mut self,
+        points: &[[f32; 3]],
+        origin: &[f32; 3],
+        starts: Option<&[f32]>,
+        params: &ScanParams,
+        deadline: Deadline<'_>,
+    ) -> Result<ScanStats, OctreeError> {
         params.validate()?;
+        debug_assert!(starts.is_none_or(|s| s.len() == points.len() && !params.discretize));
         if origin.iter().any(|v| !v.is_finite()) {
             return Err(OctreeError::NonFinite { field: "origin" });
         }
@@ -296,9 +325,9 @@ impl Octree {
             .saturating_mul(plan.dims[1])
             .saturating_mul(plan.dims[2]);
         let traced = if cells <= params.dense_limit_cells {
-            self.trace_dense(pts, origin, params.max_range, &plan, deadline)
+            self.trace_dense(pts, origin, starts, params.max_range, &plan, deadline)
         } else {
-            self.trace_sorted(pts, origin, params, &plan, deadline)?
+            self.trace_sorted(pts, origin, starts, params, &plan, deadline)?
         };
         stats.trace_us = t0.elapsed().as_micros() as u64;
         let Some(cells) = traced else {
@@ -308,21 +337,24 @@ impl Octree {
         let t1 = Instant::now();
         let (hit, miss) = (self.model.hit, self.model.miss);
         let mut updates = 0usize;
+        let mut batch = BatchUpdate::new();
         for (keys, delta, is_free) in [(&cells.free, miss, true), (&cells.occupied, hit, false)] {
             for key in keys.iter() {
                 if updates.is_multiple_of(UPDATES_PER_CHECK) {
                     if self.num_nodes > params.max_nodes {
+                        batch.finish(self);
                         return Err(OctreeError::TreeGrewTooLarge {
                             limit: params.max_nodes,
                         });
                     }
                     if deadline.expired() {
+                        batch.finish(self);
                         stats.update_us = t1.elapsed().as_micros() as u64;
                         stats.nodes = self.num_nodes;
                         return Ok(stats);
                     }
                 }
-                self.update_key(&key, delta);
+                batch.update(self, &key, delta);
                 if is_free {
                     stats.free_cells += 1;
                 } else {
@@ -331,6 +363,7 @@ impl Octree {
                 updates += 1;
             }
         }
+        batch.finish(self);
         if self.num_nodes > params.max_nodes {
             return Err(OctreeError::TreeGrewTooLarge {
                 limit: params.max_nodes,
@@ -417,6 +450,7 @@ impl Octree {
         &self,
         pts: &[[f32; 3]],
         origin: &[f32; 3],
+        starts: Option<&[f32]>,
         max_range: f64,
         plan: &ScanPlan,
         deadline: Deadline<'_>,
@@ -440,18 +474,30 @@ impl Octree {
                     if deadline.expired() {
                         return None;
                     }
-                    for p in &pts[range.clone()] {
+                    for (j, p) in pts[range.clone()].iter().enumerate() {
                         if p.iter().any(|v| !v.is_finite()) {
                             skipped += 1;
                             continue;
                         }
+                        let t0 = starts.map_or(0.0, |s| s[range.start + j] as f64);
                         let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
                         let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
                         let mut mark = |_: &OcKey, i: usize| {
                             free[i >> 6] |= 1 << (i & 63);
                         };
-                        if max_range < 0.0 || norm <= max_range {
-                            self.visit_ray_cells(origin, p, &lo, strides, &mut mark);
+                        if t0 >= norm.min(if max_range < 0.0 { f64::MAX } else { max_range }) {
+                            // no free cell after the start: the end point only
+                            if norm <= max_range || max_range < 0.0 {
+                                match self.key_of_f32(p) {
+                                    Some(k) => {
+                                        let i = index(&k);
+                                        occ[i >> 6] |= 1 << (i & 63);
+                                    }
+                                    None => skipped += 1,
+                                }
+                            }
+                        } else if max_range < 0.0 || norm <= max_range {
+                            self.visit_ray_cells_from(origin, p, t0, &lo, strides, &mut mark);
                             match self.key_of_f32(p) {
                                 Some(k) => {
                                     let i = index(&k);
@@ -462,7 +508,7 @@ impl Octree {
                         } else {
                             let (n, m) = (norm as f32, max_range as f32);
                             let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                            self.visit_ray_cells(origin, &e, &lo, strides, &mut mark);
+                            self.visit_ray_cells_from(origin, &e, t0, &lo, strides, &mut mark);
                         }
                     }
                 }
@@ -480,15 +526,9 @@ impl Octree {
         for (f, o) in free.iter_mut().zip(&occ) {
             *f &= !o;
         }
-        let key_of = move |i: usize| {
-            let x = i % dims[0];
-            let y = (i / dims[0]) % dims[1];
-            let z = i / (dims[0] * dims[1]);
-            [lo[0] + x as u16, lo[1] + y as u16, lo[2] + z as u16]
-        };
         Some(ScanCells {
-            free: CellSet::Dense(free, Box::new(key_of)),
-            occupied: CellSet::Dense(occ, Box::new(key_of)),
+            free: CellSet::Dense { bits: free, lo, dims },
+            occupied: CellSet::Dense { bits: occ, lo, dims },
             skipped,
         })
     }
@@ -500,6 +540,7 @@ impl Octree {
         &self,
         pts: &[[f32; 3]],
         origin: &[f32; 3],
+        starts: Option<&[f32]>,
         params: &ScanParams,
         plan: &ScanPlan,
         deadline: Deadline<'_>,
@@ -521,20 +562,19 @@ impl Octree {
                     if deadline.expired() {
                         return None;
                     }
-                    let mut ray = Vec::with_capacity(512);
                     let mut chunk_free = Vec::with_capacity(*cells as usize);
                     let (mut chunk_occ, mut chunk_skipped) = (Vec::with_capacity(range.len()), 0usize);
-                    for p in &pts[range.clone()] {
+                    for (j, p) in pts[range.clone()].iter().enumerate() {
                         if p.iter().any(|v| !v.is_finite()) {
                             chunk_skipped += 1;
                             continue;
                         }
+                        let t0 = starts.map_or(0.0, |s| s[range.start + j] as f64);
+                        let mut push = |k: &OcKey, _: usize| chunk_free.push(morton(k));
                         let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
                         let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
                         if max_range < 0.0 || norm <= max_range {
-                            if self.compute_ray_keys(origin, p, &mut ray) {
-                                chunk_free.extend(ray.iter().map(morton));
-                            }
+                            self.visit_ray_cells_from(origin, p, t0, &[0; 3], [0; 3], &mut push);
                             match self.key_of_f32(p) {
                                 Some(k) => chunk_occ.push(morton(&k)),
                                 None => chunk_skipped += 1,
@@ -543,9 +583,7 @@ impl Octree {
                             let n = norm as f32;
                             let m = max_range as f32;
                             let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                            if self.compute_ray_keys(origin, &e, &mut ray) {
-                                chunk_free.extend(ray.iter().map(morton));
-                            }
+                            self.visit_ray_cells_from(origin, &e, t0, &[0; 3], [0; 3], &mut push);
                         }
                     }
                     chunk_free.sort_unstable();
@@ -608,9 +646,47 @@ impl Octree {
         params: &ScanParams,
         deadline: Deadline<'_>,
     ) -> Result<ScanStats, OctreeError> {
-        let pts = depth_image_points(depth, width, height, intrinsics, camera_pose)?;
+        params.validate()?;
         let o = camera_pose.translation.vector;
-        self.insert_scan(&pts, &[o.x as f32, o.y as f32, o.z as f32], params, deadline)
+        let origin = [o.x as f32, o.y as f32, o.z as f32];
+        if params.near_ray_spacing <= 0.0 || origin.iter().any(|v| !v.is_finite()) {
+            let pts = depth_image_points(depth, width, height, intrinsics, camera_pose)?;
+            return self.insert_scan(&pts, &origin, params, deadline);
+        }
+        let mut pts = Vec::with_capacity(depth.len());
+        let mut beams = vec![
+            PixelBeam {
+                covered: 0.0,
+                point: u32::MAX,
+            };
+            depth.len()
+        ];
+        back_project(depth, width, height, intrinsics, camera_pose, |i, p| {
+            let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+            let range = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
+            let covered = if params.max_range > 0.0 && range > params.max_range {
+                params.max_range
+            } else if p.iter().all(|v| v.is_finite()) && self.key_of_f32(&p).is_some() {
+                range
+            } else {
+                0.0
+            };
+            beams[i] = PixelBeam {
+                covered: covered as f32,
+                point: pts.len() as u32,
+            };
+            pts.push(p);
+        })?;
+        let starts = near_field_starts(
+            &beams,
+            width,
+            height,
+            pts.len(),
+            intrinsics.fx.min(intrinsics.fy),
+            params.near_ray_spacing * self.resolution,
+            self.near_field_margin(),
+        );
+        self.insert_beams(&pts, &origin, Some(&starts), params, deadline)
     }
 }
 
@@ -640,6 +716,23 @@ pub fn depth_image_points(
     k: &PinholeIntrinsics,
     camera_pose: &Isometry3<f64>,
 ) -> Result<Vec<[f32; 3]>, OctreeError> {
+    let mut out = Vec::with_capacity(depth.len());
+    back_project(depth, width, height, k, camera_pose, |_, p| out.push(p))?;
+    Ok(out)
+}
+
+/// Checks the image and hands each pixel with a return to `each` as
+/// `(row-major pixel index, map-frame point)`, in pixel order: `z > 0` finite,
+/// `p_c = (a_u·z, b_v·z, z)` with `a_u = (u − cx)/fx`, `b_v = (v − cy)/fy`, and
+/// `p = R·p_c + t` for the pose's rotation matrix `R` and translation `t`.
+pub(crate) fn back_project(
+    depth: &[f32],
+    width: usize,
+    height: usize,
+    k: &PinholeIntrinsics,
+    camera_pose: &Isometry3<f64>,
+    mut each: impl FnMut(usize, [f32; 3]),
+) -> Result<(), OctreeError> {
     let expected = width.checked_mul(height).ok_or(OctreeError::InvalidParam {
         field: "width",
         value: width as f64,
@@ -666,37 +759,21 @@ pub fn depth_image_points(
             field: "principal point",
         });
     }
-    let mut out = Vec::with_capacity(expected);
+    let r = *camera_pose.rotation.to_rotation_matrix().matrix();
+    let t = camera_pose.translation.vector;
+    let a: Vec<f64> = (0..width).map(|u| (u as f64 - k.cx) / k.fx).collect();
     for v in 0..height {
-        for u in 0..width {
-            let z = depth[v * width + u] as f64;
+        let b = (v as f64 - k.cy) / k.fy;
+        let row = &depth[v * width..(v + 1) * width];
+        for (u, (&z, &a)) in row.iter().zip(&a).enumerate() {
+            let z = z as f64;
             if !(z.is_finite() && z > 0.0) {
                 continue;
             }
-            let pc = Point3::new((u as f64 - k.cx) * z / k.fx, (v as f64 - k.cy) * z / k.fy, z);
-            let pm = camera_pose * pc;
-            out.push([pm.x as f32, pm.y as f32, pm.z as f32]);
+            let (x, y) = (a * z, b * z);
+            let p = [0, 1, 2].map(|i| (r[(i, 0)] * x + r[(i, 1)] * y + r[(i, 2)] * z + t[i]) as f32);
+            each(v * width + u, p);
         }
     }
-    Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn morton_round_trips() {
-        for k in [[0u16, 0, 0], [65535, 1, 32768], [12345, 54321, 7]] {
-            assert_eq!(unmorton(morton(&k)), k);
-        }
-        assert_eq!(morton(&[1, 0, 0]), 1);
-        assert_eq!(morton(&[0, 1, 0]), 2);
-        assert_eq!(morton(&[0, 0, 1]), 4);
-        assert_eq!(morton(&[2, 0, 0]), 8);
-        assert_eq!(
-            morton(&[0xffff, 0, 0]),
-            0x1249_2492_4924_9249 & ((1u64 << 48) - 1)
-        );
-    }
+    Ok(())
 }

@@ -15,7 +15,9 @@ use crate::status::nbv::nbv_error;
 use crate::status::octree::octree_error;
 use convert::{box_in, camera_in, nbv_params_in, nbv_response, octree_out, stats_out};
 use kinplan_core::nbv::next_best_view;
-use kinplan_core::octree::{Octree, OctreeLimits, PinholeIntrinsics, ScanParams, ScanStatus};
+use kinplan_core::octree::{
+    MAX_DEPTH_PIXELS, Octree, OctreeLimits, PinholeIntrinsics, ScanParams, ScanStatus,
+};
 
 pub(crate) mod convert;
 pub(crate) mod explore_loop;
@@ -119,15 +121,20 @@ impl ExplorationService for ExplorationApi {
         request: Request<pb::InsertScanRequest>,
     ) -> Result<Response<pb::InsertScanResponse>, Status> {
         let (_permit, budget) = self.shared.compute.admit(&request)?;
-        let req = request.into_inner();
+        let mut req = request.into_inner();
         let sensor = pose_in("sensor_pose", req.sensor_pose.as_ref())?;
         let params = ScanParams {
             max_range: finite("max_range", req.max_range.unwrap_or(-1.0))?,
             discretize: req.discretize,
             max_nodes: MAX_OCTREE_NODES,
+            near_ray_spacing: finite("near_ray_spacing", req.near_ray_spacing)?,
             ..ScanParams::default()
         };
-        let scan = match &req.scan {
+        params.validate().map_err(|e| match e {
+            kinplan_core::octree::OctreeError::InvalidParam { field, .. } => invalid(field, e.to_string()),
+            e => octree_error("scan", e),
+        })?;
+        let scan = match req.scan.take() {
             None => return Err(invalid("scan", "one of points or depth_image is required")),
             Some(pb::insert_scan_request::Scan::Points(p)) => {
                 if p.xyz.len() % 3 != 0 {
@@ -140,7 +147,7 @@ impl ExplorationService for ExplorationApi {
             }
             Some(pb::insert_scan_request::Scan::DepthImage(d)) => depth_image_in(d)?,
         };
-        let existing = req.octree.clone();
+        let existing = req.octree.take();
         let resolution = req.resolution;
         let full = req.full;
         let reply = self
@@ -238,12 +245,9 @@ enum Scan {
     },
 }
 
-/// Most pixels a depth image may hold (the camera model's limit).
-const MAX_DEPTH_PIXELS: usize = 1 << 24;
-
 /// A depth image in metres (float32 or uint16 millimetres) with its
 /// intrinsics (given, or from the camera model), checked field by field.
-fn depth_image_in(d: &pb::DepthImage) -> Result<Scan, Status> {
+fn depth_image_in(mut d: pb::DepthImage) -> Result<Scan, Status> {
     let (width, height) = (d.width as usize, d.height as usize);
     if width == 0 || height == 0 {
         return Err(invalid(
@@ -273,7 +277,7 @@ fn depth_image_in(d: &pb::DepthImage) -> Result<Scan, Status> {
                     ),
                 ));
             }
-            d.depth.clone()
+            std::mem::take(&mut d.depth)
         }
         (true, false) => {
             if d.depth_mm.len() != 2 * pixels {
