@@ -371,8 +371,9 @@ class Robot(RobotRefs):
         """Times a joint path (n x dof, from any planner) within the joint
         limits: ``method`` "time_optimal" (circular blends at most
         ``path_tolerance`` from the waypoints, TOPP-RA; needs
-        ``max_acceleration``), "jerk_limited" (straight segments, an S-curve
-        each, stopping at every waypoint; needs ``max_acceleration`` and
+        ``max_acceleration``), "jerk_limited" (straight segments joined by
+        S-curve blends in time, passing each waypoint within
+        ``path_tolerance`` without stopping; needs ``max_acceleration`` and
         ``max_jerk``) or "waypoint". Limits per joint in rad/s, rad/s^2,
         rad/s^3 (``max_velocity`` defaults to the model's). Returns a
         :class:`TimedTrajectory` sampled every ``sample_period`` s."""

@@ -17,9 +17,10 @@ pub enum TimingMethod {
     /// time-optimal speed along that path by TOPP-RA (Pham & Pham 2018),
     /// sampled every `sample_period`.
     TimeOptimal,
-    /// Straight segments, each a rest-to-rest seven-phase S-curve shared by
-    /// all joints, within velocity, acceleration and jerk limits; sampled
-    /// every `sample_period`.
+    /// Straight segments at constant velocity joined at every waypoint by
+    /// a blend in time with trapezoidal acceleration, within velocity,
+    /// acceleration and jerk limits, passing each waypoint within
+    /// `path_tolerance` without stopping; sampled every `sample_period`.
     JerkLimited,
 }
 
@@ -44,8 +45,8 @@ pub struct TimingParams {
     /// Fraction of the velocity limits used (0 < s ≤ 1). Default 1.
     pub velocity_scale: f64,
     /// Largest distance of a blend from the waypoint it rounds, rad (m),
-    /// Euclidean in joint space, finite and > 0 ([`TimingMethod::TimeOptimal`]).
-    /// Default 0.05.
+    /// Euclidean in joint space, finite and > 0 ([`TimingMethod::TimeOptimal`]
+    /// and [`TimingMethod::JerkLimited`]). Default 0.05.
     pub path_tolerance: f64,
     /// Joint velocity at the start (rad/s or m/s, one per joint), along the
     /// path's first segment; `None`: at rest. Only
