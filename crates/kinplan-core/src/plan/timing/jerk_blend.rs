@@ -3,6 +3,7 @@
 //! trapezoid, so the motion passes the waypoints without stopping.
 
 use super::TimedTrajectory;
+use super::scurve::SCurve;
 use super::waypoint::MIN_SEGMENT_TIME;
 use crate::Deadline;
 
@@ -377,7 +378,8 @@ const STOP_ANGLE: f64 = 2.0;
 
 /// The jerk-limited trajectory: the path cut at its sharp corners (turning
 /// by more than [`STOP_ANGLE`]) into pieces, each a [`JerkBlends`] from rest
-/// to rest, run one after another.
+/// to rest, run one after another — or cut at every waypoint, when the
+/// rest-to-rest S-curves of the segments ([`SCurve`]) add up to less.
 pub(super) struct JerkPath {
     dof: usize,
     pieces: Vec<JerkBlends>,
@@ -410,6 +412,42 @@ impl JerkPath {
             }
         }
         cuts.push(rows.len() - 1);
+        let path = Self::with_cuts(&rows, &cuts, dof, v, a, j, tolerance);
+        // where the corners force a crawl on long segments, stopping at
+        // every waypoint (rest-to-rest S-curves, closed form) can be faster
+        let stops: f64 = rows
+            .windows(2)
+            .map(|w| {
+                let lim = |l: &[f64]| {
+                    (0..dof)
+                        .filter(|&c| w[1][c] != w[0][c])
+                        .map(|c| l[c] / (w[1][c] - w[0][c]).abs())
+                        .fold(f64::INFINITY, f64::min)
+                };
+                SCurve::rest_to_rest(1.0, lim(v), lim(a), lim(j)).duration()
+            })
+            .sum();
+        if rows.len() > 2 && stops < path.duration() {
+            let every: Vec<usize> = (0..rows.len()).collect();
+            let stopping = Self::with_cuts(&rows, &every, dof, v, a, j, tolerance);
+            if stopping.duration() < path.duration() {
+                return stopping;
+            }
+        }
+        path
+    }
+
+    /// One [`JerkBlends`] from rest to rest between consecutive `cuts`
+    /// (indices into `rows`, first and last included).
+    fn with_cuts(
+        rows: &[&[f64]],
+        cuts: &[usize],
+        dof: usize,
+        v: &[f64],
+        a: &[f64],
+        j: &[f64],
+        tolerance: f64,
+    ) -> Self {
         let mut path = JerkPath {
             dof,
             pieces: Vec::with_capacity(cuts.len()),

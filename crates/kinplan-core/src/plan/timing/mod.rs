@@ -76,8 +76,9 @@ impl TimedTrajectory {
 ///   joined at every waypoint by a blend in time of trapezoidal
 ///   acceleration (an S-curve velocity change), passing each interior
 ///   waypoint within `path_tolerance` without stopping (except at corners
-///   sharper than about 115°, where it stops on the waypoint); every limit
-///   holds in closed form. Sampled every `sample_period` and at the end.
+///   sharper than about 115°, or everywhere when stopping at every waypoint
+///   is faster); every limit holds in closed form. Sampled every
+///   `sample_period` and at the end.
 ///
 /// Errors name the field: waypoints malformed, a start velocity off the path
 /// or too fast to stop from, a sample period or grid step too fine for the

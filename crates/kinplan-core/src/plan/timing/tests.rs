@@ -217,7 +217,11 @@ fn jerk_limited_trajectories_match_the_s_curve_and_keep_every_limit_at_1_khz() {
             .sum();
         // (a corner sharper than about 115° is stopped at: a path of such
         // corners only may take as long as the S-curves)
-        assert!(r.duration() <= stops * (1.0 + 1e-3), "case {case}: {} vs {stops}", r.duration());
+        assert!(
+            r.duration() <= stops * (1.0 + 1e-3),
+            "case {case}: {} vs {stops}",
+            r.duration()
+        );
         total += r.duration();
         total_stops += stops;
     }
