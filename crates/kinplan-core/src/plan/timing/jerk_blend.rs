@@ -223,8 +223,8 @@ impl JerkBlends {
             for k in 0..m {
                 rho[k] = (tb.shapes[k].h + tb.shapes[k + 1].h) / dur[k];
             }
-            for i in 1..m {
-                dev[i] = if tb.corner[i] {
+            for (i, d) in dev.iter_mut().enumerate().take(m).skip(1) {
+                *d = if tb.corner[i] {
                     tb.passing(i) / tolerance
                 } else {
                     0.0
@@ -260,8 +260,8 @@ impl JerkBlends {
         }
         tb.shape(&dur, a, j);
         tb.tau[0] = tb.shapes[0].h;
-        for k in 0..m {
-            tb.tau[k + 1] = tb.tau[k] + dur[k];
+        for (k, d) in dur.iter().enumerate() {
+            tb.tau[k + 1] = tb.tau[k] + d;
         }
         tb
     }
@@ -271,9 +271,9 @@ impl JerkBlends {
     fn shape(&mut self, dur: &[f64], a: &[f64], j: &[f64]) {
         let dof = self.dof;
         let m = dur.len();
-        for k in 0..m {
+        for (k, d) in dur.iter().enumerate() {
             for c in 0..dof {
-                self.vel[k * dof + c] = (self.points[(k + 1) * dof + c] - self.points[k * dof + c]) / dur[k];
+                self.vel[k * dof + c] = (self.points[(k + 1) * dof + c] - self.points[k * dof + c]) / d;
             }
         }
         for i in 0..=m {
@@ -296,8 +296,8 @@ impl JerkBlends {
     fn worst(&self, dur: &[f64], tolerance: f64) -> f64 {
         let m = dur.len();
         let mut worst = 0.0f64;
-        for k in 0..m {
-            worst = worst.max((self.shapes[k].h + self.shapes[k + 1].h) / dur[k]);
+        for (k, d) in dur.iter().enumerate() {
+            worst = worst.max((self.shapes[k].h + self.shapes[k + 1].h) / d);
         }
         for i in 1..m {
             if self.corner[i] {
