@@ -95,7 +95,7 @@ async fn retime_is_time_optimal_on_a_line_and_keeps_the_limits_on_a_path() {
     check_points(&t, &PATH[0], &PATH[3]);
     assert_eq!(t.joint_names.len(), 6);
     assert!((t.points.last().unwrap().time_from_start - r.duration).abs() < 1e-12);
-    // at least as fast as stopping at every waypoint on the straight lines
+    // faster than the jerk-limited motion, which also bounds the jerk
     let stops = planning
         .retime(request(&PATH, timing(pb::TimingMethod::JerkLimited)))
         .await
