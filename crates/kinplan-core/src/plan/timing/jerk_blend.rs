@@ -250,13 +250,16 @@ impl JerkBlends {
                 break;
             }
         }
-        loop {
+        // one stretch settles it in exact arithmetic; the growing margin
+        // bounds the loop whatever the rounding
+        for round in 0..64 {
             tb.shape(&dur, a, j);
             let worst = tb.worst(&dur, tolerance);
             if worst <= 1.0 {
                 break;
             }
-            dur.iter_mut().for_each(|d| *d *= worst * (1.0 + 1e-12));
+            let f = worst * (1.0 + 1e-12) * 1.5f64.powi(round / 8);
+            dur.iter_mut().for_each(|d| *d *= f);
         }
         tb.shape(&dur, a, j);
         tb.tau[0] = tb.shapes[0].h;

@@ -229,6 +229,54 @@ fn jerk_limited_trajectories_match_the_s_curve_and_keep_every_limit_at_1_khz() {
 }
 
 #[test]
+fn jerk_limited_copes_with_repeats_tiny_segments_and_tight_tolerances() {
+    let (v, a, j) = ([1.0, 2.0], [2.0, 3.0], [10.0, 40.0]);
+    let cases: [(&[f64], f64); 4] = [
+        // a single waypoint, and one repeated: at rest
+        (&[0.3, 0.4], 0.05),
+        (&[0.3, 0.4, 0.3, 0.4], 0.05),
+        // repeats and micro-segments between right angles
+        (
+            &[0.0, 0.0, 0.0, 0.0, 1e-9, 0.0, 1e-9, 1e-9, 1.0, 1e-9, 1.0, 1.0],
+            0.05,
+        ),
+        // a zig-zag with a tolerance far below the corners' natural offset
+        (&[0.0, 0.0, 0.5, 0.1, 1.0, 0.0, 1.5, 0.1, 2.0, 0.0], 1e-6),
+    ];
+    for (case, (w, tol)) in cases.iter().enumerate() {
+        let mut p = params(TimingMethod::JerkLimited, &a, Some(&j));
+        p.path_tolerance = *tol;
+        let r = retime(w, 2, &v, &p, Deadline::none()).unwrap();
+        assert!(r.duration().is_finite(), "case {case}");
+        for (i, (qd, qdd)) in r.qd.chunks_exact(2).zip(r.qdd.chunks_exact(2)).enumerate() {
+            for k in 0..2 {
+                assert!(
+                    qd[k].abs() <= v[k] * (1.0 + 1e-9),
+                    "case {case} sample {i}: v {}",
+                    qd[k]
+                );
+                assert!(
+                    qdd[k].abs() <= a[k] * (1.0 + 1e-9),
+                    "case {case} sample {i}: a {}",
+                    qdd[k]
+                );
+            }
+        }
+        for q in r.q.chunks_exact(2) {
+            let d = if w.len() > 2 {
+                polyline_distance(w, 2, q)
+            } else {
+                (q[0] - w[0]).hypot(q[1] - w[1])
+            };
+            assert!(d <= tol + 1e-9, "case {case}: {d}");
+        }
+        assert_eq!(&r.q[..2], &w[..2]);
+        let end = &r.q[r.q.len() - 2..];
+        assert!((end[0] - w[w.len() - 2]).abs() < 1e-9 && (end[1] - w[w.len() - 1]).abs() < 1e-9);
+    }
+}
+
+#[test]
 fn a_start_velocity_along_the_path_is_kept_and_one_across_it_is_refused() {
     let mut p = params(TimingMethod::TimeOptimal, &[1.0, 1.0], None);
     p.start_velocity = Some(vec![0.3, 0.4]);
