@@ -15,6 +15,20 @@ const SPLITS: [&[f64]; 3] = [&[0.5], &[0.25, 0.5, 0.75], &[0.15, 0.5, 0.85]];
 /// Sweeps of the local stretching before the uniform one.
 const SWEEPS: usize = 12;
 
+/// What one jerk-limited timing keeps.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Limits<'a> {
+    /// Velocity, acceleration and jerk limit per joint (finite, > 0).
+    pub v: &'a [f64],
+    pub a: &'a [f64],
+    pub j: &'a [f64],
+    /// Largest distance at which an interior waypoint is passed (> 0).
+    pub tolerance: f64,
+    /// Joint velocity at the start, within `v` (empty: at rest); the
+    /// acceleration there is zero.
+    pub start: &'a [f64],
+}
+
 /// One blend: half-duration `h` and ramp time `r` (0 < r ≤ h) of the
 /// normalised acceleration `g` on `[−h, h]`: a trapezoid rising linearly over
 /// `r`, flat at `1/(2h − r)`, falling over `r`, so that `∫g = 1`.
@@ -143,6 +157,8 @@ struct JerkBlends {
     /// `Δv_i = V_i − V_{i−1}` (`(m + 1) × dof`).
     dv: Vec<f64>,
     shapes: Vec<Shape>,
+    /// Velocity before the first blend (the start velocity; zeros at rest).
+    start: Vec<f64>,
     /// Whether point `i` is a waypoint (else a point inserted on a segment).
     corner: Vec<bool>,
     /// Nominal waypoint times `τ_i`, `τ_0 = h_0`.
@@ -151,9 +167,9 @@ struct JerkBlends {
 
 impl JerkBlends {
     /// Times the path through `waypoints` (`n × dof`, finite, n ≥ 1) within
-    /// `v`, `a`, `j` (finite, > 0) passing every interior waypoint within
-    /// `tolerance` (> 0).
-    pub fn new(waypoints: &[f64], dof: usize, v: &[f64], a: &[f64], j: &[f64], tolerance: f64) -> Self {
+    /// `lim`. `None` when no split keeps a moving start (see
+    /// [`JerkBlends::with_splits`]).
+    fn new(waypoints: &[f64], dof: usize, lim: Limits<'_>) -> Option<Self> {
         let mut merged: Vec<f64> = Vec::with_capacity(waypoints.len());
         for row in waypoints.chunks_exact(dof) {
             let n = merged.len();
@@ -163,25 +179,34 @@ impl JerkBlends {
         }
         let mut best: Option<JerkBlends> = None;
         for fracs in SPLITS {
-            let tb = Self::with_splits(&merged, dof, fracs, v, a, j, tolerance);
+            let Some(tb) = Self::with_splits(&merged, dof, fracs, lim) else {
+                continue;
+            };
             if best.as_ref().is_none_or(|b| tb.duration() < b.duration()) {
                 best = Some(tb);
             }
         }
-        best.unwrap_or_else(|| Self::with_splits(&merged, dof, &[], v, a, j, tolerance))
+        best
     }
 
     /// The timing with every segment split at `fracs` (increasing, in
     /// (0, 1)) of its length; `merged` has no repeated rows.
-    fn with_splits(
-        merged: &[f64],
-        dof: usize,
-        fracs: &[f64],
-        v: &[f64],
-        a: &[f64],
-        j: &[f64],
-        tolerance: f64,
-    ) -> Self {
+    ///
+    /// A moving start `v₀` enters as the velocity before the first blend,
+    /// whose corner is then placed at `w₀ + v₀ h₀` (and the first segment
+    /// runs from there), so that the motion starts on `w₀` at `v₀`; `h₀`
+    /// depends on the corner, which is iterated to a fixed point. `None`
+    /// when it does not settle (the start is then not kept) or the path has
+    /// no length to move along.
+    fn with_splits(merged: &[f64], dof: usize, fracs: &[f64], lim: Limits<'_>) -> Option<Self> {
+        let Limits {
+            v,
+            a,
+            j,
+            tolerance,
+            start,
+        } = lim;
+        let moving = start.iter().any(|x| *x != 0.0);
         let mut points: Vec<f64> = Vec::with_capacity(merged.len() * (fracs.len() + 1));
         let mut corner = vec![true];
         points.extend_from_slice(&merged[..dof]);
@@ -201,12 +226,17 @@ impl JerkBlends {
             dv: vec![0.0; (m + 1) * dof],
             shapes: vec![Shape::default(); m + 1],
             tau: vec![0.0; m + 1],
+            start: if moving { start.to_vec() } else { vec![0.0; dof] },
             points,
             corner,
         };
         if m == 0 {
-            return tb;
+            return (!moving).then_some(tb);
         }
+        let w0 = merged[..dof].to_vec();
+        let scale = 1.0 + w0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        // the first waypoint's segment: points 0 ..= first
+        let first = fracs.len() + 1;
         let delta = |k: usize, c: usize| tb.points[(k + 1) * dof + c] - tb.points[k * dof + c];
         let mut dur: Vec<f64> = (0..m)
             .map(|k| {
@@ -215,10 +245,13 @@ impl JerkBlends {
                     .fold(MIN_SEGMENT_TIME, f64::max)
             })
             .collect();
-        let tmin = dur.clone();
+        let mut tmin = dur.clone();
         let mut rho = vec![0.0; m];
         let mut dev = vec![0.0; m + 1];
         for _ in 0..SWEEPS {
+            if moving {
+                tb.place_start(&w0, fracs, first, v, &mut tmin, &mut dur);
+            }
             tb.shape(&dur, a, j);
             for k in 0..m {
                 rho[k] = (tb.shapes[k].h + tb.shapes[k + 1].h) / dur[k];
@@ -246,27 +279,75 @@ impl JerkBlends {
                 }
                 dur[k] = next;
             }
-            if settled {
+            // a moving start moves the first corner: settled once it stays
+            if settled && (!moving || tb.start_gap(&w0) <= 1e-12 * scale) {
                 break;
             }
         }
         // one stretch settles it in exact arithmetic; the growing margin
         // bounds the loop whatever the rounding
-        for round in 0..64 {
+        let mut stretches = 0;
+        for _ in 0..64 {
+            if moving {
+                tb.place_start(&w0, fracs, first, v, &mut tmin, &mut dur);
+            }
             tb.shape(&dur, a, j);
             let worst = tb.worst(&dur, tolerance);
-            if worst <= 1.0 {
+            if worst > 1.0 {
+                let f = worst * (1.0 + 1e-12) * 1.5f64.powi(stretches / 8);
+                dur.iter_mut().for_each(|d| *d *= f);
+                stretches += 1;
+            } else if tb.start_gap(&w0) <= 1e-12 * scale {
                 break;
             }
-            let f = worst * (1.0 + 1e-12) * 1.5f64.powi(round / 8);
-            dur.iter_mut().for_each(|d| *d *= f);
         }
         tb.shape(&dur, a, j);
+        if tb.worst(&dur, tolerance) > 1.0 || tb.start_gap(&w0) > 1e-9 * scale {
+            return None;
+        }
         tb.tau[0] = tb.shapes[0].h;
         for (k, d) in dur.iter().enumerate() {
             tb.tau[k + 1] = tb.tau[k] + d;
         }
-        tb
+        Some(tb)
+    }
+
+    /// Puts the first blend's corner at `w₀ + v₀ h₀` (the current `h₀`) and
+    /// the split points of the first segment between it and the next
+    /// waypoint; their shortest durations follow.
+    fn place_start(
+        &mut self,
+        w0: &[f64],
+        fracs: &[f64],
+        first: usize,
+        v: &[f64],
+        tmin: &mut [f64],
+        dur: &mut [f64],
+    ) {
+        let dof = self.dof;
+        let h0 = self.shapes[0].h;
+        for (c, w) in w0.iter().enumerate() {
+            let corner = w + self.start[c] * h0;
+            let next = self.points[first * dof + c];
+            self.points[c] = corner;
+            for (p, f) in fracs.iter().enumerate() {
+                self.points[(p + 1) * dof + c] = corner + f * (next - corner);
+            }
+        }
+        for k in 0..first {
+            tmin[k] = (0..dof)
+                .map(|c| (self.points[(k + 1) * dof + c] - self.points[k * dof + c]).abs() / v[c])
+                .fold(MIN_SEGMENT_TIME, f64::max);
+            dur[k] = dur[k].max(tmin[k]);
+        }
+    }
+
+    /// How far the motion's start, `corner − v₀ h₀`, is from `w₀`.
+    fn start_gap(&self, w0: &[f64]) -> f64 {
+        let h0 = self.shapes[0].h;
+        (0..self.dof)
+            .map(|c| (self.points[c] - self.start[c] * h0 - w0[c]).abs())
+            .fold(0.0, f64::max)
     }
 
     /// Velocities, velocity changes and blend shapes for the durations
@@ -282,7 +363,11 @@ impl JerkBlends {
         for i in 0..=m {
             for c in 0..dof {
                 let after = if i < m { self.vel[i * dof + c] } else { 0.0 };
-                let before = if i > 0 { self.vel[(i - 1) * dof + c] } else { 0.0 };
+                let before = if i > 0 {
+                    self.vel[(i - 1) * dof + c]
+                } else {
+                    self.start[c]
+                };
                 self.dv[i * dof + c] = after - before;
             }
             self.shapes[i] = Shape::for_change(&self.dv[i * dof..(i + 1) * dof], a, j);
@@ -392,9 +477,11 @@ pub(super) struct JerkPath {
 
 impl JerkPath {
     /// Times the path through `waypoints` (`n × dof`, finite, n ≥ 1) within
-    /// `v`, `a`, `j` (finite, > 0), passing every interior waypoint it does
-    /// not stop at within `tolerance` (> 0).
-    pub fn new(waypoints: &[f64], dof: usize, v: &[f64], a: &[f64], j: &[f64], tolerance: f64) -> Self {
+    /// `lim`, passing every interior waypoint it does not stop at within the
+    /// tolerance. `None` when a moving start cannot be kept (no length to
+    /// move along, or no fixed point for the first blend).
+    pub fn new(waypoints: &[f64], dof: usize, lim: Limits<'_>) -> Option<Self> {
+        let Limits { v, a, j, .. } = lim;
         let mut rows: Vec<&[f64]> = Vec::with_capacity(waypoints.len() / dof);
         for row in waypoints.chunks_exact(dof) {
             if rows.last().is_none_or(|last| *last != row) {
@@ -415,7 +502,7 @@ impl JerkPath {
             }
         }
         cuts.push(rows.len() - 1);
-        let path = Self::with_cuts(&rows, &cuts, dof, v, a, j, tolerance);
+        let path = Self::with_cuts(&rows, &cuts, dof, lim)?;
         // where the corners force a crawl on long segments, stopping at
         // every waypoint (rest-to-rest S-curves, closed form) can be faster
         let stops: f64 = rows
@@ -432,34 +519,32 @@ impl JerkPath {
             .sum();
         if rows.len() > 2 && stops < path.duration() {
             let every: Vec<usize> = (0..rows.len()).collect();
-            let stopping = Self::with_cuts(&rows, &every, dof, v, a, j, tolerance);
-            if stopping.duration() < path.duration() {
-                return stopping;
+            if let Some(stopping) = Self::with_cuts(&rows, &every, dof, lim)
+                && stopping.duration() < path.duration()
+            {
+                return Some(stopping);
             }
         }
-        path
+        Some(path)
     }
 
-    /// One [`JerkBlends`] from rest to rest between consecutive `cuts`
-    /// (indices into `rows`, first and last included).
-    fn with_cuts(
-        rows: &[&[f64]],
-        cuts: &[usize],
-        dof: usize,
-        v: &[f64],
-        a: &[f64],
-        j: &[f64],
-        tolerance: f64,
-    ) -> Self {
+    /// One [`JerkBlends`] between consecutive `cuts` (indices into `rows`,
+    /// first and last included), from rest to rest but the first, which
+    /// starts at `lim.start`.
+    fn with_cuts(rows: &[&[f64]], cuts: &[usize], dof: usize, lim: Limits<'_>) -> Option<Self> {
         let mut path = JerkPath {
             dof,
             pieces: Vec::with_capacity(cuts.len()),
             starts: Vec::with_capacity(cuts.len()),
         };
         let mut t = 0.0;
-        for w in cuts.windows(2) {
+        for (n, w) in cuts.windows(2).enumerate() {
             let flat: Vec<f64> = rows[w[0]..=w[1]].concat();
-            let piece = JerkBlends::new(&flat, dof, v, a, j, tolerance);
+            let piece_lim = Limits {
+                start: if n == 0 { lim.start } else { &[] },
+                ..lim
+            };
+            let piece = JerkBlends::new(&flat, dof, piece_lim)?;
             path.starts.push(t);
             t += piece.duration();
             path.pieces.push(piece);
@@ -467,10 +552,9 @@ impl JerkPath {
         if path.pieces.is_empty() {
             // a single waypoint: one piece at rest
             path.starts.push(0.0);
-            path.pieces
-                .push(JerkBlends::new(rows[0], dof, v, a, j, tolerance));
+            path.pieces.push(JerkBlends::new(rows[0], dof, lim)?);
         }
-        path
+        Some(path)
     }
 
     /// Duration, s.
@@ -551,7 +635,14 @@ mod tests {
         // Δv = (−1, 1): the motion passes at √2 · 0.0658333 from (2, 0).
         let w = [0.0, 0.0, 2.0, 0.0, 2.0, 2.0];
         let lim = [1.0, 1.0];
-        let tb = JerkBlends::new(&w, 2, &lim, &[2.0, 2.0], &[10.0, 10.0], 0.1);
+        let limits = |tolerance| Limits {
+            v: &lim,
+            a: &[2.0, 2.0],
+            j: &[10.0, 10.0],
+            tolerance,
+            start: &[],
+        };
+        let tb = JerkBlends::new(&w, 2, limits(0.1)).unwrap();
         assert!((tb.duration() - 4.7).abs() < 1e-12, "{}", tb.duration());
         let off = (0.15f64.powi(2) / 2.0 + 0.35 * 0.2 / 2.0 - 0.04 / 3.0) / 0.5;
         let tr = tb.sample(&[0.35 + 2.0], Deadline::none()).unwrap();
@@ -564,7 +655,7 @@ mod tests {
         // half-way along the blend the velocity is the mean of the two lines
         assert!((tr.qd[0] - 0.5).abs() < 1e-12 && (tr.qd[1] - 0.5).abs() < 1e-12);
         // a tolerance of 0.05 is tighter: the corner is slowed until it fits
-        let tight = JerkBlends::new(&w, 2, &lim, &[2.0, 2.0], &[10.0, 10.0], 0.05);
+        let tight = JerkBlends::new(&w, 2, limits(0.05)).unwrap();
         assert!(tight.passing_distances()[1] <= 0.05 + 1e-12);
         assert!(tight.duration() > 4.7);
     }

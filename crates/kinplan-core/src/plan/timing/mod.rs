@@ -140,7 +140,28 @@ pub fn retime(
                 .jerk_limits
                 .as_deref()
                 .ok_or(missing(PlanField::JerkLimits))?;
-            let blends = jerk_blend::JerkPath::new(waypoints, dof, v, a, j, params.path_tolerance);
+            let start = params.start_velocity.as_deref().unwrap_or(&[]);
+            for (x, lim) in start.iter().zip(v) {
+                if x.abs() > *lim {
+                    return Err(PlanError::InvalidParam {
+                        field: PlanField::StartVelocity,
+                        value: *x,
+                        reason: "beyond the joint's speed limit",
+                    });
+                }
+            }
+            let lim = jerk_blend::Limits {
+                v,
+                a,
+                j,
+                tolerance: params.path_tolerance,
+                start,
+            };
+            let blends = jerk_blend::JerkPath::new(waypoints, dof, lim).ok_or(PlanError::InvalidParam {
+                field: PlanField::StartVelocity,
+                value: start.iter().fold(0.0, |m: f64, x| m.max(x.abs())),
+                reason: "cannot be kept: the path has no length to move along, or the first blend finds no start on the first waypoint",
+            })?;
             let times = sample::sample_times(blends.duration(), params.sample_period, dof)
                 .ok_or(too_many_samples(params.sample_period))?;
             blends.sample(&times, deadline).ok_or(PlanError::Interrupted)

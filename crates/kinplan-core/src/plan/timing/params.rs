@@ -48,9 +48,12 @@ pub struct TimingParams {
     /// Euclidean in joint space, finite and > 0 ([`TimingMethod::TimeOptimal`]
     /// and [`TimingMethod::JerkLimited`]). Default 0.05.
     pub path_tolerance: f64,
-    /// Joint velocity at the start (rad/s or m/s, one per joint), along the
-    /// path's first segment; `None`: at rest. Only
-    /// [`TimingMethod::TimeOptimal`] takes one. The end is always at rest.
+    /// Joint velocity at the start (rad/s or m/s, one per joint); `None`:
+    /// at rest. [`TimingMethod::TimeOptimal`] needs it along the path's
+    /// first segment; [`TimingMethod::JerkLimited`] takes any within the
+    /// speed limits (zero acceleration at the start), its first blend
+    /// turning onto the path. The waypoint method starts at rest. The end
+    /// is always at rest.
     pub start_velocity: Option<Vec<f64>>,
     /// Time between samples of the time-optimal and jerk-limited
     /// trajectories, s, in [1e-4, 10]. Default 0.01.
@@ -158,10 +161,10 @@ impl TimingParams {
         if let Some(v0) = &self.start_velocity {
             check_vector(PlanField::StartVelocity, v0, dof)?;
             require(
-                self.method == TimingMethod::TimeOptimal || v0.iter().all(|v| *v == 0.0),
+                self.method != TimingMethod::Waypoint || v0.iter().all(|v| *v == 0.0),
                 PlanField::StartVelocity,
                 v0.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
-                "only the time-optimal method starts in motion",
+                "the waypoint method starts at rest",
             )?;
         }
         Ok(())

@@ -277,6 +277,60 @@ fn jerk_limited_copes_with_repeats_tiny_segments_and_tight_tolerances() {
 }
 
 #[test]
+fn jerk_limited_starts_at_the_given_velocity() {
+    // one joint, 1 rad from 0.5 rad/s at v = 1, a = 2, j = 10: speed up by
+    // 0.5 in 0.5/2 + 2/10 = 0.45 s over (0.5 + 1)/2 · 0.45 = 0.3375 rad,
+    // stop from 1 in 0.7 s over 0.35 rad, cruise 0.3125 rad: 1.4625 s
+    let mut p = params(TimingMethod::JerkLimited, &[2.0], Some(&[10.0]));
+    p.sample_period = 1e-3;
+    p.start_velocity = Some(vec![0.5]);
+    let r = retime(&[0.0, 1.0], 1, &[1.0], &p, Deadline::none()).unwrap();
+    // (the first corner is a fixed point, settled to a few parts in 10⁷)
+    assert!((r.duration() - 1.4625).abs() < 1e-5, "{}", r.duration());
+    assert!(r.q[0].abs() < 1e-12 && (r.qd[0] - 0.5).abs() < 1e-12 && r.qdd[0].abs() < 1e-12);
+    // two joints, moving across the first segment: starts on the first
+    // waypoint at that velocity, turns onto the path, keeps every limit
+    let (v, a, j) = ([1.0, 1.5], [2.0, 3.0], [10.0, 20.0]);
+    let mut p = params(TimingMethod::JerkLimited, &a, Some(&j));
+    p.sample_period = 1e-3;
+    p.start_velocity = Some(vec![0.0, 0.8]);
+    let w = [0.0, 0.0, 1.0, 0.0, 1.0, 1.0];
+    let r = retime(&w, 2, &v, &p, Deadline::none()).unwrap();
+    assert!(r.q[0].abs() < 1e-9 && r.q[1].abs() < 1e-9, "{:?}", &r.q[..2]);
+    assert!(r.qd[0].abs() < 1e-9 && (r.qd[1] - 0.8).abs() < 1e-9);
+    let h = 1e-3;
+    for i in 0..r.len().saturating_sub(5) {
+        for k in 0..2 {
+            let x = |m: usize| r.q[(i + m) * 2 + k];
+            assert!(((x(1) - x(0)) / h).abs() <= v[k] * (1.0 + 1e-9), "{i}: v");
+            assert!(
+                ((x(2) - 2.0 * x(1) + x(0)) / (h * h)).abs() <= a[k] * (1.0 + 1e-6),
+                "{i}: a"
+            );
+            let jerk = (x(3) - 3.0 * x(2) + 3.0 * x(1) - x(0)) / (h * h * h);
+            assert!(jerk.abs() <= j[k] * (1.0 + 1e-3), "{i}: j {jerk}");
+        }
+    }
+    let end = &r.q[r.q.len() - 2..];
+    assert!((end[0] - 1.0).abs() < 1e-9 && (end[1] - 1.0).abs() < 1e-9);
+    // refused by field: beyond the speed limit, or nowhere to move
+    for (w, v0) in [(&w[..], vec![0.0, 1.6]), (&w[..2], vec![0.0, 0.8])] {
+        p.start_velocity = Some(v0);
+        let e = retime(w, 2, &v, &p, Deadline::none()).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                PlanError::InvalidParam {
+                    field: PlanField::StartVelocity,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+    }
+}
+
+#[test]
 fn a_start_velocity_along_the_path_is_kept_and_one_across_it_is_refused() {
     let mut p = params(TimingMethod::TimeOptimal, &[1.0, 1.0], None);
     p.start_velocity = Some(vec![0.3, 0.4]);
