@@ -152,6 +152,36 @@ async fn jerk_limited_retime_matches_the_s_curve_and_keeps_every_limit_at_1_khz(
 }
 
 #[tokio::test]
+async fn jerk_limited_retime_starts_at_the_given_velocity() {
+    let server = start(ServerConfig::default()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut options = timing(pb::TimingMethod::JerkLimited);
+    options.start_velocity = vec![0.5, 0.0, 0.0, 0.0, 0.0, 0.0];
+    // joint 0 alone, 1 rad from 0.5 rad/s at v = 1, a = 2, j = 10: 0.45 s
+    // to reach 1 rad/s (0.3375 rad), 0.3125 s of cruise, 0.7 s to stop
+    // (0.35 rad): 1.4625 s
+    let mut line = [PATH[0], PATH[0]];
+    line[1][0] += 1.0;
+    let r = planning
+        .retime(request(&line, options.clone()))
+        .await
+        .unwrap()
+        .into_inner();
+    assert!((r.duration - 1.4625).abs() < 1e-5, "{}", r.duration);
+    let first = &r.trajectory.unwrap().points[0];
+    assert!((first.velocities[0] - 0.5).abs() < 1e-12 && (first.positions[0] - PATH[0][0]).abs() < 1e-9);
+    // beyond joint 0's speed limit: refused by field
+    options.start_velocity[0] = 1.5;
+    let err = planning.retime(request(&line, options)).await.unwrap_err();
+    assert_eq!(err.code(), Code::InvalidArgument);
+    assert!(
+        err.message().contains("timing.start_velocity"),
+        "{}",
+        err.message()
+    );
+}
+
+#[tokio::test]
 async fn plan_times_its_path_by_the_requested_method() {
     let server = start(ServerConfig {
         acm_samples: 300,
