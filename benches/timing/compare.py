@@ -11,11 +11,16 @@ Paths: seeded random walks of 50 waypoints (each joint steps uniformly in
   waypoints (Kunz & Stilman 2012, eqs. 3-8) as a toppra geometric path, and
   every kinplan sample is checked to lie on it. toppra runs on a grid of
   0.0025 rad (8x finer than kinplan's default 0.02) with the piece ends added.
-- Jerk-limited: kinplan's JERK_LIMITED stops at every waypoint (a rest-to-rest
-  S-curve per straight segment, shared by all joints so the segment is followed
-  exactly). ruckig (community edition: no intermediate waypoints) is run the
-  same way, waypoint to waypoint from rest to rest, and its segment durations
-  summed. kinplan's 1 kHz samples are checked by finite differences.
+- Jerk-limited: kinplan's JERK_LIMITED passes each waypoint within
+  path_tolerance without stopping (straight segments joined by S-curve blends
+  in time). ruckig's community edition takes no intermediate waypoints, so it
+  is run state to state through the states kinplan's trajectory passes nearest
+  each waypoint (position, velocity and acceleration of that 1 ms sample):
+  ruckig's time-optimal profile between two such states bounds from below any
+  motion joining them, and the sum of its durations is the anchor. ruckig run
+  waypoint to waypoint from rest to rest (what stopping at every waypoint
+  costs) is printed beside it. kinplan's 1 kHz samples are checked by finite
+  differences, and their distance to each waypoint against path_tolerance.
 
 Run (a kinplan binary and the client on the path):
     python -m venv /tmp/venv-timing && /tmp/venv-timing/bin/pip install toppra ruckig numpy grpcio protobuf
@@ -160,6 +165,45 @@ def ruckig_time(waypoints, v, a, j):
     return total, elapsed
 
 
+def ruckig_through_states(tr, waypoints, v, a, j):
+    """ruckig from state to state through the samples of `tr` nearest each interior waypoint.
+
+    Returns (sum of ruckig durations, kinplan's own time between the same samples,
+    largest distance of those samples from their waypoints, failures)."""
+    dof = waypoints.shape[1]
+    idx = [0]
+    for w in waypoints[1:-1]:
+        d = np.linalg.norm(tr.q - w, axis=1)
+        d[: idx[-1]] = np.inf  # in order along the trajectory
+        idx.append(int(np.argmin(d)))
+    idx.append(len(tr.t) - 1)
+    gap = max([float(np.linalg.norm(tr.q[i] - w)) for i, w in zip(idx[1:-1], waypoints[1:-1])] + [0.0])
+    total, failures = 0.0, 0
+    for i0, i1 in zip(idx[:-1], idx[1:]):
+        if i1 <= i0:
+            continue
+        otg = ruckig.Ruckig(dof)
+        inp = ruckig.InputParameter(dof)
+        inp.current_position, inp.target_position = list(tr.q[i0]), list(tr.q[i1])
+        inp.current_velocity, inp.target_velocity = list(tr.qd[i0]), list(tr.qd[i1])
+        # ruckig refuses an acceleration on its limit: kinplan's blends reach it
+        # exactly, so the states are clipped a part in 1e9 inside
+        acc = lambda i: list(np.clip(tr.qdd[i], -a * (1 - 1e-9), a * (1 - 1e-9)))  # noqa: E731
+        inp.current_acceleration, inp.target_acceleration = acc(i0), acc(i1)
+        inp.max_velocity, inp.max_acceleration, inp.max_jerk = list(v), list(a), list(j)
+        traj = ruckig.Trajectory(dof)
+        try:
+            result = otg.calculate(inp, traj)
+        except ruckig.RuckigError:
+            result = None
+        if result != ruckig.Result.Working:
+            failures += 1
+            total += tr.t[i1] - tr.t[i0]  # counted at kinplan's own time
+            continue
+        total += traj.duration
+    return total, tr.t[idx[-1]] - tr.t[idx[0]], gap, failures
+
+
 def fd_worst(q, h, v, a, j):
     """Largest finite-difference velocity, acceleration, jerk as fractions of the limits."""
     q = q[:-1]  # the last sample may be closer than h
@@ -198,13 +242,18 @@ def main():
                 off = max(np.linalg.norm(dense - q, axis=1).min() for q in ours.q[:: max(1, len(ours.q) // 50)])
                 t_toppra, c_toppra = toppra_time(path, v, a)
                 jerk = robot.retime(w, method="jerk_limited", max_velocity=v, max_acceleration=a, max_jerk=j,
-                                    sample_period=1e-3)
-                t_ruckig, c_ruckig = ruckig_time(w, v, a, j)
+                                    sample_period=1e-3, path_tolerance=TOLERANCE)
+                t_rest, c_ruckig = ruckig_time(w, v, a, j)
+                t_ruckig, _, passing, failures = ruckig_through_states(jerk, w, v, a, j)
+                # the farthest any sample passes from its waypoint (closest approach)
+                farthest = max([float(np.linalg.norm(jerk.q - x, axis=1).min()) for x in w[1:-1]] + [0.0])
                 rows.append(dict(
                     robot=name, path=label, waypoints=len(w),
                     kinplan_time_optimal=ours.duration, toppra=t_toppra,
                     ratio_toppra=ours.duration / t_toppra, path_gap=off,
                     kinplan_jerk_limited=jerk.duration, ruckig=t_ruckig, ratio_ruckig=jerk.duration / t_ruckig,
+                    ruckig_failures=failures, ruckig_rest_to_rest=t_rest, passing=farthest,
+                    compute_jerk_s=jerk.compute_time,
                     fd_worst=fd_worst(jerk.q, 1e-3, v, a, j),
                     samples_within_limits=bool(np.all(np.abs(ours.qd) <= v * (1 + 1e-9))
                                                and np.all(np.abs(ours.qdd) <= a * (1 + 1e-9))),
@@ -213,8 +262,11 @@ def main():
                 r = rows[-1]
                 print(f"{name:13s} {label:32s} TOPP {r['kinplan_time_optimal']:.4f}/{r['toppra']:.4f} = "
                       f"{r['ratio_toppra']:.4f} (gap {off:.1e})  jerk {r['kinplan_jerk_limited']:.4f}/"
-                      f"{r['ruckig']:.4f} = {r['ratio_ruckig']:.4f}  fd v/a/j "
-                      + "/".join(f"{x:.4f}" for x in r["fd_worst"]), flush=True)
+                      f"{r['ruckig']:.4f} = {r['ratio_ruckig']:.4f} (ruckig fails {failures}, rest-to-rest "
+                      f"{t_rest:.4f}, passing {farthest:.4f})  fd v/a/j "
+                      + "/".join(f"{x:.4f}" for x in r["fd_worst"])
+                      + f"  compute TO {1e6 * ours.compute_time:.0f} us JL {1e6 * jerk.compute_time:.0f} us",
+                      flush=True)
     json.dump(rows, sys.stdout if "--json" in sys.argv else open("/dev/null", "w"), indent=1)
 
 

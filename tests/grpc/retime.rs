@@ -95,7 +95,7 @@ async fn retime_is_time_optimal_on_a_line_and_keeps_the_limits_on_a_path() {
     check_points(&t, &PATH[0], &PATH[3]);
     assert_eq!(t.joint_names.len(), 6);
     assert!((t.points.last().unwrap().time_from_start - r.duration).abs() < 1e-12);
-    // at least as fast as stopping at every waypoint on the straight lines
+    // faster than the jerk-limited motion, which also bounds the jerk
     let stops = planning
         .retime(request(&PATH, timing(pb::TimingMethod::JerkLimited)))
         .await
@@ -149,6 +149,36 @@ async fn jerk_limited_retime_matches_the_s_curve_and_keeps_every_limit_at_1_khz(
             assert!(jerk.abs() <= J[j] * (1.0 + 1e-3), "{i}: j {jerk}");
         }
     }
+}
+
+#[tokio::test]
+async fn jerk_limited_retime_starts_at_the_given_velocity() {
+    let server = start(ServerConfig::default()).await;
+    let mut planning = PlanningServiceClient::new(server.channel.clone());
+    let mut options = timing(pb::TimingMethod::JerkLimited);
+    options.start_velocity = vec![0.5, 0.0, 0.0, 0.0, 0.0, 0.0];
+    // joint 0 alone, 1 rad from 0.5 rad/s at v = 1, a = 2, j = 10: 0.45 s
+    // to reach 1 rad/s (0.3375 rad), 0.3125 s of cruise, 0.7 s to stop
+    // (0.35 rad): 1.4625 s
+    let mut line = [PATH[0], PATH[0]];
+    line[1][0] += 1.0;
+    let r = planning
+        .retime(request(&line, options.clone()))
+        .await
+        .unwrap()
+        .into_inner();
+    assert!((r.duration - 1.4625).abs() < 1e-5, "{}", r.duration);
+    let first = &r.trajectory.unwrap().points[0];
+    assert!((first.velocities[0] - 0.5).abs() < 1e-12 && (first.positions[0] - PATH[0][0]).abs() < 1e-9);
+    // beyond joint 0's speed limit: refused by field
+    options.start_velocity[0] = 1.5;
+    let err = planning.retime(request(&line, options)).await.unwrap_err();
+    assert_eq!(err.code(), Code::InvalidArgument);
+    assert!(
+        err.message().contains("timing.start_velocity"),
+        "{}",
+        err.message()
+    );
 }
 
 #[tokio::test]

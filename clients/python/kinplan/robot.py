@@ -376,10 +376,13 @@ class Robot(RobotRefs):
         """Times a joint path (n x dof, from any planner) within the joint
         limits: ``method`` "time_optimal" (circular blends at most
         ``path_tolerance`` from the waypoints, TOPP-RA; needs
-        ``max_acceleration``), "jerk_limited" (straight segments, an S-curve
-        each, stopping at every waypoint; needs ``max_acceleration`` and
+        ``max_acceleration``), "jerk_limited" (straight segments joined by
+        S-curve blends in time, passing each waypoint within
+        ``path_tolerance`` without stopping; needs ``max_acceleration`` and
         ``max_jerk``) or "waypoint". Limits per joint in rad/s, rad/s^2,
-        rad/s^3 (``max_velocity`` defaults to the model's). Returns a
+        rad/s^3 (``max_velocity`` defaults to the model's). ``start_velocity``
+        (rad/s per joint; at rest by default): along the first segment for
+        "time_optimal", any within the limits for "jerk_limited". Returns a
         :class:`TimedTrajectory` sampled every ``sample_period`` s."""
         timing = dict(method=method, max_velocity=max_velocity, max_acceleration=max_acceleration,
                       max_jerk=max_jerk, path_tolerance=path_tolerance, start_velocity=start_velocity,

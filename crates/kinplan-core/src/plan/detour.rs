@@ -102,7 +102,8 @@ fn solve_tool_path<C: StateChecker + ?Sized>(
 }
 
 /// Per waypoint: true where the state collides or a motion to a neighbour
-/// does. `None` when `clock` was interrupted.
+/// does; the ends (the request's start and goal, already valid) are not
+/// checked again. `None` when `clock` was interrupted.
 fn blocked_waypoints<C: StateChecker + ?Sized>(
     checker: &C,
     q: &[f64],
@@ -110,7 +111,12 @@ fn blocked_waypoints<C: StateChecker + ?Sized>(
     clock: &Clock<'_>,
 ) -> Option<Vec<bool>> {
     let rows: Vec<&[f64]> = q.chunks_exact(dof).collect();
-    let mut bad: Vec<bool> = rows.iter().map(|r| !checker.is_valid(r)).collect();
+    let last = rows.len() - 1;
+    let mut bad: Vec<bool> = rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| i > 0 && i < last && !checker.is_valid(r))
+        .collect();
     let mut buf = vec![0.0; dof];
     for s in 0..rows.len() - 1 {
         if bad[s] || bad[s + 1] {
@@ -129,6 +135,26 @@ fn blocked_waypoints<C: StateChecker + ?Sized>(
         }
     }
     Some(bad)
+}
+
+/// Whether every motion between consecutive waypoints of `q` is valid (its
+/// interior states; the waypoints themselves are the caller's), stopping at
+/// the first that is not. `None` when `clock` was interrupted.
+fn motions_valid<C: StateChecker + ?Sized>(
+    checker: &C,
+    q: &[f64],
+    dof: usize,
+    clock: &Clock<'_>,
+) -> Option<bool> {
+    let mut buf = vec![0.0; dof];
+    let resolution = resolution_of(checker);
+    for s in 0..q.len() / dof - 1 {
+        let (a, b) = (&q[s * dof..(s + 1) * dof], &q[(s + 1) * dof..(s + 2) * dof]);
+        if !interior_valid(checker, a, b, resolution, &mut buf, clock)? {
+            return Some(false);
+        }
+    }
+    Some(true)
 }
 
 /// The detour's height profile `b(i) ∈ [0, 1]` over waypoints `0 … n−1`:
@@ -178,7 +204,9 @@ pub(super) fn perpendicular_frame(u: &Vector3<f64>) -> (Vector3<f64>, Vector3<f6
 /// This is the Descartes-style way of planning a Cartesian path (a sampled
 /// tool path, joint states by IK, the first collision-free chain kept;
 /// ros-industrial-consortium/descartes) applied to S0 §3's tube instead of a
-/// fixed line. `None` when no candidate is valid or `clock` was interrupted.
+/// fixed line. `start` and `goal` must be valid states (the planner checks
+/// them first); every other state is checked once. `None` when no
+/// candidate is valid or `clock` was interrupted.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn tube_start<C: StateChecker + ?Sized>(
     chain: &Chain,
@@ -229,9 +257,11 @@ pub(crate) fn tube_start<C: StateChecker + ?Sized>(
                     p.rotation,
                 )
             };
+            // the solve checks every interior waypoint as it goes and the
+            // ends are valid: only the motions remain
             match solve_tool_path(&mut solver, Some(checker), start, goal, n, &pose, &mut q, clock) {
                 Ok(()) => {
-                    if !blocked_waypoints(checker, &q, dof, clock)?.contains(&true) {
+                    if motions_valid(checker, &q, dof, clock)? {
                         return Some(q);
                     }
                 }

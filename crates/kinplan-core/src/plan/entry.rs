@@ -142,8 +142,9 @@ pub struct PlanResult {
     pub time_from_start: Vec<f64>,
     /// The trajectory to execute, timed by `timing.method`: for the waypoint
     /// method one sample per waypoint, otherwise samples every
-    /// `sample_period` along the blended (time-optimal) or straight
-    /// (jerk-limited) path. Empty without waypoints, or when the deadline
+    /// `sample_period` along the path blended at the waypoints (circular
+    /// arcs for the time-optimal method, blends in time for the jerk-limited
+    /// one). Empty without waypoints, or when the deadline
     /// or a cancellation cut the timing short.
     pub trajectory: TimedTrajectory,
     pub dof: usize,
@@ -235,8 +236,9 @@ fn validate(chain: &Chain, checker_dof: usize, req: &PlanRequest) -> Result<(), 
 ///    optimised by STOMP.
 /// 4. The result is re-checked state by state and motion by motion at the
 ///    checker's resolution (skipped after an interruption), timed by
-///    [`retime`] with `timing.method` (a time-optimal trajectory, whose
-///    blends leave the checked polyline, is checked again sample to sample)
+///    [`retime`] with `timing.method` (a time-optimal or jerk-limited
+///    trajectory, whose blends leave the checked polyline, is checked again
+///    sample to sample)
 ///    and scored on the timed points (S0 criteria, unit joint weights, jerk
 ///    on the real time axis).
 ///
@@ -441,13 +443,18 @@ pub fn plan<C: StateChecker + ?Sized>(
             .collect();
         result.violates_tolerance = result.deviation.iter().any(|d| violates(d, &req.cartesian));
         let v = req.timing.velocities(chain);
-        result.time_from_start =
-            time_parameterize(&result.q, dof, &v, req.timing.acceleration_limits.as_deref());
         match retime(&result.q, dof, &v, &req.timing, clock.deadline) {
             Ok(t) => {
+                // the waypoint method's samples are the waypoints at these
+                // very times: computed once
+                result.time_from_start = if req.timing.method == TimingMethod::Waypoint {
+                    t.t.clone()
+                } else {
+                    time_parameterize(&result.q, dof, &v, req.timing.acceleration_limits.as_deref())
+                };
                 // the blends cut the corners the re-check above proved: the
                 // timed trajectory itself is checked, sample to sample
-                if req.timing.method == TimingMethod::TimeOptimal && result.valid {
+                if req.timing.method != TimingMethod::Waypoint && result.valid {
                     let t0 = Instant::now();
                     result.valid =
                         path_valid(checker, &t.q, dof, resolution_of(checker), &clock) == Some(true);
@@ -456,6 +463,8 @@ pub fn plan<C: StateChecker + ?Sized>(
                 result.trajectory = t;
             }
             Err(PlanError::Interrupted) => {
+                result.time_from_start =
+                    time_parameterize(&result.q, dof, &v, req.timing.acceleration_limits.as_deref());
                 // no executable timed trajectory: reported as the interruption
                 result.valid = false;
                 interrupted = clock.interrupted().or(Some(Interrupt::Deadline));

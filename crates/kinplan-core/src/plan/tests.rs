@@ -963,6 +963,64 @@ fn ccstomp_detours_around_a_box_on_the_straight_tool_line() {
     }
 }
 
+/// The detour search asks the checker about each state once: a candidate's
+/// waypoints are checked while it is solved, not again with its motions.
+#[test]
+fn the_detour_search_checks_each_state_once() {
+    use std::collections::HashMap;
+    use std::sync::Mutex;
+    let (chain, checker, start, goal) = kr210_box_on_the_line();
+    // the scene checker behind a counter of the exact states it is asked about
+    // (interpolated motions, so every query is a state)
+    struct Counting<'a> {
+        inner: &'a crate::collision::SceneChecker,
+        seen: Mutex<HashMap<Vec<u64>, usize>>,
+    }
+    impl StateChecker for Counting<'_> {
+        fn dof(&self) -> usize {
+            self.inner.dof()
+        }
+        fn is_valid(&self, q: &[f64]) -> bool {
+            let key = q.iter().map(|v| v.to_bits()).collect();
+            *self.seen.lock().unwrap().entry(key).or_default() += 1;
+            self.inner.is_valid(q)
+        }
+        fn clearance(&self, q: &[f64], d: f64) -> f64 {
+            self.inner.clearance(q, d)
+        }
+    }
+    let counting = Counting {
+        inner: &checker,
+        seen: Mutex::new(HashMap::new()),
+    };
+    let clock = super::clock::Clock {
+        start: Instant::now(),
+        deadline: Deadline::none(),
+    };
+    let tube = CartesianParams::default();
+    let n = 20;
+    let q = super::detour::tube_start(&chain, &counting, &start, &goal, n, Some(&tube), &clock)
+        .expect("a detour around the box");
+    let seen = counting.seen.lock().unwrap();
+    // the straight line collides, so at least one detour was solved: its
+    // waypoints were asked about, once each
+    for row in q.chunks_exact(6).skip(1).take(n - 2) {
+        let key: Vec<u64> = row.iter().map(|v| v.to_bits()).collect();
+        assert_eq!(seen.get(&key), Some(&1), "{row:?}");
+    }
+    let twice: Vec<_> = seen.iter().filter(|(_, c)| **c > 1).collect();
+    assert!(
+        twice.is_empty(),
+        "{} states asked about more than once",
+        twice.len()
+    );
+    // neither end is asked about again
+    for end in [&start, &goal] {
+        let key: Vec<u64> = end.iter().map(|v| v.to_bits()).collect();
+        assert_eq!(seen.get(&key), None);
+    }
+}
+
 /// The ladder graph alone, on the planar 3-link arm: the tool moves 0.6 m
 /// along y at x = 0.6 m pointing along +x, through a 5 cm circle at
 /// (0.6, 0). Only a detour towards the base (−x) clears it (towards +x the

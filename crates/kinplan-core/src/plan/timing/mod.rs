@@ -4,6 +4,7 @@
 
 mod blend;
 mod curve;
+mod jerk_blend;
 mod params;
 mod sample;
 mod scurve;
@@ -71,10 +72,13 @@ impl TimedTrajectory {
 ///   [`BlendedPath`] (no point farther than `path_tolerance` from the
 ///   polyline), timed by [`topp_ra`], sampled every `sample_period` and at
 ///   the end. A start velocity must point along the first segment.
-/// - [`TimingMethod::JerkLimited`]: straight segments, each a rest-to-rest
-///   [`SCurve`] of the segment fraction with the tightest joint limits, so
-///   the polyline is followed exactly and the trajectory stops at every
-///   waypoint; sampled every `sample_period` and at the end.
+/// - [`TimingMethod::JerkLimited`]: straight segments at constant velocity
+///   joined at every waypoint by a blend in time of trapezoidal
+///   acceleration (an S-curve velocity change), passing each interior
+///   waypoint within `path_tolerance` without stopping (except at corners
+///   sharper than about 115°, or everywhere when stopping at every waypoint
+///   is faster); every limit holds in closed form. Sampled every
+///   `sample_period` and at the end.
 ///
 /// Errors name the field: waypoints malformed, a start velocity off the path
 /// or too fast to stop from, a sample period or grid step too fine for the
@@ -136,10 +140,31 @@ pub fn retime(
                 .jerk_limits
                 .as_deref()
                 .ok_or(missing(PlanField::JerkLimits))?;
-            let seg = sample::Segments::new(waypoints, dof, v, a, j);
-            let times = sample::sample_times(seg.duration(), params.sample_period, dof)
+            let start = params.start_velocity.as_deref().unwrap_or(&[]);
+            for (x, lim) in start.iter().zip(v) {
+                if x.abs() > *lim {
+                    return Err(PlanError::InvalidParam {
+                        field: PlanField::StartVelocity,
+                        value: *x,
+                        reason: "beyond the joint's speed limit",
+                    });
+                }
+            }
+            let lim = jerk_blend::Limits {
+                v,
+                a,
+                j,
+                tolerance: params.path_tolerance,
+                start,
+            };
+            let blends = jerk_blend::JerkPath::new(waypoints, dof, lim).ok_or(PlanError::InvalidParam {
+                field: PlanField::StartVelocity,
+                value: start.iter().fold(0.0, |m: f64, x| m.max(x.abs())),
+                reason: "cannot be kept: the path has no length to move along, or the first blend finds no start on the first waypoint",
+            })?;
+            let times = sample::sample_times(blends.duration(), params.sample_period, dof)
                 .ok_or(too_many_samples(params.sample_period))?;
-            seg.sample(&times, deadline).ok_or(PlanError::Interrupted)
+            blends.sample(&times, deadline).ok_or(PlanError::Interrupted)
         }
     }
 }
@@ -243,13 +268,28 @@ fn time_optimal(
 }
 
 /// `max(|q̇_j|/v_j, √(|q̈_j|/a_j))` over every sample and joint: the factor
-/// by which the trajectory must slow down to keep every limit.
+/// by which the trajectory must slow down to keep every limit. One running
+/// maximum per joint (independent chains), one square root per joint.
 fn worst_ratio(tr: &TimedTrajectory, v: &[f64], a: &[f64]) -> f64 {
     let dof = tr.dof;
+    let (mut max_v, mut max_a) = ([0.0f64; 16], [0.0f64; 16]);
     let mut worst = 0.0f64;
-    for (i, (qd, qdd)) in tr.qd.iter().zip(&tr.qdd).enumerate() {
-        let j = i % dof;
-        worst = worst.max(qd.abs() / v[j]).max((qdd.abs() / a[j]).sqrt());
+    // joints in blocks of 16, so the maxima live on the stack
+    for base in (0..dof).step_by(16) {
+        let w = (dof - base).min(16);
+        max_v[..w].fill(0.0);
+        max_a[..w].fill(0.0);
+        for (qd, qdd) in tr.qd.chunks_exact(dof).zip(tr.qdd.chunks_exact(dof)) {
+            for j in 0..w {
+                max_v[j] = max_v[j].max(qd[base + j].abs());
+                max_a[j] = max_a[j].max(qdd[base + j].abs());
+            }
+        }
+        for j in 0..w {
+            worst = worst
+                .max(max_v[j] / v[base + j])
+                .max((max_a[j] / a[base + j]).sqrt());
+        }
     }
     worst
 }

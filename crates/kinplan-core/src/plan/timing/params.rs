@@ -17,9 +17,10 @@ pub enum TimingMethod {
     /// time-optimal speed along that path by TOPP-RA (Pham & Pham 2018),
     /// sampled every `sample_period`.
     TimeOptimal,
-    /// Straight segments, each a rest-to-rest seven-phase S-curve shared by
-    /// all joints, within velocity, acceleration and jerk limits; sampled
-    /// every `sample_period`.
+    /// Straight segments at constant velocity joined at every waypoint by
+    /// a blend in time with trapezoidal acceleration, within velocity,
+    /// acceleration and jerk limits, passing each waypoint within
+    /// `path_tolerance` without stopping; sampled every `sample_period`.
     JerkLimited,
 }
 
@@ -44,12 +45,15 @@ pub struct TimingParams {
     /// Fraction of the velocity limits used (0 < s ≤ 1). Default 1.
     pub velocity_scale: f64,
     /// Largest distance of a blend from the waypoint it rounds, rad (m),
-    /// Euclidean in joint space, finite and > 0 ([`TimingMethod::TimeOptimal`]).
-    /// Default 0.05.
+    /// Euclidean in joint space, finite and > 0 ([`TimingMethod::TimeOptimal`]
+    /// and [`TimingMethod::JerkLimited`]). Default 0.05.
     pub path_tolerance: f64,
-    /// Joint velocity at the start (rad/s or m/s, one per joint), along the
-    /// path's first segment; `None`: at rest. Only
-    /// [`TimingMethod::TimeOptimal`] takes one. The end is always at rest.
+    /// Joint velocity at the start (rad/s or m/s, one per joint); `None`:
+    /// at rest. [`TimingMethod::TimeOptimal`] needs it along the path's
+    /// first segment; [`TimingMethod::JerkLimited`] takes any within the
+    /// speed limits (zero acceleration at the start), its first blend
+    /// turning onto the path. The waypoint method starts at rest. The end
+    /// is always at rest.
     pub start_velocity: Option<Vec<f64>>,
     /// Time between samples of the time-optimal and jerk-limited
     /// trajectories, s, in [1e-4, 10]. Default 0.01.
@@ -157,10 +161,10 @@ impl TimingParams {
         if let Some(v0) = &self.start_velocity {
             check_vector(PlanField::StartVelocity, v0, dof)?;
             require(
-                self.method == TimingMethod::TimeOptimal || v0.iter().all(|v| *v == 0.0),
+                self.method != TimingMethod::Waypoint || v0.iter().all(|v| *v == 0.0),
                 PlanField::StartVelocity,
                 v0.iter().fold(0.0, |m: f64, v| m.max(v.abs())),
-                "only the time-optimal method starts in motion",
+                "the waypoint method starts at rest",
             )?;
         }
         Ok(())

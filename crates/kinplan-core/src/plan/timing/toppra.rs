@@ -9,7 +9,7 @@ use crate::Deadline;
 /// Most grid points of one profile (memory: about 2·dof + 6 values each).
 pub const MAX_GRID_POINTS: usize = 1_000_000;
 /// Largest tangent turn between two grid points on a curved piece, rad.
-const MAX_TURN_STEP: f64 = 0.1;
+const MAX_TURN_STEP: f64 = 0.2;
 
 /// Why no profile came out.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -119,34 +119,9 @@ fn build_grid<C: Curve + ?Sized>(curve: &C, step: f64) -> Result<Grid, ToppError
 }
 
 /// Lines `u ≥ α + βx` (lower) and `u ≤ α + βx` (upper) of the joint
-/// constraints `|q'_j u + q''_j x| ≤ a_j`, and the bound on `x` from
-/// `|q'_j| ṡ ≤ v_j` (and from `|q''_j| x ≤ a_j` where `q'_j = 0`).
-fn joint_lines(
-    d1: &[f64],
-    d2: &[f64],
-    v: &[f64],
-    a: &[f64],
-    lower: &mut Vec<(f64, f64)>,
-    upper: &mut Vec<(f64, f64)>,
-    cap: &mut f64,
-) {
-    for j in 0..d1.len() {
-        let (p, q) = (d1[j], d2[j]);
-        if p.abs() > 1e-12 {
-            let ip = 1.0 / p;
-            *cap = cap.min((v[j] * ip).powi(2));
-            let slope = -q * ip;
-            let w = a[j] * ip.abs();
-            lower.push((-w, slope));
-            upper.push((w, slope));
-        } else if q.abs() > 1e-12 {
-            *cap = cap.min(a[j] / q.abs());
-        }
-    }
-}
-
-/// The acceleration lines of [`joint_lines`] alone, for coefficients that
-/// are not a path tangent (no speed bound from them).
+/// acceleration constraints `|p_j u + q_j x| ≤ a_j`, appended to `lower` and
+/// `upper`; where `p_j = 0` the constraint bounds `x` alone
+/// (`|q_j| x ≤ a_j`), which lowers `cap`.
 fn accel_lines(
     p: &[f64],
     q: &[f64],
@@ -166,6 +141,18 @@ fn accel_lines(
             *cap = cap.min(a[j] / q[j].abs());
         }
     }
+}
+
+/// The speed bound of `|q'_j| ṡ ≤ v_j` on `x = ṡ²` at a path point with
+/// tangent `d1`: `min_j (v_j / q'_j)²` (∞ where no joint moves).
+fn speed_cap(d1: &[f64], v: &[f64]) -> f64 {
+    let mut cap = f64::INFINITY;
+    for (p, vj) in d1.iter().zip(v) {
+        if p.abs() > 1e-12 {
+            cap = cap.min((vj / p).powi(2));
+        }
+    }
+    cap
 }
 
 /// The largest `x` in `[0, cap]` for which some `u` lies above every lower
@@ -222,11 +209,11 @@ fn largest_feasible(lower: &[(f64, f64)], upper: &[(f64, f64)], cap: f64) -> f64
 /// grid).
 /// Interval times are `2Δ_i / (√x_i + √x_{i+1})`.
 ///
-/// The limits are then checked at both ends of every interval and in the
-/// middle of curved ones (the derivatives change along an arc); if the grid
-/// lets a limit be exceeded by a factor, `x` and `u` are divided by `k²`
-/// with `k = max(v ratio, √(a ratio))` — a uniform slow-down that makes every
-/// checked value feasible.
+/// Both ends of every interval are within the limits by construction; the
+/// middle of each interval on a curved piece (the derivatives change along
+/// an arc) is then checked, and if a limit is exceeded there by a factor,
+/// `x` and `u` are divided by `k²` with `k = max(v ratio, √(a ratio))` — a
+/// uniform slow-down that makes every checked value feasible.
 pub fn topp_ra<C: Curve + ?Sized>(
     curve: &C,
     v: &[f64],
@@ -259,9 +246,9 @@ pub fn topp_ra<C: Curve + ?Sized>(
     let mut stage = |i: usize, lower: &mut Vec<(f64, f64)>, upper: &mut Vec<(f64, f64)>| -> f64 {
         lower.clear();
         upper.clear();
-        let mut cap = g.cap[i];
         let r = i * dof..(i + 1) * dof;
-        joint_lines(&g.d1[r.clone()], &g.d2[r], v, a, lower, upper, &mut cap);
+        let mut cap = g.cap[i].min(speed_cap(&g.d1[r.clone()], v));
+        accel_lines(&g.d1[r.clone()], &g.d2[r], a, lower, upper, &mut cap);
         if curve.turn(g.piece[i]) > 0.0 {
             let delta = g.s[i + 1] - g.s[i];
             let (e1, e2) = end_of(i);
@@ -342,35 +329,31 @@ pub fn topp_ra<C: Curve + ?Sized>(
         x[i + 1] = (x[i] + 2.0 * delta * joint_max.min(reach_max)).clamp(0.0, hi[i + 1]);
         u[i] = (x[i + 1] - x[i]) / (2.0 * delta);
     }
-    // check both ends of every interval and the middle of curved ones;
-    // slow down uniformly if needed
-    let (mut worst_v, mut worst_a) = (1.0f64, 1.0f64);
-    let inv_v: Vec<f64> = v.iter().map(|x| 1.0 / x).collect();
-    let inv_a: Vec<f64> = a.iter().map(|x| 1.0 / x).collect();
+    // The stages hold every limit where each interval starts and ends (the
+    // speed through the next stage's cap, the acceleration through the lines
+    // of both ends), and a straight piece's limits are the same all along
+    // it; only the middle of an interval on a curved piece is left to check.
+    // Should a limit be exceeded there by a factor, slow down uniformly.
+    // One running maximum per joint: independent chains, no square roots.
+    let (mut max_v, mut max_a) = (vec![0.0f64; dof], vec![0.0f64; dof]);
     let (mut q, mut m1, mut m2) = (vec![0.0; dof], vec![0.0; dof], vec![0.0; dof]);
     for i in 0..n - 1 {
-        let here = i * dof..(i + 1) * dof;
-        let (e1, e2) = end_of(i);
         let k = g.piece[i];
-        let curved = curve.turn(k) > 0.0;
-        if curved {
-            curve.eval(k, (g.s[i] + g.s[i + 1]) / 2.0, &mut q, &mut m1, &mut m2);
+        if curve.turn(k) == 0.0 {
+            continue;
         }
-        let x_mid = (x[i] + x[i + 1]) / 2.0;
-        let checks = [
-            (&g.d1[here.clone()], &g.d2[here], x[i]),
-            (e1, e2, x[i + 1]),
-            (&m1[..], &m2[..], x_mid),
-        ];
-        for &(d1, d2, xx) in &checks[..if curved { 3 } else { 2 }] {
-            let sd = xx.sqrt();
-            for j in 0..dof {
-                worst_v = worst_v.max(d1[j].abs() * sd * inv_v[j]);
-                worst_a = worst_a.max((d1[j] * u[i] + d2[j] * xx).abs() * inv_a[j]);
-            }
+        curve.eval(k, (g.s[i] + g.s[i + 1]) / 2.0, &mut q, &mut m1, &mut m2);
+        let xm = (x[i] + x[i + 1]) / 2.0;
+        let sd = xm.sqrt();
+        for j in 0..dof {
+            max_v[j] = max_v[j].max(m1[j].abs() * sd);
+            max_a[j] = max_a[j].max((m1[j] * u[i] + m2[j] * xm).abs());
         }
     }
-    let worst = worst_v.max(worst_a.sqrt());
+    let mut worst = 1.0f64;
+    for j in 0..dof {
+        worst = worst.max(max_v[j] / v[j]).max((max_a[j] / a[j]).sqrt());
+    }
     if worst > 1.0 {
         let f = 1.0 / (worst * worst * (1.0 + 1e-12));
         x.iter_mut().for_each(|v| *v *= f);

@@ -1,0 +1,662 @@
+//! The jerk-limited method: straight segments at constant joint velocity,
+//! joined at every waypoint by a blend in time whose acceleration is a
+//! trapezoid, so the motion passes the waypoints without stopping.
+
+use super::TimedTrajectory;
+use super::scurve::SCurve;
+use super::waypoint::MIN_SEGMENT_TIME;
+use crate::Deadline;
+
+/// Where the segments are split, as fractions of their length: each split
+/// is timed and the fastest kept (finer splits let a long segment speed up
+/// between corners, coarser ones leave short segments room for blends).
+const SPLITS: [&[f64]; 3] = [&[0.5], &[0.25, 0.5, 0.75], &[0.15, 0.5, 0.85]];
+
+/// Sweeps of the local stretching before the uniform one.
+const SWEEPS: usize = 12;
+
+/// What one jerk-limited timing keeps.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Limits<'a> {
+    /// Velocity, acceleration and jerk limit per joint (finite, > 0).
+    pub v: &'a [f64],
+    pub a: &'a [f64],
+    pub j: &'a [f64],
+    /// Largest distance at which an interior waypoint is passed (> 0).
+    pub tolerance: f64,
+    /// Joint velocity at the start, within `v` (empty: at rest); the
+    /// acceleration there is zero.
+    pub start: &'a [f64],
+}
+
+/// One blend: half-duration `h` and ramp time `r` (0 < r ≤ h) of the
+/// normalised acceleration `g` on `[−h, h]`: a trapezoid rising linearly over
+/// `r`, flat at `1/(2h − r)`, falling over `r`, so that `∫g = 1`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Shape {
+    h: f64,
+    r: f64,
+}
+
+impl Shape {
+    /// The shortest blend that changes the joint velocities by `dv` with
+    /// `|q̈_j| ≤ a_j` and `|q⃛_j| ≤ j_j`, every joint on the same shape
+    /// (`q̈ = Δv g`): with `D_a = max_j |Δv_j|/a_j`, `D_j = max_j |Δv_j|/j_j`
+    /// and `w = 2h − r`, the peak is `|Δv_j|/w` and the jerk `|Δv_j|/(r w)`;
+    /// the least `2h = w + r` with `w ≥ D_a`, `r w ≥ D_j`, `r ≤ w` is
+    /// `w = D_a, r = D_j/D_a` when `D_a² ≥ D_j`, else `w = r = √D_j` — the
+    /// velocity change of a seven-phase S-curve (Biagiotti & Melchiorri,
+    /// "Trajectory Planning for Automatic Machines and Robots", Springer
+    /// 2008, §3.4).
+    fn for_change(dv: &[f64], a: &[f64], j: &[f64]) -> Shape {
+        let (mut da, mut dj) = (0.0f64, 0.0f64);
+        for k in 0..dv.len() {
+            let m = dv[k].abs();
+            da = da.max(m / a[k]);
+            dj = dj.max(m / j[k]);
+        }
+        if dj == 0.0 {
+            return Shape::default();
+        }
+        let (w, r) = if da * da >= dj {
+            (da, dj / da)
+        } else {
+            let s = dj.sqrt();
+            (s, s)
+        };
+        Shape { h: (w + r) / 2.0, r }
+    }
+
+    /// `∫_{−h}^{0} (−s) g(s) ds`: the distance by which the blend passes its
+    /// corner, per unit of `|Δv|`,
+    /// `((h − r)²/2 + h r/2 − r²/3) / (2h − r)` (`h/6` for a triangle, `h/4`
+    /// for a rectangle).
+    fn offset(&self) -> f64 {
+        let (h, r) = (self.h, self.r);
+        if h <= 0.0 {
+            return 0.0;
+        }
+        ((h - r).powi(2) / 2.0 + h * r / 2.0 - r * r / 3.0) / (2.0 * h - r)
+    }
+
+    /// `[G₂, G₁, g]` at `s`: `G₁ = ∫_{−h}^{s} g`, `G₂ = ∫_{−h}^{s} G₁`
+    /// (0 before the blend; `[s, 1, 0]` after it, as `G₂(h) = h` for an
+    /// even `g`).
+    fn at(&self, s: f64) -> [f64; 3] {
+        let (h, r) = (self.h, self.r);
+        if s >= h {
+            return [s, 1.0, 0.0];
+        }
+        if s <= -h {
+            return [0.0, 0.0, 0.0];
+        }
+        let jerk = 1.0 / ((2.0 * h - r) * r);
+        let mut rest = s + h;
+        let mut state = [0.0; 3];
+        for (len, jk) in [(r, jerk), (2.0 * (h - r), 0.0), (r, -jerk)] {
+            let dt = rest.min(len);
+            state = advance(state, jk, dt);
+            rest -= dt;
+            if rest <= 0.0 {
+                break;
+            }
+        }
+        state
+    }
+}
+
+/// `[p, v, a]` after `dt` of constant jerk `jk`.
+fn advance([p, v, a]: [f64; 3], jk: f64, dt: f64) -> [f64; 3] {
+    [
+        p + v * dt + a * dt * dt / 2.0 + jk * dt * dt * dt / 6.0,
+        v + a * dt + jk * dt * dt / 2.0,
+        a + jk * dt,
+    ]
+}
+
+/// Straight segments between the waypoints `w_0 … w_m`, segment `k` run at
+/// the constant velocity `V_k = (w_{k+1} − w_k)/T_k`, with a blend at every
+/// waypoint `i` centred on its nominal time `τ_i` (`τ_{i+1} = τ_i + T_i`)
+/// that changes the velocity from `V_{i−1}` to `V_i` (rest before the first
+/// waypoint and after the last) with the acceleration `q̈ = (V_i − V_{i−1})
+/// g_i(t − τ_i)`, `g_i` the trapezoid of [`Shape::for_change`]. This is the
+/// linear-segments-with-blends scheme (Paul, "Manipulator Cartesian path
+/// control", IEEE SMC 9(11), 1979; Taylor, "Planning and execution of
+/// straight line manipulator trajectories", IBM J. R&D 23(4), 1979) with
+/// S-curve blends in place of parabolic ones.
+///
+/// Because `g_i` is even, the blend leaves the line of segment `i − 1` and
+/// joins that of segment `i` exactly; the motion starts `h_0` before `τ_0`
+/// at rest on `w_0` and ends `h_m` after `τ_m` at rest on `w_m`. Every limit
+/// holds in closed form: the velocity during a blend is a convex
+/// combination of `V_{i−1}` and `V_i`, the acceleration and jerk are those
+/// of the shape. At an interior waypoint the motion passes at
+/// `|Δv_i| · offset_i` from it (the farthest it gets from the polyline).
+///
+/// Each segment is split at points along it (a blend there changes the
+/// speed along the line and leaves it nowhere), so the motion can speed up
+/// between two corners and slow down into the next: at its midpoint, at
+/// its quarters, or at 0.15, 0.5 and 0.85 of it — every segment alike, the
+/// fastest of the three kept.
+///
+/// Durations: first `T_k = max_j |Δq_{k,j}|/v_j`; then, in sweeps, every
+/// segment is scaled by `√w_k`, `w_k` the largest ratio its velocity enters
+/// — `ρ_l = (h_l + h_{l+1})/T_l` (the two half-blends must fit in segment
+/// `l`) for `l = k − 1, k, k + 1`, and `e_i/δ` (the passing distance over the
+/// tolerance) at both its ends — never below the first `T_k`: segments
+/// stretch where a ratio exceeds 1 and shrink where all have room. Once the
+/// sweeps settle (or run out), every segment is stretched by the worst
+/// ratio left until none exceeds 1 (both kinds fall at least as `1/f` under
+/// a uniform stretch `f`).
+struct JerkBlends {
+    dof: usize,
+    /// Waypoints `w_0 … w_m` with repeats removed (`(m + 1) × dof`).
+    points: Vec<f64>,
+    /// `V_k` (`m × dof`).
+    vel: Vec<f64>,
+    /// `Δv_i = V_i − V_{i−1}` (`(m + 1) × dof`).
+    dv: Vec<f64>,
+    shapes: Vec<Shape>,
+    /// Velocity before the first blend (the start velocity; zeros at rest).
+    start: Vec<f64>,
+    /// Whether point `i` is a waypoint (else a point inserted on a segment).
+    corner: Vec<bool>,
+    /// Nominal waypoint times `τ_i`, `τ_0 = h_0`.
+    tau: Vec<f64>,
+}
+
+impl JerkBlends {
+    /// Times the path through `waypoints` (`n × dof`, finite, n ≥ 1) within
+    /// `lim`. `None` when no split keeps a moving start (see
+    /// [`JerkBlends::with_splits`]).
+    fn new(waypoints: &[f64], dof: usize, lim: Limits<'_>) -> Option<Self> {
+        let mut merged: Vec<f64> = Vec::with_capacity(waypoints.len());
+        for row in waypoints.chunks_exact(dof) {
+            let n = merged.len();
+            if n == 0 || merged[n - dof..] != *row {
+                merged.extend_from_slice(row);
+            }
+        }
+        let mut best: Option<JerkBlends> = None;
+        for fracs in SPLITS {
+            let Some(tb) = Self::with_splits(&merged, dof, fracs, lim) else {
+                continue;
+            };
+            if best.as_ref().is_none_or(|b| tb.duration() < b.duration()) {
+                best = Some(tb);
+            }
+        }
+        best
+    }
+
+    /// The timing with every segment split at `fracs` (increasing, in
+    /// (0, 1)) of its length; `merged` has no repeated rows.
+    ///
+    /// A moving start `v₀` enters as the velocity before the first blend,
+    /// whose corner is then placed at `w₀ + v₀ h₀` (and the first segment
+    /// runs from there), so that the motion starts on `w₀` at `v₀`; `h₀`
+    /// depends on the corner, which is iterated to a fixed point. `None`
+    /// when it does not settle (the start is then not kept) or the path has
+    /// no length to move along.
+    fn with_splits(merged: &[f64], dof: usize, fracs: &[f64], lim: Limits<'_>) -> Option<Self> {
+        let Limits {
+            v,
+            a,
+            j,
+            tolerance,
+            start,
+        } = lim;
+        let moving = start.iter().any(|x| *x != 0.0);
+        let mut points: Vec<f64> = Vec::with_capacity(merged.len() * (fracs.len() + 1));
+        let mut corner = vec![true];
+        points.extend_from_slice(&merged[..dof]);
+        for w in merged.windows(2 * dof).step_by(dof) {
+            let (from, to) = w.split_at(dof);
+            for f in fracs {
+                points.extend((0..dof).map(|c| from[c] + f * (to[c] - from[c])));
+                corner.push(false);
+            }
+            points.extend_from_slice(to);
+            corner.push(true);
+        }
+        let m = points.len() / dof - 1;
+        let mut tb = JerkBlends {
+            dof,
+            vel: vec![0.0; m * dof],
+            dv: vec![0.0; (m + 1) * dof],
+            shapes: vec![Shape::default(); m + 1],
+            tau: vec![0.0; m + 1],
+            start: if moving { start.to_vec() } else { vec![0.0; dof] },
+            points,
+            corner,
+        };
+        if m == 0 {
+            return (!moving).then_some(tb);
+        }
+        let w0 = merged[..dof].to_vec();
+        let scale = 1.0 + w0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        // the first waypoint's segment: points 0 ..= first
+        let first = fracs.len() + 1;
+        let delta = |k: usize, c: usize| tb.points[(k + 1) * dof + c] - tb.points[k * dof + c];
+        let mut dur: Vec<f64> = (0..m)
+            .map(|k| {
+                (0..dof)
+                    .map(|c| delta(k, c).abs() / v[c])
+                    .fold(MIN_SEGMENT_TIME, f64::max)
+            })
+            .collect();
+        let mut tmin = dur.clone();
+        let mut rho = vec![0.0; m];
+        let mut dev = vec![0.0; m + 1];
+        for _ in 0..SWEEPS {
+            if moving {
+                tb.place_start(&w0, fracs, first, v, &mut tmin, &mut dur);
+            }
+            tb.shape(&dur, a, j);
+            for k in 0..m {
+                rho[k] = (tb.shapes[k].h + tb.shapes[k + 1].h) / dur[k];
+            }
+            for (i, d) in dev.iter_mut().enumerate().take(m).skip(1) {
+                *d = if tb.corner[i] {
+                    tb.passing(i) / tolerance
+                } else {
+                    0.0
+                };
+            }
+            let mut settled = true;
+            for k in 0..m {
+                // every ratio segment k's velocity enters
+                let mut w = rho[k].max(dev[k]).max(dev[k + 1]);
+                if k > 0 {
+                    w = w.max(rho[k - 1]);
+                }
+                if k + 1 < m {
+                    w = w.max(rho[k + 1]);
+                }
+                let next = (dur[k] * w.sqrt()).max(tmin[k]);
+                if w > 1.0 || (next - dur[k]).abs() > 1e-3 * dur[k] {
+                    settled = false;
+                }
+                dur[k] = next;
+            }
+            // a moving start moves the first corner: settled once it stays
+            if settled && (!moving || tb.start_gap(&w0) <= 1e-12 * scale) {
+                break;
+            }
+        }
+        // one stretch settles it in exact arithmetic; the growing margin
+        // bounds the loop whatever the rounding
+        let mut stretches = 0;
+        for _ in 0..64 {
+            if moving {
+                tb.place_start(&w0, fracs, first, v, &mut tmin, &mut dur);
+            }
+            tb.shape(&dur, a, j);
+            let worst = tb.worst(&dur, tolerance);
+            if worst > 1.0 {
+                let f = worst * (1.0 + 1e-12) * 1.5f64.powi(stretches / 8);
+                dur.iter_mut().for_each(|d| *d *= f);
+                stretches += 1;
+            } else if tb.start_gap(&w0) <= 1e-12 * scale {
+                break;
+            }
+        }
+        tb.shape(&dur, a, j);
+        if tb.worst(&dur, tolerance) > 1.0 || tb.start_gap(&w0) > 1e-9 * scale {
+            return None;
+        }
+        tb.tau[0] = tb.shapes[0].h;
+        for (k, d) in dur.iter().enumerate() {
+            tb.tau[k + 1] = tb.tau[k] + d;
+        }
+        Some(tb)
+    }
+
+    /// Puts the first blend's corner at `w₀ + v₀ h₀` (the current `h₀`) and
+    /// the split points of the first segment between it and the next
+    /// waypoint; their shortest durations follow.
+    fn place_start(
+        &mut self,
+        w0: &[f64],
+        fracs: &[f64],
+        first: usize,
+        v: &[f64],
+        tmin: &mut [f64],
+        dur: &mut [f64],
+    ) {
+        let dof = self.dof;
+        let h0 = self.shapes[0].h;
+        for (c, w) in w0.iter().enumerate() {
+            let corner = w + self.start[c] * h0;
+            let next = self.points[first * dof + c];
+            self.points[c] = corner;
+            for (p, f) in fracs.iter().enumerate() {
+                self.points[(p + 1) * dof + c] = corner + f * (next - corner);
+            }
+        }
+        for k in 0..first {
+            tmin[k] = (0..dof)
+                .map(|c| (self.points[(k + 1) * dof + c] - self.points[k * dof + c]).abs() / v[c])
+                .fold(MIN_SEGMENT_TIME, f64::max);
+            dur[k] = dur[k].max(tmin[k]);
+        }
+    }
+
+    /// How far the motion's start, `corner − v₀ h₀`, is from `w₀`.
+    fn start_gap(&self, w0: &[f64]) -> f64 {
+        let h0 = self.shapes[0].h;
+        (0..self.dof)
+            .map(|c| (self.points[c] - self.start[c] * h0 - w0[c]).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// Velocities, velocity changes and blend shapes for the durations
+    /// `dur`.
+    fn shape(&mut self, dur: &[f64], a: &[f64], j: &[f64]) {
+        let dof = self.dof;
+        let m = dur.len();
+        for (k, d) in dur.iter().enumerate() {
+            for c in 0..dof {
+                self.vel[k * dof + c] = (self.points[(k + 1) * dof + c] - self.points[k * dof + c]) / d;
+            }
+        }
+        for i in 0..=m {
+            for c in 0..dof {
+                let after = if i < m { self.vel[i * dof + c] } else { 0.0 };
+                let before = if i > 0 {
+                    self.vel[(i - 1) * dof + c]
+                } else {
+                    self.start[c]
+                };
+                self.dv[i * dof + c] = after - before;
+            }
+            self.shapes[i] = Shape::for_change(&self.dv[i * dof..(i + 1) * dof], a, j);
+        }
+    }
+
+    /// How far the motion passes from waypoint `i`: `|Δv_i| · offset_i`.
+    fn passing(&self, i: usize) -> f64 {
+        let d = &self.dv[i * self.dof..(i + 1) * self.dof];
+        d.iter().map(|x| x * x).sum::<f64>().sqrt() * self.shapes[i].offset()
+    }
+
+    /// The largest of every `ρ_k` and `e_i/δ`.
+    fn worst(&self, dur: &[f64], tolerance: f64) -> f64 {
+        let m = dur.len();
+        let mut worst = 0.0f64;
+        for (k, d) in dur.iter().enumerate() {
+            worst = worst.max((self.shapes[k].h + self.shapes[k + 1].h) / d);
+        }
+        for i in 1..m {
+            if self.corner[i] {
+                worst = worst.max(self.passing(i) / tolerance);
+            }
+        }
+        worst
+    }
+
+    /// Duration, s.
+    pub fn duration(&self) -> f64 {
+        let m = self.shapes.len() - 1;
+        if m == 0 {
+            return 0.0;
+        }
+        self.tau[m] + self.shapes[m].h
+    }
+
+    /// How far the motion passes from each waypoint, rad (m): 0 at the ends.
+    #[cfg(test)]
+    pub fn passing_distances(&self) -> Vec<f64> {
+        let m = self.shapes.len() - 1;
+        (0..=m)
+            .filter(|&i| self.corner[i])
+            .map(|i| if i == 0 || i == m { 0.0 } else { self.passing(i) })
+            .collect()
+    }
+
+    /// The motion at `times` (sorted): on segment `k` (`τ_k ≤ t ≤ τ_{k+1}`,
+    /// extended before `τ_0` and after `τ_m`), with `s = t − τ_k`,
+    /// `s' = t − τ_{k+1}`,
+    /// `q = w_k + V_k s + Δv_k (G₂,k(s) − s) + Δv_{k+1} G₂,k+1(s')`,
+    /// `q̇ = V_k + Δv_k (G₁,k(s) − 1) + Δv_{k+1} G₁,k+1(s')`,
+    /// `q̈ = Δv_k g_k(s) + Δv_{k+1} g_{k+1}(s')`. `None` once the deadline
+    /// passes or the caller cancels (looked at every 4096 samples).
+    pub fn sample(&self, times: &[f64], deadline: Deadline<'_>) -> Option<TimedTrajectory> {
+        let dof = self.dof;
+        let m = self.shapes.len() - 1;
+        let mut out = TimedTrajectory::with_capacity(dof, times.len());
+        let mut k = 0;
+        for (n, &t) in times.iter().enumerate() {
+            if n % 4096 == 0 && deadline.expired() {
+                return None;
+            }
+            out.t.push(t);
+            if m == 0 {
+                out.q.extend_from_slice(&self.points[..dof]);
+                out.qd.extend(std::iter::repeat_n(0.0, dof));
+                out.qdd.extend(std::iter::repeat_n(0.0, dof));
+                continue;
+            }
+            while k + 1 < m && self.tau[k + 1] <= t {
+                k += 1;
+            }
+            let s = t - self.tau[k];
+            let s2 = t - self.tau[k + 1];
+            let [p1, v1, a1] = self.shapes[k].at(s);
+            let [p2, v2, a2] = self.shapes[k + 1].at(s2);
+            let w = &self.points[k * dof..(k + 1) * dof];
+            let vk = &self.vel[k * dof..(k + 1) * dof];
+            let d1 = &self.dv[k * dof..(k + 1) * dof];
+            let d2 = &self.dv[(k + 1) * dof..(k + 2) * dof];
+            out.q
+                .extend((0..dof).map(|c| w[c] + vk[c] * s + d1[c] * (p1 - s) + d2[c] * p2));
+            out.qd
+                .extend((0..dof).map(|c| vk[c] + d1[c] * (v1 - 1.0) + d2[c] * v2));
+            out.qdd.extend((0..dof).map(|c| d1[c] * a1 + d2[c] * a2));
+        }
+        Some(out)
+    }
+}
+
+/// Corners turning the path by more than this, rad (the angle between the
+/// incoming and outgoing directions), are stopped at rather than passed:
+/// near a reversal a blend within the tolerance must crawl, and stopping on
+/// the waypoint is faster.
+const STOP_ANGLE: f64 = 2.0;
+
+/// The jerk-limited trajectory: the path cut at its sharp corners (turning
+/// by more than [`STOP_ANGLE`]) into pieces, each a [`JerkBlends`] from rest
+/// to rest, run one after another — or cut at every waypoint, when the
+/// rest-to-rest S-curves of the segments ([`SCurve`]) add up to less.
+pub(super) struct JerkPath {
+    dof: usize,
+    pieces: Vec<JerkBlends>,
+    /// Start time of each piece, s.
+    starts: Vec<f64>,
+}
+
+impl JerkPath {
+    /// Times the path through `waypoints` (`n × dof`, finite, n ≥ 1) within
+    /// `lim`, passing every interior waypoint it does not stop at within the
+    /// tolerance. `None` when a moving start cannot be kept (no length to
+    /// move along, or no fixed point for the first blend).
+    pub fn new(waypoints: &[f64], dof: usize, lim: Limits<'_>) -> Option<Self> {
+        let Limits { v, a, j, .. } = lim;
+        let mut rows: Vec<&[f64]> = Vec::with_capacity(waypoints.len() / dof);
+        for row in waypoints.chunks_exact(dof) {
+            if rows.last().is_none_or(|last| *last != row) {
+                rows.push(row);
+            }
+        }
+        let unit = |from: &[f64], to: &[f64]| -> Vec<f64> {
+            let d: Vec<f64> = (0..dof).map(|c| to[c] - from[c]).collect();
+            let n = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+            d.iter().map(|x| x / n).collect()
+        };
+        let mut cuts = vec![0];
+        for i in 1..rows.len().saturating_sub(1) {
+            let (din, dout) = (unit(rows[i - 1], rows[i]), unit(rows[i], rows[i + 1]));
+            let cos: f64 = din.iter().zip(&dout).map(|(x, y)| x * y).sum();
+            if cos.clamp(-1.0, 1.0).acos() > STOP_ANGLE {
+                cuts.push(i);
+            }
+        }
+        cuts.push(rows.len() - 1);
+        let path = Self::with_cuts(&rows, &cuts, dof, lim)?;
+        // where the corners force a crawl on long segments, stopping at
+        // every waypoint (rest-to-rest S-curves, closed form) can be faster
+        let stops: f64 = rows
+            .windows(2)
+            .map(|w| {
+                let lim = |l: &[f64]| {
+                    (0..dof)
+                        .filter(|&c| w[1][c] != w[0][c])
+                        .map(|c| l[c] / (w[1][c] - w[0][c]).abs())
+                        .fold(f64::INFINITY, f64::min)
+                };
+                SCurve::rest_to_rest(1.0, lim(v), lim(a), lim(j)).duration()
+            })
+            .sum();
+        if rows.len() > 2 && stops < path.duration() {
+            let every: Vec<usize> = (0..rows.len()).collect();
+            if let Some(stopping) = Self::with_cuts(&rows, &every, dof, lim)
+                && stopping.duration() < path.duration()
+            {
+                return Some(stopping);
+            }
+        }
+        Some(path)
+    }
+
+    /// One [`JerkBlends`] between consecutive `cuts` (indices into `rows`,
+    /// first and last included), from rest to rest but the first, which
+    /// starts at `lim.start`.
+    fn with_cuts(rows: &[&[f64]], cuts: &[usize], dof: usize, lim: Limits<'_>) -> Option<Self> {
+        let mut path = JerkPath {
+            dof,
+            pieces: Vec::with_capacity(cuts.len()),
+            starts: Vec::with_capacity(cuts.len()),
+        };
+        let mut t = 0.0;
+        for (n, w) in cuts.windows(2).enumerate() {
+            let flat: Vec<f64> = rows[w[0]..=w[1]].concat();
+            let piece_lim = Limits {
+                start: if n == 0 { lim.start } else { &[] },
+                ..lim
+            };
+            let piece = JerkBlends::new(&flat, dof, piece_lim)?;
+            path.starts.push(t);
+            t += piece.duration();
+            path.pieces.push(piece);
+        }
+        if path.pieces.is_empty() {
+            // a single waypoint: one piece at rest
+            path.starts.push(0.0);
+            path.pieces.push(JerkBlends::new(rows[0], dof, lim)?);
+        }
+        Some(path)
+    }
+
+    /// Duration, s.
+    pub fn duration(&self) -> f64 {
+        match (self.starts.last(), self.pieces.last()) {
+            (Some(t), Some(p)) => t + p.duration(),
+            _ => 0.0,
+        }
+    }
+
+    /// The motion at `times` (sorted), each piece from its own start time;
+    /// `None` once the deadline passes or the caller cancels.
+    pub fn sample(&self, times: &[f64], deadline: Deadline<'_>) -> Option<TimedTrajectory> {
+        let mut out = TimedTrajectory::with_capacity(self.dof, times.len());
+        let mut from = 0;
+        for (p, piece) in self.pieces.iter().enumerate() {
+            let start = self.starts[p];
+            let to = match self.starts.get(p + 1) {
+                Some(next) => from + times[from..].partition_point(|t| t < next),
+                None => times.len(),
+            };
+            let local: Vec<f64> = times[from..to].iter().map(|t| t - start).collect();
+            let part = piece.sample(&local, deadline)?;
+            out.t.extend_from_slice(&times[from..to]);
+            out.q.extend_from_slice(&part.q);
+            out.qd.extend_from_slice(&part.qd);
+            out.qdd.extend_from_slice(&part.qdd);
+            from = to;
+        }
+        Some(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_shape_integrates_to_one_and_its_offset_matches_the_integral() {
+        for (h, r) in [(0.35, 0.2), (0.3, 0.3), (0.5, 0.01)] {
+            let s = Shape { h, r };
+            // G₁(h) = 1, G₂(h) = h (g even), g(±h) = 0
+            let [p, v, a] = s.at(h - 1e-15);
+            assert!((v - 1.0).abs() < 1e-9 && (p - h).abs() < 1e-9 && a.abs() < 1e-9);
+            // offset = ∫_{−h}^{0} (−σ) g(σ) dσ by the midpoint rule
+            let n = 200_000;
+            let step = h / n as f64;
+            let integral: f64 = (0..n)
+                .map(|i| {
+                    let sigma = -h + (i as f64 + 0.5) * step;
+                    -sigma * s.at(sigma)[2] * step
+                })
+                .sum();
+            assert!(
+                (integral - s.offset()).abs() < 1e-8,
+                "{integral} vs {}",
+                s.offset()
+            );
+            // and G₂(0) is that offset too: ∫_{−h}^{0} G₁ = ∫ (0 − σ) g
+            assert!((s.at(0.0)[0] - s.offset()).abs() < 1e-12);
+        }
+        // hand-derived: a velocity change of 1 at a = 2, j = 10: w = 0.5,
+        // r = 0.2, h = 0.35
+        let s = Shape::for_change(&[1.0, -0.5], &[2.0, 2.0], &[10.0, 10.0]);
+        assert!((s.h - 0.35).abs() < 1e-15 && (s.r - 0.2).abs() < 1e-15);
+        // at j = 1 the jerk binds: w = r = 1, h = 1
+        let s = Shape::for_change(&[1.0], &[2.0], &[1.0]);
+        assert!((s.h - 1.0).abs() < 1e-15 && (s.r - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_right_angle_is_blended_at_the_hand_derived_distance_and_time() {
+        // (0,0) → (2,0) → (2,2) at v = 1, a = 2, j = 10: each segment runs at
+        // 1 rad/s for 2 s; every blend changes one or two joints by 1 rad/s,
+        // so h = 0.35, r = 0.2 (see above) and the total is 2 + 2 + 0.35 +
+        // 0.35 = 4.7 s. At the corner the offset is
+        // ((0.15)²/2 + 0.35·0.2/2 − 0.2²/3)/0.5 = 0.0658333…, along
+        // Δv = (−1, 1): the motion passes at √2 · 0.0658333 from (2, 0).
+        let w = [0.0, 0.0, 2.0, 0.0, 2.0, 2.0];
+        let lim = [1.0, 1.0];
+        let limits = |tolerance| Limits {
+            v: &lim,
+            a: &[2.0, 2.0],
+            j: &[10.0, 10.0],
+            tolerance,
+            start: &[],
+        };
+        let tb = JerkBlends::new(&w, 2, limits(0.1)).unwrap();
+        assert!((tb.duration() - 4.7).abs() < 1e-12, "{}", tb.duration());
+        let off = (0.15f64.powi(2) / 2.0 + 0.35 * 0.2 / 2.0 - 0.04 / 3.0) / 0.5;
+        let tr = tb.sample(&[0.35 + 2.0], Deadline::none()).unwrap();
+        assert!(
+            (tr.q[0] - (2.0 - off)).abs() < 1e-12 && (tr.q[1] - off).abs() < 1e-12,
+            "{:?}",
+            tr.q
+        );
+        assert!((tb.passing_distances()[1] - 2f64.sqrt() * off).abs() < 1e-12);
+        // half-way along the blend the velocity is the mean of the two lines
+        assert!((tr.qd[0] - 0.5).abs() < 1e-12 && (tr.qd[1] - 0.5).abs() < 1e-12);
+        // a tolerance of 0.05 is tighter: the corner is slowed until it fits
+        let tight = JerkBlends::new(&w, 2, limits(0.05)).unwrap();
+        assert!(tight.passing_distances()[1] <= 0.05 + 1e-12);
+        assert!(tight.duration() > 4.7);
+    }
+}
