@@ -87,8 +87,18 @@ impl CameraModel {
     /// Unit direction (camera frame) of the ray through pixel `(u, v)`, pixel centres
     /// spread evenly so the first and last rays lie on the field-of-view edges.
     pub fn ray_direction(&self, u: usize, v: usize) -> Vector3<f64> {
-        let th = (self.hfov / 2.0).tan();
-        let tv = (self.vfov / 2.0).tan();
+        self.ray_direction_with(self.half_tangents(), u, v)
+    }
+
+    /// `(tan(hfov/2), tan(vfov/2))`, for [`ray_direction_with`](Self::ray_direction_with).
+    pub fn half_tangents(&self) -> (f64, f64) {
+        ((self.hfov / 2.0).tan(), (self.vfov / 2.0).tan())
+    }
+
+    /// [`ray_direction`](Self::ray_direction) with the half-angle tangents computed once
+    /// by [`half_tangents`](Self::half_tangents) (the same value, bit for bit).
+    #[inline]
+    pub fn ray_direction_with(&self, (th, tv): (f64, f64), u: usize, v: usize) -> Vector3<f64> {
         let x = if self.width > 1 {
             -th + 2.0 * th * u as f64 / (self.width - 1) as f64
         } else {

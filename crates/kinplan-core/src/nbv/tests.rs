@@ -457,3 +457,92 @@ fn a_view_behind_a_wall_is_dropped_by_the_visibility_check() {
     assert!(p.reached >= p.first);
     assert!((c.ig - 1.0).abs() < 1e-12);
 }
+
+#[test]
+fn the_grid_prediction_counts_what_the_tree_walk_counts() {
+    use rand::{Rng, SeedableRng};
+    let vp = VisibilityParams {
+        pixel_stride: 1,
+        lookahead: 3,
+        ..VisibilityParams::default()
+    };
+    // hand count: the corridor's ray inside a region that ends with the grid at cell
+    // 32779: the unknown cells 32778 and 32779 are reached, 32778 first
+    let (t, cam, pose) = corridor();
+    let region = ([32770, 32760, 32760], [32779, 32775, 32775]);
+    let g = grid::StateGrid::new(&t, [32760, 32760, 32760], [32779, 32775, 32775], 1 << 20).unwrap();
+    let mut ws = PredictWorkspace::default();
+    let p = visibility::predict_view_in(
+        &t,
+        Some(&g),
+        &cam,
+        &pose,
+        &vp,
+        Some(region),
+        &mut ws,
+        Deadline::none(),
+    );
+    assert_eq!((p.first, p.reached), (1, 2));
+
+    // random boxes of free and occupied cells; views inside, at the edge of and
+    // outside the grid: the grid path against the tree walk, view by view
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(27);
+    let mut t = Octree::new(0.1).unwrap();
+    let (hit, miss) = hm(&t);
+    free_box(&mut t, [32758, 32758, 32762], [32778, 32778, 32774]);
+    for _ in 0..60 {
+        let c: [u16; 3] = [0, 1, 2].map(|_| rng.random_range(32752..32784));
+        let h: [u16; 3] = [0, 1, 2].map(|_| rng.random_range(0..3));
+        let v = if rng.random_bool(0.5) { hit } else { miss };
+        for x in c[0]..=c[0] + h[0] {
+            for y in c[1]..=c[1] + h[1] {
+                for z in c[2]..=c[2] + h[2] {
+                    t.update_key(&[x, y, z], v);
+                }
+            }
+        }
+    }
+    let cam = small_camera();
+    let region: (OcKey, OcKey) = ([32754, 32756, 32758], [32782, 32780, 32778]);
+    let g = grid::StateGrid::new(&t, [32750, 32752, 32756], [32786, 32784, 32780], 1 << 20).unwrap();
+    let mut ws = PredictWorkspace::default();
+    let mut counted = 0;
+    for i in 0..40 {
+        let at = match i % 3 {
+            0 => Point3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-0.5..0.5),
+            ),
+            1 => Point3::new(
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-2.0..2.0),
+            ),
+            _ => Point3::new(3.2, rng.random_range(-0.5..0.5), 0.05),
+        };
+        let aim = Point3::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), 0.0) - at;
+        let Some(pose) = look_along(&at, &aim) else {
+            continue;
+        };
+        let on_tree = predict_view(&t, &cam, &pose, &vp, Some(region), &mut ws, Deadline::none());
+        let on_grid = visibility::predict_view_in(
+            &t,
+            Some(&g),
+            &cam,
+            &pose,
+            &vp,
+            Some(region),
+            &mut ws,
+            Deadline::none(),
+        );
+        assert_eq!(
+            (on_grid.first, on_grid.reached, on_grid.rays),
+            (on_tree.first, on_tree.reached, on_tree.rays),
+            "view {i}"
+        );
+        assert!(on_grid.steps <= on_tree.steps);
+        counted += (on_tree.reached > 0) as usize;
+    }
+    assert!(counted >= 10, "too few views see unknown cells: {counted}");
+}

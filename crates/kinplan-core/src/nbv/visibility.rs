@@ -109,7 +109,15 @@ pub struct ViewPrediction {
 pub struct PredictWorkspace {
     first: Vec<u64>,
     reached: Vec<u64>,
+    /// One bit per region cell (the grid path): some ray's first unknown cell.
+    first_bits: Vec<u64>,
+    /// One bit per region cell (the grid path): among some ray's first unknown cells.
+    reached_bits: Vec<u64>,
 }
+
+/// Largest region (cells) the grid path marks in bit sets: 2^22 cells, two bit sets of
+/// 512 KiB per workspace. Larger regions take the key lists.
+const MAX_BITSET_CELLS: usize = 1 << 22;
 
 #[inline]
 fn in_keys(k: &OcKey, keys: &Option<(OcKey, OcKey)>) -> bool {
@@ -152,6 +160,11 @@ pub(crate) fn predict_view_in(
     ws: &mut PredictWorkspace,
     deadline: Deadline<'_>,
 ) -> ViewPrediction {
+    if let (Some(g), Some(keys)) = (grid, region_keys)
+        && let Some(prediction) = predict_on_grid(tree, g, camera, pose, params, keys, ws, deadline)
+    {
+        return prediction;
+    }
     let mut cache = SearchCache::default();
     let mut lookup = |k: &OcKey| match grid.and_then(|g| g.index_of(k).map(|i| g.cells[i])) {
         Some(UNKNOWN) => (CellState::Unknown, None),
@@ -160,6 +173,7 @@ pub(crate) fn predict_view_in(
         _ => tree_state(tree, k, &mut cache),
     };
     let stride = params.pixel_stride.max(1);
+    let tangents = camera.half_tangents();
     let origin = Point3::from(pose.translation.vector);
     ws.first.clear();
     ws.reached.clear();
@@ -174,7 +188,7 @@ pub(crate) fn predict_view_in(
                 break 'rows;
             }
             out.rays += 1;
-            let local = camera.ray_direction(u, v);
+            let local = camera.ray_direction_with(tangents, u, v);
             let dir = pose.rotation * local;
             let mut unknown = 0usize;
             out.steps += walk_with(
@@ -217,4 +231,205 @@ pub(crate) fn predict_view_in(
     out.first = ws.first.len() as u32;
     out.reached = ws.reached.len() as u32;
     out
+}
+
+/// The prediction of [`predict_view_in`] when the state grid covers the region: the
+/// same rays and the same DDA (Amanatides & Woo, as [`walk_with`]), with the cell
+/// states read from the grid by index and the distinct region cells marked in bit
+/// sets instead of sorted key lists. A ray that has been inside the grid and leaves it
+/// is stopped there: the grid's box is convex and holds the region, so the straight
+/// ray cannot meet a region cell again and nothing further can be counted (only the
+/// reported DDA steps are fewer). Before a ray enters the grid, cells are read from the
+/// tree. `None` when the region is not inside the grid or has more than
+/// [`MAX_BITSET_CELLS`] cells (the caller then takes the key lists).
+#[allow(clippy::too_many_arguments)]
+fn predict_on_grid(
+    tree: &Octree,
+    grid: &StateGrid,
+    camera: &CameraModel,
+    pose: &Isometry3<f64>,
+    params: &VisibilityParams,
+    (rlo, rhi): (OcKey, OcKey),
+    ws: &mut PredictWorkspace,
+    deadline: Deadline<'_>,
+) -> Option<ViewPrediction> {
+    let glo = grid.lo;
+    let gdims = grid.dims.map(|d| d as i64);
+    let mut rdims = [0usize; 3];
+    for i in 0..3 {
+        if rlo[i] > rhi[i] || (rlo[i] as i64) < glo[i] || rhi[i] as i64 >= glo[i] + gdims[i] {
+            return None;
+        }
+        rdims[i] = (rhi[i] - rlo[i]) as usize + 1;
+    }
+    let rcells = rdims[0] * rdims[1] * rdims[2];
+    if rcells > MAX_BITSET_CELLS {
+        return None;
+    }
+    let words = rcells.div_ceil(64);
+    for bits in [&mut ws.first_bits, &mut ws.reached_bits] {
+        bits.clear();
+        bits.resize(words, 0);
+    }
+    let (first_bits, reached_bits) = (&mut ws.first_bits[..], &mut ws.reached_bits[..]);
+    let mut cache = SearchCache::default();
+    let res = tree.resolution();
+    let stride = params.pixel_stride.max(1);
+    let tangents = camera.half_tangents();
+    let origin = Point3::from(pose.translation.vector);
+    let mut out = ViewPrediction::default();
+    let (mut first, mut reached) = (0u32, 0u32);
+    let Ok(k0) = tree.key_of(&origin) else {
+        // every ray starts outside the key space: the DDA takes no step
+        out.rays = camera.height.div_ceil(stride) as u32 * camera.width.div_ceil(stride) as u32;
+        return Some(out);
+    };
+    'rows: for v in (0..camera.height).step_by(stride) {
+        'ray: for u in (0..camera.width).step_by(stride) {
+            if out.rays % 64 == 63 && deadline.expired() {
+                break 'rows;
+            }
+            out.rays += 1;
+            let local = camera.ray_direction_with(tangents, u, v);
+            let dir = pose.rotation * local;
+            let t1 = camera.far / local.z;
+            // the DDA set-up of `walk_with` from t0 = 0
+            let mut k = k0;
+            let mut step = [0i32; 3];
+            let mut t_max = [f64::INFINITY; 3];
+            let mut t_delta = [f64::INFINITY; 3];
+            for i in 0..3 {
+                if dir[i] != 0.0 {
+                    step[i] = if dir[i] > 0.0 { 1 } else { -1 };
+                    let lo = (k[i] as f64 - 32768.0) * res;
+                    let border = if dir[i] > 0.0 { lo + res } else { lo };
+                    t_max[i] = (border - origin[i]) / dir[i];
+                    t_delta[i] = res / dir[i].abs();
+                }
+            }
+            let mut unknown = 0usize;
+            // phase 1: outside the grid, states from the tree, until the ray enters it
+            let in_grid =
+                |k: &OcKey| (0..3).all(|i| k[i] as i64 >= glo[i] && (k[i] as i64) < glo[i] + gdims[i]);
+            let mut inside = in_grid(&k);
+            while !inside {
+                out.steps += 1;
+                if tree_state(tree, &k, &mut cache).0 == CellState::Occupied {
+                    continue 'ray;
+                }
+                let a = next_axis(&t_max);
+                if t_max[a] > t1 {
+                    continue 'ray;
+                }
+                let nk = k[a] as i32 + step[a];
+                if !(0..65536).contains(&nk) {
+                    continue 'ray;
+                }
+                k[a] = nk as u16;
+                t_max[a] += t_delta[a];
+                inside = in_grid(&k);
+            }
+            // phase 2: inside the grid. The DDA state sits in scalars and each step is
+            // branch-free; per axis, `rem` counts the steps left before the key leaves the
+            // grid or the key space (either ends the ray: no region cell lies ahead)
+            let g = [0, 1, 2].map(|i| k[i] as i64 - glo[i]);
+            let mut idx = grid.index(g) as i64;
+            let rem_on = |i: usize| {
+                let (last_key, last_g) = if step[i] > 0 {
+                    (65535 - k[i] as i64, gdims[i] - 1 - g[i])
+                } else {
+                    (k[i] as i64, g[i])
+                };
+                if step[i] == 0 {
+                    i64::MAX
+                } else {
+                    last_key.min(last_g)
+                }
+            };
+            let (mut rx, mut ry, mut rz) = (rem_on(0), rem_on(1), rem_on(2));
+            let (sx, sy, sz) = (step[0] as i64, step[1] as i64, step[2] as i64);
+            let (gx, gy, gz) = (sx, sy * gdims[0], sz * gdims[0] * gdims[1]);
+            let (mut kx, mut ky, mut kz) = (k[0] as i64, k[1] as i64, k[2] as i64);
+            let [mut tx, mut ty, mut tz] = t_max;
+            let [dx, dy, dz] = t_delta;
+            loop {
+                out.steps += 1;
+                let state = grid.cells[idx as usize];
+                if state != FREE {
+                    let key = [kx as u16, ky as u16, kz as u16];
+                    let go_on = match state {
+                        OCCUPIED => false,
+                        UNKNOWN if (0..3).all(|i| key[i] >= rlo[i] && key[i] <= rhi[i]) => {
+                            unknown += 1;
+                            let r = (key[0] - rlo[0]) as usize
+                                + rdims[0]
+                                    * ((key[1] - rlo[1]) as usize + rdims[1] * (key[2] - rlo[2]) as usize);
+                            let (w, bit) = (r / 64, 1u64 << (r % 64));
+                            if unknown == 1 && first_bits[w] & bit == 0 {
+                                first_bits[w] |= bit;
+                                first += 1;
+                            }
+                            if reached_bits[w] & bit == 0 {
+                                reached_bits[w] |= bit;
+                                reached += 1;
+                            }
+                            unknown < params.lookahead
+                        }
+                        // unknown outside the region: passed as open
+                        UNKNOWN => true,
+                        // a grid cell past the key space cannot hold a key; read the tree
+                        _ => tree_state(tree, &key, &mut cache).0 != CellState::Occupied,
+                    };
+                    if !go_on {
+                        break;
+                    }
+                }
+                // the axis of `next_axis`, as three flags
+                let x_lt_y = tx < ty;
+                let ax = x_lt_y & (tx < tz);
+                let ay = !x_lt_y & (ty < tz);
+                let az = !(ax | ay);
+                let t = if ax {
+                    tx
+                } else if ay {
+                    ty
+                } else {
+                    tz
+                };
+                if t > t1 {
+                    break;
+                }
+                let (fx, fy, fz) = (ax as i64, ay as i64, az as i64);
+                rx -= fx;
+                ry -= fy;
+                rz -= fz;
+                if (rx | ry | rz) < 0 {
+                    break;
+                }
+                tx += if ax { dx } else { 0.0 };
+                ty += if ay { dy } else { 0.0 };
+                tz += if az { dz } else { 0.0 };
+                kx += fx * sx;
+                ky += fy * sy;
+                kz += fz * sz;
+                idx += fx * gx + fy * gy + fz * gz;
+            }
+        }
+    }
+    out.first = first;
+    out.reached = reached;
+    Some(out)
+}
+
+/// The axis whose cell border the DDA crosses next (the smallest `t_max`; ties to the
+/// later axis, as in [`walk_with`]).
+#[inline(always)]
+fn next_axis(t_max: &[f64; 3]) -> usize {
+    if t_max[0] < t_max[1] {
+        if t_max[0] < t_max[2] { 0 } else { 2 }
+    } else if t_max[1] < t_max[2] {
+        1
+    } else {
+        2
+    }
 }
