@@ -381,3 +381,44 @@ fn the_search_stops_at_the_deadline() {
     let live = solve_ik(&panda, &target, Some(&q), &params, 0, Deadline::none()).unwrap();
     assert!(live.success());
 }
+
+/// The iiwa's arm turned to a held value (no new analysis) solves the poses of
+/// that value: every solution, with the held value put back, reproduces the
+/// pose by the chain's own forward kinematics, and the sampled joints are
+/// among them; also at joint 3 = 0, where axes 2 and 4 line up and the
+/// analysis from scratch reads another family.
+#[test]
+fn the_turned_iiwa_arm_solves_every_held_value() {
+    use super::turned::TurnedArm;
+    let iiwa = builtin_chain("kuka_lbr_iiwa14_r820").unwrap();
+    let axes = *ChainModel::of_chain(&iiwa).axes().unwrap();
+    let tol = AnalyticParams::default().geometry_tolerance;
+    let turned = TurnedArm::new(&axes, 2, axes.generic(2), tol).unwrap();
+    // holding joint 4 leaves the shoulder on the arm's third axis: refused
+    assert!(TurnedArm::new(&axes, 3, axes.generic(3), tol).is_none());
+    let params = AnalyticParams {
+        turns: Turns::NearestSeed,
+        ..AnalyticParams::default()
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(29);
+    let mut out = Vec::new();
+    for case in 0..200 {
+        let mut q = random_q(&iiwa, &mut rng);
+        if case % 10 == 0 {
+            q[2] = 0.0;
+        }
+        let t = iiwa.fk(&q);
+        let arm = turned.at(q[2]);
+        let q6 = [q[0], q[1], q[3], q[4], q[5], q[6]];
+        arm.solve_into(&t, Some(&q6), &params, &mut out);
+        assert!(!out.is_empty(), "case {case}");
+        let mut found = false;
+        for s in &out {
+            let mut full = s.joints.to_vec();
+            full.insert(2, q[2]);
+            assert!(pose_close(&iiwa.fk(&full), &t, 1e-9), "case {case}: {full:?}");
+            found |= dist2(&full, &q) < 1e-12;
+        }
+        assert!(found, "case {case}: the sampled joints are missing");
+    }
+}
