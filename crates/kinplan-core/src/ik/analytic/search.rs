@@ -54,6 +54,10 @@ struct Objective<'a> {
     m_inv: Isometry3<f64>,
     buf: Vec<AnalyticSolution>,
     relaxed: bool,
+    /// Values of `f` at or above this (rad²) need not be exact: they are
+    /// reported as some value at least as high (and `g` likewise), which
+    /// spares the wrists of far branches while the samples are scanned.
+    bound: f64,
 }
 
 impl Objective<'_> {
@@ -87,8 +91,9 @@ impl Objective<'_> {
             },
         };
         // every branch in (−π, π], without limits
-        arm.nearest(&target, Some(&self.seed6), &self.params, &mut self.buf);
         let dv = (v - self.seed[self.j]).powi(2);
+        let tol = self.params.solve_tolerance;
+        arm.exact_near(&target, &self.seed6, tol, self.bound - dv, &mut self.buf);
         let (mut f, mut g) = (f64::INFINITY, f64::INFINITY);
         for s in self.buf.iter().filter(|s| s.exact) {
             let (mut d, mut viol) = (dv, 0.0);
@@ -190,6 +195,7 @@ pub(crate) fn search_held(
         m_inv: axes.m.inverse(),
         buf: Vec::with_capacity(8),
         relaxed: false,
+        bound: f64::INFINITY,
     };
     let (lo, hi) = match axes.limits[j] {
         (lo, hi) if lo.is_finite() && hi.is_finite() && hi - lo <= 4.0 * std::f64::consts::TAU => (lo, hi),
@@ -206,6 +212,8 @@ pub(crate) fn search_held(
             return best_f.0;
         }
         let v = lo + step * k as f64;
+        // a sample matters only when below the best f so far (and then g ≤ f)
+        f.bound = best_f.1;
         let (fv, gv) = f.both(v);
         if fv < best_f.1 {
             best_f = (v, fv, Some(k));
@@ -214,6 +222,7 @@ pub(crate) fn search_held(
             best_g = (v, gv, Some(k));
         }
     }
+    f.bound = f64::INFINITY;
     // the held value of a local numerical answer from the seed, when given
     let mut best = (best_f.0, best_f.1);
     if let Some(v) = proposal.filter(|v| (lo..=hi).contains(v)) {
