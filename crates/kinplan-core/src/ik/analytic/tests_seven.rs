@@ -422,3 +422,57 @@ fn the_turned_iiwa_arm_solves_every_held_value() {
         assert!(found, "case {case}: the sampled joints are missing");
     }
 }
+
+/// The bounded solve keeps every exact branch nearer the seed than the bound
+/// (distances computed here over each joint's nearest whole turn), and with no
+/// bound returns exactly the exact branches of the unbounded least-squares
+/// solve, on the iiwa and on the Panda (solved reversed).
+#[test]
+fn bounded_solve_keeps_every_branch_inside_the_bound() {
+    use std::f64::consts::{PI, TAU};
+    let wrapped = |a: &[f64; 6], b: &[f64; 6]| -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| {
+                let d = (x - y).rem_euclid(TAU);
+                let d = if d > PI { TAU - d } else { d };
+                d * d
+            })
+            .sum()
+    };
+    let params = AnalyticParams::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(2929);
+    let (mut out, mut all) = (Vec::new(), Vec::new());
+    for name in ["franka_panda", "kuka_lbr_iiwa14_r820"] {
+        let chain = builtin_chain(name).unwrap();
+        let mut dropped = 0;
+        for case in 0..100 {
+            let q = random_q(&chain, &mut rng);
+            let r = reduced_of(&chain, &q);
+            let q6: [f64; 6] = r.reduce(&q).try_into().unwrap();
+            let seed: [f64; 6] = std::array::from_fn(|i| q6[i] + rng.random_range(-0.5..0.5));
+            let t = chain.fk(&q);
+            r.arm.nearest(&t, Some(&seed), &params, &mut all);
+            all.retain(|s| s.exact);
+            r.arm
+                .exact_near(&t, &seed, params.solve_tolerance, f64::INFINITY, &mut out);
+            assert_eq!(out, all, "{name} {case}");
+            let mut d: Vec<f64> = all.iter().map(|s| wrapped(&s.joints, &seed)).collect();
+            d.sort_by(f64::total_cmp);
+            let bound = d[d.len() / 2];
+            r.arm
+                .exact_near(&t, &seed, params.solve_tolerance, bound, &mut out);
+            for s in &all {
+                if wrapped(&s.joints, &seed) < bound {
+                    assert!(
+                        out.contains(s),
+                        "{name} {case}: a branch inside the bound was dropped"
+                    );
+                }
+            }
+            dropped += all.len() - out.len();
+        }
+        // the bound does spare work: some far branches are dropped
+        assert!(dropped > 0, "{name}");
+    }
+}
