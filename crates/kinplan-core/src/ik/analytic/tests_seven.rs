@@ -394,6 +394,9 @@ fn the_turned_iiwa_arm_solves_every_held_value() {
     let axes = *ChainModel::of_chain(&iiwa).axes().unwrap();
     let tol = AnalyticParams::default().geometry_tolerance;
     let turned = TurnedArm::new(&axes, 2, axes.generic(2), tol).unwrap();
+    // analysed afresh at joint 3 = 0, axes 2 and 4 are parallel: another family
+    let at_zero = AnalyticArm::from_axes(&axes.held(2, 0.0), tol).unwrap();
+    assert_eq!(at_zero.family(), Family::SphericalWrist);
     // holding joint 4 leaves the shoulder on the arm's third axis: refused
     assert!(TurnedArm::new(&axes, 3, axes.generic(3), tol).is_none());
     let params = AnalyticParams {
