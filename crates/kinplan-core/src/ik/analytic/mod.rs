@@ -9,6 +9,7 @@ mod redundant;
 mod search;
 mod solve;
 mod subproblems;
+mod turned;
 
 #[cfg(test)]
 mod tests;

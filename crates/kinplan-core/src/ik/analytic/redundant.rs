@@ -109,7 +109,7 @@ impl ChainAxes {
 
     /// A value of joint `j` special to no geometry: 0.382 of the way across its
     /// limits (0.5 rad when unlimited).
-    fn generic(&self, j: usize) -> f64 {
+    pub(crate) fn generic(&self, j: usize) -> f64 {
         let (lo, hi) = self.limits[j];
         if lo.is_finite() && hi.is_finite() {
             lo + 0.381_966 * (hi - lo)

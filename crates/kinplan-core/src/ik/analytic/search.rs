@@ -7,6 +7,7 @@ use super::family::AnalyticArm;
 use super::params::{AnalyticParams, Turns};
 use super::redundant::{ChainAxes, ChainModel, ReducedArm, hold_at};
 use super::solve::AnalyticSolution;
+use super::turned::TurnedArm;
 use crate::ik::attempt::Clock;
 use crate::ik::{IkMethod, IkParams, IkSolver, IkTarget};
 use crate::robot::Chain;
@@ -31,7 +32,9 @@ const LIMIT_WEIGHT: f64 = 1.0;
 /// with `relaxed`, `g(v)`: the same over every branch with the limits replaced
 /// by a penalty, `min (distance² + LIMIT_WEIGHT · violation²)`, finite wherever
 /// the pose is reachable, so that a branch the limits allow only on a short
-/// stretch of `v` still shows as a valley between samples.
+/// stretch of `v` still shows as a valley between samples. A middle held
+/// joint of a spherical-shoulder arm moves one once-analysed arm
+/// ([`TurnedArm`]); other middle joints are analysed afresh at each value.
 struct Objective<'a> {
     axes: &'a ChainAxes,
     j: usize,
@@ -45,10 +48,16 @@ struct Objective<'a> {
     continuous: [bool; 6],
     /// End joints: the arm at `v = 0` and how `v` moves the target instead.
     fixed: Option<AnalyticArm>,
+    /// Middle joints: the arm analysed once, turned to each held value.
+    turned: Option<TurnedArm>,
     /// `M⁻¹` of the 7-joint chain (last joint held).
     m_inv: Isometry3<f64>,
     buf: Vec<AnalyticSolution>,
     relaxed: bool,
+    /// Values of `f` at or above this (rad²) need not be exact: they are
+    /// reported as some value at least as high (and `g` likewise), which
+    /// spares the wrists of far branches while the samples are scanned.
+    bound: f64,
 }
 
 impl Objective<'_> {
@@ -61,15 +70,19 @@ impl Objective<'_> {
     fn both(&mut self, v: f64) -> (f64, f64) {
         use std::f64::consts::TAU;
         let built;
-        let (arm, target) = match &self.fixed {
+        let (arm, target) = match (&self.fixed, &self.turned) {
             // T = E₁(v) E₂⋯E₇ M: arm(v) reaches T where arm(0) reaches E₁(−v) T
-            Some(arm) if self.j == 0 => (arm, self.axes.motion(0, -v) * self.target),
+            (Some(arm), _) if self.j == 0 => (arm, self.axes.motion(0, -v) * self.target),
             // T = E₁⋯E₆ E₇(v) M: arm(v) reaches T where arm(0) reaches T M⁻¹ E₇(−v) M
-            Some(arm) => (
+            (Some(arm), _) => (
                 arm,
                 self.target * self.m_inv * self.axes.motion(self.j, -v) * self.axes.m,
             ),
-            None => match AnalyticArm::from_axes(&self.axes.held(self.j, v), self.tol) {
+            (None, Some(turned)) => {
+                built = turned.at(v);
+                (&built, self.target)
+            }
+            (None, None) => match AnalyticArm::from_axes(&self.axes.held(self.j, v), self.tol) {
                 Ok(a) => {
                     built = a;
                     (&built, self.target)
@@ -78,8 +91,9 @@ impl Objective<'_> {
             },
         };
         // every branch in (−π, π], without limits
-        arm.nearest(&target, Some(&self.seed6), &self.params, &mut self.buf);
         let dv = (v - self.seed[self.j]).powi(2);
+        let tol = self.params.solve_tolerance;
+        arm.exact_near(&target, &self.seed6, tol, self.bound - dv, &mut self.buf);
         let (mut f, mut g) = (f64::INFINITY, f64::INFINITY);
         for s in self.buf.iter().filter(|s| s.exact) {
             let (mut d, mut viol) = (dv, 0.0);
@@ -126,8 +140,9 @@ impl Objective<'_> {
 /// neighbouring samples, to 1e-6 rad, by Brent's minimiser (parabolic
 /// interpolation with golden-section steps; R. P. Brent, *Algorithms for
 /// Minimization without Derivatives*, 1973, ch. 5) when the neighbours
-/// bracket it, else by a compass search (step halved on failure) that copes
-/// with held values where the limits leave no solution (`f = ∞`) — unless a
+/// bracket it, else by walking downhill with growing steps until `f` rises
+/// and then Brent's minimiser (see `downhill`; a compass search, step halved
+/// on failure, takes over where the limits leave no solution, `f = ∞`) — unless a
 /// proposal is given (the caller's Levenberg–Marquardt solve from the seed: a
 /// local answer, usually on the seed's own branch) and `f` refined next to
 /// its held value is already below the best sample's value. When the best sample of `g` lies elsewhere and is lower
@@ -143,7 +158,7 @@ impl Objective<'_> {
 /// `(upper − lower)/(samples − 1)` that no sample falls in; more samples narrow
 /// that gap, at one closed-form solve each (the proposal closes it for the
 /// branch the seed's local answer lies on). Cost: `samples + 1` solves, one LM
-/// attempt, and at most four refinements of at most 85 solves each. The
+/// attempt, and at most four refinements of at most 170 solves each. The
 /// deadline and cancellation end the search early with the best value so far.
 pub(crate) fn search_held(
     axes: &ChainAxes,
@@ -176,9 +191,11 @@ pub(crate) fn search_held(
         limits: std::array::from_fn(|k| axes.limits[idx(k)]),
         continuous: std::array::from_fn(|k| axes.continuous[idx(k)]),
         fixed,
+        turned: TurnedArm::new(axes, j, axes.generic(j), tol),
         m_inv: axes.m.inverse(),
         buf: Vec::with_capacity(8),
         relaxed: false,
+        bound: f64::INFINITY,
     };
     let (lo, hi) = match axes.limits[j] {
         (lo, hi) if lo.is_finite() && hi.is_finite() && hi - lo <= 4.0 * std::f64::consts::TAU => (lo, hi),
@@ -195,6 +212,8 @@ pub(crate) fn search_held(
             return best_f.0;
         }
         let v = lo + step * k as f64;
+        // a sample matters only when below the best f so far (and then g ≤ f)
+        f.bound = best_f.1;
         let (fv, gv) = f.both(v);
         if fv < best_f.1 {
             best_f = (v, fv, Some(k));
@@ -203,6 +222,7 @@ pub(crate) fn search_held(
             best_g = (v, gv, Some(k));
         }
     }
+    f.bound = f64::INFINITY;
     // the held value of a local numerical answer from the seed, when given
     let mut best = (best_f.0, best_f.1);
     if let Some(v) = proposal.filter(|v| (lo..=hi).contains(v)) {
@@ -247,8 +267,8 @@ struct Grid {
 /// Refines the sample `best` (index `k`, or the seed's value `v_seed` when
 /// `None`) between its neighbouring samples: Brent's minimiser when they
 /// bracket it (both finite and higher), else (a neighbour without a solution
-/// inside the limits, or the best at an end of the range) a compass search
-/// that never steps where the objective is infinite.
+/// inside the limits, or the best at an end of the range) [`downhill`], which
+/// never steps where the objective is infinite.
 fn refine(
     f: &mut Objective<'_>,
     grid: &Grid,
@@ -270,6 +290,8 @@ fn refine(
         a < best.0 && best.0 < b && fa.is_finite() && fb.is_finite() && fa >= best.1 && fb >= best.1;
     if bracketed {
         brent(f, a, b, best, xtol, clock)
+    } else if best.1.is_finite() {
+        downhill(f, (lo, hi), best, 0.5 * step, xtol, clock)
     } else {
         compass(f, (lo, hi), best, 0.5 * step, xtol, clock)
     }
@@ -289,7 +311,59 @@ fn local(f: &mut Objective<'_>, (lo, hi): (f64, f64), v: f64, h: f64, clock: &Cl
     if !start.1.is_finite() {
         return start;
     }
-    compass(f, (lo, hi), start, 0.5 * h, X_TOLERANCE, clock)
+    downhill(f, (lo, hi), start, h, X_TOLERANCE, clock)
+}
+
+/// `f`'s local minimum downhill of `start` on `[lo, hi]`: steps growing by the
+/// golden ratio from `h` in the direction `f` falls until it rises again
+/// (W. H. Press et al., *Numerical Recipes*, 3rd ed., 2007, §10.1, bracketing
+/// a minimum), then Brent's minimiser on that bracket. Where a step meets an
+/// end of the range or a held value without a solution inside the limits
+/// (`f = ∞`), a compass search from the lowest point so far takes over.
+fn downhill(
+    f: &mut Objective<'_>,
+    (lo, hi): (f64, f64),
+    start: (f64, f64),
+    h: f64,
+    xtol: f64,
+    clock: &Clock<'_>,
+) -> (f64, f64) {
+    const GROW: f64 = 1.618_033_988_749_895;
+    let (x0, f0) = start;
+    let up = (x0 + h).min(hi);
+    let f_up = if up > x0 { f.eval(up) } else { f64::INFINITY };
+    let (dir, mut b) = if f_up < f0 {
+        (1.0, (up, f_up))
+    } else {
+        let down = (x0 - h).max(lo);
+        let f_down = if down < x0 { f.eval(down) } else { f64::INFINITY };
+        if f_down < f0 {
+            (-1.0, (down, f_down))
+        } else if f_up.is_finite() && f_down.is_finite() {
+            return brent(f, down, up, start, xtol, clock);
+        } else {
+            return compass(f, (lo, hi), start, 0.5 * h, xtol, clock);
+        }
+    };
+    let mut a = x0;
+    let mut step = (b.0 - x0).abs();
+    for _ in 0..MAX_REFINE {
+        if clock.interrupted().is_some() {
+            break;
+        }
+        step *= GROW;
+        let c = (b.0 + dir * step).clamp(lo, hi);
+        let fc = if c == b.0 { f64::INFINITY } else { f.eval(c) };
+        if !fc.is_finite() {
+            return compass(f, (lo, hi), b, 0.5 * (c - b.0).abs().max(h), xtol, clock);
+        }
+        if fc >= b.1 {
+            let (l, r) = if dir > 0.0 { (a, c) } else { (c, a) };
+            return brent(f, l, r, b, xtol, clock);
+        }
+        (a, b) = (b.0, (c, fc));
+    }
+    b
 }
 
 /// Compass search on `[lo, hi]` from `start`: try `x ± h`, move to the first

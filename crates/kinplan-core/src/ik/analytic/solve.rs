@@ -146,7 +146,7 @@ impl AnalyticArm {
         out: &mut Vec<AnalyticSolution>,
     ) {
         out.clear();
-        let base = self.base_in_order(target, seed, false, params.solve_tolerance);
+        let base = self.base_in_order(target, seed, false, params.solve_tolerance, f64::INFINITY);
         for s in &base.sols[..base.n] {
             self.push_turns(s, seed, params.turns, out);
         }
@@ -162,7 +162,27 @@ impl AnalyticArm {
         out: &mut Vec<AnalyticSolution>,
     ) {
         out.clear();
-        let base = self.base_in_order(target, seed, true, params.solve_tolerance);
+        let base = self.base_in_order(target, seed, true, params.solve_tolerance, f64::INFINITY);
+        out.extend_from_slice(&base.sols[..base.n]);
+    }
+
+    /// The exact solutions of every configuration (angles in (−π, π], no
+    /// limits or turns) that may lie nearer `seed` than `bound` (rad², each
+    /// joint's difference taken over its nearest whole turn): on a
+    /// spherical-shoulder arm a branch whose three arm joints alone already lie
+    /// `bound` from the seed's is dropped before its wrist is solved (a lower
+    /// bound, as the wrist's terms are not negative); other families return
+    /// every exact branch.
+    pub(crate) fn exact_near(
+        &self,
+        target: &Isometry3<f64>,
+        seed: &[f64; 6],
+        tol: f64,
+        bound: f64,
+        out: &mut Vec<AnalyticSolution>,
+    ) {
+        out.clear();
+        let base = self.base_in_order(target, Some(seed), false, tol, bound);
         out.extend_from_slice(&base.sols[..base.n]);
     }
 
@@ -174,9 +194,10 @@ impl AnalyticArm {
         seed: Option<&[f64]>,
         keep_inexact: bool,
         tol: f64,
+        bound: f64,
     ) -> Base {
         if !self.reversed {
-            return self.base(target, seed, keep_inexact, tol);
+            return self.base(target, seed, keep_inexact, tol, bound);
         }
         let rseed: Option<[f64; 6]> = seed
             .filter(|s| s.len() == 6)
@@ -186,6 +207,7 @@ impl AnalyticArm {
             rseed.as_ref().map(|s| &s[..]),
             keep_inexact,
             tol,
+            bound,
         );
         for s in &mut base.sols[..base.n] {
             s.joints.reverse();
@@ -193,7 +215,14 @@ impl AnalyticArm {
         base
     }
 
-    fn base(&self, target: &Isometry3<f64>, seed: Option<&[f64]>, keep_inexact: bool, tol: f64) -> Base {
+    fn base(
+        &self,
+        target: &Isometry3<f64>,
+        seed: Option<&[f64]>,
+        keep_inexact: bool,
+        tol: f64,
+        bound: f64,
+    ) -> Base {
         let g = target * self.m_inv;
         let seed = match seed {
             Some(s) if s.len() == 6 => [s[0], s[1], s[2], s[3], s[4], s[5]],
@@ -212,7 +241,7 @@ impl AnalyticArm {
             Family::SphericalWrist => self.spherical(&g, &seed, keep_inexact, tol, &mut base),
             Family::ThreeParallel => self.three_parallel(&g, &seed, keep_inexact, tol, &mut base),
             Family::SphericalTwoIntersecting => {
-                self.spherical_shoulder(&g, &seed, keep_inexact, tol, &mut base)
+                self.spherical_shoulder(&g, &seed, (keep_inexact, tol, bound), &mut base)
             }
         }
         base
@@ -278,7 +307,15 @@ impl AnalyticArm {
     /// Spherical wrist and spherical shoulder `s` (axes 1, 2 meet): `q₃` by
     /// subproblem 3 from `‖E₃ w₀ − s‖ = ‖w − s‖`, `(q₁, q₂)` by subproblem 2 from
     /// `R₁R₂ (E₃ w₀ − s) = w − s`, then the wrist as for [`Family::SphericalWrist`].
-    fn spherical_shoulder(&self, g: &Isometry3<f64>, seed: &[f64; 6], keep: bool, tol: f64, out: &mut Base) {
+    /// A branch whose `q₁, q₂, q₃` lie `bound` (rad²) or farther from the
+    /// seed's (nearest whole turns) is dropped before its wrist is solved.
+    fn spherical_shoulder(
+        &self,
+        g: &Isometry3<f64>,
+        seed: &[f64; 6],
+        (keep, tol, bound): (bool, f64, f64),
+        out: &mut Base,
+    ) {
         let (h, p, s) = (&self.h, &self.p, self.shoulder);
         let rg = *g.rotation.to_rotation_matrix().matrix();
         let w = (g * nalgebra::Point3::from(self.wrist)).coords;
@@ -305,6 +342,11 @@ impl AnalyticArm {
                 } else {
                     (q1, q2)
                 };
+                let arm_d =
+                    wrap(q1 - seed[0]).powi(2) + wrap(q2 - seed[1]).powi(2) + wrap(q3 - seed[2]).powi(2);
+                if arm_d >= bound {
+                    continue;
+                }
                 let r1 = rot(&h[0], q1);
                 let y = self.inv_apply(0, &r1, &w);
                 let r36 = (r1 * rot(&h[1], q2) * r3).tr_mul(&rg);

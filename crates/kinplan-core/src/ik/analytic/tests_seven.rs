@@ -381,3 +381,101 @@ fn the_search_stops_at_the_deadline() {
     let live = solve_ik(&panda, &target, Some(&q), &params, 0, Deadline::none()).unwrap();
     assert!(live.success());
 }
+
+/// The iiwa's arm turned to a held value (no new analysis) solves the poses of
+/// that value: every solution, with the held value put back, reproduces the
+/// pose by the chain's own forward kinematics, and the sampled joints are
+/// among them; also at joint 3 = 0, where axes 2 and 4 line up and the
+/// analysis from scratch reads another family.
+#[test]
+fn the_turned_iiwa_arm_solves_every_held_value() {
+    use super::turned::TurnedArm;
+    let iiwa = builtin_chain("kuka_lbr_iiwa14_r820").unwrap();
+    let axes = *ChainModel::of_chain(&iiwa).axes().unwrap();
+    let tol = AnalyticParams::default().geometry_tolerance;
+    let turned = TurnedArm::new(&axes, 2, axes.generic(2), tol).unwrap();
+    // analysed afresh at joint 3 = 0, axes 2 and 4 are parallel: another family
+    let at_zero = AnalyticArm::from_axes(&axes.held(2, 0.0), tol).unwrap();
+    assert_eq!(at_zero.family(), Family::SphericalWrist);
+    // holding joint 4 leaves the shoulder on the arm's third axis: refused
+    assert!(TurnedArm::new(&axes, 3, axes.generic(3), tol).is_none());
+    let params = AnalyticParams {
+        turns: Turns::NearestSeed,
+        ..AnalyticParams::default()
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(29);
+    let mut out = Vec::new();
+    for case in 0..200 {
+        let mut q = random_q(&iiwa, &mut rng);
+        if case % 10 == 0 {
+            q[2] = 0.0;
+        }
+        let t = iiwa.fk(&q);
+        let arm = turned.at(q[2]);
+        let q6 = [q[0], q[1], q[3], q[4], q[5], q[6]];
+        arm.solve_into(&t, Some(&q6), &params, &mut out);
+        assert!(!out.is_empty(), "case {case}");
+        let mut found = false;
+        for s in &out {
+            let mut full = s.joints.to_vec();
+            full.insert(2, q[2]);
+            assert!(pose_close(&iiwa.fk(&full), &t, 1e-9), "case {case}: {full:?}");
+            found |= dist2(&full, &q) < 1e-12;
+        }
+        assert!(found, "case {case}: the sampled joints are missing");
+    }
+}
+
+/// The bounded solve keeps every exact branch nearer the seed than the bound
+/// (distances computed here over each joint's nearest whole turn), and with no
+/// bound returns exactly the exact branches of the unbounded least-squares
+/// solve, on the iiwa and on the Panda (solved reversed).
+#[test]
+fn bounded_solve_keeps_every_branch_inside_the_bound() {
+    use std::f64::consts::{PI, TAU};
+    let wrapped = |a: &[f64; 6], b: &[f64; 6]| -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| {
+                let d = (x - y).rem_euclid(TAU);
+                let d = if d > PI { TAU - d } else { d };
+                d * d
+            })
+            .sum()
+    };
+    let params = AnalyticParams::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(2929);
+    let (mut out, mut all) = (Vec::new(), Vec::new());
+    for name in ["franka_panda", "kuka_lbr_iiwa14_r820"] {
+        let chain = builtin_chain(name).unwrap();
+        let mut dropped = 0;
+        for case in 0..100 {
+            let q = random_q(&chain, &mut rng);
+            let r = reduced_of(&chain, &q);
+            let q6: [f64; 6] = r.reduce(&q).try_into().unwrap();
+            let seed: [f64; 6] = std::array::from_fn(|i| q6[i] + rng.random_range(-0.5..0.5));
+            let t = chain.fk(&q);
+            r.arm.nearest(&t, Some(&seed), &params, &mut all);
+            all.retain(|s| s.exact);
+            r.arm
+                .exact_near(&t, &seed, params.solve_tolerance, f64::INFINITY, &mut out);
+            assert_eq!(out, all, "{name} {case}");
+            let mut d: Vec<f64> = all.iter().map(|s| wrapped(&s.joints, &seed)).collect();
+            d.sort_by(f64::total_cmp);
+            let bound = d[d.len() / 2];
+            r.arm
+                .exact_near(&t, &seed, params.solve_tolerance, bound, &mut out);
+            for s in &all {
+                if wrapped(&s.joints, &seed) < bound {
+                    assert!(
+                        out.contains(s),
+                        "{name} {case}: a branch inside the bound was dropped"
+                    );
+                }
+            }
+            dropped += all.len() - out.len();
+        }
+        // the bound does spare work: some far branches are dropped
+        assert!(dropped > 0, "{name}");
+    }
+}
