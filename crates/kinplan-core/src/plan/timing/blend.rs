@@ -76,14 +76,20 @@ impl BlendedPath {
             return path;
         }
         let m = pts.len() - 1;
+        // at most a line and an arc per segment; one flat buffer of unit
+        // directions and one of each per-corner vector, reused
+        path.pieces.reserve(2 * m);
+        path.data.reserve(5 * m * dof);
         let lens: Vec<f64> = (0..m).map(|k| dist(pts[k], pts[k + 1])).collect();
-        let dirs: Vec<Vec<f64>> = (0..m)
-            .map(|k| (0..dof).map(|j| (pts[k + 1][j] - pts[k][j]) / lens[k]).collect())
-            .collect();
+        let mut dirs = Vec::with_capacity(m * dof);
+        for k in 0..m {
+            dirs.extend((0..dof).map(|j| (pts[k + 1][j] - pts[k][j]) / lens[k]));
+        }
+        let (mut start, mut centre, mut x) = (vec![0.0; dof], vec![0.0; dof], vec![0.0; dof]);
         // where the current line starts
         let mut from: Vec<f64> = pts[0].to_vec();
         for i in 1..m {
-            let (yi, yo) = (&dirs[i - 1], &dirs[i]);
+            let (yi, yo) = (&dirs[(i - 1) * dof..i * dof], &dirs[i * dof..(i + 1) * dof]);
             let cos = dot(yi, yo).clamp(-1.0, 1.0);
             let alpha = cos.acos();
             if alpha < MIN_CORNER {
@@ -97,19 +103,22 @@ impl BlendedPath {
             let q = pts[i];
             if std::f64::consts::PI - alpha < MIN_REVERSAL || radius < 1e-12 {
                 path.push_line(&from, q, true);
-                from = q.to_vec();
+                from.copy_from_slice(q);
                 continue;
             }
-            let start: Vec<f64> = (0..dof).map(|j| q[j] - l * yi[j]).collect();
+            for j in 0..dof {
+                start[j] = q[j] - l * yi[j];
+            }
             path.push_line(&from, &start, false);
-            let bis: Vec<f64> = (0..dof).map(|j| yo[j] - yi[j]).collect();
-            let bn = norm(&bis);
-            let centre: Vec<f64> = (0..dof)
-                .map(|j| q[j] + radius / half.cos() * bis[j] / bn)
-                .collect();
-            let x: Vec<f64> = (0..dof).map(|j| (start[j] - centre[j]) / radius).collect();
+            let bn = dist(yo, yi);
+            for j in 0..dof {
+                centre[j] = q[j] + radius / half.cos() * (yo[j] - yi[j]) / bn;
+                x[j] = (start[j] - centre[j]) / radius;
+            }
             path.push_arc(&centre, &x, yi, radius, alpha);
-            from = (0..dof).map(|j| q[j] + l * yo[j]).collect();
+            for j in 0..dof {
+                from[j] = q[j] + l * yo[j];
+            }
         }
         path.push_line(&from, pts[m], false);
         path
@@ -251,10 +260,6 @@ impl Curve for BlendedPath {
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-fn norm(a: &[f64]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 fn dist(a: &[f64], b: &[f64]) -> f64 {

@@ -315,8 +315,9 @@ pub fn topp_ra<C: Curve + ?Sized>(
                 .map(|&(al, be)| al + be * x[i])
                 .fold(f64::INFINITY, f64::min)
         };
-        let reach_max = (hi[i + 1] - x[i]) / (2.0 * delta);
-        x[i + 1] = (x[i] + 2.0 * delta * joint_max.min(reach_max)).clamp(0.0, hi[i + 1]);
+        // u_i = min(joint_max, (hi_{i+1} − x_i)/2Δ), written in x_{i+1} so
+        // that no division lies on the chain from one grid point to the next
+        x[i + 1] = (x[i] + 2.0 * delta * joint_max).clamp(0.0, hi[i + 1]);
         u[i] = (x[i + 1] - x[i]) / (2.0 * delta);
     }
     // The stages hold every limit where each interval starts and ends (the
