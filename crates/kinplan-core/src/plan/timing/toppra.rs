@@ -354,8 +354,13 @@ pub fn topp_ra<C: Curve + ?Sized>(
         u.iter_mut().for_each(|v| *v *= f);
     }
     let mut t = vec![0.0; n];
+    // one square root per grid point: ṡ at the end of an interval is ṡ at
+    // the start of the next
+    let mut sd = x[0].sqrt();
     for i in 0..n - 1 {
-        let speed = x[i].sqrt() + x[i + 1].sqrt();
+        let sd_next = x[i + 1].sqrt();
+        let speed = sd + sd_next;
+        sd = sd_next;
         // both ends at rest means x_{i+1} = x_i + 2Δu = 0 with u = 0: the
         // backward pass keeps every interior hi_i > 0 (braking to rest over
         // one interval is always feasible), so only a rounding-level
