@@ -76,14 +76,20 @@ impl BlendedPath {
             return path;
         }
         let m = pts.len() - 1;
+        // at most a line and an arc per segment; one flat buffer of unit
+        // directions and one of each per-corner vector, reused
+        path.pieces.reserve(2 * m);
+        path.data.reserve(5 * m * dof);
         let lens: Vec<f64> = (0..m).map(|k| dist(pts[k], pts[k + 1])).collect();
-        let dirs: Vec<Vec<f64>> = (0..m)
-            .map(|k| (0..dof).map(|j| (pts[k + 1][j] - pts[k][j]) / lens[k]).collect())
-            .collect();
+        let mut dirs = Vec::with_capacity(m * dof);
+        for k in 0..m {
+            dirs.extend((0..dof).map(|j| (pts[k + 1][j] - pts[k][j]) / lens[k]));
+        }
+        let (mut start, mut centre, mut x) = (vec![0.0; dof], vec![0.0; dof], vec![0.0; dof]);
         // where the current line starts
         let mut from: Vec<f64> = pts[0].to_vec();
         for i in 1..m {
-            let (yi, yo) = (&dirs[i - 1], &dirs[i]);
+            let (yi, yo) = (&dirs[(i - 1) * dof..i * dof], &dirs[i * dof..(i + 1) * dof]);
             let cos = dot(yi, yo).clamp(-1.0, 1.0);
             let alpha = cos.acos();
             if alpha < MIN_CORNER {
@@ -97,19 +103,22 @@ impl BlendedPath {
             let q = pts[i];
             if std::f64::consts::PI - alpha < MIN_REVERSAL || radius < 1e-12 {
                 path.push_line(&from, q, true);
-                from = q.to_vec();
+                from.copy_from_slice(q);
                 continue;
             }
-            let start: Vec<f64> = (0..dof).map(|j| q[j] - l * yi[j]).collect();
+            for j in 0..dof {
+                start[j] = q[j] - l * yi[j];
+            }
             path.push_line(&from, &start, false);
-            let bis: Vec<f64> = (0..dof).map(|j| yo[j] - yi[j]).collect();
-            let bn = norm(&bis);
-            let centre: Vec<f64> = (0..dof)
-                .map(|j| q[j] + radius / half.cos() * bis[j] / bn)
-                .collect();
-            let x: Vec<f64> = (0..dof).map(|j| (start[j] - centre[j]) / radius).collect();
+            let bn = dist(yo, yi);
+            for j in 0..dof {
+                centre[j] = q[j] + radius / half.cos() * (yo[j] - yi[j]) / bn;
+                x[j] = (start[j] - centre[j]) / radius;
+            }
             path.push_arc(&centre, &x, yi, radius, alpha);
-            from = (0..dof).map(|j| q[j] + l * yo[j]).collect();
+            for j in 0..dof {
+                from[j] = q[j] + l * yo[j];
+            }
         }
         path.push_line(&from, pts[m], false);
         path
@@ -208,14 +217,49 @@ impl Curve for BlendedPath {
             }
         }
     }
+
+    /// On a line the derivatives are constant. On an arc `q'` and `q''` are
+    /// linear in `(cos θ, sin θ)`, and the sum of that unit vector at two
+    /// angles is `2 cos(Δθ/2)` times the unit vector at their mean; `x`, `y`
+    /// orthonormal make `|q'(θ_a) + q'(θ_b)| = 2 cos(Δθ/2)`, so
+    /// `q'(θ_m) = (q'_a + q'_b) / |q'_a + q'_b|` and likewise `q''` (no sine
+    /// or cosine). `q` is left as it is.
+    fn eval_mid(
+        &self,
+        k: usize,
+        s_a: f64,
+        s_b: f64,
+        ends: [&[f64]; 4],
+        d1: &mut [f64],
+        d2: &mut [f64],
+        q: &mut [f64],
+    ) {
+        let [a1, a2, b1, b2] = ends;
+        let n = self.dof;
+        match self.pieces[k].kind {
+            Kind::Line => {
+                d1[..n].copy_from_slice(&a1[..n]);
+                d2[..n].fill(0.0);
+            }
+            Kind::Arc { .. } => {
+                let norm = (0..n).map(|j| (a1[j] + b1[j]).powi(2)).sum::<f64>().sqrt();
+                // ends half a turn apart or more: the sum says nothing
+                if norm < 0.5 {
+                    self.eval(k, (s_a + s_b) / 2.0, q, d1, d2);
+                    return;
+                }
+                let f = 1.0 / norm;
+                for j in 0..n {
+                    d1[j] = (a1[j] + b1[j]) * f;
+                    d2[j] = (a2[j] + b2[j]) * f;
+                }
+            }
+        }
+    }
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-fn norm(a: &[f64]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 fn dist(a: &[f64], b: &[f64]) -> f64 {
@@ -263,6 +307,32 @@ mod tests {
         assert!((q[0] - 1.0).abs() < 1e-12 && (q[1] - l).abs() < 1e-12);
         assert!(d1[0].abs() < 1e-12 && (d1[1] - 1.0).abs() < 1e-12);
         assert!((p.length() - (2.0 - 2.0 * l + l * std::f64::consts::FRAC_PI_2)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_midpoint_from_the_ends_matches_the_arc_evaluated_there() {
+        // a 3-joint corner of 2 rad, and a line piece
+        let p = BlendedPath::new(&[0.0, 0.0, 0.0, 1.0, 0.2, 0.0, 0.3, 0.9, 0.4], 3, 0.2);
+        let n = p.dof();
+        let ev = |k: usize, s: f64| {
+            let (mut q, mut d1, mut d2) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+            p.eval(k, s, &mut q, &mut d1, &mut d2);
+            (d1, d2)
+        };
+        for k in 0..p.pieces() {
+            let (a, b) = p.span(k);
+            for (fa, fb) in [(0.0, 1.0), (0.1, 0.3), (0.55, 0.6)] {
+                let (sa, sb) = (a + (b - a) * fa, a + (b - a) * fb);
+                let ((a1, a2), (b1, b2)) = (ev(k, sa), ev(k, sb));
+                let (m1, m2) = ev(k, (sa + sb) / 2.0);
+                let (mut d1, mut d2, mut q) = (vec![9.0; n], vec![9.0; n], vec![0.0; n]);
+                p.eval_mid(k, sa, sb, [&a1, &a2, &b1, &b2], &mut d1, &mut d2, &mut q);
+                for j in 0..n {
+                    assert!((d1[j] - m1[j]).abs() < 1e-13, "piece {k} q' {j}");
+                    assert!((d2[j] - m2[j]).abs() < 1e-12, "piece {k} q'' {j}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -16,4 +16,21 @@ pub trait Curve {
     fn stop_after(&self, k: usize) -> bool;
     /// `q(s)`, `q'(s)` and `q''(s)` on piece `k` (one-sided at its ends).
     fn eval(&self, k: usize, s: f64, q: &mut [f64], d1: &mut [f64], d2: &mut [f64]);
+    /// `q'` and `q''` halfway between `s_a` and `s_b` on piece `k`, given
+    /// their values at both (`a1`, `a2` at `s_a`; `b1`, `b2` at `s_b`).
+    /// By default an [`eval`](Curve::eval) at the midpoint; a curve whose
+    /// pieces are lines and circular arcs can combine the ends instead.
+    #[allow(clippy::too_many_arguments)]
+    fn eval_mid(
+        &self,
+        k: usize,
+        s_a: f64,
+        s_b: f64,
+        _ends: [&[f64]; 4],
+        d1: &mut [f64],
+        d2: &mut [f64],
+        q: &mut [f64],
+    ) {
+        self.eval(k, (s_a + s_b) / 2.0, q, d1, d2);
+    }
 }

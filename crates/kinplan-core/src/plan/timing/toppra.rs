@@ -118,25 +118,18 @@ fn build_grid<C: Curve + ?Sized>(curve: &C, step: f64) -> Result<Grid, ToppError
     Ok(g)
 }
 
-/// Lines `u ≥ α + βx` (lower) and `u ≤ α + βx` (upper) of the joint
-/// acceleration constraints `|p_j u + q_j x| ≤ a_j`, appended to `lower` and
-/// `upper`; where `p_j = 0` the constraint bounds `x` alone
-/// (`|q_j| x ≤ a_j`), which lowers `cap`.
-fn accel_lines(
-    p: &[f64],
-    q: &[f64],
-    a: &[f64],
-    lower: &mut Vec<(f64, f64)>,
-    upper: &mut Vec<(f64, f64)>,
-    cap: &mut f64,
-) {
+/// Bands `βx − w ≤ u ≤ βx + w` of the joint acceleration constraints
+/// `|p_j u + q_j x| ≤ a_j` (`w = a_j/|p_j|`, `β = −q_j/p_j`), appended to
+/// `bands` as `(w, β)`: each is a lower line `(−w, β)` and an upper line
+/// `(w, β)` of the same slope. Where `p_j = 0` the constraint bounds `x`
+/// alone (`|q_j| x ≤ a_j`), which lowers `cap`.
+fn accel_lines(p: &[f64], q: &[f64], a: &[f64], bands: &mut Vec<(f64, f64)>, cap: &mut f64) {
     for j in 0..p.len() {
         if p[j].abs() > 1e-12 {
             let ip = 1.0 / p[j];
             let slope = -q[j] * ip;
             let w = a[j] * ip.abs();
-            lower.push((-w, slope));
-            upper.push((w, slope));
+            bands.push((w, slope));
         } else if q[j].abs() > 1e-12 {
             *cap = cap.min(a[j] / q[j].abs());
         }
@@ -156,29 +149,30 @@ fn speed_cap(d1: &[f64], v: &[f64]) -> f64 {
 }
 
 /// The largest `x` in `[0, cap]` for which some `u` lies above every lower
-/// line and below every upper line, given that `x = 0` is such a point.
+/// line and below every upper line, given that `x = 0` is such a point. The
+/// lines are the two sides of each band `(w, β)` of [`accel_lines`] and one
+/// more of each kind, `lower1` and `upper1` (`(α, β)`: `u = α + βx`).
 ///
 /// `g(x) = min_m u_m(x) − max_l l_l(x)` is concave and piecewise linear with
 /// `g(0) ≥ 0`, so the feasible `x` form an interval `[0, x*]`. Newton's
 /// method on `g` from `x = cap` moves left monotonically (a concave
 /// function lies below its tangents) and lands on `x*` exactly after at most
 /// as many steps as `g` has pieces — usually one or two, each O(lines).
-fn largest_feasible(lower: &[(f64, f64)], upper: &[(f64, f64)], cap: f64) -> f64 {
+fn largest_feasible(bands: &[(f64, f64)], lower1: (f64, f64), upper1: (f64, f64), cap: f64) -> f64 {
     let mut x = cap;
     for _ in 0..64 {
-        let (mut lv, mut ls) = (f64::NEG_INFINITY, 0.0);
-        for &(a, b) in lower {
-            let y = a + b * x;
+        // one pass: both sides of a band share the product βx
+        let (mut lv, mut ls) = (lower1.0 + lower1.1 * x, lower1.1);
+        let (mut uv, mut us) = (upper1.0 + upper1.1 * x, upper1.1);
+        for &(w, b) in bands {
+            let bx = b * x;
+            let (l, u) = (-w + bx, w + bx);
             // ties: the smaller slope is the one active just left of x
-            if y > lv || (y == lv && b < ls) {
-                (lv, ls) = (y, b);
+            if l > lv || (l == lv && b < ls) {
+                (lv, ls) = (l, b);
             }
-        }
-        let (mut uv, mut us) = (f64::INFINITY, 0.0);
-        for &(a, b) in upper {
-            let y = a + b * x;
-            if y < uv || (y == uv && b > us) {
-                (uv, us) = (y, b);
+            if u < uv || (u == uv && b > us) {
+                (uv, us) = (u, b);
             }
         }
         let g = uv - lv;
@@ -225,8 +219,7 @@ pub fn topp_ra<C: Curve + ?Sized>(
     let dof = curve.dof();
     let g = build_grid(curve, step)?;
     let n = g.s.len();
-    let mut lower = Vec::with_capacity(2 * dof + 1);
-    let mut upper = Vec::with_capacity(2 * dof + 1);
+    let mut bands = Vec::with_capacity(2 * dof);
     let mut end1 = vec![0.0; dof];
     let mut end2 = vec![0.0; dof];
     // q', q'' where interval i ends, on its own piece
@@ -243,12 +236,11 @@ pub fn topp_ra<C: Curve + ?Sized>(
     // Constraints of interval i on (u_i, x_i), without the transition lines:
     // at its start, and on a curved piece also at its end, where
     // q'_e u + q''_e (x + 2Δu) = (q'_e + 2Δ q''_e) u + q''_e x.
-    let mut stage = |i: usize, lower: &mut Vec<(f64, f64)>, upper: &mut Vec<(f64, f64)>| -> f64 {
-        lower.clear();
-        upper.clear();
+    let mut stage = |i: usize, bands: &mut Vec<(f64, f64)>| -> f64 {
+        bands.clear();
         let r = i * dof..(i + 1) * dof;
         let mut cap = g.cap[i].min(speed_cap(&g.d1[r.clone()], v));
-        accel_lines(&g.d1[r.clone()], &g.d2[r], a, lower, upper, &mut cap);
+        accel_lines(&g.d1[r.clone()], &g.d2[r], a, bands, &mut cap);
         if curve.turn(g.piece[i]) > 0.0 {
             let delta = g.s[i + 1] - g.s[i];
             let (e1, e2) = end_of(i);
@@ -256,7 +248,7 @@ pub fn topp_ra<C: Curve + ?Sized>(
                 end1[j] = e1[j] + 2.0 * delta * e2[j];
                 end2[j] = e2[j];
             }
-            accel_lines(&end1, &end2, a, lower, upper, &mut cap);
+            accel_lines(&end1, &end2, a, bands, &mut cap);
         }
         cap
     };
@@ -299,13 +291,11 @@ pub fn topp_ra<C: Curve + ?Sized>(
                 .min(hi[i + 1] + 2.0 * delta * line_acc[k]);
             continue;
         }
-        let cap = stage(i, &mut lower, &mut upper);
-        kept_at[i] = (kept_upper.len() as u32, (kept_upper.len() + upper.len()) as u32);
-        kept_upper.extend_from_slice(&upper);
+        let cap = stage(i, &mut bands);
+        kept_at[i] = (kept_upper.len() as u32, (kept_upper.len() + bands.len()) as u32);
+        kept_upper.extend_from_slice(&bands);
         let w = 1.0 / (2.0 * delta);
-        lower.push((0.0, -w));
-        upper.push((hi[i + 1] * w, -w));
-        hi[i] = largest_feasible(&lower, &upper, cap);
+        hi[i] = largest_feasible(&bands, (0.0, -w), (hi[i + 1] * w, -w), cap);
     }
     if x0 > hi[0] * (1.0 + 1e-9) + 1e-12 {
         return Err(ToppError::StartTooFast { max: hi[0] });
@@ -325,8 +315,9 @@ pub fn topp_ra<C: Curve + ?Sized>(
                 .map(|&(al, be)| al + be * x[i])
                 .fold(f64::INFINITY, f64::min)
         };
-        let reach_max = (hi[i + 1] - x[i]) / (2.0 * delta);
-        x[i + 1] = (x[i] + 2.0 * delta * joint_max.min(reach_max)).clamp(0.0, hi[i + 1]);
+        // u_i = min(joint_max, (hi_{i+1} − x_i)/2Δ), written in x_{i+1} so
+        // that no division lies on the chain from one grid point to the next
+        x[i + 1] = (x[i] + 2.0 * delta * joint_max).clamp(0.0, hi[i + 1]);
         u[i] = (x[i + 1] - x[i]) / (2.0 * delta);
     }
     // The stages hold every limit where each interval starts and ends (the
@@ -342,7 +333,10 @@ pub fn topp_ra<C: Curve + ?Sized>(
         if curve.turn(k) == 0.0 {
             continue;
         }
-        curve.eval(k, (g.s[i] + g.s[i + 1]) / 2.0, &mut q, &mut m1, &mut m2);
+        let r = i * dof..(i + 1) * dof;
+        let (e1, e2) = end_of(i);
+        let ends = [&g.d1[r.clone()], &g.d2[r], e1, e2];
+        curve.eval_mid(k, g.s[i], g.s[i + 1], ends, &mut m1, &mut m2, &mut q);
         let xm = (x[i] + x[i + 1]) / 2.0;
         let sd = xm.sqrt();
         for j in 0..dof {
@@ -360,8 +354,13 @@ pub fn topp_ra<C: Curve + ?Sized>(
         u.iter_mut().for_each(|v| *v *= f);
     }
     let mut t = vec![0.0; n];
+    // one square root per grid point: ṡ at the end of an interval is ṡ at
+    // the start of the next
+    let mut sd = x[0].sqrt();
     for i in 0..n - 1 {
-        let speed = x[i].sqrt() + x[i + 1].sqrt();
+        let sd_next = x[i + 1].sqrt();
+        let speed = sd + sd_next;
+        sd = sd_next;
         // both ends at rest means x_{i+1} = x_i + 2Δu = 0 with u = 0: the
         // backward pass keeps every interior hi_i > 0 (braking to rest over
         // one interval is always feasible), so only a rounding-level
@@ -511,14 +510,16 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         for _ in 0..2000 {
             let m = rng.random_range(1..9);
-            // lines through a feasible x = 0: lower α ≤ 0 ≤ upper α
-            let lower: Vec<(f64, f64)> = (0..m)
-                .map(|_| (-rng.random_range(0.0..3.0), rng.random_range(-5.0..5.0)))
-                .collect();
-            let upper: Vec<(f64, f64)> = (0..m)
+            // bands around a feasible x = 0 (w ≥ 0), one more line of each
+            // kind through it: lower α ≤ 0 ≤ upper α
+            let bands: Vec<(f64, f64)> = (0..m)
                 .map(|_| (rng.random_range(0.0..3.0), rng.random_range(-5.0..5.0)))
                 .collect();
+            let lower1 = (-rng.random_range(0.0..3.0), rng.random_range(-5.0..5.0));
+            let upper1 = (rng.random_range(0.0..3.0), rng.random_range(-5.0..5.0));
             let cap: f64 = rng.random_range(0.1..10.0);
+            let lower: Vec<(f64, f64)> = bands.iter().map(|&(w, b)| (-w, b)).chain([lower1]).collect();
+            let upper: Vec<(f64, f64)> = bands.iter().copied().chain([upper1]).collect();
             // each pair: (β_l − β_u) x ≤ α_u − α_l
             let mut pairs = cap;
             for &(al, bl) in &lower {
@@ -528,7 +529,7 @@ mod tests {
                     }
                 }
             }
-            let newton = largest_feasible(&lower, &upper, cap);
+            let newton = largest_feasible(&bands, lower1, upper1, cap);
             assert!(
                 (newton - pairs).abs() <= 1e-9 * (1.0 + pairs),
                 "{newton} vs {pairs}"
