@@ -275,6 +275,11 @@ where
 pub(crate) struct Unanswered(pub(crate) Option<CallLabels>);
 
 impl Unanswered {
+    /// The call's labels while it waits.
+    pub(crate) fn labels(&self) -> &CallLabels {
+        self.0.as_ref().expect("labels are taken only by `answered`")
+    }
+
     /// The call's labels, now that it is answered (no longer recorded on drop).
     pub(crate) fn answered(mut self) -> CallLabels {
         self.0

@@ -94,8 +94,10 @@ where
     Resp: Message,
     Fut: Future<Output = Result<tonic::Response<Resp>, Status>>,
 {
-    let labels = CallLabels::for_path(path).with_timeout(effective_timeout(timeout, limits.default_timeout));
-    let waiting = Unanswered(Some(labels.clone()));
+    let waiting = Unanswered(Some(
+        CallLabels::for_path(path).with_timeout(effective_timeout(timeout, limits.default_timeout)),
+    ));
+    let labels = waiting.labels();
     let answer: Result<Bytes, Status> = async {
         let deadline = call_deadline(timeout, limits.default_timeout);
         within_limit("request", message.len(), limits.max_message_bytes)?;
@@ -104,7 +106,7 @@ where
         let mut request = tonic::Request::new(decoded);
         request.extensions_mut().insert(RequestDeadline(deadline));
         let future = std::panic::catch_unwind(AssertUnwindSafe(|| handler(request)))
-            .map_err(|panic| panic_status(&labels, &*panic))?;
+            .map_err(|panic| panic_status(labels, &*panic))?;
         let guarded = catch_unwind(future);
         let outcome = match deadline {
             Some(d) => tokio::time::timeout_at(d.into(), guarded)
@@ -113,12 +115,12 @@ where
             None => guarded.await,
         };
         let reply = outcome
-            .map_err(|panic| panic_status(&labels, &*panic))??
+            .map_err(|panic| panic_status(labels, &*panic))??
             .into_inner();
         let encoded = reply.encode_to_vec();
         within_limit("reply", encoded.len(), limits.max_message_bytes)?;
         if let Some(reply_type) = finite::reply_type(path) {
-            finite::check(reply_type, &encoded).map_err(|at| non_finite_status(Some(&labels), &at))?;
+            finite::check(reply_type, &encoded).map_err(|at| non_finite_status(Some(labels), &at))?;
         }
         Ok(Bytes::from(encoded))
     }
