@@ -20,36 +20,14 @@ import argparse
 import subprocess
 import sys
 import tempfile
-import time
 
 import numpy as np
 
+# the H/P FK and the timer of the 6R script beside this one (its directory is on sys.path
+# when this file runs as a script)
+from run import best_of, fk  # noqa: E402
+
 ARMS = ["franka_panda", "kuka_lbr_iiwa14_r820"]
-
-
-def rot(h: np.ndarray, q: float) -> np.ndarray:
-    """Rodrigues: rotation about unit axis h by q."""
-    k = np.array([[0, -h[2], h[1]], [h[2], 0, -h[0]], [-h[1], h[0], 0]])
-    return np.eye(3) + np.sin(q) * k + (1 - np.cos(q)) * (k @ k)
-
-
-def fk(H: np.ndarray, P: np.ndarray, q) -> tuple[np.ndarray, np.ndarray]:
-    """Product-of-exponentials FK in the H/P convention: p = P0 + R1 P1 + ... ."""
-    R = np.eye(3)
-    p = P[0].copy()
-    for i in range(len(H)):
-        R = R @ rot(H[i], q[i])
-        p = p + R @ P[i + 1]
-    return R, p
-
-
-def best_of(passes, fn):
-    best = float("inf")
-    for _ in range(passes):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def main() -> None:
