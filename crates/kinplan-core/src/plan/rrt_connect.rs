@@ -321,6 +321,12 @@ fn dist(a: &[f64], b: &[f64]) -> f64 {
         .sqrt()
 }
 
+/// Least shortening (joint-space path length: rad, or m for prismatic
+/// joints) a random shortcut must bring to be checked at all: converged paths
+/// draw many shortcuts that are valid but change nothing, each costing a
+/// motion check.
+const MIN_SHORTCUT_GAIN: f64 = 1e-3;
+
 /// Greedy vertex shortcut: from each kept vertex, jump to the farthest
 /// later vertex reachable by a valid straight motion.
 fn greedy_pass<C: StateChecker + ?Sized>(
@@ -359,11 +365,17 @@ fn greedy_pass<C: StateChecker + ?Sized>(
 /// Shortens a valid path in place: a greedy vertex pass, `attempts` random
 /// partial shortcuts (two points `p1`, `p2` drawn uniformly by arc length on
 /// different segments replace the path between them when the motions
-/// `v_{s1} → p1 → p2 → v_{s2+1}` are valid — the pieces of old segments are
-/// re-checked, since an interpolated check of a piece visits other states),
-/// and a final greedy pass. The ends are kept exactly; every edge of the
-/// result is checked at `resolution`. Stops early when `clock` is
-/// interrupted (the path stays valid).
+/// `v_{s1} → p1 → p2 → v_{s2+1}` are valid), and a final greedy pass.
+///
+/// Under interpolated checks the pieces of old segments (`v_{s1} → p1`,
+/// `p2 → v_{s2+1}`) are re-checked, since an interpolated check of a piece
+/// visits other states. Under padded checks they are not: every state of a
+/// proved motion is free, so its pieces are too, and only the chord
+/// `p1 → p2` needs a proof. An attempt that would shorten the path by at
+/// most [`MIN_SHORTCUT_GAIN`] is skipped without a check. The ends are kept
+/// exactly; every edge of the result is checked at `resolution` (or lies on
+/// an edge that was). Stops early when `clock` is interrupted (the path
+/// stays valid).
 pub(crate) fn shortcut<C: StateChecker + ?Sized>(
     checker: &C,
     path: &mut Vec<f64>,
@@ -378,6 +390,7 @@ pub(crate) fn shortcut<C: StateChecker + ?Sized>(
     let mut cum = Vec::new();
     let mut p1 = vec![0.0; dof];
     let mut p2 = vec![0.0; dof];
+    let padded = checker.motion_check().is_padded();
     for _ in 0..attempts {
         if clock.interrupted().is_some() {
             return;
@@ -414,10 +427,15 @@ pub(crate) fn shortcut<C: StateChecker + ?Sized>(
         };
         point(s1, u1, &mut p1);
         point(s2, u2, &mut p2);
+        // the path between p1 and p2 is u2 - u1 long; the chord replaces it
+        if u2 - u1 - dist(&p1, &p2) <= MIN_SHORTCUT_GAIN {
+            continue;
+        }
         let v1 = &path[s1 * dof..(s1 + 1) * dof];
         let v2 = &path[(s2 + 1) * dof..(s2 + 2) * dof];
-        let mut ok = checker.is_valid(&p1) && checker.is_valid(&p2);
-        for (x, y) in [(v1, &p1[..]), (&p1[..], &p2[..]), (&p2[..], v2)] {
+        let mut ok = padded || (checker.is_valid(&p1) && checker.is_valid(&p2));
+        let motions = [(&p1[..], &p2[..]), (v1, &p1[..]), (&p2[..], v2)];
+        for (x, y) in &motions[..if padded { 1 } else { 3 }] {
             if !ok {
                 break;
             }

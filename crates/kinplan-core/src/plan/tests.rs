@@ -650,36 +650,96 @@ fn ccstomp_starts_on_the_cartesian_line_unless_told_otherwise() {
     );
 }
 
-#[test]
-fn a_refused_motion_is_replaced_through_a_nudged_waypoint_proved_free() {
+/// A padded-motion checker for a 2 cm sphere on an x–y slide (±0.5 m)
+/// among `obstacle`.
+fn slide_checker(obstacle: crate::collision::Obstacle) -> crate::collision::SceneChecker {
     use crate::collision::{
-        AllowedCollisions, CheckerParams, Geometry, Obstacle, RobotModel, Scene, SceneChecker, SceneGeometry,
-        SceneLimits,
+        AllowedCollisions, CheckerParams, RobotModel, Scene, SceneChecker, SceneGeometry, SceneLimits,
     };
     use crate::robot::{ChainSpec, UrdfLimits, parse_chain};
-    use nalgebra::{Isometry3, Vector3};
-    use rand::SeedableRng;
-    // A 2 cm sphere on an x–y slide (±0.5 m) and a 2 cm cube at the origin
-    // on its straight way from x = −0.1 to x = 0.1.
     let urdf = r#"<robot name="slide"><link name="base"/><link name="px"/>
       <link name="probe"><collision><geometry><sphere radius="0.02"/></geometry></collision></link>
       <joint name="jx" type="prismatic"><parent link="base"/><child link="px"/><axis xyz="1 0 0"/>
         <limit lower="-0.5" upper="0.5" effort="0" velocity="1"/></joint>
       <joint name="jy" type="prismatic"><parent link="px"/><child link="probe"/><axis xyz="0 1 0"/>
         <limit lower="-0.5" upper="0.5" effort="0" velocity="1"/></joint></robot>"#;
-    let checker_with = |obstacle: Obstacle| {
-        let chain =
-            std::sync::Arc::new(parse_chain(urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
-        let model = std::sync::Arc::new(RobotModel::new(chain).unwrap());
-        let acm = AllowedCollisions::adjacent(&model);
-        let scene = Scene::new(vec![obstacle], &SceneLimits::default()).unwrap();
-        let world = std::sync::Arc::new(SceneGeometry::build(&scene).unwrap());
-        let params = CheckerParams {
-            padded_motion: true,
-            ..CheckerParams::default()
-        };
-        SceneChecker::new(model, &acm, world, params).unwrap()
+    let chain = std::sync::Arc::new(parse_chain(urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
+    let model = std::sync::Arc::new(RobotModel::new(chain).unwrap());
+    let acm = AllowedCollisions::adjacent(&model);
+    let scene = Scene::new(vec![obstacle], &SceneLimits::default()).unwrap();
+    let world = std::sync::Arc::new(SceneGeometry::build(&scene).unwrap());
+    let params = CheckerParams {
+        padded_motion: true,
+        ..CheckerParams::default()
     };
+    SceneChecker::new(model, &acm, world, params).unwrap()
+}
+
+/// Every state of the straight slide motion `a → b`, 2,000 steps, valid.
+fn slide_fine_free(checker: &crate::collision::SceneChecker, a: &[f64], b: &[f64]) -> bool {
+    (0..=2000).all(|i| {
+        let t = f64::from(i) / 2000.0;
+        checker.is_valid(&[a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])])
+    })
+}
+
+#[test]
+fn padded_shortcuts_shorten_a_detour_and_every_edge_stays_free() {
+    use crate::collision::{Geometry, Obstacle};
+    use nalgebra::{Isometry3, Vector3};
+    use rand::SeedableRng;
+    // a 10 cm cube at the origin; the path climbs over it on a wide detour
+    let cube = Obstacle::new(
+        "cube",
+        Isometry3::identity(),
+        Geometry::Box {
+            half_extents: Vector3::repeat(0.05),
+        },
+    );
+    let checker = slide_checker(cube);
+    let detour = [-0.3, 0.0, -0.3, 0.4, 0.0, 0.45, 0.3, 0.4, 0.3, 0.0];
+    let length = |p: &[f64]| -> f64 {
+        p.windows(4)
+            .step_by(2)
+            .map(|w| ((w[2] - w[0]).powi(2) + (w[3] - w[1]).powi(2)).sqrt())
+            .sum()
+    };
+    let clock = super::clock::Clock {
+        start: Instant::now(),
+        deadline: Deadline::none(),
+    };
+    for seed in 0..5 {
+        let mut path = detour.to_vec();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        rrt_connect::shortcut(&checker, &mut path, 2, 0.05, 100, &mut rng, &clock);
+        assert_eq!(
+            (&path[..2], &path[path.len() - 2..]),
+            (&detour[..2], &detour[8..])
+        );
+        // the straight line is 0.6 long and blocked; going over the cube's
+        // corners at the sphere's clearance is about 0.66; the detour 2.12
+        assert!(
+            length(&path) < 0.8,
+            "seed {seed}: {path:?} is {} long",
+            length(&path)
+        );
+        for w in path.windows(4).step_by(2) {
+            assert!(
+                slide_fine_free(&checker, &w[..2], &w[2..]),
+                "seed {seed}: edge {w:?} collides"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_refused_motion_is_replaced_through_a_nudged_waypoint_proved_free() {
+    use crate::collision::{Geometry, Obstacle};
+    use nalgebra::{Isometry3, Vector3};
+    use rand::SeedableRng;
+    // A 2 cm sphere on an x–y slide and a 2 cm cube at the origin on its
+    // straight way from x = −0.1 to x = 0.1.
+    let checker_with = slide_checker;
     let cube = Obstacle::new(
         "cube",
         Isometry3::identity(),
@@ -691,12 +751,7 @@ fn a_refused_motion_is_replaced_through_a_nudged_waypoint_proved_free() {
     let (x, y) = ([-0.1, 0.0], [0.1, 0.0]);
     let bounds = [(-0.5, 0.5), (-0.5, 0.5)];
     assert!(!checker.motion_valid(&x, &y));
-    let fine_free = |a: &[f64], b: &[f64]| {
-        (0..=2000).all(|i| {
-            let t = f64::from(i) / 2000.0;
-            checker.is_valid(&[a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])])
-        })
-    };
+    let fine_free = |a: &[f64], b: &[f64]| slide_fine_free(&checker, a, b);
     let clock = super::clock::Clock {
         start: Instant::now(),
         deadline: Deadline::none(),
