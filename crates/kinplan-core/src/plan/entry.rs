@@ -337,7 +337,9 @@ pub fn plan<C: StateChecker + ?Sized>(
     };
     result.goal = Some(goal.clone());
     let mut interrupted: Option<Interrupt> = None;
-    let mut interrupted_valid: Option<bool> = None;
+    // a verdict that stands without the re-check below: the planner's after
+    // an interruption, or a path every edge of which the padded check proved
+    let mut settled_valid: Option<bool> = None;
     let mut planner_valid = false;
     match req.algorithm {
         Algorithm::RrtConnect => {
@@ -348,6 +350,12 @@ pub fn plan<C: StateChecker + ?Sized>(
                 RrtStop::Connected => {
                     result.q = out.path;
                     planner_valid = true;
+                    // every edge was proved by the padded check, or lies on
+                    // an edge that was (a shortcut keeps pieces of proved
+                    // edges); proving a piece again could only refuse more
+                    if checker.motion_check().is_padded() {
+                        settled_valid = Some(true);
+                    }
                 }
                 RrtStop::SampleBudget => {}
                 RrtStop::Deadline => interrupted = Some(Interrupt::Deadline),
@@ -408,7 +416,7 @@ pub fn plan<C: StateChecker + ?Sized>(
             }
             timings.stomp_us = t0.elapsed().as_micros() as u64;
             if matches!(out.stop, StompStop::Deadline | StompStop::Cancelled) {
-                interrupted_valid = Some(out.valid);
+                settled_valid = Some(out.valid);
             }
             interrupted = match out.stop {
                 StompStop::Deadline if !out.valid => Some(Interrupt::Deadline),
@@ -424,9 +432,10 @@ pub fn plan<C: StateChecker + ?Sized>(
     let n = result.q.len() / dof;
     let t0 = Instant::now();
     // The re-check costs about one trajectory evaluation; after an
-    // interruption (before or during it) the planner's own verdict stands.
+    // interruption (before or during it), or for a path the padded check
+    // proved edge by edge, the planner's own verdict stands.
     result.valid = n >= 2
-        && match interrupted_valid {
+        && match settled_valid {
             Some(v) => v,
             None => {
                 path_valid(checker, &result.q, dof, resolution_of(checker), &clock).unwrap_or(planner_valid)

@@ -1198,3 +1198,71 @@ fn ccstomp_on_a_blocked_line_answers_by_its_deadline() {
         assert!(!r.valid);
     }
 }
+
+/// Regression: a MotionBenchMaker box problem (no. 5 of `../shared/bench/mbm/`,
+/// fingers held at 40 mm) planned with padded motions and shortcuts came back
+/// NO_VALID_TRAJECTORY: the final re-check proved each edge again on pieces
+/// of its own, and a piece of a proved edge can fail a proof of its own
+/// (the pads differ) though every state of it is free. The plan succeeds,
+/// and every edge is free at a 0.01 rad re-check.
+#[test]
+fn a_padded_rrt_connect_plan_with_shortcuts_is_valid_on_a_motionbenchmaker_box() {
+    use crate::collision::{
+        AcmParams, AllowedCollisions, CheckerParams, RobotModel, SceneChecker, SceneGeometry, SceneLimits,
+        attached_bodies, parse_joint_request, parse_planning_scene,
+    };
+    use crate::robot::builtin_urdf;
+    use std::sync::Arc;
+    let chain = builtin_chain("franka_panda_hand").unwrap();
+    let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
+    let attached = attached_bodies(builtin_urdf("franka_panda_hand").unwrap(), &chain, &fingers).unwrap();
+    let model = Arc::new(RobotModel::with_parts(chain.clone(), &attached, &[]).unwrap());
+    let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
+    let scene = parse_planning_scene(
+        include_str!("fixtures/mbm_box_scene0005.yaml"),
+        &SceneLimits::default(),
+    )
+    .unwrap();
+    let world = Arc::new(SceneGeometry::build(&scene).unwrap());
+    let params = CheckerParams {
+        padded_motion: true,
+        ..CheckerParams::default()
+    };
+    let checker = SceneChecker::new(model, &acm, world, params).unwrap();
+    let joints = parse_joint_request(include_str!("fixtures/mbm_box_request0005.yaml")).unwrap();
+    let arm = |state: &[(String, f64)]| -> Vec<f64> {
+        (1..=7)
+            .map(|i| {
+                state
+                    .iter()
+                    .find(|(n, _)| *n == format!("panda_joint{i}"))
+                    .unwrap()
+                    .1
+            })
+            .collect()
+    };
+    let (start, goal) = (arm(&joints.start), arm(&joints.goal));
+    let request = PlanRequest {
+        start: start.clone(),
+        goal: Goal::Joints(goal.clone()),
+        algorithm: Algorithm::RrtConnect,
+        seed: 5,
+        ..Default::default()
+    };
+    let r = plan(&chain, &checker, &request, PlanControl::default()).unwrap();
+    assert_eq!((r.status, r.valid), (PlanStatus::Succeeded, true));
+    assert_ends(&r, &start, &goal);
+    for w in r.q.chunks_exact(7).collect::<Vec<_>>().windows(2) {
+        let span = w[0]
+            .iter()
+            .zip(w[1])
+            .map(|(a, b)| (b - a).abs())
+            .fold(0.0, f64::max);
+        let steps = (span / 0.01).ceil().max(1.0) as usize;
+        for k in 0..=steps {
+            let t = k as f64 / steps as f64;
+            let q: Vec<f64> = w[0].iter().zip(w[1]).map(|(a, b)| a + t * (b - a)).collect();
+            assert!(checker.is_valid(&q), "state {q:?} of edge {w:?} collides");
+        }
+    }
+}
