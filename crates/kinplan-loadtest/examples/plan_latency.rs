@@ -35,20 +35,18 @@ use std::time::{Duration, Instant};
 
 use kinplan_core::collision::{Geometry, Obstacle, SceneLimits, parse_joint_request, parse_planning_scene};
 use kinplan_core::robot::builtin_urdf;
+use kinplan_loadtest::pose_msg;
 use kinplan_proto as pb;
-use nalgebra::Isometry3;
 use pb::planning_service_client::PlanningServiceClient;
 use tonic::transport::{Channel, Endpoint};
 
-const SETS: [&str; 7] = [
-    "table_pick",
-    "table_under_pick",
-    "box",
-    "bookshelf_small",
-    "bookshelf_tall",
-    "bookshelf_thin",
-    "cage",
-];
+// the problem sets and the arm joints of a MoveIt state, as the in-process
+// MotionBenchMaker runner reads them (its collision model is not used here)
+#[path = "../../../examples/common/mbm_panda.rs"]
+#[allow(dead_code)]
+mod mbm_panda;
+use mbm_panda::{SETS, arm};
+
 const ROBOT: &str = "franka_panda_hand";
 const FINGERS: [&str; 2] = ["panda_finger_joint1", "panda_finger_joint2"];
 const FINGER_OPENING: f64 = 0.04;
@@ -98,23 +96,6 @@ fn args() -> Result<Args, String> {
     })
 }
 
-fn pose(p: &Isometry3<f64>) -> pb::Pose {
-    let (t, q) = (p.translation.vector, p.rotation.quaternion());
-    pb::Pose {
-        position: Some(pb::Vec3 {
-            x: t.x,
-            y: t.y,
-            z: t.z,
-        }),
-        orientation: Some(pb::Quaternion {
-            x: q.i,
-            y: q.j,
-            z: q.k,
-            w: q.w,
-        }),
-    }
-}
-
 /// A MotionBenchMaker obstacle as the client sends it (boxes, spheres,
 /// cylinders: all these scenes hold).
 fn object(o: &Obstacle) -> Result<pb::CollisionObject, String> {
@@ -136,20 +117,10 @@ fn object(o: &Obstacle) -> Result<pb::CollisionObject, String> {
     };
     Ok(pb::CollisionObject {
         id: o.name.clone(),
-        pose: Some(pose(&o.pose)),
+        pose: Some(pose_msg(&o.pose)),
         shape: Some(shape),
         unknown_as_obstacle: false,
     })
-}
-
-/// The seven arm joints of a MoveIt joint state.
-fn arm(joints: &[(String, f64)]) -> Option<Vec<f64>> {
-    (1..=7)
-        .map(|i| {
-            let name = format!("panda_joint{i}");
-            joints.iter().find(|(n, _)| *n == name).map(|(_, v)| *v)
-        })
-        .collect()
 }
 
 fn robot_ref(as_urdf: bool) -> pb::RobotRef {
@@ -277,10 +248,7 @@ fn load_set(dir: &Path) -> Result<Vec<Problem>, Box<dyn std::error::Error>> {
         let scene = parse_planning_scene(&std::fs::read_to_string(&scene_path)?, &SceneLimits::default())?;
         let joints = parse_joint_request(&std::fs::read_to_string(dir.join(format!("request{k:04}.yaml")))?)?;
         let objects = scene.obstacles().iter().map(object).collect::<Result<_, _>>()?;
-        let (start, goal) = (
-            arm(&joints.start).ok_or("start")?,
-            arm(&joints.goal).ok_or("goal")?,
-        );
+        let (start, goal) = (arm(&joints.start, "start")?, arm(&joints.goal, "goal")?);
         out.push((k, pb::Scene { objects }, start, goal));
     }
     Ok(out)

@@ -10,4 +10,4 @@ mod workload;
 
 pub use report::{LatencyReport, Report};
 pub use run::{LoadtestArgs, MIN_WORKER_INTERVAL, run_loadtest, workers_for_rate};
-pub use workload::{Rpc, Workload};
+pub use workload::{Rpc, Workload, pose_msg};

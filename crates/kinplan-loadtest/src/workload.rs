@@ -114,7 +114,8 @@ fn random_state(chain: &Chain, rng: &mut ChaCha8Rng) -> Vec<f64> {
         .collect()
 }
 
-fn pose_msg(t: &Isometry3<f64>) -> pb::Pose {
+/// A pose as the contract sends it (position in metres, unit quaternion).
+pub fn pose_msg(t: &Isometry3<f64>) -> pb::Pose {
     let p = t.translation.vector;
     let q = t.rotation.quaternion();
     pb::Pose {
