@@ -4,6 +4,7 @@
 
 mod family;
 pub(crate) mod front;
+mod general;
 mod params;
 mod redundant;
 mod search;
@@ -13,6 +14,8 @@ mod turned;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_general;
 #[cfg(test)]
 mod tests_seven;
 
