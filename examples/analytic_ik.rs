@@ -471,6 +471,8 @@ fn main() {
         let first_wrist_axis = match arm.family() {
             Family::SphericalWrist | Family::SphericalTwoIntersecting => 3,
             Family::ThreeParallel => 4,
+            // ik-geo's searched solvers take the axes' points as they are
+            Family::Searched6R => 6,
         };
         for p in &mut z.p[first_wrist_axis..] {
             *p = arm.wrist_point();

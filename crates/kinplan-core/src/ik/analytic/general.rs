@@ -335,22 +335,25 @@ impl AnalyticArm {
     /// `Q(v) = R_a R_b`, is reachable by two joints only when
     /// `r(v) = h_aᵀ Q(v) h_b − h_aᵀ h_b = 0` (joint `a` keeps `h_a`, joint `b`
     /// keeps `h_b`). Each branch's `r` is sampled at `samples` evenly spaced
-    /// values over the circle `(−π, π]`; an interval whose ends differ in
+    /// values over the circle `(−π, π]`; (1) an interval whose ends differ in
     /// sign is refined by Brent's root finder (R. P. Brent, *Algorithms for
-    /// Minimization without Derivatives*, 1973, ch. 4) to 1e-13 rad; where a
-    /// branch ends inside an interval (the position problem loses its roots
-    /// there), the end is found by bisection and the piece up to it is
-    /// bracketed the same way. At each root, `q_a` and `q_b` follow by
-    /// subproblem 1.
+    /// Minimization without Derivatives*, 1973, ch. 4) to 1e-13 rad; (2) where
+    /// a branch ends inside an interval (a fold: the position problem's two
+    /// roots merge and `r` moves like the square root of the distance), the
+    /// fold is found by bisection and the piece up to it sampled again evenly
+    /// in that square root ([`Self::fold`]); (3) where `|r|` dips at a sample
+    /// without a sign change around it, a golden-section search stops at the
+    /// first sign change or at a tangent zero ([`Self::dip`]). At each root,
+    /// `q_a` and `q_b` follow by subproblem 1.
     ///
     /// Guarantee: every returned root is exact to the root finder's
     /// tolerance (and re-checked by forward kinematics by the caller). A
-    /// solution is missed only where a branch's `r` has an even number of
-    /// zeros inside one sample spacing `2π/samples` (two solutions of one
-    /// branch closer than that in the searched joint, or a zero where `r`
-    /// touches 0 without changing sign, as at a singular pose), or where a
-    /// branch exists only strictly between two samples. More samples narrow
-    /// that, at four closed-form position solves each.
+    /// solution is missed only where one branch's `r` has an even number of
+    /// zeros inside one sample spacing `2π/samples` that steps (2) and (3) do
+    /// not reveal (zeros next to a fold together with another sign change, a
+    /// wiggle of `r` with no dip at a sample), or where a branch exists only
+    /// strictly between two samples. More samples narrow that, at four
+    /// closed-form position solves each.
     pub(super) fn searched_6r(
         &self,
         g: &Isometry3<f64>,
