@@ -12,16 +12,19 @@ use super::family::{AnalyticArm, Axes6, Family, NotAnalytic, meet, normal_to, pa
 use super::solve::{Base, ConfigFlags, pick};
 use super::subproblems::{DEGENERATE, rot, sp1, wrap};
 
-/// Bisection steps that locate where a branch ends (2⁻⁴⁴ of a sample spacing).
-const BOUNDARY_STEPS: usize = 44;
+/// Bisection steps that locate where a branch ends (2⁻³⁴ of a sample spacing).
+const BOUNDARY_STEPS: usize = 34;
 /// Brent's root finder stops when the bracket is this narrow (rad) …
 const ROOT_TOLERANCE: f64 = 1e-13;
 /// … or after this many evaluations.
 const MAX_ROOT_STEPS: usize = 100;
 /// Extra samples between a sample and the end of a branch next to it.
 const FOLD_SAMPLES: usize = 8;
-/// Golden-section steps spent on one dip of `|r|` (shrinks it by 0.618⁴⁰).
-const DIP_STEPS: usize = 40;
+/// A dip is searched when the parabola through its samples falls below this
+/// fraction of its least sample.
+const DIP_DEPTH: f64 = 1.0;
+/// Golden-section steps spent on one dip of `|r|` (shrinks it by 0.618³²).
+const DIP_STEPS: usize = 32;
 /// Two roots of one search whose joints all agree to this (rad) are one.
 const SAME_ROOT: f64 = 1e-9;
 
@@ -38,6 +41,23 @@ pub(crate) enum Position {
     /// Axes 2 and 3 meet at this point `t`: `q₁` by subproblem 3 from
     /// `‖E₁⁻¹w − t‖ = ‖x − t‖`, `(q₂, q₃)` by subproblem 2.
     TwoThreeMeet(Vector3<f64>),
+}
+
+/// Three evenly spaced residuals of one sign whose middle one is the least
+/// in size, and the parabola through them dips below [`DIP_DEPTH`] of it:
+/// the minimum of `|r|` between may reach zero (two roots close together).
+/// A parabola through `(−h, φ₀), (0, φ₁), (h, φ₂)` has its least value
+/// `φ₁ − (φ₂ − φ₀)² / (8 (φ₀ − 2φ₁ + φ₂))`.
+fn deep_dip(r0: f64, r1: f64, r2: f64) -> bool {
+    if (r0 < 0.0) != (r1 < 0.0) || (r1 < 0.0) != (r2 < 0.0) {
+        return false;
+    }
+    let (f0, f1, f2) = (r0.abs(), r1.abs(), r2.abs());
+    if !(f1 < f0 && f1 <= f2) {
+        return false;
+    }
+    let curvature = f0 - 2.0 * f1 + f2;
+    curvature > 0.0 && f1 - (f2 - f0).powi(2) / (8.0 * curvature) < DIP_DEPTH * f1
 }
 
 /// The geometry the 1-D search uses.
@@ -61,29 +81,62 @@ impl SearchGeometry {
     }
 }
 
-/// The two roots `φ ± acos(C/ρ)` of subproblem 4, `hᵀ rot(k, θ) p = d`,
-/// always in this order, so that each root moves continuously with the
-/// data; `C/ρ` clamped to `[−1, 1]` with `in_range = false` when it was
-/// outside (the least-squares angle, both roots then equal). `None` when
-/// the left side does not depend on `θ`.
-fn sp4_both(h: &Vector3<f64>, k: &Vector3<f64>, p: &Vector3<f64>, d: f64) -> Option<([f64; 2], bool)> {
+/// An angle as its cosine and sine (no trigonometric call to get either).
+type Cs = (f64, f64);
+
+/// `rot(k, θ)` from `(cos θ, sin θ)` (Rodrigues, as [`rot`]).
+#[inline]
+fn rot_cs(k: &Vector3<f64>, (c, s): Cs) -> Matrix3<f64> {
+    let v = 1.0 - c;
+    let (x, y, z) = (k.x, k.y, k.z);
+    Matrix3::new(
+        c + x * x * v,
+        x * y * v - z * s,
+        x * z * v + y * s,
+        y * x * v + z * s,
+        c + y * y * v,
+        y * z * v - x * s,
+        z * x * v - y * s,
+        z * y * v + x * s,
+        c + z * z * v,
+    )
+}
+
+/// The two roots `φ ± acos(C/ρ)` of subproblem 4, `hᵀ rot(k, θ) p = d`
+/// (see [`sp4`](super::sp4)), as cosines and sines: with `cos φ = A/ρ`,
+/// `sin φ = B/ρ`, `cos α = C/ρ`, `sin α = √(1 − cos²α)`,
+/// `cos(φ ± α) = cos φ cos α ∓ sin φ sin α` and
+/// `sin(φ ± α) = sin φ cos α ± cos φ sin α`; always in this order, so that
+/// each root moves continuously with the data. `C/ρ` is clamped to
+/// `[−1, 1]` with `in_range = false` when it was outside (the least-squares
+/// angle, both roots then equal). `None` when the left side does not depend
+/// on `θ`.
+fn sp4_both(h: &Vector3<f64>, k: &Vector3<f64>, p: &Vector3<f64>, d: f64) -> Option<([Cs; 2], bool)> {
     let kp = k.dot(p);
     let perp = p - k * kp;
     let a = h.dot(&perp);
     let b = h.dot(&k.cross(p));
     let c = d - h.dot(k) * kp;
-    let rho = a.hypot(b);
+    // √ rather than hypot: the terms are lengths of a robot's size
+    let rho = (a * a + b * b).sqrt();
     if rho <= DEGENERATE * (1.0 + h.norm() * p.norm()) {
         return None;
     }
     let ratio = c / rho;
-    let alpha = ratio.clamp(-1.0, 1.0).acos();
-    let phi = b.atan2(a);
-    Some(([phi + alpha, phi - alpha], ratio.abs() <= 1.0))
+    let ca = ratio.clamp(-1.0, 1.0);
+    let sa = (1.0 - ca * ca).max(0.0).sqrt();
+    let (cp, sp) = (a / rho, b / rho);
+    Some((
+        [
+            (cp * ca - sp * sa, sp * ca + cp * sa),
+            (cp * ca + sp * sa, sp * ca - cp * sa),
+        ],
+        ratio.abs() <= 1.0,
+    ))
 }
 
 /// Subproblem 3 in the form of [`sp4_both`]: `‖rot(k, θ) p − q‖ = δ`.
-fn sp3_both(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>, delta: f64) -> Option<([f64; 2], bool)> {
+fn sp3_both(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>, delta: f64) -> Option<([Cs; 2], bool)> {
     sp4_both(
         q,
         k,
@@ -92,13 +145,27 @@ fn sp3_both(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>, delta: f64) ->
     )
 }
 
+/// Subproblem 1 (see [`sp1`]) as a cosine and sine: the normalised
+/// `(p′ᵀq′, kᵀ(p′ × q′))` of the projections normal to `k`; `(1, 0)` when
+/// one vanishes.
+fn sp1_cs(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>) -> Cs {
+    let pp = p - k * k.dot(p);
+    let qp = q - k * k.dot(q);
+    let (c, s) = (pp.dot(&qp), k.dot(&pp.cross(&qp)));
+    let n = (c * c + s * s).sqrt();
+    if n <= DEGENERATE * DEGENERATE {
+        (1.0, 0.0)
+    } else {
+        (c / n, s / n)
+    }
+}
+
 /// One branch at one searched value: joints 1–3 (and the searched one), the
 /// rotation left for the two joints of the meeting pair, and the residual.
 #[derive(Debug, Clone, Copy)]
 struct Eval {
-    q: [f64; 6],
-    /// `R_a R_b` required of the pair `(a, b)`.
-    pair_rotation: Matrix3<f64>,
+    /// Joints 1–3 as cosines and sines.
+    cs: [Cs; 3],
     /// `h_aᵀ Q h_b − h_aᵀ h_b`: zero exactly where the pair can produce `Q`.
     residual: f64,
     /// Every subproblem on the way held (no clamped root).
@@ -197,13 +264,18 @@ impl AnalyticArm {
     /// searched value `v`: with axes 5, 6 meeting at `c`, `G c = E₁E₂E₃E₄ c`
     /// so `x = E₄(v) c`, `w = G c`; with axes 4, 5 meeting,
     /// `G E₆(v)⁻¹ c = E₁E₂E₃ c` so `x = c`, `w = G E₆(v)⁻¹ c`.
-    fn search_points(&self, geo: &SearchGeometry, t: &Target, v: f64) -> (Vector3<f64>, Vector3<f64>) {
-        let (h, p, c) = (&self.h, &self.p, geo.c);
+    fn search_points(
+        &self,
+        geo: &SearchGeometry,
+        t: &Target,
+        rv: &Matrix3<f64>,
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let (p, c) = (&self.p, geo.c);
         if geo.pair == 4 {
-            let x = rot(&h[3], v) * (c - p[3]) + p[3];
+            let x = rv * (c - p[3]) + p[3];
             (x, (t.g * Point3::from(c)).coords)
         } else {
-            let back = rot(&h[5], v).tr_mul(&(c - p[5])) + p[5];
+            let back = rv.tr_mul(&(c - p[5])) + p[5];
             (c, (t.g * Point3::from(back)).coords)
         }
     }
@@ -221,25 +293,27 @@ impl AnalyticArm {
     ) {
         *out = [None; 4];
         let (h, p) = (&self.h, &self.p);
-        let (x, w) = self.search_points(geo, t, v);
+        let (sv, cv) = v.sin_cos();
+        let rv = rot_cs(&h[geo.searched()], (cv, sv));
+        let (x, w) = self.search_points(geo, t, &rv);
         let want = |b: usize| only.is_none_or(|o| o == b);
-        let mut finish = |b: usize, q0: f64, q1: f64, q2: f64, in_range: bool, y: Vector3<f64>| {
-            let r012 = rot(&h[0], q0) * rot(&h[1], q1) * rot(&h[2], q2);
-            let (a, bb) = (geo.pair, geo.pair + 1);
-            let qm = if geo.pair == 4 {
-                (r012 * rot(&h[3], v)).tr_mul(&t.rg)
-            } else {
-                r012.tr_mul(&t.rg) * rot(&h[5], v).transpose()
-            };
-            let residual = h[a].dot(&(qm * h[bb])) - h[a].dot(&h[bb]);
-            let mut q = [0.0; 6];
-            q[0] = q0;
-            q[1] = q1;
-            q[2] = q2;
-            q[geo.searched()] = v;
+        // the residual needs only h_aᵀ Q h_b: with pair (5, 6),
+        // Q = (R₁R₂R₃R₄)ᵀ R_G, so h₅ᵀ Q h₆ = (R₁R₂R₃ R₄h₅)ᵀ (R_G h₆); with pair
+        // (4, 5), Q = (R₁R₂R₃)ᵀ R_G R₆ᵀ, so h₄ᵀ Q h₅ = (R₁R₂R₃ h₄)ᵀ (R_G R₆ᵀ h₅)
+        let (a, bb) = (geo.pair, geo.pair + 1);
+        let (left, right) = if geo.pair == 4 {
+            (rv * h[a], t.rg * h[bb])
+        } else {
+            (h[a], t.rg * rv.tr_mul(&h[bb]))
+        };
+        let target_dot = h[a].dot(&h[bb]);
+        let mut finish = |b: usize, cs: [Cs; 3], in_range: bool, y: Vector3<f64>| {
+            let r0 = rot_cs(&h[0], cs[0]);
+            let r1 = rot_cs(&h[1], cs[1]);
+            let r2 = rot_cs(&h[2], cs[2]);
+            let residual = (r0 * (r1 * (r2 * left))).dot(&right) - target_dot;
             out[b] = Some(Eval {
-                q,
-                pair_rotation: qm,
+                cs,
                 residual,
                 in_range,
                 y,
@@ -251,22 +325,22 @@ impl AnalyticArm {
                 let Some((r1, ok1)) = sp4_both(&(w - p[0]), &h[0], &h[1], h[1].dot(&(x - p[0]))) else {
                     return;
                 };
-                for (i, &q0) in r1.iter().enumerate() {
+                for (i, &c0) in r1.iter().enumerate() {
                     if !(want(2 * i) || want(2 * i + 1)) {
                         continue;
                     }
-                    let y = rot(&h[0], q0).tr_mul(&(w - p[0])) + p[0];
+                    let y = rot_cs(&h[0], c0).tr_mul(&(w - p[0])) + p[0];
                     let Some((r3, ok3)) = sp3_both(&h[2], &(x - p[2]), &(p[1] - p[2]), (y - p[1]).norm())
                     else {
                         continue;
                     };
-                    for (j, &q2) in r3.iter().enumerate() {
+                    for (j, &c2) in r3.iter().enumerate() {
                         if !want(2 * i + j) {
                             continue;
                         }
-                        let e3x = rot(&h[2], q2) * (x - p[2]) + p[2];
-                        let q1 = sp1(&h[1], &(e3x - p[1]), &(y - p[1]), 1.0).angles[0];
-                        finish(2 * i + j, q0, q1, q2, ok1 && ok3, y);
+                        let e3x = rot_cs(&h[2], c2) * (x - p[2]) + p[2];
+                        let c1 = sp1_cs(&h[1], &(e3x - p[1]), &(y - p[1]));
+                        finish(2 * i + j, [c0, c1, c2], ok1 && ok3, y);
                     }
                 }
             }
@@ -274,22 +348,22 @@ impl AnalyticArm {
                 let Some((r3, ok3)) = sp3_both(&h[2], &(x - p[2]), &(s - p[2]), (w - s).norm()) else {
                     return;
                 };
-                for (i, &q2) in r3.iter().enumerate() {
+                for (i, &c2) in r3.iter().enumerate() {
                     if !(want(2 * i) || want(2 * i + 1)) {
                         continue;
                     }
-                    let u = rot(&h[2], q2) * (x - p[2]) + p[2] - s;
+                    let u = rot_cs(&h[2], c2) * (x - p[2]) + p[2] - s;
                     // subproblem 2: h₁ᵀ R₂ u = h₁ᵀ (w − s), then R₁ (R₂ u) = w − s
                     let Some((r2, ok2)) = sp4_both(&h[0], &h[1], &u, h[0].dot(&(w - s))) else {
                         continue;
                     };
-                    for (j, &q1) in r2.iter().enumerate() {
+                    for (j, &c1) in r2.iter().enumerate() {
                         if !want(2 * i + j) {
                             continue;
                         }
-                        let q0 = sp1(&h[0], &(rot(&h[1], q1) * u), &(w - s), 1.0).angles[0];
-                        let y = rot(&h[0], q0).tr_mul(&(w - p[0])) + p[0];
-                        finish(2 * i + j, q0, q1, q2, ok3 && ok2, y);
+                        let c0 = sp1_cs(&h[0], &(rot_cs(&h[1], c1) * u), &(w - s));
+                        let y = rot_cs(&h[0], c0).tr_mul(&(w - p[0])) + p[0];
+                        finish(2 * i + j, [c0, c1, c2], ok3 && ok2, y);
                     }
                 }
             }
@@ -297,21 +371,21 @@ impl AnalyticArm {
                 let Some((r1, ok1)) = sp3_both(&h[0], &(tp - p[0]), &(w - p[0]), (x - tp).norm()) else {
                     return;
                 };
-                for (i, &q0) in r1.iter().enumerate() {
+                for (i, &c0) in r1.iter().enumerate() {
                     if !(want(2 * i) || want(2 * i + 1)) {
                         continue;
                     }
-                    let y = rot(&h[0], q0).tr_mul(&(w - p[0])) + p[0];
+                    let y = rot_cs(&h[0], c0).tr_mul(&(w - p[0])) + p[0];
                     // subproblem 2: h₂ᵀ R₃ (x − t) = h₂ᵀ (y − t), then R₂ (R₃ (x − t)) = y − t
                     let Some((r3, ok3)) = sp4_both(&h[1], &h[2], &(x - tp), h[1].dot(&(y - tp))) else {
                         continue;
                     };
-                    for (j, &q2) in r3.iter().enumerate() {
+                    for (j, &c2) in r3.iter().enumerate() {
                         if !want(2 * i + j) {
                             continue;
                         }
-                        let q1 = sp1(&h[1], &(rot(&h[2], q2) * (x - tp)), &(y - tp), 1.0).angles[0];
-                        finish(2 * i + j, q0, q1, q2, ok1 && ok3, y);
+                        let c1 = sp1_cs(&h[1], &(rot_cs(&h[2], c2) * (x - tp)), &(y - tp));
+                        finish(2 * i + j, [c0, c1, c2], ok1 && ok3, y);
                     }
                 }
             }
@@ -407,10 +481,7 @@ impl AnalyticArm {
                 let (ra, rb) = (in_range(&prev[b]), in_range(&cur[b]));
                 // a dip of |r| at the sample before: two roots may hide in it
                 if let (Some(r0), Some(ra), Some(rb)) = (in_range(&prev2[b]), ra, rb)
-                    && (r0 < 0.0) == (ra < 0.0)
-                    && (ra < 0.0) == (rb < 0.0)
-                    && ra.abs() < r0.abs()
-                    && ra.abs() <= rb.abs()
+                    && deep_dip(r0, ra, rb)
                 {
                     self.dip(&geo, &t, b, (a - step, a, v), ra, (seed, tol), out);
                 }
@@ -432,10 +503,7 @@ impl AnalyticArm {
         for b in 0..4 {
             if let (Some(r0), Some(ra), Some(rb)) =
                 (in_range(&prev2[b]), in_range(&first[b]), in_range(&second[b]))
-                && (r0 < 0.0) == (ra < 0.0)
-                && (ra < 0.0) == (rb < 0.0)
-                && ra.abs() < r0.abs()
-                && ra.abs() <= rb.abs()
+                && deep_dip(r0, ra, rb)
             {
                 self.dip(&geo, &t, b, (-PI - step, -PI, -PI + step), ra, (seed, tol), out);
             }
@@ -545,7 +613,7 @@ impl AnalyticArm {
         }
     }
 
-    /// The last value from `inside` towards `outside` (within 2⁻⁴⁴ of their
+    /// The last value from `inside` towards `outside` (within 2⁻³⁴ of their
     /// distance) where branch `b` still exists.
     fn branch_end(
         &self,
@@ -662,14 +730,25 @@ impl AnalyticArm {
             return;
         };
         let (h, (a, bb)) = (&self.h, (geo.pair, geo.pair + 1));
-        let qm = e.pair_rotation;
+        let r012 = rot_cs(&h[0], e.cs[0]) * rot_cs(&h[1], e.cs[1]) * rot_cs(&h[2], e.cs[2]);
+        let rv = rot(&h[geo.searched()], v);
+        // the rotation left to the pair: R_a R_b = Q
+        let qm = if geo.pair == 4 {
+            (r012 * rv).tr_mul(&t.rg)
+        } else {
+            r012.tr_mul(&t.rg) * rv.transpose()
+        };
         let aa = pick(sp1(&h[a], &h[bb], &(qm * h[bb]), tol), seed[a]);
         let ra = rot(&h[a], aa.angles[0]);
         let ab = pick(
             sp1(&h[bb], &geo.normal, &(ra.tr_mul(&qm) * geo.normal), tol),
             seed[bb],
         );
-        let mut q = e.q;
+        let mut q = [0.0; 6];
+        for (i, (c, s)) in e.cs.iter().enumerate() {
+            q[i] = s.atan2(*c);
+        }
+        q[geo.searched()] = v;
         q[a] = aa.angles[0];
         q[bb] = ab.angles[0];
         for x in &mut q {
