@@ -389,6 +389,9 @@ fn main() {
         counts.push(out.len());
         if !out.iter().any(|s| same(&s.joints, q, 1e-7)) {
             missing += 1;
+            if missing <= 3 {
+                eprintln!("{label}: sampled configuration {q:?} not among {} solutions", out.len());
+            }
         }
         for s in &out {
             let f = chain.fk(&s.joints);

@@ -345,3 +345,4 @@ fn more_samples_find_the_same_solutions() {
         );
     }
 }
+
