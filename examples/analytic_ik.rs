@@ -390,7 +390,10 @@ fn main() {
         if !out.iter().any(|s| same(&s.joints, q, 1e-7)) {
             missing += 1;
             if missing <= 3 {
-                eprintln!("{label}: sampled configuration {q:?} not among {} solutions", out.len());
+                eprintln!(
+                    "{label}: sampled configuration {q:?} not among {} solutions",
+                    out.len()
+                );
             }
         }
         for s in &out {

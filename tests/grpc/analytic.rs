@@ -375,7 +375,7 @@ async fn offset_wrist_arm_is_searched_and_its_solutions_reach_the_pose() {
     let reply = ik
         .solve_ik(pb::SolveIkRequest {
             robot: robot.clone(),
-            target: pose.clone(),
+            target: pose,
             seed: q.clone(),
             options: analytic(1000),
         })

@@ -345,4 +345,3 @@ fn more_samples_find_the_same_solutions() {
         );
     }
 }
-
