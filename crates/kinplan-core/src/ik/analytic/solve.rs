@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::family::{AnalyticArm, Family};
 use super::params::{AnalyticParams, Turns};
-use super::subproblems::{Angles, rot, sp1, sp2, sp3, sp4, wrap};
+use super::subproblems::{Angles, ceil_i, floor_i, rot, round_f, sp1, sp2, sp3, sp4, wrap};
 
 /// Most whole-turn variants returned per joint with [`Turns::All`].
 pub const MAX_TURNS: usize = 4;
@@ -457,15 +457,15 @@ impl AnalyticArm {
             let (lo, hi) = self.limits[i];
             if self.continuous[i] {
                 let v = match (turns, seed) {
-                    (Turns::NearestSeed, Some(sd)) => q + TAU * ((sd[i] - q) / TAU).round(),
+                    (Turns::NearestSeed, Some(sd)) => q + TAU * round_f((sd[i] - q) / TAU),
                     _ => q,
                 };
                 cand[i][0] = v;
                 count[i] = 1;
                 continue;
             }
-            let k_lo = ((lo - eps - q) / TAU).ceil() as i64;
-            let k_hi = ((hi + eps - q) / TAU).floor() as i64;
+            let k_lo = ceil_i((lo - eps - q) / TAU);
+            let k_hi = floor_i((hi + eps - q) / TAU);
             if k_lo > k_hi {
                 return; // outside the limits at every turn
             }
@@ -473,13 +473,13 @@ impl AnalyticArm {
             match turns {
                 Turns::NearestSeed => {
                     let target = seed.map_or(0.0, |sd| sd[i]);
-                    let k = (((target - q) / TAU).round() as i64).clamp(k_lo, k_hi);
+                    let k = (round_f((target - q) / TAU) as i64).clamp(k_lo, k_hi);
                     cand[i][0] = clampq(k);
                     count[i] = 1;
                 }
                 Turns::All => {
                     // nearest zero first when there are more than MAX_TURNS
-                    let k0 = ((-q / TAU).round() as i64).clamp(k_lo, k_hi);
+                    let k0 = (round_f(-q / TAU) as i64).clamp(k_lo, k_hi);
                     let mut n = 0;
                     let mut step = 0i64;
                     while n < MAX_TURNS && (k0 - step >= k_lo || k0 + step <= k_hi) {
@@ -503,6 +503,7 @@ impl AnalyticArm {
                 }
             }
         }
+        out.reserve(count.iter().product());
         let mut idx = [0usize; 6];
         loop {
             let mut sol = *s;
