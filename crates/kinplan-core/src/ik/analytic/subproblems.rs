@@ -286,7 +286,7 @@ mod tests {
     #[test]
     fn truncating_floor_ceil_round_match_the_c_library() {
         for x in [
-            -3.5,
+            -3.5f64,
             -3.0,
             -2.7,
             -0.5,
