@@ -165,6 +165,7 @@ def main() -> None:
                   f"| {missing}/{n} · {int(g_miss)}/{len(rows_c)} (1e-3 rad) · — | {g_bad} · — "
                   f"| {lm_found}, {lm_missed} |", flush=True)
             continue
+        geo_ans = [[s[0] for s in geo.get_ik(R, t) if not s[1]] for R, t in geo_in[: args.check]]
         eaik = HPRobot(H, P)
         Ts = []
         for row in rows:

@@ -503,25 +503,23 @@ impl AnalyticArm {
                 }
             }
         }
+        // the first variant, then for each joint the block so far copied once
+        // per further value of that joint (joint 1 varies fastest): whole
+        // solutions move by block copies, and each copy writes one joint
+        let start = out.len();
         out.reserve(count.iter().product());
-        let mut idx = [0usize; 6];
-        loop {
-            let mut sol = *s;
-            for i in 0..6 {
-                sol.joints[i] = cand[i][idx[i]];
-            }
-            out.push(sol);
-            let mut i = 0;
-            while i < 6 {
-                idx[i] += 1;
-                if idx[i] < count[i] {
-                    break;
+        let mut first = *s;
+        for i in 0..6 {
+            first.joints[i] = cand[i][0];
+        }
+        out.push(first);
+        for i in 0..6 {
+            let block = out.len() - start;
+            for (c, &v) in cand[i][..count[i]].iter().enumerate().skip(1) {
+                out.extend_from_within(start..start + block);
+                for sol in &mut out[start + c * block..] {
+                    sol.joints[i] = v;
                 }
-                idx[i] = 0;
-                i += 1;
-            }
-            if i == 6 {
-                break;
             }
         }
     }
