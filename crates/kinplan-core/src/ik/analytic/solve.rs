@@ -509,8 +509,8 @@ impl AnalyticArm {
         let start = out.len();
         out.reserve(count.iter().product());
         let mut first = *s;
-        for i in 0..6 {
-            first.joints[i] = cand[i][0];
+        for (j, c) in first.joints.iter_mut().zip(&cand) {
+            *j = c[0];
         }
         out.push(first);
         for i in 0..6 {
