@@ -389,6 +389,12 @@ fn main() {
         counts.push(out.len());
         if !out.iter().any(|s| same(&s.joints, q, 1e-7)) {
             missing += 1;
+            if missing <= 3 {
+                eprintln!(
+                    "{label}: sampled configuration {q:?} not among {} solutions",
+                    out.len()
+                );
+            }
         }
         for s in &out {
             let f = chain.fk(&s.joints);
@@ -471,6 +477,8 @@ fn main() {
         let first_wrist_axis = match arm.family() {
             Family::SphericalWrist | Family::SphericalTwoIntersecting => 3,
             Family::ThreeParallel => 4,
+            // ik-geo's searched solvers take the axes' points as they are
+            Family::Searched6R => 6,
         };
         for p in &mut z.p[first_wrist_axis..] {
             *p = arm.wrist_point();

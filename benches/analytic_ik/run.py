@@ -42,6 +42,12 @@ ARMS = [
     (f"{ERD}/ur5_robot.urdf", "tool0"),
     (f"{ERD}/ur10_robot.urdf", "tool0"),
 ]
+HERE = os.path.dirname(os.path.abspath(__file__))
+# hand-made offset-wrist arms (family searched_6r): `--searched` runs these
+SEARCHED = [
+    (f"{HERE}/offset_wrist_45.urdf", "tool"),
+    (f"{HERE}/offset_wrist_56.urdf", "tool"),
+]
 
 
 def rot(h: np.ndarray, q: float) -> np.ndarray:
@@ -95,6 +101,10 @@ def main() -> None:
     ap.add_argument("--runner", required=True)
     ap.add_argument("--n", type=int, default=10_000)
     ap.add_argument("--check", type=int, default=2000, help="poses whose ik-geo/EAIK answers are FK-checked")
+    ap.add_argument("--searched", action="store_true",
+                    help="the offset-wrist arms (searched_6r) instead: ik-geo's 1-D search solver "
+                         "(two_parallel) beside kinplan's; EAIK has no decomposition for them")
+    ap.add_argument("--geo-n", type=int, default=None, help="poses ik-geo is timed on (default: all)")
     args = ap.parse_args()
     import ik_geo
     from eaik.IK_HP import HPRobot
@@ -104,7 +114,7 @@ def main() -> None:
           "| EAIK µs | ratio | EAIK batched µs | ratio | solutions/pose kinplan · ik-geo · EAIK "
           "| sampled config missing kinplan · ik-geo · EAIK | FK > 1e-9 ik-geo · EAIK | LM 64 seeds: found, missed |")
     print("|" + "---|" * 14)
-    for arm, tip in ARMS:
+    for arm, tip in (SEARCHED if args.searched else ARMS):
         cmd = [args.runner, arm, str(args.n), out] + ([tip] if tip else [])
         res = subprocess.run(cmd, capture_output=True, text=True, check=True)
         line = next(l for l in res.stdout.splitlines() if l.startswith("RESULT"))
@@ -117,10 +127,44 @@ def main() -> None:
         make = {
             "spherical_wrist": ik_geo.Robot.spherical_two_parallel,
             "three_parallel": ik_geo.Robot.three_parallel_two_intersecting,
+            "searched_6r": ik_geo.Robot.two_parallel,
         }[family]
         geo = make(H.tolist(), P.tolist())
         geo_in = [(row[6:15].reshape(3, 3).T.tolist(), row[15:18].tolist()) for row in rows]
-        geo_time = best_of(3, lambda: [geo.get_ik(R, t) for R, t in geo_in]) / len(rows) * 1e6
+        geo_n = min(args.geo_n or len(rows), len(rows))
+        if family == "searched_6r":
+            try:
+                geo.get_ik(*geo_in[0])
+            except BaseException as e:  # pyo3 turns a Rust panic into PanicException
+                print(f"| {label} | {family} | {float(us8):.2f} | {float(usall):.2f} | ik-geo two_parallel panics "
+                      f"({type(e).__name__}) | — | — | — | — | — | {int(total) / int(n):.2f} · — · — "
+                      f"| {missing}/{n} · — · — | — | {lm_found}, {lm_missed} |", flush=True)
+                continue
+        geo_time = best_of(3, lambda: [geo.get_ik(R, t) for R, t in geo_in[:geo_n]]) / geo_n * 1e6
+        if family == "searched_6r":
+            # ik-geo flags every searched answer least-squares and refines it
+            # coarsely: keep those whose FK reaches the pose to 1e-4 (rotation
+            # entries, m), and count the sampled configuration found at 1e-3 rad
+            rows_c = rows[: args.check]
+            g_total = g_miss = g_worst = 0.0
+            for (R, t), row in zip(geo_in[: args.check], rows_c):
+                Rw, tw = row[6:15].reshape(3, 3), row[15:18]
+                kept = []
+                for s in geo.get_ik(R, t):
+                    Rs, ts = fk(H, P, s[0])
+                    err = max(np.abs(Rs - Rw).max(), np.abs(ts - tw).max())
+                    if err <= 1e-4:
+                        kept.append(s[0])
+                        g_worst = max(g_worst, err)
+                g_total += len(kept)
+                g_miss += not any(wrapped_equal(s, row[:6], 1e-3) for s in kept)
+            g_per, g_bad = g_total / len(rows_c), f"worst FK {g_worst:.1e}"
+            us8, usall = float(us8), float(usall)
+            print(f"| {label} | {family} | {us8:.2f} | {usall:.2f} | {geo_time:.2f} | {geo_time / us8:.2f} "
+                  f"| — | — | — | — | {int(total) / int(n):.2f} · {g_per:.2f} · — "
+                  f"| {missing}/{n} · {int(g_miss)}/{len(rows_c)} (1e-3 rad) · — | {g_bad} · — "
+                  f"| {lm_found}, {lm_missed} |", flush=True)
+            continue
         geo_ans = [[s[0] for s in geo.get_ik(R, t) if not s[1]] for R, t in geo_in[: args.check]]
         eaik = HPRobot(H, P)
         Ts = []

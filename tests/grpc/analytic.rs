@@ -334,3 +334,73 @@ async fn stream_ik_analytic_keeps_one_configuration_along_s2s_circle() {
         drop(tx);
     }
 }
+
+/// An offset-wrist 6R arm given inline: DescribeRobot names the searched
+/// family, and the analytic method returns solutions that the server's own
+/// forward kinematics puts on the pose, the seed's configuration first.
+#[tokio::test]
+async fn offset_wrist_arm_is_searched_and_its_solutions_reach_the_pose() {
+    let server = start(ServerConfig::default()).await;
+    let mut ik = KinematicsServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let robot = Some(pb::RobotRef {
+        source: Some(pb::robot_ref::Source::Urdf(
+            include_str!("../../benches/analytic_ik/offset_wrist_45.urdf").into(),
+        )),
+        ..Default::default()
+    });
+    let d = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: robot.clone(),
+            ..Default::default()
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert_eq!(d.analytic_family, "searched_6r");
+    assert!(d.analytic_reason.is_empty(), "{}", d.analytic_reason);
+    assert!(!d.analytic_reversed);
+    let fk_inline = |q: Vec<f64>| pb::ForwardKinematicsRequest {
+        robot: robot.clone(),
+        joint_positions: q,
+        include_links: false,
+    };
+    let q = vec![0.4, -0.9, 0.7, 1.0, 0.8, -0.5];
+    let pose = robots
+        .forward_kinematics(fk_inline(q.clone()))
+        .await
+        .unwrap()
+        .into_inner()
+        .tool_pose;
+    let reply = ik
+        .solve_ik(pb::SolveIkRequest {
+            robot: robot.clone(),
+            target: pose,
+            seed: q.clone(),
+            options: analytic(1000),
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert!(reply.success);
+    assert!(reply.solutions.len() >= 2);
+    assert!(
+        reply.solutions[0]
+            .joints
+            .iter()
+            .zip(&q)
+            .all(|(a, b)| (a - b).abs() < 1e-8)
+    );
+    let target = crate::poses::iso(pose.as_ref().unwrap());
+    for s in &reply.solutions {
+        assert!(s.config.is_some());
+        let got = robots
+            .forward_kinematics(fk_inline(s.joints.clone()))
+            .await
+            .unwrap()
+            .into_inner();
+        let got = crate::poses::iso(got.tool_pose.as_ref().unwrap());
+        assert!((got.translation.vector - target.translation.vector).norm() < 1e-9);
+        assert!(got.rotation.angle_to(&target.rotation) < 1e-9);
+    }
+}

@@ -43,8 +43,9 @@ class RobotDescription:
 
     @property
     def analytic_family(self) -> str:
-        """The chain's closed-form IK family ("spherical_wrist",
-        "three_parallel", "spherical_two_intersecting"), or "" when ``method="analytic"`` does not apply
+        """The chain's analytic IK family ("spherical_wrist",
+        "three_parallel", "spherical_two_intersecting", or "searched_6r" for a 6-joint offset wrist
+        solved by a 1-D search), or "" when ``method="analytic"`` does not apply
         (then :attr:`analytic_reason` says why)."""
         return "" if self.raw is None else str(self.raw.analytic_family)
 

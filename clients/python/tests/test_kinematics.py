@@ -2,6 +2,7 @@
 answers are checked with the server's forward kinematics (robot.fk), linear
 solves with numpy (lstsq, pinv)."""
 import math
+import pathlib
 
 import grpc
 import numpy as np
@@ -331,3 +332,19 @@ def test_analytic_options_hold_turns_and_start(client):
     far = np.array([1.5, -0.2, 0.3, 0.9, -0.7, 1.4])
     s = robot.ik(T, seed=far, max_restarts=0, analytic_start=True)
     assert s.success and s.iterations == 0
+
+
+def test_analytic_ik_offset_wrist_is_searched(client):
+    # a hand-made 6R arm with an offset wrist (no three axes meet or are parallel)
+    text = (pathlib.Path(__file__).resolve().parents[3] / "benches" / "analytic_ik" / "offset_wrist_45.urdf").read_text()
+    robot = client.robot(urdf=text)
+    d = robot.describe()
+    assert d.analytic_family == "searched_6r" and d.analytic_reason == "" and not d.analytic_reversed
+    q = np.array([0.4, -0.9, 0.7, 1.0, 0.8, -0.5])
+    T = robot.fk(q)
+    r = robot.ik(T, seed=q, method="analytic", num_solutions=1000)
+    assert r.success and len(r.solutions) >= 2
+    assert np.allclose(r.solutions[0].q, q, atol=1e-8)
+    for s in r.solutions:
+        assert np.abs(robot.fk(s.q) - T).max() <= 1e-9
+        assert isinstance(s.config, kinplan.ConfigFlags)

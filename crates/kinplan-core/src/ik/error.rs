@@ -33,6 +33,8 @@ pub enum IkParam {
     SolveTolerance,
     /// `AnalyticParams::redundant_samples`.
     RedundantSamples,
+    /// `AnalyticParams::search_samples`.
+    SearchSamples,
 }
 
 /// A parameter of a sampled path ([`line_path`](super::line_path),
@@ -70,6 +72,7 @@ impl IkParam {
             IkParam::Lengths => "lengths",
             IkParam::GeometryTolerance => "geometry_tolerance",
             IkParam::RedundantSamples => "redundant_samples",
+            IkParam::SearchSamples => "search_samples",
             IkParam::SolveTolerance => "solve_tolerance",
         }
     }

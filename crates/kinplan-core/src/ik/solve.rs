@@ -209,7 +209,20 @@ impl<'c> IkSolver<'c> {
         if params.method == IkMethod::Analytic {
             // validated: the chain is analytic
             if let Ok(arm) = analyse(chain, &params.analytic, seed) {
-                let arm = super::analytic::searched(chain, arm, target, seed, &params.analytic, clock);
+                // Levenberg–Marquardt from the seed (one attempt) lands on a
+                // solution near it; its held value is one more start for the
+                // search. It runs on this solver's workspace.
+                let proposal =
+                    super::analytic::searched_joint(&arm, target, &params.analytic).and_then(|j| {
+                        let seed_q = seed.map_or_else(|| chain.mid_limits(), <[f64]>::to_vec);
+                        let lm = super::analytic::proposal_params();
+                        self.solve_validated(target, Some(&seed_q), &lm, 0, clock)
+                            .solutions
+                            .first()
+                            .map(|s| s.joints[j])
+                    });
+                let arm =
+                    super::analytic::searched(chain, arm, target, seed, proposal, &params.analytic, clock);
                 return super::analytic::front::solve_with(chain, &arm, target, seed, params, clock);
             }
         }

@@ -67,6 +67,7 @@ pub fn param_field(param: IkParam) -> &'static str {
         IkParam::TimeBudget => "options.time_budget",
         IkParam::Lengths => "robot",
         IkParam::RedundantSamples => "options.redundant_samples",
+        IkParam::SearchSamples => "options.search_samples",
         // not settable on the wire (the service uses the domain defaults)
         IkParam::GeometryTolerance | IkParam::SolveTolerance => "options.method",
     }

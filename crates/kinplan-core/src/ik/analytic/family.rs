@@ -22,6 +22,11 @@ pub enum Family {
     /// shoulder): a 7-joint S-R-S arm such as the iiwa with its third joint
     /// held. Up to 8 solutions.
     SphericalTwoIntersecting,
+    /// None of the above from either end, but joints 1–3 place a point in
+    /// closed form (axes 2, 3 parallel, or axes 1, 2 or 2, 3 meeting) and two
+    /// consecutive wrist axes (4, 5 or 5, 6) meet: the third wrist joint is
+    /// searched (an offset wrist). Up to 16 solutions.
+    Searched6R,
 }
 
 impl Family {
@@ -31,6 +36,7 @@ impl Family {
             Family::SphericalWrist => "spherical_wrist",
             Family::ThreeParallel => "three_parallel",
             Family::SphericalTwoIntersecting => "spherical_two_intersecting",
+            Family::Searched6R => "searched_6r",
         }
     }
 }
@@ -113,7 +119,7 @@ pub(crate) fn meet(
     Some(((xa + xb) * 0.5, (xa - xb).norm()))
 }
 
-fn parallel(a: &Vector3<f64>, b: &Vector3<f64>, tol: f64) -> bool {
+pub(crate) fn parallel(a: &Vector3<f64>, b: &Vector3<f64>, tol: f64) -> bool {
     a.cross(b).norm() <= tol
 }
 
@@ -151,6 +157,8 @@ pub struct AnalyticArm {
     /// The family is that of the chain read from the tool end (see
     /// [`Axes6::reversed`]): the solvers invert the pose and reverse the joints.
     pub(super) reversed: bool,
+    /// The searched family's geometry ([`Family::Searched6R`] only).
+    pub(super) search: Option<super::general::SearchGeometry>,
 }
 
 /// The six joints an analytic arm solves for: unit axes `h`, points `p` on
@@ -184,7 +192,7 @@ impl Axes6 {
     }
 }
 
-fn normal_to(h: &Vector3<f64>) -> Vector3<f64> {
+pub(crate) fn normal_to(h: &Vector3<f64>) -> Vector3<f64> {
     let a = if h.x.abs() < 0.9 {
         Vector3::x()
     } else {
@@ -233,7 +241,34 @@ impl AnalyticArm {
                 j.kind == JointKind::Continuous || !(j.upper - j.lower).is_finite()
             }),
         };
-        Self::from_axes(&axes, tol)
+        Self::from_axes6(&axes, tol)
+    }
+
+    /// The family of a 6-joint chain: a closed-form one ([`Self::from_axes`]),
+    /// else the searched one read from the base, else from the tool end.
+    pub(crate) fn from_axes6(axes: &Axes6, tol: f64) -> Result<Self, NotAnalytic> {
+        let closed = match Self::from_axes(axes, tol) {
+            Ok(arm) => return Ok(arm),
+            Err(e) => e,
+        };
+        let forward = match Self::classify_searched(axes, tol) {
+            Ok(arm) => return Ok(arm),
+            Err(e) => e,
+        };
+        match Self::classify_searched(&axes.reversed(), tol) {
+            Ok(mut arm) => {
+                arm.reversed = true;
+                arm.limits = axes.limits;
+                arm.continuous = axes.continuous;
+                Ok(arm)
+            }
+            Err(back) => Err(NotAnalytic {
+                reason: format!(
+                    "{}; for a 1-D search: {}; read from the tool end, {}",
+                    closed.reason, forward.reason, back.reason
+                ),
+            }),
+        }
     }
 
     /// The family of six revolute joints given by their axes: read from the
@@ -312,8 +347,7 @@ impl AnalyticArm {
             (Family::ThreeParallel, w)
         } else {
             return Err(not(
-                "axes 4, 5, 6 do not meet in a point and axes 2, 3, 4 are not parallel (a general \
-                 6-joint arm needs a 1-D search, not implemented)",
+                "axes 4, 5, 6 do not meet in a point and axes 2, 3, 4 are not parallel",
             ));
         };
         let mut forward = h[1].cross(&h[0]).normalize();
@@ -325,11 +359,11 @@ impl AnalyticArm {
         let (far, near) = match family {
             Family::SphericalWrist => (wrist, p[1]),
             Family::ThreeParallel => (p[3], p[1]),
-            Family::SphericalTwoIntersecting => (wrist, shoulder),
+            Family::SphericalTwoIntersecting | Family::Searched6R => (wrist, shoulder),
         };
         let q3_stretched = sp1(&h[2], &(far - p[2]), &(p[2] - near), 1.0).angles[0];
         let singular_with = match family {
-            Family::SphericalWrist | Family::SphericalTwoIntersecting => h[3],
+            Family::SphericalWrist | Family::SphericalTwoIntersecting | Family::Searched6R => h[3],
             Family::ThreeParallel => h[1],
         };
         let q5_singular = sp1(&h[4], &h[5], &singular_with, 1.0).angles[0];
@@ -350,6 +384,7 @@ impl AnalyticArm {
             limits: a.limits,
             continuous: a.continuous,
             reversed: false,
+            search: None,
         })
     }
 

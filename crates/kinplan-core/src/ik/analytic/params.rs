@@ -41,6 +41,12 @@ pub struct AnalyticParams {
     /// search can miss a nearer solution only in a gap between two samples.
     /// Default 24.
     pub redundant_samples: usize,
+    /// 6-joint arms of the searched family (`searched_6r`): evenly spaced
+    /// values (count, ≥ 8) of the searched joint over its circle at which
+    /// the residual is sampled; a solution is missed only where two of one
+    /// branch lie within `2π/search_samples` rad of each other in that joint
+    /// (or at a tangent zero). Default 128.
+    pub search_samples: usize,
 }
 
 impl Default for AnalyticParams {
@@ -53,6 +59,7 @@ impl Default for AnalyticParams {
             redundant_joint: None,
             search_redundant: false,
             redundant_samples: 24,
+            search_samples: 128,
         }
     }
 }
@@ -77,6 +84,13 @@ impl AnalyticParams {
                 field: IkParam::RedundantSamples,
                 value: self.redundant_samples as f64,
                 reason: "must be at least 2 and at most 4096",
+            });
+        }
+        if !(8..=MAX_SAMPLES).contains(&self.search_samples) {
+            return Err(IkError::InvalidParam {
+                field: IkParam::SearchSamples,
+                value: self.search_samples as f64,
+                reason: "must be at least 8 and at most 4096",
             });
         }
         Ok(())

@@ -156,7 +156,7 @@ impl ChainModel {
         let default = match &axes {
             Err(e) => Err(e.clone()),
             Ok(a) if a.n == 6 => {
-                AnalyticArm::from_axes(&a.six(), tol).map(|arm| Default6or7::Six(Box::new(arm)))
+                AnalyticArm::from_axes6(&a.six(), tol).map(|arm| Default6or7::Six(Box::new(arm)))
             }
             Ok(a) => default_hold(a, tol).map(Default6or7::Hold),
         };
@@ -174,7 +174,7 @@ impl ChainModel {
 }
 
 const NONE_COVERED: &str = "it has 7 joints and holding any one of them leaves no covered 6-joint arm, read from \
-                            either end (a general 6-joint arm needs a 1-D search, not implemented)";
+                            either end (the searched 6-joint family is not offered with a held joint)";
 
 /// The first joint of [`HOLD_ORDER`] whose holding leaves a covered arm, read
 /// at two values so that a value special to the geometry (the Panda's joint 5
@@ -280,7 +280,7 @@ pub fn analyse(
                 arm: (**arm).clone(),
                 held: None,
             }),
-            _ => AnalyticArm::from_axes(&axes.six(), tol).map(|arm| ReducedArm { arm, held: None }),
+            _ => AnalyticArm::from_axes6(&axes.six(), tol).map(|arm| ReducedArm { arm, held: None }),
         };
     }
     let value = |j: usize| match seed {

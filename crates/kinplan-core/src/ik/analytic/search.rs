@@ -9,7 +9,7 @@ use super::redundant::{ChainAxes, ChainModel, ReducedArm, hold_at};
 use super::solve::AnalyticSolution;
 use super::turned::TurnedArm;
 use crate::ik::attempt::Clock;
-use crate::ik::{IkMethod, IkParams, IkSolver, IkTarget};
+use crate::ik::{IkMethod, IkParams, IkTarget};
 use crate::robot::Chain;
 
 /// Brent's minimiser stops when the bracket is this narrow (rad).
@@ -489,38 +489,53 @@ fn brent(
     (x, fx)
 }
 
+/// The joint whose value [`searched`] searches for `target`: the held joint
+/// of a 7-joint chain with [`AnalyticParams::search_redundant`] and a pose
+/// target; `None` otherwise.
+pub(crate) fn searched_joint(
+    reduced: &ReducedArm,
+    target: &IkTarget,
+    params: &AnalyticParams,
+) -> Option<usize> {
+    match (reduced.held, params.search_redundant, target) {
+        (Some((j, _)), true, IkTarget::Pose(_)) => Some(j),
+        _ => None,
+    }
+}
+
+/// The Levenberg–Marquardt options of the search's proposal: one attempt
+/// from the seed, no restarts, one solution.
+pub(crate) fn proposal_params() -> IkParams {
+    IkParams {
+        method: IkMethod::LevenbergMarquardt,
+        max_restarts: 0,
+        num_solutions: 1,
+        analytic_start: false,
+        ..IkParams::default()
+    }
+}
+
 /// With [`AnalyticParams::search_redundant`] and a 7-joint chain: `reduced`
-/// with its held joint moved to the value [`search_held`] finds for `target`;
+/// with its held joint moved to the value [`search_held`] finds for `target`,
+/// `proposal` being the held value of a Levenberg–Marquardt solve from the
+/// seed ([`proposal_params`], run by the caller on its own solver workspace);
 /// otherwise `reduced` unchanged.
 pub(crate) fn searched(
     chain: &Chain,
     reduced: ReducedArm,
     target: &IkTarget,
     seed: Option<&[f64]>,
+    proposal: Option<f64>,
     params: &AnalyticParams,
     clock: &Clock<'_>,
 ) -> ReducedArm {
-    let (Some((j, _)), true, IkTarget::Pose(pose)) = (reduced.held, params.search_redundant, target) else {
+    let (Some(j), IkTarget::Pose(pose)) = (searched_joint(&reduced, target, params), target) else {
         return reduced;
     };
     let Ok(axes) = ChainModel::of_chain(chain).axes() else {
         return reduced;
     };
     let seed_q = seed.map_or_else(|| chain.mid_limits(), <[f64]>::to_vec);
-    // Levenberg–Marquardt from the seed (one attempt, no restarts) lands on a
-    // solution near it; its held value is one more start for the search
-    let lm = IkParams {
-        method: IkMethod::LevenbergMarquardt,
-        max_restarts: 0,
-        num_solutions: 1,
-        analytic_start: false,
-        ..IkParams::default()
-    };
-    let proposal = IkSolver::new(chain)
-        .solve_validated(target, Some(&seed_q), &lm, 0, clock)
-        .solutions
-        .first()
-        .map(|s| s.joints[j]);
     let v = search_held(axes, j, pose, &seed_q, proposal, params, clock);
     hold_at(axes, j, v, params.geometry_tolerance).unwrap_or(reduced)
 }

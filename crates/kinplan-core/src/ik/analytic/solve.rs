@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::family::{AnalyticArm, Family};
 use super::params::{AnalyticParams, Turns};
-use super::subproblems::{Angles, rot, sp1, sp2, sp3, sp4, wrap};
+use super::subproblems::{Angles, ceil_i, floor_i, rot, round_f, sp1, sp2, sp3, sp4, wrap};
 
 /// Most whole-turn variants returned per joint with [`Turns::All`].
 pub const MAX_TURNS: usize = 4;
@@ -38,7 +38,7 @@ pub struct AnalyticSolution {
 }
 
 /// The choice for a free angle: the seed's value, wrapped.
-fn pick(a: Angles, seed: f64) -> Angles {
+pub(super) fn pick(a: Angles, seed: f64) -> Angles {
     if a.free {
         Angles {
             angles: [wrap(seed), wrap(seed)],
@@ -49,15 +49,19 @@ fn pick(a: Angles, seed: f64) -> Angles {
     }
 }
 
-/// Up to 8 base solutions (angles in (−π, π]).
-struct Base {
-    n: usize,
-    sols: [AnalyticSolution; 8],
+/// Most base solutions of one pose: 8 for the closed-form families, 16 for a
+/// general 6-joint arm (the degree of its characteristic polynomial).
+const MAX_BASE: usize = 16;
+
+/// Up to [`MAX_BASE`] base solutions (angles in (−π, π]).
+pub(super) struct Base {
+    pub(super) n: usize,
+    pub(super) sols: [AnalyticSolution; MAX_BASE],
 }
 
 impl Base {
-    fn push(&mut self, joints: [f64; 6], config: ConfigFlags, singular: bool, exact: bool) {
-        if self.n < 8 {
+    pub(super) fn push(&mut self, joints: [f64; 6], config: ConfigFlags, singular: bool, exact: bool) {
+        if self.n < MAX_BASE {
             self.sols[self.n] = AnalyticSolution {
                 joints,
                 config,
@@ -105,6 +109,7 @@ impl AnalyticArm {
         let last = match self.family {
             Family::SphericalWrist | Family::SphericalTwoIntersecting => 2,
             Family::ThreeParallel => 3,
+            Family::Searched6R => return self.searched_config(&q),
         };
         let mut x = self.wrist;
         for i in (1..=last).rev() {
@@ -146,7 +151,12 @@ impl AnalyticArm {
         out: &mut Vec<AnalyticSolution>,
     ) {
         out.clear();
-        let base = self.base_in_order(target, seed, false, params.solve_tolerance, f64::INFINITY);
+        let base = self.base_in_order(
+            target,
+            seed,
+            false,
+            (params.solve_tolerance, f64::INFINITY, params.search_samples),
+        );
         for s in &base.sols[..base.n] {
             self.push_turns(s, seed, params.turns, out);
         }
@@ -162,7 +172,12 @@ impl AnalyticArm {
         out: &mut Vec<AnalyticSolution>,
     ) {
         out.clear();
-        let base = self.base_in_order(target, seed, true, params.solve_tolerance, f64::INFINITY);
+        let base = self.base_in_order(
+            target,
+            seed,
+            true,
+            (params.solve_tolerance, f64::INFINITY, params.search_samples),
+        );
         out.extend_from_slice(&base.sols[..base.n]);
     }
 
@@ -182,7 +197,8 @@ impl AnalyticArm {
         out: &mut Vec<AnalyticSolution>,
     ) {
         out.clear();
-        let base = self.base_in_order(target, Some(seed), false, tol, bound);
+        let samples = AnalyticParams::default().search_samples;
+        let base = self.base_in_order(target, Some(seed), false, (tol, bound, samples));
         out.extend_from_slice(&base.sols[..base.n]);
     }
 
@@ -193,11 +209,10 @@ impl AnalyticArm {
         target: &Isometry3<f64>,
         seed: Option<&[f64]>,
         keep_inexact: bool,
-        tol: f64,
-        bound: f64,
+        (tol, bound, samples): (f64, f64, usize),
     ) -> Base {
         if !self.reversed {
-            return self.base(target, seed, keep_inexact, tol, bound);
+            return self.base(target, seed, keep_inexact, (tol, bound, samples));
         }
         let rseed: Option<[f64; 6]> = seed
             .filter(|s| s.len() == 6)
@@ -206,8 +221,7 @@ impl AnalyticArm {
             &target.inverse(),
             rseed.as_ref().map(|s| &s[..]),
             keep_inexact,
-            tol,
-            bound,
+            (tol, bound, samples),
         );
         for s in &mut base.sols[..base.n] {
             s.joints.reverse();
@@ -220,8 +234,7 @@ impl AnalyticArm {
         target: &Isometry3<f64>,
         seed: Option<&[f64]>,
         keep_inexact: bool,
-        tol: f64,
-        bound: f64,
+        (tol, bound, samples): (f64, f64, usize),
     ) -> Base {
         let g = target * self.m_inv;
         let seed = match seed {
@@ -235,7 +248,7 @@ impl AnalyticArm {
                 config: ConfigFlags::default(),
                 singular: false,
                 exact: true,
-            }; 8],
+            }; MAX_BASE],
         };
         match self.family {
             Family::SphericalWrist => self.spherical(&g, &seed, keep_inexact, tol, &mut base),
@@ -243,6 +256,7 @@ impl AnalyticArm {
             Family::SphericalTwoIntersecting => {
                 self.spherical_shoulder(&g, &seed, (keep_inexact, tol, bound), &mut base)
             }
+            Family::Searched6R => self.searched_6r(&g, &seed, keep_inexact, tol, samples, &mut base),
         }
         base
     }
@@ -443,15 +457,15 @@ impl AnalyticArm {
             let (lo, hi) = self.limits[i];
             if self.continuous[i] {
                 let v = match (turns, seed) {
-                    (Turns::NearestSeed, Some(sd)) => q + TAU * ((sd[i] - q) / TAU).round(),
+                    (Turns::NearestSeed, Some(sd)) => q + TAU * round_f((sd[i] - q) / TAU),
                     _ => q,
                 };
                 cand[i][0] = v;
                 count[i] = 1;
                 continue;
             }
-            let k_lo = ((lo - eps - q) / TAU).ceil() as i64;
-            let k_hi = ((hi + eps - q) / TAU).floor() as i64;
+            let k_lo = ceil_i((lo - eps - q) / TAU);
+            let k_hi = floor_i((hi + eps - q) / TAU);
             if k_lo > k_hi {
                 return; // outside the limits at every turn
             }
@@ -459,13 +473,13 @@ impl AnalyticArm {
             match turns {
                 Turns::NearestSeed => {
                     let target = seed.map_or(0.0, |sd| sd[i]);
-                    let k = (((target - q) / TAU).round() as i64).clamp(k_lo, k_hi);
+                    let k = (round_f((target - q) / TAU) as i64).clamp(k_lo, k_hi);
                     cand[i][0] = clampq(k);
                     count[i] = 1;
                 }
                 Turns::All => {
                     // nearest zero first when there are more than MAX_TURNS
-                    let k0 = ((-q / TAU).round() as i64).clamp(k_lo, k_hi);
+                    let k0 = (round_f(-q / TAU) as i64).clamp(k_lo, k_hi);
                     let mut n = 0;
                     let mut step = 0i64;
                     while n < MAX_TURNS && (k0 - step >= k_lo || k0 + step <= k_hi) {
@@ -489,24 +503,23 @@ impl AnalyticArm {
                 }
             }
         }
-        let mut idx = [0usize; 6];
-        loop {
-            let mut sol = *s;
-            for i in 0..6 {
-                sol.joints[i] = cand[i][idx[i]];
-            }
-            out.push(sol);
-            let mut i = 0;
-            while i < 6 {
-                idx[i] += 1;
-                if idx[i] < count[i] {
-                    break;
+        // the first variant, then for each joint the block so far copied once
+        // per further value of that joint (joint 1 varies fastest): whole
+        // solutions move by block copies, and each copy writes one joint
+        let start = out.len();
+        out.reserve(count.iter().product());
+        let mut first = *s;
+        for (j, c) in first.joints.iter_mut().zip(&cand) {
+            *j = c[0];
+        }
+        out.push(first);
+        for i in 0..6 {
+            let block = out.len() - start;
+            for (c, &v) in cand[i][..count[i]].iter().enumerate().skip(1) {
+                out.extend_from_within(start..start + block);
+                for sol in &mut out[start + c * block..] {
+                    sol.joints[i] = v;
                 }
-                idx[i] = 0;
-                i += 1;
-            }
-            if i == 6 {
-                break;
             }
         }
     }

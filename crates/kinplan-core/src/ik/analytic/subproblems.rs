@@ -83,11 +83,38 @@ pub fn rot(k: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
     )
 }
 
+/// `⌊x⌋`, `⌈x⌉` and `x` rounded half up, as integers, by truncation: the
+/// baseline x86-64 target has no rounding instruction and calls the C
+/// library for `f64::floor` and friends. Exact for `|x| < 2⁵²`; larger or
+/// non-finite values saturate (the callers keep those out).
+#[inline]
+pub(crate) fn floor_i(x: f64) -> i64 {
+    let t = x as i64;
+    t - i64::from(x < t as f64)
+}
+
+#[inline]
+pub(crate) fn ceil_i(x: f64) -> i64 {
+    let t = x as i64;
+    t + i64::from(x > t as f64)
+}
+
+/// `x` rounded half up (as `f64`), falling back to `f64::round` where
+/// truncation is not exact.
+#[inline]
+pub(crate) fn round_f(x: f64) -> f64 {
+    if x.abs() < 4.0e15 {
+        floor_i(x + 0.5) as f64
+    } else {
+        x.round()
+    }
+}
+
 /// Wraps an angle into (−π, π].
 #[inline]
 pub fn wrap(a: f64) -> f64 {
     use std::f64::consts::{PI, TAU};
-    let r = a - TAU * (a / TAU).round();
+    let r = a - TAU * round_f(a / TAU);
     if r <= -PI { r + TAU } else { r }
 }
 
@@ -254,6 +281,37 @@ mod tests {
         let k = v(1.0, 1.0, 1.0).normalize();
         assert!((rot(&k, 2.0 * PI / 3.0) * Vector3::x() - Vector3::y()).norm() < 1e-15);
         assert!((rot(&k, 2.0 * PI / 3.0) * Vector3::y() - Vector3::z()).norm() < 1e-15);
+    }
+
+    #[test]
+    fn truncating_floor_ceil_round_match_the_c_library() {
+        for x in [
+            -3.5f64,
+            -3.0,
+            -2.7,
+            -0.5,
+            -0.2,
+            -0.0,
+            0.0,
+            0.2,
+            0.5,
+            0.7,
+            1.0,
+            2.5,
+            3.2,
+            1e15 + 0.5,
+            -1e15 - 0.5,
+            1e17,
+            -1e17,
+        ] {
+            if x.abs() < 4.0e15 {
+                assert_eq!(floor_i(x), x.floor() as i64, "{x}");
+                assert_eq!(ceil_i(x), x.ceil() as i64, "{x}");
+                assert_eq!(round_f(x), (x + 0.5).floor(), "{x}");
+            } else {
+                assert_eq!(round_f(x), x.round(), "{x}");
+            }
+        }
     }
 
     #[test]
