@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 
 use super::camera::Frustum;
-use crate::octree::{KnownCellCounts, NodeRef, OcKey, Octree, TREE_DEPTH, child_key, key_to_coord_axis};
+use crate::octree::{CountBlock, KnownCellCounts, OcKey, Octree, TREE_DEPTH, child_key, key_to_coord_axis};
 
 /// Unknown cubes of at most `2^ROW_LOG` cells a side that a plane cuts are counted row
 /// by row instead of being split further.
@@ -23,8 +23,10 @@ struct Entry {
     depth: u8,
     /// Planes (bits 0–5) that may still cut this cube.
     mask: u8,
-    node: Option<NodeRef>,
-    /// Known depth-16 cells below `node` (0 when absent).
+    /// The cube's node: [`CountBlock::ABSENT`] (unknown space) or the block of its children in
+    /// [`KnownCellCounts`] (known leaves and wholly known subtrees are never pushed).
+    block: u32,
+    /// Known depth-16 cells below the cube's node (0 when absent).
     known: u64,
 }
 
@@ -33,8 +35,10 @@ struct Entry {
 /// (one pass over the nodes) and shared by every view (and thread) after that.
 ///
 /// Per view, a depth-first walk from the root (a fixed-size stack, no allocation):
+/// - a known leaf, or a subtree whose cells are all known (`known(node) = 8^(16−d)`),
+///   holds no unknown cells and is not visited;
 /// - a cube whose cell centres all lie outside one plane, or outside the key box, is
-///   dropped; a known leaf holds no unknown cells;
+///   dropped;
 /// - a cube inside every plane (planes already cleared by an ancestor are not tested
 ///   again) and inside the key box adds `8^(16−d) − known(node)` cells, in closed form;
 /// - an unknown (absent) cube of at most `2^ROW_LOG` cells a side cut by planes is
@@ -102,30 +106,30 @@ impl<'a> FrustumCounter<'a> {
             }
         }
         let rows = RowCounter::new(planes, res, lo, hi);
+        let known = &self.known;
+        let root = known.root_child();
+        if root == CountBlock::LEAF || known.root() == 1u64 << (3 * TREE_DEPTH as u32) {
+            return 0;
+        }
         let mut stack = [Entry {
             key: [0; 3],
             depth: 0,
             mask: 0,
-            node: None,
+            block: CountBlock::ABSENT,
             known: 0,
         }; STACK];
         stack[0] = Entry {
             key: [0; 3],
             depth: 0,
             mask: 0b11_1111,
-            node: tree.root_ref(),
-            known: self.known.root(),
+            block: root,
+            known: known.root(),
         };
         let mut len = 1usize;
         let mut count = 0u64;
         while len > 0 {
             len -= 1;
             let e = stack[len];
-            if let Some(n) = e.node
-                && !tree.has_children(n)
-            {
-                continue; // a known leaf: no unknown cells
-            }
             let side = 1u32 << (TREE_DEPTH - e.depth);
             let (mut overlaps, mut within) = (true, true);
             for i in 0..3 {
@@ -165,24 +169,36 @@ impl<'a> FrustumCounter<'a> {
                 count += (1u64 << (3 * (TREE_DEPTH - e.depth) as u32)) - e.known;
                 continue;
             }
-            if e.node.is_none() && e.depth >= TREE_DEPTH - ROW_LOG {
-                count += rows.count(&e.key, side, mask);
+            if e.block == CountBlock::ABSENT {
+                if e.depth >= TREE_DEPTH - ROW_LOG {
+                    count += rows.count(&e.key, side, mask);
+                    continue;
+                }
+                for i in 0..8 {
+                    stack[len] = Entry {
+                        key: child_key(&e.key, e.depth, i),
+                        depth: e.depth + 1,
+                        mask,
+                        block: CountBlock::ABSENT,
+                        known: 0,
+                    };
+                    len += 1;
+                }
                 continue;
             }
+            let b = known.block(e.block);
+            // a child of this many cells with as many known holds no unknown one
+            let full = 1u64 << (3 * (TREE_DEPTH - e.depth - 1) as u32);
             for i in 0..8 {
-                let (node, known) = match e.node {
-                    Some(n) => match tree.child_ref(n, i) {
-                        Some(c) => (Some(c), self.known.child(n, i)),
-                        None => (None, 0),
-                    },
-                    None => (None, 0),
-                };
+                if b.child[i] == CountBlock::LEAF || b.known[i] == full {
+                    continue;
+                }
                 stack[len] = Entry {
                     key: child_key(&e.key, e.depth, i),
                     depth: e.depth + 1,
                     mask,
-                    node,
-                    known,
+                    block: b.child[i],
+                    known: b.known[i],
                 };
                 len += 1;
             }
