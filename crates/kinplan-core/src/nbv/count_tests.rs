@@ -332,3 +332,59 @@ fn frontier_and_field_at_the_edge_of_the_key_space() {
         assert!((f[i] - want).abs() < 1e-9, "{f}");
     }
 }
+
+#[test]
+fn a_view_leaving_the_key_space_counts_like_every_cell() {
+    // the key space at 0.1 m ends at ±3276.8 m: the far corners of this view lie beyond
+    // it, so the view's key box is the whole key space and the counter walks the tree
+    let mut t = Octree::new(0.1).unwrap();
+    let m = t.sensor_model().log_odds();
+    for x in 65_520u16..65_535 {
+        for y in 32_760u16..32_772 {
+            for z in 32_764u16..32_770 {
+                if (x as u32 + y as u32 + z as u32) % 3 != 0 {
+                    t.update_key(
+                        &[x, y, z],
+                        if (x as u32 + z as u32) % 4 == 0 {
+                            m.hit
+                        } else {
+                            m.miss
+                        },
+                    );
+                }
+            }
+        }
+    }
+    let cam = CameraModel {
+        hfov: 1.0,
+        vfov: 0.8,
+        near: 0.05,
+        far: 1.5,
+        width: 8,
+        height: 6,
+    };
+    let pose = look_along(&Point3::new(3276.05, 0.03, 0.02), &Vector3::new(1.0, 0.1, -0.05)).unwrap();
+    let f = Frustum::new(&cam, &pose);
+    assert!(f.corners.iter().any(|c| t.key_of(c).is_err()));
+    // every cell centre in the frustum lies in the box of its corners clamped to the key space
+    let clamped = |i: usize, pick: fn(f64, f64) -> f64, init: f64| {
+        let v = f.corners.iter().fold(init, |a, c| pick(a, c[i]));
+        v.clamp(-3276.75, 3276.75)
+    };
+    let lo_p = Point3::new(
+        clamped(0, f64::min, f64::MAX),
+        clamped(1, f64::min, f64::MAX),
+        clamped(2, f64::min, f64::MAX),
+    );
+    let hi_p = Point3::new(
+        clamped(0, f64::max, f64::MIN),
+        clamped(1, f64::max, f64::MIN),
+        clamped(2, f64::max, f64::MIN),
+    );
+    let (lo, hi) = (t.key_of(&lo_p).unwrap(), t.key_of(&hi_p).unwrap());
+    let n = brute(&t, &f, lo, hi);
+    // some cells of the view known, some not
+    let all = brute(&Octree::new(0.1).unwrap(), &f, lo, hi);
+    assert!(n > 30 && n < all, "{n} {all}");
+    assert_eq!(FrustumCounter::new(&t).count(&f), n);
+}
