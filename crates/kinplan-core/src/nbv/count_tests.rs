@@ -342,10 +342,10 @@ fn a_view_leaving_the_key_space_counts_like_every_cell() {
     for x in 65_520u16..65_535 {
         for y in 32_760u16..32_772 {
             for z in 32_764u16..32_770 {
-                if (x as u32 + y as u32 + z as u32) % 3 != 0 {
+                if !(x as u32 + y as u32 + z as u32).is_multiple_of(3) {
                     t.update_key(
                         &[x, y, z],
-                        if (x as u32 + z as u32) % 4 == 0 {
+                        if (x as u32 + z as u32).is_multiple_of(4) {
                             m.hit
                         } else {
                             m.miss
