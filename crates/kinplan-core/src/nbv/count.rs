@@ -47,9 +47,9 @@ struct Entry {
 /// - `known`: a depth-first walk over the known nodes only: a node inside every plane
 ///   (planes already cleared by an ancestor are not tested again) and inside the key
 ///   box adds `known(node)`, one outside a plane or the key box nothing, a known leaf
-///   of at most `2^ROW_LOG` cells a side cut by planes its cells inside them row by
-///   row (larger leaves are split virtually first), an inner node its children that
-///   hold known cells.
+///   or wholly known subtree of at most `2^ROW_LOG` cells a side cut by planes its
+///   cells inside them row by row (larger ones are split virtually first), an inner
+///   node its children that hold known cells.
 ///
 /// A view whose corners leave the key space (its key box is the whole key space) is
 /// counted by one walk over known and unknown space alike instead: known leaves and
@@ -279,7 +279,8 @@ impl<'a> FrustumCounter<'a> {
                 count += e.known;
                 continue;
             }
-            if e.block == CountBlock::LEAF {
+            // a leaf, or a subtree whose cells are all known: its cells inside the planes
+            if e.block == CountBlock::LEAF || e.known == 1u64 << (3 * (TREE_DEPTH - e.depth) as u32) {
                 if e.depth >= TREE_DEPTH - ROW_LOG {
                     count += rows.count(&e.key, side, mask);
                 } else {
