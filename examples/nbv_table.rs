@@ -277,5 +277,17 @@ fn main() {
                 b.utility, b.distance_term, b.rotation_term, b.ig, b.reachable
             );
         }
+        // the whole ranking in one number (FNV-1a over each ranked candidate's position,
+        // unknown cells and utility), to compare builds
+        let mut h = 0xcbf2_9ce4_8422_2325u64;
+        for c in &r.candidates {
+            let p = c.pose.translation.vector;
+            for v in [p.x, p.y, p.z, c.unknown_cells, c.utility] {
+                for byte in v.to_bits().to_le_bytes() {
+                    h = (h ^ byte as u64).wrapping_mul(0x0100_0000_01b3);
+                }
+            }
+        }
+        eprintln!("{name}: {} ranked, ranking digest {h:016x}", r.candidates.len());
     }
 }

@@ -144,6 +144,36 @@ async fn an_exploration_streams_iterations_then_a_summary_with_the_tree() {
 }
 
 #[tokio::test]
+async fn an_exploration_with_the_shared_near_field_knows_what_the_exact_inserts_know() {
+    let server = start(ServerConfig::default()).await;
+    let mut client = ExplorationServiceClient::new(server.channel.clone());
+    let mut summaries = Vec::new();
+    for spacing in [None, Some(0.7)] {
+        let mut r = request();
+        r.near_ray_spacing = spacing;
+        r.stop.as_mut().unwrap().max_iterations = Some(1);
+        let mut stream = client.explore(r).await.unwrap().into_inner();
+        let mut summary = None;
+        while let Some(msg) = stream.message().await.unwrap() {
+            if let Event::Summary(s) = msg.event.unwrap() {
+                summary = Some(s);
+            }
+        }
+        summaries.push(summary.expect("a summary closes the stream"));
+    }
+    // the initial sweep's scans: the same cells known to within a few per thousand
+    let (exact, shared) = (&summaries[0], &summaries[1]);
+    assert_eq!(exact.observable_cells, shared.observable_cells);
+    assert!(exact.initial_known_ratio > 0.0);
+    assert!(
+        (exact.initial_known_ratio - shared.initial_known_ratio).abs() <= 0.005,
+        "{} {}",
+        exact.initial_known_ratio,
+        shared.initial_known_ratio
+    );
+}
+
+#[tokio::test]
 async fn bad_exploration_requests_are_named_by_field() {
     let server = start(ServerConfig::default()).await;
     let mut client = ExplorationServiceClient::new(server.channel.clone());
@@ -224,7 +254,13 @@ async fn bad_exploration_requests_are_named_by_field() {
     stride.pixel_stride = Some(0);
     let mut noise = request();
     noise.noise_stddev = Some(-1.0);
-    for (field, req) in [("pixel_stride", stride), ("noise_stddev", noise)] {
+    let mut near = request();
+    near.near_ray_spacing = Some(1.5);
+    for (field, req) in [
+        ("pixel_stride", stride),
+        ("noise_stddev", noise),
+        ("near_ray_spacing", near),
+    ] {
         let Err(err) = client.explore(req).await else {
             panic!("{field}: accepted");
         };

@@ -395,7 +395,9 @@ class Client:
         by default). ``nbv`` takes ``NbvOptions`` fields, ``plan_options``
         ``PlanOptions`` fields (e.g. ``{"stomp": {"timesteps": 20}}``), and
         further ``options`` the remaining ``ExploreRequest`` fields
-        (``noise_stddev``, ``candidates_per_iteration``, ``plan_time_budget``,
+        (``noise_stddev``, ``near_ray_spacing`` — cells in [0, 1], each scan
+        inserted as its depth image with the beams' near field shared, 0 by
+        default —, ``candidates_per_iteration``, ``plan_time_budget``,
         ``time_budget``)."""
         call = _exploration.explore(
             self.robot, robot, scene, start, region, planner, weights, seed, resolution, pixel_stride, known_ratio,

@@ -393,7 +393,7 @@ class ExploreStopRule(_message.Message):
     def __init__(self, known_ratio: _Optional[float] = ..., max_iterations: _Optional[int] = ..., max_consecutive_failures: _Optional[int] = ...) -> None: ...
 
 class ExploreRequest(_message.Message):
-    __slots__ = ("robot", "start", "scene", "region", "camera", "camera_mount", "nbv", "algorithm", "plan_options", "stop", "resolution", "pixel_stride", "noise_stddev", "candidates_per_iteration", "plan_time_budget", "initial_offsets", "no_initial_offsets", "extra_views", "no_extra_views", "seed", "time_budget", "visibility", "no_visibility_check", "camera_link")
+    __slots__ = ("robot", "start", "scene", "region", "camera", "camera_mount", "nbv", "algorithm", "plan_options", "stop", "resolution", "pixel_stride", "noise_stddev", "near_ray_spacing", "candidates_per_iteration", "plan_time_budget", "initial_offsets", "no_initial_offsets", "extra_views", "no_extra_views", "seed", "time_budget", "visibility", "no_visibility_check", "camera_link")
     ROBOT_FIELD_NUMBER: _ClassVar[int]
     START_FIELD_NUMBER: _ClassVar[int]
     SCENE_FIELD_NUMBER: _ClassVar[int]
@@ -407,6 +407,7 @@ class ExploreRequest(_message.Message):
     RESOLUTION_FIELD_NUMBER: _ClassVar[int]
     PIXEL_STRIDE_FIELD_NUMBER: _ClassVar[int]
     NOISE_STDDEV_FIELD_NUMBER: _ClassVar[int]
+    NEAR_RAY_SPACING_FIELD_NUMBER: _ClassVar[int]
     CANDIDATES_PER_ITERATION_FIELD_NUMBER: _ClassVar[int]
     PLAN_TIME_BUDGET_FIELD_NUMBER: _ClassVar[int]
     INITIAL_OFFSETS_FIELD_NUMBER: _ClassVar[int]
@@ -431,6 +432,7 @@ class ExploreRequest(_message.Message):
     resolution: float
     pixel_stride: int
     noise_stddev: float
+    near_ray_spacing: float
     candidates_per_iteration: int
     plan_time_budget: float
     initial_offsets: _common_pb2.Matrix
@@ -442,7 +444,7 @@ class ExploreRequest(_message.Message):
     visibility: VisibilityCheck
     no_visibility_check: bool
     camera_link: str
-    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., start: _Optional[_Iterable[float]] = ..., scene: _Optional[_Union[_common_pb2.Scene, _Mapping]] = ..., region: _Optional[_Union[BoundingBox, _Mapping]] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ..., camera_mount: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., nbv: _Optional[_Union[NbvOptions, _Mapping]] = ..., algorithm: _Optional[_Union[_planning_pb2.PlanAlgorithm, str]] = ..., plan_options: _Optional[_Union[_planning_pb2.PlanOptions, _Mapping]] = ..., stop: _Optional[_Union[ExploreStopRule, _Mapping]] = ..., resolution: _Optional[float] = ..., pixel_stride: _Optional[int] = ..., noise_stddev: _Optional[float] = ..., candidates_per_iteration: _Optional[int] = ..., plan_time_budget: _Optional[float] = ..., initial_offsets: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., no_initial_offsets: _Optional[bool] = ..., extra_views: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., no_extra_views: _Optional[bool] = ..., seed: _Optional[int] = ..., time_budget: _Optional[float] = ..., visibility: _Optional[_Union[VisibilityCheck, _Mapping]] = ..., no_visibility_check: _Optional[bool] = ..., camera_link: _Optional[str] = ...) -> None: ...
+    def __init__(self, robot: _Optional[_Union[_common_pb2.RobotRef, _Mapping]] = ..., start: _Optional[_Iterable[float]] = ..., scene: _Optional[_Union[_common_pb2.Scene, _Mapping]] = ..., region: _Optional[_Union[BoundingBox, _Mapping]] = ..., camera: _Optional[_Union[CameraModel, _Mapping]] = ..., camera_mount: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., nbv: _Optional[_Union[NbvOptions, _Mapping]] = ..., algorithm: _Optional[_Union[_planning_pb2.PlanAlgorithm, str]] = ..., plan_options: _Optional[_Union[_planning_pb2.PlanOptions, _Mapping]] = ..., stop: _Optional[_Union[ExploreStopRule, _Mapping]] = ..., resolution: _Optional[float] = ..., pixel_stride: _Optional[int] = ..., noise_stddev: _Optional[float] = ..., near_ray_spacing: _Optional[float] = ..., candidates_per_iteration: _Optional[int] = ..., plan_time_budget: _Optional[float] = ..., initial_offsets: _Optional[_Union[_common_pb2.Matrix, _Mapping]] = ..., no_initial_offsets: _Optional[bool] = ..., extra_views: _Optional[_Iterable[_Union[_common_pb2.Pose, _Mapping]]] = ..., no_extra_views: _Optional[bool] = ..., seed: _Optional[int] = ..., time_budget: _Optional[float] = ..., visibility: _Optional[_Union[VisibilityCheck, _Mapping]] = ..., no_visibility_check: _Optional[bool] = ..., camera_link: _Optional[str] = ...) -> None: ...
 
 class FailedView(_message.Message):
     __slots__ = ("position", "reason")

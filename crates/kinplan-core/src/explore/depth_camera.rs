@@ -21,6 +21,13 @@ pub struct SensorParams {
     /// Standard deviation of Gaussian noise added to each measured depth (m,
     /// ≥ 0). Default 0.
     pub noise_stddev: f64,
+    /// The near field of the image's beams is shared when the scan is
+    /// inserted ([`ScanParams::near_ray_spacing`](crate::octree::ScanParams::near_ray_spacing),
+    /// docs/octree.md#whole-frame-insertion): close to the camera only a
+    /// lattice of beams at most this far apart is traced (cells, in [0, 1]);
+    /// 0 inserts the image's points with every beam traced from the camera
+    /// (OctoMap's `insertPointCloud`). Default 0.
+    pub near_ray_spacing: f64,
 }
 
 impl Default for SensorParams {
@@ -28,6 +35,7 @@ impl Default for SensorParams {
         SensorParams {
             pixel_stride: 4,
             noise_stddev: 0.0,
+            near_ray_spacing: 0.0,
         }
     }
 }
@@ -138,6 +146,20 @@ pub fn render_depth_until(
         height: rows.len(),
         depth,
     })
+}
+
+/// The pinhole intrinsics of the pixel grid [`render_depth`] casts at `stride`:
+/// image pixel `(c, r)` is camera pixel `(c·s, r·s)`, so
+/// `(u − cx)/fx = (c − cx/s)/(fx/s)` and likewise in y.
+pub fn strided_intrinsics(camera: &CameraModel, stride: usize) -> crate::octree::PinholeIntrinsics {
+    let s = stride.max(1) as f64;
+    let k = camera.intrinsics();
+    crate::octree::PinholeIntrinsics {
+        fx: k.fx / s,
+        fy: k.fy / s,
+        cx: k.cx / s,
+        cy: k.cy / s,
+    }
 }
 
 /// The base-frame points of `image` (rendered by [`render_depth`] with the

@@ -12,7 +12,9 @@ mod world_model;
 #[cfg(test)]
 mod tests;
 
-pub use depth_camera::{DepthImage, SensorParams, depth_to_points, render_depth, render_depth_until};
+pub use depth_camera::{
+    DepthImage, SensorParams, depth_to_points, render_depth, render_depth_until, strided_intrinsics,
+};
 pub use error::{ExploreError, ExploreField};
 pub use params::{ExploreParams, MAX_RAYS_PER_IMAGE, MAX_REGION_CELLS, StopRule};
 pub use run::{

@@ -219,6 +219,9 @@ impl ExploreParams {
         if !(self.sensor.noise_stddev.is_finite() && self.sensor.noise_stddev >= 0.0) {
             return bad(F::NoiseStddev, "must be finite and ≥ 0");
         }
+        if !(0.0..=1.0).contains(&self.sensor.near_ray_spacing) {
+            return bad(F::NearRaySpacing, "must lie in [0, 1] cells");
+        }
         if !(self.stop.known_ratio > 0.0 && self.stop.known_ratio <= 1.0) {
             return bad(F::KnownRatio, "must lie in (0, 1]");
         }

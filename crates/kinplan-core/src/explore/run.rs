@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use nalgebra::{Isometry3, Point3};
 
-use super::depth_camera::{depth_to_points, render_depth_until};
+use super::depth_camera::{depth_to_points, render_depth_until, strided_intrinsics};
 use super::world_model::{ObservableCells, occupied_obstacles};
 use super::{ExploreError, ExploreField, ExploreParams};
 use crate::collision::{
@@ -221,25 +221,38 @@ impl Explorer<'_> {
         ) else {
             return Ok((us(t0), 0)); // stopped: nothing inserted
         };
-        let points = depth_to_points(
-            &image,
-            &self.params.camera,
-            &pose,
-            self.params.sensor.pixel_stride,
-        );
+        let sensor = self.params.sensor;
+        // with the near field shared the image itself goes in, else its points
+        let points = (sensor.near_ray_spacing <= 0.0)
+            .then(|| depth_to_points(&image, &self.params.camera, &pose, sensor.pixel_stride));
         let sense = us(t0);
         let t1 = Instant::now();
-        let o = pose.translation.vector;
-        let origin = [o.x as f32, o.y as f32, o.z as f32];
-        let stats = self
-            .tree
-            // a view rendered in time is inserted whole: only a cancellation stops it
-            .insert_scan(
-                &points,
-                &origin,
-                &ScanParams::default(),
-                self.deadline.without_instant(),
-            )?;
+        // a view rendered in time is inserted whole: only a cancellation stops it
+        let deadline = self.deadline.without_instant();
+        let stats = match points {
+            Some(points) => {
+                let o = pose.translation.vector;
+                let origin = [o.x as f32, o.y as f32, o.z as f32];
+                self.tree
+                    .insert_scan(&points, &origin, &ScanParams::default(), deadline)?
+            }
+            None => {
+                let k = strided_intrinsics(&self.params.camera, sensor.pixel_stride);
+                let scan = ScanParams {
+                    near_ray_spacing: sensor.near_ray_spacing,
+                    ..ScanParams::default()
+                };
+                self.tree.insert_depth_image(
+                    &image.depth,
+                    image.width,
+                    image.height,
+                    &k,
+                    &pose,
+                    &scan,
+                    deadline,
+                )?
+            }
+        };
         if stats.status == ScanStatus::Inserted {
             self.scans += 1;
         }

@@ -39,6 +39,7 @@ fn a_wall_at_known_distance_gives_that_depth_in_every_pixel() {
     let sensor = SensorParams {
         pixel_stride: 1,
         noise_stddev: 0.0,
+        ..SensorParams::default()
     };
     let img = render_depth(&world, &cam, &pose, &sensor, 0);
     assert_eq!((img.width, img.height), (41, 31));
@@ -71,6 +72,7 @@ fn a_sphere_is_seen_at_the_distance_of_its_surface_and_out_of_range_is_no_return
     let sensor = SensorParams {
         pixel_stride: 1,
         noise_stddev: 0.0,
+        ..SensorParams::default()
     };
     let img = render_depth(&world, &cam, &pose, &sensor, 0);
     // the centre pixel (20, 15) looks straight at the sphere: depth 3 − r
@@ -90,6 +92,7 @@ fn a_sphere_is_seen_at_the_distance_of_its_surface_and_out_of_range_is_no_return
     let noisy = SensorParams {
         pixel_stride: 1,
         noise_stddev: 0.01,
+        ..SensorParams::default()
     };
     let a = render_depth(&world, &cam, &pose, &noisy, 7);
     assert_eq!(a, render_depth(&world, &cam, &pose, &noisy, 7));
@@ -291,6 +294,11 @@ fn bad_parameters_are_refused_naming_the_field() {
     let mut p = base.clone();
     p.sensor.pixel_stride = 0;
     assert_eq!(field_of(&p, &scene.start), Some(ExploreField::PixelStride));
+    for v in [-0.1, 1.5, f64::NAN] {
+        let mut p = base.clone();
+        p.sensor.near_ray_spacing = v;
+        assert_eq!(field_of(&p, &scene.start), Some(ExploreField::NearRaySpacing));
+    }
     // 2048 x 2048 rays at stride 1 is more than one image may cast
     let mut p = base.clone();
     p.camera.width = 2048;
@@ -417,6 +425,7 @@ fn a_depth_image_from_the_simulated_camera_inserts_like_its_points() {
     let sensor = SensorParams {
         pixel_stride: 1,
         noise_stddev: 0.0,
+        ..SensorParams::default()
     };
     let img = render_depth(&world, &cam, &pose, &sensor, 0);
     assert!(img.returns() > 96 * 72 / 2);
@@ -472,4 +481,76 @@ fn a_depth_image_from_the_simulated_camera_inserts_like_its_points() {
         .unwrap();
     assert_eq!(cells_of(&by_mm_points), cells_of(&by_mm));
     assert!(depth_from_millimetres(&mm[1..], "depth_mm").is_err());
+}
+
+#[test]
+fn a_strided_image_with_the_shared_near_field_inserts_like_its_points() {
+    use crate::octree::{NEAR_RAY_SPACING, Octree, ScanParams};
+    // the explore loop's scan: a Kinect v2 image at stride 4, 0.1 m cells; a wall,
+    // a box close to the camera and a ball
+    let world = geometry(vec![
+        Obstacle::new(
+            "wall",
+            Isometry3::translation(3.6, 0.0, 0.0),
+            Geometry::Box {
+                half_extents: Vector3::new(0.1, 5.0, 5.0),
+            },
+        ),
+        Obstacle::new(
+            "box",
+            Isometry3::translation(0.9, 0.3, -0.2),
+            Geometry::Box {
+                half_extents: Vector3::new(0.2, 0.25, 0.3),
+            },
+        ),
+        Obstacle::new(
+            "ball",
+            Isometry3::translation(2.2, -0.6, 0.4),
+            Geometry::Sphere { radius: 0.35 },
+        ),
+    ]);
+    let cam = CameraModel::default();
+    let stride = SensorParams::default().pixel_stride;
+    let pose = look_along(&Point3::new(0.02, 0.03, 0.01), &Vector3::new(1.0, 0.05, -0.1)).unwrap();
+    let sensor = SensorParams::default();
+    let img = render_depth(&world, &cam, &pose, &sensor, 0);
+    assert_eq!((img.width, img.height), (128, 106));
+    let o = pose.translation.vector;
+    let origin = [o.x as f32, o.y as f32, o.z as f32];
+    // the reference: the points along each cast pixel's unit ray, every beam traced
+    let mut by_points = Octree::new(0.1).unwrap();
+    by_points
+        .insert_scan(
+            &depth_to_points(&img, &cam, &pose, stride),
+            &origin,
+            &ScanParams::default(),
+            Deadline::none(),
+        )
+        .unwrap();
+    let k = strided_intrinsics(&cam, stride);
+    let image = |spacing: f64| {
+        let mut t = Octree::new(0.1).unwrap();
+        let p = ScanParams {
+            near_ray_spacing: spacing,
+            ..ScanParams::default()
+        };
+        t.insert_depth_image(&img.depth, img.width, img.height, &k, &pose, &p, Deadline::none())
+            .unwrap();
+        cells_of(&t)
+    };
+    let reference = cells_of(&by_points);
+    assert!(reference.len() > 5000, "{}", reference.len());
+    // the strided intrinsics put every pixel on its ray: the same cells
+    assert_eq!(image(0.0), reference);
+    // the shared near field: at least 99.9 % of the known cells classified the same
+    let shared = image(NEAR_RAY_SPACING);
+    let a: std::collections::HashMap<[u16; 3], bool> = reference.into_iter().collect();
+    let b: std::collections::HashMap<[u16; 3], bool> = shared.into_iter().collect();
+    let differ = a.iter().filter(|(k, v)| b.get(*k) != Some(*v)).count()
+        + b.keys().filter(|k| !a.contains_key(*k)).count();
+    let known = a.len().max(b.len());
+    assert!(
+        (differ as f64) <= 0.001 * known as f64,
+        "{differ} of {known} cells differ"
+    );
 }

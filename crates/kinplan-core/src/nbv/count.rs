@@ -5,7 +5,7 @@
 use nalgebra::Vector3;
 
 use super::camera::Frustum;
-use crate::octree::{KnownCellCounts, NodeRef, OcKey, Octree, TREE_DEPTH, child_key, key_to_coord_axis};
+use crate::octree::{CountBlock, KnownCellCounts, OcKey, Octree, TREE_DEPTH, child_key, key_to_coord_axis};
 
 /// Unknown cubes of at most `2^ROW_LOG` cells a side that a plane cuts are counted row
 /// by row instead of being split further.
@@ -23,8 +23,10 @@ struct Entry {
     depth: u8,
     /// Planes (bits 0–5) that may still cut this cube.
     mask: u8,
-    node: Option<NodeRef>,
-    /// Known depth-16 cells below `node` (0 when absent).
+    /// The cube's node: [`CountBlock::ABSENT`] (unknown space) or the block of its children in
+    /// [`KnownCellCounts`] (known leaves and wholly known subtrees are never pushed).
+    block: u32,
+    /// Known depth-16 cells below the cube's node (0 when absent).
     known: u64,
 }
 
@@ -32,21 +34,32 @@ struct Entry {
 /// known-cell counts ([`KnownCellCounts`]) are built once in [`FrustumCounter::new`]
 /// (one pass over the nodes) and shared by every view (and thread) after that.
 ///
-/// Per view, a depth-first walk from the root (a fixed-size stack, no allocation):
-/// - a cube whose cell centres all lie outside one plane, or outside the key box, is
-///   dropped; a known leaf holds no unknown cells;
-/// - a cube inside every plane (planes already cleared by an ancestor are not tested
-///   again) and inside the key box adds `8^(16−d) − known(node)` cells, in closed form;
-/// - an unknown (absent) cube of at most `2^ROW_LOG` cells a side cut by planes is
-///   counted row by row: along the row axis each cutting plane `n·c + d ≥ 0` bounds the
-///   cells to one interval, found from the crossing `x* = −(n_b·c_b + n_c·c_c + d)/n_a`
-///   and then confirmed with the per-cell test itself (the test is monotone along a
-///   row), so the count equals the count of every cell centre;
-/// - anything else is split into its eight children (absent space virtually).
+/// Per view (fixed-size stacks, no allocation), `unknown = all − known` over the cells
+/// whose centres lie in the frustum and whose keys lie in the view's key box:
+/// - `all`: columns of cells along the axis the view direction is steepest in, in
+///   tiles of 16 × 16 columns spanning the key box; a tile whose cell centres all pass
+///   every plane adds its volume, one whose centres all fail a plane nothing, and the
+///   others are counted row by row: along the row axis each cutting plane
+///   `n·c + d ≥ 0` bounds the cells to one interval, found from the crossing
+///   `x* = −(n_b·c_b + n_c·c_c + d)/n_a` and confirmed with the per-cell test itself
+///   wherever the crossing lies within rounding of a cell centre (the test is monotone
+///   along a row), so the count equals the count of every cell centre;
+/// - `known`: a depth-first walk over the known nodes only: a node inside every plane
+///   (planes already cleared by an ancestor are not tested again) and inside the key
+///   box adds `known(node)`, one outside a plane or the key box nothing, a known leaf
+///   or wholly known subtree of at most `2^ROW_LOG` cells a side cut by planes its
+///   cells inside them row by row (larger ones are split virtually first), an inner
+///   node its children that hold known cells.
+///
+/// A view whose corners leave the key space (its key box is the whole key space) is
+/// counted by one walk over known and unknown space alike instead: known leaves and
+/// wholly known subtrees skipped, a cube inside every plane adding
+/// `8^(16−d) − known(node)`, unknown cubes of at most `2^ROW_LOG` cells a side cut by
+/// planes counted row by row, anything else split.
 ///
 /// The cube test uses the centre `c` of the cube's cell centres and their half span
 /// `h = (size − res)/2`: all inside plane j when `n·c + d − h·‖n‖₁ ≥ ε`, all outside when
-/// `n·c + d + h·‖n‖₁ < −ε`.
+/// `n·c + d + h·‖n‖₁ < −ε` (per axis half spans `h_i` for tiles: `Σ|n_i|·h_i`).
 #[derive(Debug, Clone)]
 pub struct FrustumCounter<'a> {
     tree: &'a Octree,
@@ -102,30 +115,46 @@ impl<'a> FrustumCounter<'a> {
             }
         }
         let rows = RowCounter::new(planes, res, lo, hi);
+        // columns along the axis the view direction (the near plane's normal) is
+        // steepest in
+        let a = rows.axis[0];
+        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+        let columns = (hi[b] - lo[b]) as u64 * (hi[c] - lo[c]) as u64;
+        if columns > MAX_COLUMNS {
+            return self.walk_unknown(&rows, &norm1);
+        }
+        let all = frustum_cells(&rows, a);
+        all - self.known_cells(&rows, &norm1)
+    }
+
+    /// The unknown cells of the view by one walk over the tree, known and unknown
+    /// space alike (the fallback for a key box of more than [`MAX_COLUMNS`] columns).
+    fn walk_unknown(&self, rows: &RowCounter<'_>, norm1: &[f64; 6]) -> u64 {
+        let (res, planes, lo, hi) = (rows.res, rows.planes, rows.lo, rows.hi);
+        let known = &self.known;
+        let root = known.root_child();
+        if root == CountBlock::LEAF || known.root() == 1u64 << (3 * TREE_DEPTH as u32) {
+            return 0;
+        }
         let mut stack = [Entry {
             key: [0; 3],
             depth: 0,
             mask: 0,
-            node: None,
+            block: CountBlock::ABSENT,
             known: 0,
         }; STACK];
         stack[0] = Entry {
             key: [0; 3],
             depth: 0,
             mask: 0b11_1111,
-            node: tree.root_ref(),
-            known: self.known.root(),
+            block: root,
+            known: known.root(),
         };
         let mut len = 1usize;
         let mut count = 0u64;
         while len > 0 {
             len -= 1;
             let e = stack[len];
-            if let Some(n) = e.node
-                && !tree.has_children(n)
-            {
-                continue; // a known leaf: no unknown cells
-            }
             let side = 1u32 << (TREE_DEPTH - e.depth);
             let (mut overlaps, mut within) = (true, true);
             for i in 0..3 {
@@ -165,30 +194,218 @@ impl<'a> FrustumCounter<'a> {
                 count += (1u64 << (3 * (TREE_DEPTH - e.depth) as u32)) - e.known;
                 continue;
             }
-            if e.node.is_none() && e.depth >= TREE_DEPTH - ROW_LOG {
-                count += rows.count(&e.key, side, mask);
+            if e.block == CountBlock::ABSENT {
+                if e.depth >= TREE_DEPTH - ROW_LOG {
+                    count += rows.count(&e.key, side, mask);
+                    continue;
+                }
+                for i in 0..8 {
+                    stack[len] = Entry {
+                        key: child_key(&e.key, e.depth, i),
+                        depth: e.depth + 1,
+                        mask,
+                        block: CountBlock::ABSENT,
+                        known: 0,
+                    };
+                    len += 1;
+                }
                 continue;
             }
+            let b = known.block(e.block);
+            // a child of this many cells with as many known holds no unknown one
+            let full = 1u64 << (3 * (TREE_DEPTH - e.depth - 1) as u32);
             for i in 0..8 {
-                let (node, known) = match e.node {
-                    Some(n) => match tree.child_ref(n, i) {
-                        Some(c) => (Some(c), self.known.child(n, i)),
-                        None => (None, 0),
-                    },
-                    None => (None, 0),
-                };
+                if b.child[i] == CountBlock::LEAF || b.known[i] == full {
+                    continue;
+                }
                 stack[len] = Entry {
                     key: child_key(&e.key, e.depth, i),
                     depth: e.depth + 1,
                     mask,
-                    node,
-                    known,
+                    block: b.child[i],
+                    known: b.known[i],
                 };
                 len += 1;
             }
         }
         count
     }
+
+    /// Known cells of the view: a walk over the known nodes only (absent space is
+    /// never entered). A node inside every plane and the key box adds `known(node)`,
+    /// a known leaf cut by planes or the key box its cells inside them (row by row,
+    /// all known; a leaf of more than `2^ROW_LOG` cells a side split virtually first),
+    /// an inner node cut by them its children that hold known cells.
+    fn known_cells(&self, rows: &RowCounter<'_>, norm1: &[f64; 6]) -> u64 {
+        let (res, planes, lo, hi) = (rows.res, rows.planes, rows.lo, rows.hi);
+        let known = &self.known;
+        let root = known.root_child();
+        if root == CountBlock::ABSENT {
+            return 0;
+        }
+        let mut stack = [Entry {
+            key: [0; 3],
+            depth: 0,
+            mask: 0,
+            block: CountBlock::ABSENT,
+            known: 0,
+        }; STACK];
+        stack[0] = Entry {
+            key: [0; 3],
+            depth: 0,
+            mask: 0b11_1111,
+            block: root,
+            known: known.root(),
+        };
+        let mut len = 1usize;
+        let mut count = 0u64;
+        while len > 0 {
+            len -= 1;
+            let e = stack[len];
+            let side = 1u32 << (TREE_DEPTH - e.depth);
+            let (mut overlaps, mut within) = (true, true);
+            for i in 0..3 {
+                let (a, b) = (e.key[i] as u32, e.key[i] as u32 + side - 1);
+                overlaps &= a <= hi[i] as u32 && b >= lo[i] as u32;
+                within &= a >= lo[i] as u32 && b <= hi[i] as u32;
+            }
+            if !overlaps {
+                continue;
+            }
+            let Some(mask) = cube_planes(planes, norm1, res, &e.key, side, e.mask) else {
+                continue;
+            };
+            if mask == 0 && within {
+                count += e.known;
+                continue;
+            }
+            // a leaf, or a subtree whose cells are all known: its cells inside the planes
+            if e.block == CountBlock::LEAF || e.known == 1u64 << (3 * (TREE_DEPTH - e.depth) as u32) {
+                if e.depth >= TREE_DEPTH - ROW_LOG {
+                    count += rows.count(&e.key, side, mask);
+                } else {
+                    for i in 0..8 {
+                        stack[len] = Entry {
+                            key: child_key(&e.key, e.depth, i),
+                            depth: e.depth + 1,
+                            mask,
+                            block: CountBlock::LEAF,
+                            known: e.known / 8,
+                        };
+                        len += 1;
+                    }
+                }
+                continue;
+            }
+            let b = known.block(e.block);
+            for i in 0..8 {
+                if b.known[i] == 0 {
+                    continue;
+                }
+                stack[len] = Entry {
+                    key: child_key(&e.key, e.depth, i),
+                    depth: e.depth + 1,
+                    mask,
+                    block: b.child[i],
+                    known: b.known[i],
+                };
+                len += 1;
+            }
+        }
+        count
+    }
+}
+
+/// Columns of the view's key box above which [`FrustumCounter`] walks the tree once
+/// instead of counting the frustum's cells column by column (a view whose corners
+/// leave the key space has the whole key space as its box).
+const MAX_COLUMNS: u64 = 1 << 22;
+
+/// Side (cells) of the tiles of columns [`frustum_cells`] classifies against the planes.
+const TILE: i64 = 16;
+
+/// Cells of the view's key box whose centres lie inside the frustum, in columns along
+/// axis `a`: tiles of `TILE × TILE` columns spanning the key box along `a` are tested
+/// against the planes like the cubes of the walk (half spans per axis); a tile inside
+/// every plane adds its volume, one outside a plane nothing, and the rest are counted
+/// row by row ([`RowCounter::count_box`]), each row bounded by the crossings of the
+/// planes that cut its tile.
+fn frustum_cells(rows: &RowCounter<'_>, a: usize) -> u64 {
+    let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+    let (res, lo, hi) = (rows.res, rows.lo, rows.hi);
+    let span = |i: usize| (lo[i] as i64, hi[i] as i64);
+    let mut total = 0u64;
+    let mut r = [span(0), span(1), span(2)];
+    let mut tc = lo[c] as i64;
+    while tc <= hi[c] as i64 {
+        r[c] = (tc, (tc + TILE - 1).min(hi[c] as i64));
+        let mut tb = lo[b] as i64;
+        while tb <= hi[b] as i64 {
+            r[b] = (tb, (tb + TILE - 1).min(hi[b] as i64));
+            tb += TILE;
+            // centre of the tile's cell centres and their half span per axis
+            let centre = Vector3::from([0, 1, 2].map(|i| ((r[i].0 + r[i].1) as f64 / 2.0 - 32767.5) * res));
+            let half = [0, 1, 2].map(|i| (r[i].1 - r[i].0) as f64 / 2.0 * res);
+            let mut mask = 0u8;
+            let mut out = false;
+            for (j, (n, d)) in rows.planes.iter().enumerate() {
+                let s = n.dot(&centre) + d;
+                let reach = n.x.abs() * half[0] + n.y.abs() * half[1] + n.z.abs() * half[2];
+                if s + reach < -EPS {
+                    out = true;
+                    break;
+                }
+                if s - reach < EPS {
+                    mask |= 1 << j;
+                }
+            }
+            if out {
+                continue;
+            }
+            total += if mask == 0 {
+                r.iter().map(|(x, y)| (y - x + 1) as u64).product()
+            } else {
+                rows.count_box(&r, mask, a)
+            };
+        }
+        tc += TILE;
+    }
+    total
+}
+
+/// The planes of `parent_mask` that may cut the cube `[key, key + side)³` (bit j: plane
+/// j), or `None` when its cell centres all lie outside one of them; see
+/// [`FrustumCounter`] for the test.
+#[inline]
+fn cube_planes(
+    planes: &[(Vector3<f64>, f64); 6],
+    norm1: &[f64; 6],
+    res: f64,
+    key: &OcKey,
+    side: u32,
+    parent_mask: u8,
+) -> Option<u8> {
+    if parent_mask == 0 {
+        return Some(0);
+    }
+    let mut mask = 0u8;
+    let size = res * side as f64;
+    let half_span = (size - res) / 2.0;
+    let c = Vector3::from(key.map(|k| (k as f64 - 32768.0) * res + size / 2.0));
+    for (j, (n, d)) in planes.iter().enumerate() {
+        if parent_mask & (1 << j) == 0 {
+            continue;
+        }
+        let s = n.dot(&c) + d;
+        let r = half_span * norm1[j];
+        if s + r < -EPS {
+            return None;
+        }
+        if s - r < EPS {
+            mask |= 1 << j;
+        }
+    }
+    Some(mask)
 }
 
 /// One cutting plane's crossing along a row: plane index, `κ0`, `κ_b`, `κ_c` (the
@@ -278,7 +495,13 @@ impl<'f> RowCounter<'f> {
             return r.iter().map(|(a, b)| (b - a + 1) as u64).product();
         }
         // rows along the axis the first cutting plane is steepest in
-        let a = self.axis[mask.trailing_zeros() as usize];
+        self.count_box(&r, mask, self.axis[mask.trailing_zeros() as usize])
+    }
+
+    /// Cells of the non-empty key box `r` (inclusive ranges, inside the key box of
+    /// the view) whose centres pass every plane in `mask` (not 0), counted in rows
+    /// along axis `a`, as [`count`](Self::count) describes.
+    fn count_box(&self, r: &[(i64, i64); 3], mask: u8, a: usize) -> u64 {
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
         let (alo, ahi) = r[a];
         // per cutting plane: crossing coefficients and tolerance (or in `exact`: per-cell tests)
@@ -300,14 +523,18 @@ impl<'f> RowCounter<'f> {
                 }
             }
         }
-        // the crossings of up to three planes in 32.32 fixed point when every plane's
-        // |cb| ≤ 2^20 and rows are at most 32 long (always below `ROW_LOG` 5)
+        // the crossings of the cutting planes in 32.32 fixed point when every plane's
+        // |cb| ≤ 2^20 and fewer than 32 rows are stepped along b (cubes of at most
+        // 2^ROW_LOG cells a side, tiles of TILE)
         let max_cb = lin[..nl].iter().fold(0.0f64, |m, p| m.max(p.2.abs()));
         if ne == 0 && max_cb <= 1_048_576.0 && r[b].1 - r[b].0 < 32 {
             match nl {
-                1 => return self.fixed_rows::<1>(&lin, &r, [a, b, c], max_cb),
-                2 => return self.fixed_rows::<2>(&lin, &r, [a, b, c], max_cb),
-                3 => return self.fixed_rows::<3>(&lin, &r, [a, b, c], max_cb),
+                1 => return self.fixed_rows::<1>(&lin, r, [a, b, c], max_cb),
+                2 => return self.fixed_rows::<2>(&lin, r, [a, b, c], max_cb),
+                3 => return self.fixed_rows::<3>(&lin, r, [a, b, c], max_cb),
+                4 => return self.fixed_rows::<4>(&lin, r, [a, b, c], max_cb),
+                5 => return self.fixed_rows::<5>(&lin, r, [a, b, c], max_cb),
+                6 => return self.fixed_rows::<6>(&lin, r, [a, b, c], max_cb),
                 _ => {}
             }
         }
@@ -322,9 +549,11 @@ impl<'f> RowCounter<'f> {
                 let (mut first_in, mut last_in) = (alo, ahi);
                 let mut near = false;
                 let (lo_f, hi_f) = (alo as f64 - 1.0, ahi as f64 + 1.0);
-                for &(_, k0, cb, cc, tol, up) in lin[..nl].iter() {
+                let mut fls = [0i64; 6];
+                for (p, &(_, k0, cb, cc, tol, up)) in lin[..nl].iter().enumerate() {
                     let kr = k0 + cb * kb as f64 + cc * kc as f64;
                     let fl = floor_i64(kr.clamp(lo_f, hi_f));
+                    fls[p] = fl;
                     let frac = kr - fl as f64;
                     near |= kr > lo_f && kr < hi_f && (frac <= tol || frac >= 1.0 - tol);
                     if up {
@@ -334,15 +563,18 @@ impl<'f> RowCounter<'f> {
                     }
                 }
                 if near {
+                    // the per-cell tests, searched from the floors
                     (first_in, last_in) = (alo, ahi);
-                    for &(j, _, _, _, _, up) in lin[..nl].iter() {
+                    for (p, &(j, _, _, _, _, up)) in lin[..nl].iter().enumerate() {
                         if first_in > last_in {
                             break;
                         }
                         if up {
-                            first_in = first_in.max(self.first_inside(j, k, a, alo, alo, ahi));
+                            let guess = (fls[p] + 1).clamp(alo, ahi + 1);
+                            first_in = first_in.max(self.first_inside(j, k, a, guess, alo, ahi));
                         } else {
-                            last_in = last_in.min(self.last_inside(j, k, a, ahi, alo, ahi));
+                            let guess = fls[p].clamp(alo - 1, ahi);
+                            last_in = last_in.min(self.last_inside(j, k, a, guess, alo, ahi));
                         }
                     }
                 }
@@ -370,7 +602,7 @@ impl<'f> RowCounter<'f> {
         total
     }
 
-    /// The rows of [`count`](Self::count) for `N` (1–3) cutting planes, all with a
+    /// The rows of [`count`](Self::count) for `N` (1–6) cutting planes, all with a
     /// crossing (`lin`), in 32.32 fixed point relative to `alo`: per c-row each
     /// crossing is evaluated once in f64 at the first b, then stepped by `cb` as an
     /// integer (at most 31 steps; truncating `cb` and the start to 2^−32 adds under
@@ -414,10 +646,12 @@ impl<'f> RowCounter<'f> {
                 // relative first and last keys inside every plane
                 let (mut first, mut last) = (0i64, len - 1);
                 let mut near = false;
+                let mut fls = [0i64; N];
                 for p in 0..N {
                     let v = vs[p];
                     vs[p] += steps[p];
                     let fl = v >> 32;
+                    fls[p] = fl;
                     let frac = v & (ONE - 1);
                     // within tol of an integer: `frac ≤ tol` or `frac ≥ 1 − tol`, i.e.
                     // `(frac + tol) mod 1 ≤ 2·tol` (tol < ¼); no branches
@@ -427,6 +661,7 @@ impl<'f> RowCounter<'f> {
                     last = last.min(if ups[p] { i64::MAX } else { fl });
                 }
                 if near {
+                    // the per-cell tests, searched from the floors
                     k[b] = kb;
                     let (mut f, mut l) = (alo, ahi);
                     for p in 0..N {
@@ -434,9 +669,11 @@ impl<'f> RowCounter<'f> {
                             break;
                         }
                         if ups[p] {
-                            f = f.max(self.first_inside(lin[p].0, k, a, alo, alo, ahi));
+                            let guess = (alo + fls[p] + 1).clamp(alo, ahi + 1);
+                            f = f.max(self.first_inside(lin[p].0, k, a, guess, alo, ahi));
                         } else {
-                            l = l.min(self.last_inside(lin[p].0, k, a, ahi, alo, ahi));
+                            let guess = (alo + fls[p]).clamp(alo - 1, ahi);
+                            l = l.min(self.last_inside(lin[p].0, k, a, guess, alo, ahi));
                         }
                     }
                     total += (l - f + 1).max(0) as u64;

@@ -186,6 +186,44 @@ fn counts_on_trees_with_no_nodes_one_leaf_and_axis_aligned_views() {
     assert_eq!(KnownCellCounts::new(&one).root(), 1);
 }
 
+#[test]
+fn a_wholly_known_subtree_of_mixed_cells_counts_no_unknown_cell() {
+    // an aligned 8-cell cube, checkerboard of occupied and free cells: never pruned,
+    // every cell known, so the walk may skip it whole; one unknown hole beside it
+    let mut t = Octree::new(0.1).unwrap();
+    let m = t.sensor_model().log_odds();
+    for x in 0..8u16 {
+        for y in 0..8u16 {
+            for z in 0..8u16 {
+                let v = if (x + y + z) % 2 == 0 { m.hit } else { m.miss };
+                t.update_key(&[32768 + x, 32768 + y, 32768 + z], v);
+            }
+        }
+    }
+    assert_eq!(KnownCellCounts::new(&t).root(), 512);
+    let cam = CameraModel {
+        hfov: 1.2,
+        vfov: 1.0,
+        near: 0.05,
+        far: 2.0,
+        width: 8,
+        height: 6,
+    };
+    let counter = FrustumCounter::new(&t);
+    for (o, d) in [
+        (Point3::new(-0.31, 0.42, 0.38), Vector3::new(1.0, 0.05, 0.02)),
+        (Point3::new(0.4, 0.37, -0.5), Vector3::new(0.1, 0.03, 1.0)),
+    ] {
+        let f = Frustum::new(&cam, &look_along(&o, &d).unwrap());
+        let (lo, hi) = corner_box(&t, &f);
+        let n = brute(&t, &f, lo, hi);
+        // the view crosses the known cube: some of its cells are not counted
+        let all = FrustumCounter::new(&Octree::new(0.1).unwrap()).count(&f);
+        assert!(n < all, "{n} {all}");
+        assert_eq!(counter.count(&f), n);
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
@@ -293,4 +331,60 @@ fn frontier_and_field_at_the_edge_of_the_key_space() {
     for i in 0..3 {
         assert!((f[i] - want).abs() < 1e-9, "{f}");
     }
+}
+
+#[test]
+fn a_view_leaving_the_key_space_counts_like_every_cell() {
+    // the key space at 0.1 m ends at ±3276.8 m: the far corners of this view lie beyond
+    // it, so the view's key box is the whole key space and the counter walks the tree
+    let mut t = Octree::new(0.1).unwrap();
+    let m = t.sensor_model().log_odds();
+    for x in 65_520u16..65_535 {
+        for y in 32_760u16..32_772 {
+            for z in 32_764u16..32_770 {
+                if !(x as u32 + y as u32 + z as u32).is_multiple_of(3) {
+                    t.update_key(
+                        &[x, y, z],
+                        if (x as u32 + z as u32).is_multiple_of(4) {
+                            m.hit
+                        } else {
+                            m.miss
+                        },
+                    );
+                }
+            }
+        }
+    }
+    let cam = CameraModel {
+        hfov: 1.0,
+        vfov: 0.8,
+        near: 0.05,
+        far: 1.5,
+        width: 8,
+        height: 6,
+    };
+    let pose = look_along(&Point3::new(3276.05, 0.03, 0.02), &Vector3::new(1.0, 0.1, -0.05)).unwrap();
+    let f = Frustum::new(&cam, &pose);
+    assert!(f.corners.iter().any(|c| t.key_of(c).is_err()));
+    // every cell centre in the frustum lies in the box of its corners clamped to the key space
+    let clamped = |i: usize, pick: fn(f64, f64) -> f64, init: f64| {
+        let v = f.corners.iter().fold(init, |a, c| pick(a, c[i]));
+        v.clamp(-3276.75, 3276.75)
+    };
+    let lo_p = Point3::new(
+        clamped(0, f64::min, f64::MAX),
+        clamped(1, f64::min, f64::MAX),
+        clamped(2, f64::min, f64::MAX),
+    );
+    let hi_p = Point3::new(
+        clamped(0, f64::max, f64::MIN),
+        clamped(1, f64::max, f64::MIN),
+        clamped(2, f64::max, f64::MIN),
+    );
+    let (lo, hi) = (t.key_of(&lo_p).unwrap(), t.key_of(&hi_p).unwrap());
+    let n = brute(&t, &f, lo, hi);
+    // some cells of the view known, some not
+    let all = brute(&Octree::new(0.1).unwrap(), &f, lo, hi);
+    assert!(n > 30 && n < all, "{n} {all}");
+    assert_eq!(FrustumCounter::new(&t).count(&f), n);
 }

@@ -21,7 +21,7 @@ mod ray_tests;
 #[cfg(test)]
 mod tests;
 
-pub use counts::KnownCellCounts;
+pub use counts::{CountBlock, KnownCellCounts};
 pub use error::OctreeError;
 pub use header::{BT_FIRST_LINE, OT_FIRST_LINE};
 pub(crate) use key::morton;

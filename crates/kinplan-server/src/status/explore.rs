@@ -16,6 +16,7 @@ pub fn explore_field(field: ExploreField) -> &'static str {
         ExploreField::CameraMount => "camera_mount",
         ExploreField::PixelStride => "pixel_stride",
         ExploreField::NoiseStddev => "noise_stddev",
+        ExploreField::NearRaySpacing => "near_ray_spacing",
         ExploreField::KnownRatio => "stop.known_ratio",
         ExploreField::MaxIterations => "stop.max_iterations",
         ExploreField::ConsecutiveFailures => "stop.max_consecutive_failures",
@@ -47,6 +48,7 @@ mod tests {
             (ExploreField::Start, "start"),
             (ExploreField::PixelStride, "pixel_stride"),
             (ExploreField::NoiseStddev, "noise_stddev"),
+            (ExploreField::NearRaySpacing, "near_ray_spacing"),
             (ExploreField::KnownRatio, "stop.known_ratio"),
             (ExploreField::ConsecutiveFailures, "stop.max_consecutive_failures"),
         ] {

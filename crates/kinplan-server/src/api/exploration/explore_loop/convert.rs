@@ -72,6 +72,11 @@ pub fn explore_params_in(
     p.resolution = number("resolution", req.resolution, p.resolution)?;
     p.sensor.pixel_stride = req.pixel_stride.map_or(p.sensor.pixel_stride, |v| v as usize);
     p.sensor.noise_stddev = number("noise_stddev", req.noise_stddev, p.sensor.noise_stddev)?;
+    p.sensor.near_ray_spacing = number(
+        "near_ray_spacing",
+        req.near_ray_spacing,
+        p.sensor.near_ray_spacing,
+    )?;
     p.candidates_per_iteration = req
         .candidates_per_iteration
         .map_or(p.candidates_per_iteration, |v| v as usize);
