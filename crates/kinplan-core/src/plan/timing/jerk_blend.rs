@@ -7,9 +7,11 @@ use super::scurve::SCurve;
 use super::waypoint::MIN_SEGMENT_TIME;
 use crate::Deadline;
 
-/// Where the segments are split, as fractions of their length: each split
-/// is timed and the fastest kept (finer splits let a long segment speed up
-/// between corners, coarser ones leave short segments room for blends).
+/// Where the segments are split, as fractions of their length, in the order
+/// tried: at the midpoint (a segment speeds up towards it and slows down
+/// into the next corner; finer splits leave less room for the blends and
+/// come out slower), then finer ones should the midpoint not keep a moving
+/// start.
 const SPLITS: [&[f64]; 3] = [&[0.5], &[0.25, 0.5, 0.75], &[0.15, 0.5, 0.85]];
 
 /// Sweeps of the local stretching before the uniform one.
@@ -36,6 +38,9 @@ pub(super) struct Limits<'a> {
 struct Shape {
     h: f64,
     r: f64,
+    /// `1/((2h − r) r)`, the jerk of `g`: set by [`Shape::finish`] once the
+    /// shape is final (0 until then).
+    jerk: f64,
 }
 
 impl Shape {
@@ -72,7 +77,11 @@ impl Shape {
             let s = dj.sqrt();
             (s, s)
         };
-        Shape { h: (w + r) / 2.0, r }
+        Shape {
+            h: (w + r) / 2.0,
+            r,
+            jerk: 0.0,
+        }
     }
 
     /// `∫_{−h}^{0} (−s) g(s) ds`: the distance by which the blend passes its
@@ -88,39 +97,42 @@ impl Shape {
         ((h - r).powi(2) / 2.0 + h * r / 2.0 - r * r / 3.0) / (2.0 * h - r)
     }
 
+    /// Sets the jerk of `g` for [`Shape::at`].
+    fn finish(&mut self) {
+        let w = 2.0 * self.h - self.r;
+        self.jerk = if self.h > 0.0 { 1.0 / (w * self.r) } else { 0.0 };
+    }
+
     /// `[G₂, G₁, g]` at `s`: `G₁ = ∫_{−h}^{s} g`, `G₂ = ∫_{−h}^{s} G₁`
     /// (0 before the blend; `[s, 1, 0]` after it, as `G₂(h) = h` for an
-    /// even `g`).
+    /// even `g`). With `x = s + h` and `J` the jerk, on the ramp (`x ≤ r`)
+    /// `[J x³/6, J x²/2, J x]`; on the flat part, `y = x − r`,
+    /// `[J r³/6 + J r²/2 y + J r y²/2, J r²/2 + J r y, J r]`; after the middle
+    /// by symmetry, `G₁(s) = 1 − G₁(−s)` and `G₂(s) = s + G₂(−s)`.
+    /// [`Shape::finish`] must have run.
     fn at(&self, s: f64) -> [f64; 3] {
-        let (h, r) = (self.h, self.r);
+        let h = self.h;
         if s >= h {
             return [s, 1.0, 0.0];
         }
         if s <= -h {
             return [0.0, 0.0, 0.0];
         }
-        let jerk = 1.0 / ((2.0 * h - r) * r);
-        let mut rest = s + h;
-        let mut state = [0.0; 3];
-        for (len, jk) in [(r, jerk), (2.0 * (h - r), 0.0), (r, -jerk)] {
-            let dt = rest.min(len);
-            state = advance(state, jk, dt);
-            rest -= dt;
-            if rest <= 0.0 {
-                break;
-            }
-        }
-        state
+        let (r, jk) = (self.r, self.jerk);
+        let x = h - s.abs();
+        let [p, v, a] = if x <= r {
+            [jk * x * x * x / 6.0, jk * x * x * 0.5, jk * x]
+        } else {
+            let y = x - r;
+            let a = jk * r;
+            [
+                a * r * r / 6.0 + a * r * 0.5 * y + a * y * y * 0.5,
+                a * r * 0.5 + a * y,
+                a,
+            ]
+        };
+        if s <= 0.0 { [p, v, a] } else { [s + p, 1.0 - v, a] }
     }
-}
-
-/// `[p, v, a]` after `dt` of constant jerk `jk`.
-fn advance([p, v, a]: [f64; 3], jk: f64, dt: f64) -> [f64; 3] {
-    [
-        p + v * dt + a * dt * dt / 2.0 + jk * dt * dt * dt / 6.0,
-        v + a * dt + jk * dt * dt / 2.0,
-        a + jk * dt,
-    ]
 }
 
 /// One joint's limits in the forms its blends use.
@@ -163,10 +175,18 @@ impl JointConst {
             let w = m * self.inv_a;
             let r = self.ramp;
             let e = m * w * 0.125 + self.tail;
-            (Shape { h: (w + r) * 0.5, r }, e)
+            let h = (w + r) * 0.5;
+            (Shape { h, r, jerk: 0.0 }, e)
         } else {
             let w = (m * self.inv_j).sqrt();
-            (Shape { h: w, r: w }, m * w / 6.0)
+            (
+                Shape {
+                    h: w,
+                    r: w,
+                    jerk: 0.0,
+                },
+                m * w / 6.0,
+            )
         }
     }
 }
@@ -252,16 +272,9 @@ impl JerkBlends {
                 merged.extend_from_slice(row);
             }
         }
-        let mut best: Option<JerkBlends> = None;
-        for fracs in SPLITS {
-            let Some(tb) = Self::with_splits(&merged, dof, fracs, lim) else {
-                continue;
-            };
-            if best.as_ref().is_none_or(|b| tb.duration() < b.duration()) {
-                best = Some(tb);
-            }
-        }
-        best
+        SPLITS
+            .iter()
+            .find_map(|fracs| Self::with_splits(&merged, dof, fracs, lim))
     }
 
     /// The timing with every segment split at `fracs` (increasing, in
@@ -332,6 +345,8 @@ impl JerkBlends {
             }
             tb.shape(&dur, &consts);
             tb.ratios(&dur, tolerance, &mut rho, &mut dev);
+            // settled once no segment changes by more than a part in 10³ (the
+            // uniform stretch below takes what ratios stay above 1)
             let mut settled = true;
             for k in 0..m {
                 // every ratio segment k's velocity enters
@@ -343,7 +358,7 @@ impl JerkBlends {
                     w = w.max(rho[k + 1]);
                 }
                 let next = (dur[k] * w.sqrt()).max(tmin[k]);
-                if w > 1.0 || (next - dur[k]).abs() > 1e-3 * dur[k] {
+                if (next - dur[k]).abs() > 1e-3 * dur[k] {
                     settled = false;
                 }
                 dur[k] = next;
@@ -374,6 +389,7 @@ impl JerkBlends {
         if tb.worst(&dur, tolerance, &mut rho, &mut dev) > 1.0 || tb.start_gap(&w0) > 1e-9 * scale {
             return None;
         }
+        tb.shapes.iter_mut().for_each(Shape::finish);
         tb.tau[0] = tb.hmax[0];
         for (k, d) in dur.iter().enumerate() {
             tb.tau[k + 1] = tb.tau[k] + d;
@@ -525,27 +541,34 @@ impl JerkBlends {
             .collect()
     }
 
-    /// The motion at `times` (sorted): on segment `k` (`τ_k ≤ t ≤ τ_{k+1}`,
-    /// extended before `τ_0` and after `τ_m`), with `s = t − τ_k`,
-    /// `s' = t − τ_{k+1}`,
+    /// The motion at `times` (sorted, s from this piece's start) into the
+    /// rows of `q`, `q̇` and `q̈` (`times.len() × dof` each): on segment `k`
+    /// (`τ_k ≤ t ≤ τ_{k+1}`, extended before `τ_0` and after `τ_m`), with
+    /// `s = t − τ_k`, `s' = t − τ_{k+1}`, for each joint
     /// `q = w_k + V_k s + Δv_k (G₂,k(s) − s) + Δv_{k+1} G₂,k+1(s')`,
     /// `q̇ = V_k + Δv_k (G₁,k(s) − 1) + Δv_{k+1} G₁,k+1(s')`,
-    /// `q̈ = Δv_k g_k(s) + Δv_{k+1} g_{k+1}(s')`. `None` once the deadline
-    /// passes or the caller cancels (looked at every 4096 samples).
-    pub fn sample(&self, times: &[f64], deadline: Deadline<'_>) -> Option<TimedTrajectory> {
+    /// `q̈ = Δv_k g_k(s) + Δv_{k+1} g_{k+1}(s')` (each term 0 outside its
+    /// window). `None` once the deadline passes or the caller cancels
+    /// (looked at every 4096 samples).
+    fn sample_into(
+        &self,
+        times: &[f64],
+        [q, qd, qdd]: [&mut [f64]; 3],
+        deadline: Deadline<'_>,
+    ) -> Option<()> {
         let dof = self.dof;
         let m = self.hmax.len() - 1;
-        let mut out = TimedTrajectory::with_capacity(dof, times.len());
         let mut k = 0;
         for (n, &t) in times.iter().enumerate() {
             if n % 4096 == 0 && deadline.expired() {
                 return None;
             }
-            out.t.push(t);
+            let row = n * dof..(n + 1) * dof;
+            let (q, qd, qdd) = (&mut q[row.clone()], &mut qd[row.clone()], &mut qdd[row]);
             if m == 0 {
-                out.q.extend_from_slice(&self.points[..dof]);
-                out.qd.extend(std::iter::repeat_n(0.0, dof));
-                out.qdd.extend(std::iter::repeat_n(0.0, dof));
+                q.copy_from_slice(&self.points[..dof]);
+                qd.fill(0.0);
+                qdd.fill(0.0);
                 continue;
             }
             while k + 1 < m && self.tau[k + 1] <= t {
@@ -554,23 +577,42 @@ impl JerkBlends {
             let s = t - self.tau[k];
             let s2 = t - self.tau[k + 1];
             let (here, next) = (k * dof, (k + 1) * dof);
-            let (mut g1, mut g2) = ([0.0; 3], [0.0; 3]);
             for c in 0..dof {
-                // joints sharing a shape share its values
-                if c == 0 || self.shapes[here + c] != self.shapes[here + c - 1] {
-                    g1 = self.shapes[here + c].at(s);
-                }
-                if c == 0 || self.shapes[next + c] != self.shapes[next + c - 1] {
-                    g2 = self.shapes[next + c].at(s2);
-                }
-                let (d1, d2) = (self.dv[here + c], self.dv[next + c]);
                 let vk = self.vel[here + c];
-                out.q
-                    .push(self.points[here + c] + vk * s + d1 * (g1[0] - s) + d2 * g2[0]);
-                out.qd.push(vk + d1 * (g1[1] - 1.0) + d2 * g2[1]);
-                out.qdd.push(d1 * g1[2] + d2 * g2[2]);
+                let (mut x, mut v, mut a) = (self.points[here + c] + vk * s, vk, 0.0);
+                let (b1, b2) = (&self.shapes[here + c], &self.shapes[next + c]);
+                if s < b1.h {
+                    let [p1, v1, a1] = b1.at(s);
+                    let d1 = self.dv[here + c];
+                    x += d1 * (p1 - s);
+                    v += d1 * (v1 - 1.0);
+                    a += d1 * a1;
+                }
+                if s2 > -b2.h {
+                    let [p2, v2, a2] = b2.at(s2);
+                    let d2 = self.dv[next + c];
+                    x += d2 * p2;
+                    v += d2 * v2;
+                    a += d2 * a2;
+                }
+                (q[c], qd[c], qdd[c]) = (x, v, a);
             }
         }
+        Some(())
+    }
+
+    /// [`JerkBlends::sample_into`] a new trajectory.
+    #[cfg(test)]
+    fn sample(&self, times: &[f64], deadline: Deadline<'_>) -> Option<TimedTrajectory> {
+        let n = times.len() * self.dof;
+        let mut out = TimedTrajectory {
+            dof: self.dof,
+            t: times.to_vec(),
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+        };
+        self.sample_into(times, [&mut out.q, &mut out.qd, &mut out.qdd], deadline)?;
         Some(out)
     }
 }
@@ -685,20 +727,33 @@ impl JerkPath {
     /// The motion at `times` (sorted), each piece from its own start time;
     /// `None` once the deadline passes or the caller cancels.
     pub fn sample(&self, times: &[f64], deadline: Deadline<'_>) -> Option<TimedTrajectory> {
-        let mut out = TimedTrajectory::with_capacity(self.dof, times.len());
+        let dof = self.dof;
+        let n = times.len() * dof;
+        let mut out = TimedTrajectory {
+            dof,
+            t: times.to_vec(),
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+        };
         let mut from = 0;
+        // the piece's own clock, reused across pieces
+        let mut local = Vec::with_capacity(times.len());
         for (p, piece) in self.pieces.iter().enumerate() {
             let start = self.starts[p];
             let to = match self.starts.get(p + 1) {
                 Some(next) => from + times[from..].partition_point(|t| t < next),
                 None => times.len(),
             };
-            let local: Vec<f64> = times[from..to].iter().map(|t| t - start).collect();
-            let part = piece.sample(&local, deadline)?;
-            out.t.extend_from_slice(&times[from..to]);
-            out.q.extend_from_slice(&part.q);
-            out.qd.extend_from_slice(&part.qd);
-            out.qdd.extend_from_slice(&part.qdd);
+            local.clear();
+            local.extend(times[from..to].iter().map(|t| t - start));
+            let rows = from * dof..to * dof;
+            let out_rows = [
+                &mut out.q[rows.clone()],
+                &mut out.qd[rows.clone()],
+                &mut out.qdd[rows],
+            ];
+            piece.sample_into(&local, out_rows, deadline)?;
             from = to;
         }
         Some(out)
@@ -712,7 +767,8 @@ mod tests {
     #[test]
     fn the_shape_integrates_to_one_and_its_offset_matches_the_integral() {
         for (h, r) in [(0.35, 0.2), (0.3, 0.3), (0.5, 0.01)] {
-            let s = Shape { h, r };
+            let mut s = Shape { h, r, jerk: 0.0 };
+            s.finish();
             // G₁(h) = 1, G₂(h) = h (g even), g(±h) = 0
             let [p, v, a] = s.at(h - 1e-15);
             assert!((v - 1.0).abs() < 1e-9 && (p - h).abs() < 1e-9 && a.abs() < 1e-9);
