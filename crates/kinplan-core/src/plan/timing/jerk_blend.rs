@@ -880,4 +880,77 @@ mod tests {
         );
         assert!((tb.passing_distances()[1] - off0.hypot(off1)).abs() < 1e-12);
     }
+
+    /// Distance from `p` to the polyline through the rows of `w`.
+    fn polyline_distance(w: &[f64], dof: usize, p: &[f64]) -> f64 {
+        let mut best = f64::INFINITY;
+        for seg in w.chunks_exact(dof).collect::<Vec<_>>().windows(2) {
+            let d: Vec<f64> = (0..dof).map(|c| seg[1][c] - seg[0][c]).collect();
+            let dd: f64 = d.iter().map(|x| x * x).sum();
+            let t = if dd > 0.0 {
+                ((0..dof).map(|c| (p[c] - seg[0][c]) * d[c]).sum::<f64>() / dd).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let e: f64 = (0..dof).map(|c| (seg[0][c] + t * d[c] - p[c]).powi(2)).sum();
+            best = best.min(e.sqrt());
+        }
+        best
+    }
+
+    #[test]
+    fn overlapping_windows_of_two_corners_keep_the_motion_within_the_tolerance() {
+        // unsplit segments between corners of a random walk, joints with
+        // different limits: on some segments one joint is still leaving one
+        // corner while another has started into the next; every 1 ms sample
+        // stays within the tolerance of the polyline and within the limits
+        use rand::{Rng, SeedableRng};
+        let dof = 4;
+        let (v, a, j) = (
+            [1.0, 2.0, 1.5, 2.5],
+            [2.0, 9.0, 4.0, 12.0],
+            [20.0, 300.0, 60.0, 500.0],
+        );
+        let tolerance = 0.02;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut overlaps = 0;
+        for case in 0..20 {
+            let mut q = [0.0; 4];
+            let mut w = Vec::new();
+            for _ in 0..10 {
+                w.extend_from_slice(&q);
+                q.iter_mut().for_each(|x| *x += rng.random_range(-0.3..0.3));
+            }
+            let lim = Limits {
+                v: &v,
+                a: &a,
+                j: &j,
+                tolerance,
+                start: &[],
+            };
+            let tb = JerkBlends::with_splits(&w, dof, &[], lim).unwrap();
+            let m = tb.hmax.len() - 1;
+            for k in 1..m - 1 {
+                if tb.hmax[k] + tb.hmax[k + 1] > tb.tau[k + 1] - tb.tau[k] {
+                    overlaps += 1;
+                }
+            }
+            let times: Vec<f64> = (0..=(tb.duration() / 1e-3) as usize)
+                .map(|i| i as f64 * 1e-3)
+                .collect();
+            let tr = tb.sample(&times, Deadline::none()).unwrap();
+            for (p, (qd, qdd)) in
+                tr.q.chunks_exact(dof)
+                    .zip(tr.qd.chunks_exact(dof).zip(tr.qdd.chunks_exact(dof)))
+            {
+                let d = polyline_distance(&w, dof, p);
+                assert!(d <= tolerance + 1e-9, "case {case}: {d}");
+                for c in 0..dof {
+                    assert!(qd[c].abs() <= v[c] * (1.0 + 1e-9), "case {case}: v");
+                    assert!(qdd[c].abs() <= a[c] * (1.0 + 1e-9), "case {case}: a");
+                }
+            }
+        }
+        assert!(overlaps > 0, "no overlapping windows: the test misses its case");
+    }
 }
