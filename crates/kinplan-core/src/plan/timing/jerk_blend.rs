@@ -11,7 +11,8 @@ use crate::Deadline;
 /// tried: at the midpoint (a segment speeds up towards it and slows down
 /// into the next corner; finer splits leave less room for the blends and
 /// come out slower), then finer ones should the midpoint not keep a moving
-/// start.
+/// start. The unsplit timing is tried beside the first that does, the
+/// faster kept.
 const SPLITS: [&[f64]; 3] = [&[0.5], &[0.25, 0.5, 0.75], &[0.15, 0.5, 0.85]];
 
 /// Sweeps of the local stretching before the uniform one.
@@ -221,11 +222,10 @@ impl JointConst {
 /// overlap in time (different joints in different blends) the bound on
 /// segment `k` is `b_k = (Σ_c max(e_{k,c}, e_{k+1,c})²)^½`.
 ///
-/// Each segment is split at points along it (a blend there changes the
+/// Each segment may be split at points along it (a blend there changes the
 /// speed along the line and leaves it nowhere), so the motion can speed up
-/// between two corners and slow down into the next: at its midpoint, at
-/// its quarters, or at 0.15, 0.5 and 0.85 of it — every segment alike, the
-/// fastest of the three kept.
+/// between two corners and slow down into the next: every segment alike,
+/// at the fractions of [`SPLITS`], or not at all — the faster kept.
 ///
 /// Durations: first `T_k = max_j |Δq_{k,j}|/v_j`; then, in sweeps, every
 /// segment is scaled by `√w_k`, `w_k` the largest ratio its velocity enters
@@ -262,7 +262,8 @@ struct JerkBlends {
 
 impl JerkBlends {
     /// Times the path through `waypoints` (`n × dof`, finite, n ≥ 1) within
-    /// `lim`. `None` when no split keeps a moving start (see
+    /// `lim`: unsplit and split at the first of [`SPLITS`] that keeps a
+    /// moving start, the faster kept. `None` when none keeps it (see
     /// [`JerkBlends::with_splits`]).
     fn new(waypoints: &[f64], dof: usize, lim: Limits<'_>) -> Option<Self> {
         let mut merged: Vec<f64> = Vec::with_capacity(waypoints.len());
@@ -272,9 +273,14 @@ impl JerkBlends {
                 merged.extend_from_slice(row);
             }
         }
-        SPLITS
+        let whole = Self::with_splits(&merged, dof, &[], lim);
+        let split = SPLITS
             .iter()
-            .find_map(|fracs| Self::with_splits(&merged, dof, fracs, lim))
+            .find_map(|fracs| Self::with_splits(&merged, dof, fracs, lim));
+        match (whole, split) {
+            (Some(a), Some(b)) => Some(if a.duration() < b.duration() { a } else { b }),
+            (a, b) => a.or(b),
+        }
     }
 
     /// The timing with every segment split at `fracs` (increasing, in
