@@ -7,9 +7,12 @@ use super::scurve::SCurve;
 use super::waypoint::MIN_SEGMENT_TIME;
 use crate::Deadline;
 
-/// Where the segments are split, as fractions of their length: each split
-/// is timed and the fastest kept (finer splits let a long segment speed up
-/// between corners, coarser ones leave short segments room for blends).
+/// Where the segments are split, as fractions of their length, in the order
+/// tried: at the midpoint (a segment speeds up towards it and slows down
+/// into the next corner; finer splits leave less room for the blends and
+/// come out slower), then finer ones should the midpoint not keep a moving
+/// start. The unsplit timing is tried beside the first that does, the
+/// faster kept.
 const SPLITS: [&[f64]; 3] = [&[0.5], &[0.25, 0.5, 0.75], &[0.15, 0.5, 0.85]];
 
 /// Sweeps of the local stretching before the uniform one.
@@ -36,18 +39,17 @@ pub(super) struct Limits<'a> {
 struct Shape {
     h: f64,
     r: f64,
+    /// `1/((2h − r) r)`, the jerk of `g`: set by [`Shape::finish`] once the
+    /// shape is final (0 until then).
+    jerk: f64,
 }
 
 impl Shape {
     /// The shortest blend that changes the joint velocities by `dv` with
     /// `|q̈_j| ≤ a_j` and `|q⃛_j| ≤ j_j`, every joint on the same shape
-    /// (`q̈ = Δv g`): with `D_a = max_j |Δv_j|/a_j`, `D_j = max_j |Δv_j|/j_j`
-    /// and `w = 2h − r`, the peak is `|Δv_j|/w` and the jerk `|Δv_j|/(r w)`;
-    /// the least `2h = w + r` with `w ≥ D_a`, `r w ≥ D_j`, `r ≤ w` is
-    /// `w = D_a, r = D_j/D_a` when `D_a² ≥ D_j`, else `w = r = √D_j` — the
-    /// velocity change of a seven-phase S-curve (Biagiotti & Melchiorri,
-    /// "Trajectory Planning for Automatic Machines and Robots", Springer
-    /// 2008, §3.4).
+    /// (`q̈ = Δv g`), from `D_a = max_j |Δv_j|/a_j` and
+    /// `D_j = max_j |Δv_j|/j_j` ([`Shape::from_bounds`]).
+    #[cfg(test)]
     fn for_change(dv: &[f64], a: &[f64], j: &[f64]) -> Shape {
         let (mut da, mut dj) = (0.0f64, 0.0f64);
         for k in 0..dv.len() {
@@ -55,6 +57,18 @@ impl Shape {
             da = da.max(m / a[k]);
             dj = dj.max(m / j[k]);
         }
+        Shape::from_bounds(da, dj)
+    }
+
+    /// The shortest blend of every joint on one shape, from
+    /// `D_a = max_j |Δv_j|/a_j` and `D_j = max_j |Δv_j|/j_j`: with
+    /// `w = 2h − r`, the peak acceleration is `|Δv_j|/w` and the jerk
+    /// `|Δv_j|/(r w)`; the least `2h = w + r` with `w ≥ D_a`, `r w ≥ D_j`,
+    /// `r ≤ w` is `w = D_a, r = D_j/D_a` when `D_a² ≥ D_j`, else
+    /// `w = r = √D_j` — the velocity change of a seven-phase S-curve
+    /// (Biagiotti & Melchiorri, "Trajectory Planning for Automatic Machines
+    /// and Robots", Springer 2008, §3.4).
+    fn from_bounds(da: f64, dj: f64) -> Shape {
         if dj == 0.0 {
             return Shape::default();
         }
@@ -64,13 +78,18 @@ impl Shape {
             let s = dj.sqrt();
             (s, s)
         };
-        Shape { h: (w + r) / 2.0, r }
+        Shape {
+            h: (w + r) / 2.0,
+            r,
+            jerk: 0.0,
+        }
     }
 
     /// `∫_{−h}^{0} (−s) g(s) ds`: the distance by which the blend passes its
     /// corner, per unit of `|Δv|`,
-    /// `((h − r)²/2 + h r/2 − r²/3) / (2h − r)` (`h/6` for a triangle, `h/4`
-    /// for a rectangle).
+    /// `((h − r)²/2 + h r/2 − r²/3) / (2h − r) = w/8 + r²/(24 w)` with
+    /// `w = 2h − r` (`h/6` for a triangle, `h/4` for a rectangle).
+    #[cfg(test)]
     fn offset(&self) -> f64 {
         let (h, r) = (self.h, self.r);
         if h <= 0.0 {
@@ -79,70 +98,140 @@ impl Shape {
         ((h - r).powi(2) / 2.0 + h * r / 2.0 - r * r / 3.0) / (2.0 * h - r)
     }
 
+    /// Sets the jerk of `g` for [`Shape::at`].
+    fn finish(&mut self) {
+        let w = 2.0 * self.h - self.r;
+        self.jerk = if self.h > 0.0 { 1.0 / (w * self.r) } else { 0.0 };
+    }
+
     /// `[G₂, G₁, g]` at `s`: `G₁ = ∫_{−h}^{s} g`, `G₂ = ∫_{−h}^{s} G₁`
     /// (0 before the blend; `[s, 1, 0]` after it, as `G₂(h) = h` for an
-    /// even `g`).
+    /// even `g`). With `x = s + h` and `J` the jerk, on the ramp (`x ≤ r`)
+    /// `[J x³/6, J x²/2, J x]`; on the flat part, `y = x − r`,
+    /// `[J r³/6 + J r²/2 y + J r y²/2, J r²/2 + J r y, J r]`; after the middle
+    /// by symmetry, `G₁(s) = 1 − G₁(−s)` and `G₂(s) = s + G₂(−s)`.
+    /// [`Shape::finish`] must have run.
     fn at(&self, s: f64) -> [f64; 3] {
-        let (h, r) = (self.h, self.r);
+        let h = self.h;
         if s >= h {
             return [s, 1.0, 0.0];
         }
         if s <= -h {
             return [0.0, 0.0, 0.0];
         }
-        let jerk = 1.0 / ((2.0 * h - r) * r);
-        let mut rest = s + h;
-        let mut state = [0.0; 3];
-        for (len, jk) in [(r, jerk), (2.0 * (h - r), 0.0), (r, -jerk)] {
-            let dt = rest.min(len);
-            state = advance(state, jk, dt);
-            rest -= dt;
-            if rest <= 0.0 {
-                break;
-            }
-        }
-        state
+        let (r, jk) = (self.r, self.jerk);
+        let x = h - s.abs();
+        let [p, v, a] = if x <= r {
+            [jk * x * x * x / 6.0, jk * x * x * 0.5, jk * x]
+        } else {
+            let y = x - r;
+            let a = jk * r;
+            [
+                a * r * r / 6.0 + a * r * 0.5 * y + a * y * y * 0.5,
+                a * r * 0.5 + a * y,
+                a,
+            ]
+        };
+        if s <= 0.0 { [p, v, a] } else { [s + p, 1.0 - v, a] }
     }
 }
 
-/// `[p, v, a]` after `dt` of constant jerk `jk`.
-fn advance([p, v, a]: [f64; 3], jk: f64, dt: f64) -> [f64; 3] {
-    [
-        p + v * dt + a * dt * dt / 2.0 + jk * dt * dt * dt / 6.0,
-        v + a * dt + jk * dt * dt / 2.0,
-        a + jk * dt,
-    ]
+/// One joint's limits in the forms its blends use.
+#[derive(Debug, Clone, Copy)]
+struct JointConst {
+    /// `1/a`, `1/j`.
+    inv_a: f64,
+    inv_j: f64,
+    /// `a/j`: the ramp time once the acceleration limit is reached.
+    ramp: f64,
+    /// `a²/j`: the least velocity change that reaches it.
+    knee: f64,
+    /// `ramp² a / 24`.
+    tail: f64,
+}
+
+impl JointConst {
+    fn new(a: f64, j: f64) -> Self {
+        let ramp = a / j;
+        Self {
+            inv_a: 1.0 / a,
+            inv_j: 1.0 / j,
+            ramp,
+            knee: a * ramp,
+            tail: ramp * ramp * a / 24.0,
+        }
+    }
+
+    /// The shortest blend changing this joint's velocity by `dv` (the shape
+    /// of [`Shape::from_bounds`] for the joint alone) and how far it passes
+    /// its corner, `|Δv| · offset`: with `m = |Δv|`, when `m ≥ a²/j`,
+    /// `w = m/a`, `r = a/j` and `m (w/8 + r²/(24 w)) = m²/(8a) + r² a/24`;
+    /// else `w = r = √(m/j)` and `m w/6`. No division.
+    fn blend(&self, dv: f64) -> (Shape, f64) {
+        let m = dv.abs();
+        if m == 0.0 {
+            return (Shape::default(), 0.0);
+        }
+        if m >= self.knee {
+            let w = m * self.inv_a;
+            let r = self.ramp;
+            let e = m * w * 0.125 + self.tail;
+            let h = (w + r) * 0.5;
+            (Shape { h, r, jerk: 0.0 }, e)
+        } else {
+            let w = (m * self.inv_j).sqrt();
+            (
+                Shape {
+                    h: w,
+                    r: w,
+                    jerk: 0.0,
+                },
+                m * w / 6.0,
+            )
+        }
+    }
 }
 
 /// Straight segments between the waypoints `w_0 … w_m`, segment `k` run at
 /// the constant velocity `V_k = (w_{k+1} − w_k)/T_k`, with a blend at every
 /// waypoint `i` centred on its nominal time `τ_i` (`τ_{i+1} = τ_i + T_i`)
 /// that changes the velocity from `V_{i−1}` to `V_i` (rest before the first
-/// waypoint and after the last) with the acceleration `q̈ = (V_i − V_{i−1})
-/// g_i(t − τ_i)`, `g_i` the trapezoid of [`Shape::for_change`]. This is the
+/// waypoint and after the last) with the acceleration of joint `c`
+/// `q̈_c = (V_{i,c} − V_{i−1,c}) g_{i,c}(t − τ_i)`. At an interior waypoint
+/// each joint has its own trapezoid `g_{i,c}` ([`JointConst::blend`]: a joint
+/// whose velocity changes little blends over a short window); at the ends
+/// and at the points splitting a segment, where `Δv_i` runs along the line,
+/// every joint shares the trapezoid of [`Shape::from_bounds`], so the motion
+/// stays on the line. This is the
 /// linear-segments-with-blends scheme (Paul, "Manipulator Cartesian path
 /// control", IEEE SMC 9(11), 1979; Taylor, "Planning and execution of
 /// straight line manipulator trajectories", IBM J. R&D 23(4), 1979) with
 /// S-curve blends in place of parabolic ones.
 ///
-/// Because `g_i` is even, the blend leaves the line of segment `i − 1` and
-/// joins that of segment `i` exactly; the motion starts `h_0` before `τ_0`
-/// at rest on `w_0` and ends `h_m` after `τ_m` at rest on `w_m`. Every limit
-/// holds in closed form: the velocity during a blend is a convex
-/// combination of `V_{i−1}` and `V_i`, the acceleration and jerk are those
-/// of the shape. At an interior waypoint the motion passes at
-/// `|Δv_i| · offset_i` from it (the farthest it gets from the polyline).
+/// Because every `g_{i,c}` is even, each joint leaves the line of segment
+/// `i − 1` and joins that of segment `i` exactly; the motion starts `h_0`
+/// before `τ_0` at rest on `w_0` and ends `h_m` after `τ_m` at rest on
+/// `w_m`. Every limit holds in closed form as long as the windows of one
+/// joint do not overlap (`h_{k,c} + h_{k+1,c} ≤ T_k`): the velocity of joint
+/// `c` during a blend is a convex combination of `V_{i−1,c}` and `V_{i,c}`,
+/// its acceleration and jerk are those of its shape. Measured from the
+/// point `w_k + V_k (t − τ_k)` of the polyline, joint `c` is off by at most
+/// `e_{i,c} = |Δv_{i,c}| · offset_{i,c}` during blend `i` (`G₂` is monotone),
+/// so the motion passes waypoint `i` at `e_i = |(e_{i,c})_c|` and keeps
+/// within it of the polyline; where the windows of blends `k` and `k + 1`
+/// overlap in time (different joints in different blends) the bound on
+/// segment `k` is `b_k = (Σ_c max(e_{k,c}, e_{k+1,c})²)^½`.
 ///
-/// Each segment is split at points along it (a blend there changes the
+/// Each segment may be split at points along it (a blend there changes the
 /// speed along the line and leaves it nowhere), so the motion can speed up
-/// between two corners and slow down into the next: at its midpoint, at
-/// its quarters, or at 0.15, 0.5 and 0.85 of it — every segment alike, the
-/// fastest of the three kept.
+/// between two corners and slow down into the next: every segment alike,
+/// at the fractions of [`SPLITS`], or not at all — the faster kept.
 ///
 /// Durations: first `T_k = max_j |Δq_{k,j}|/v_j`; then, in sweeps, every
 /// segment is scaled by `√w_k`, `w_k` the largest ratio its velocity enters
-/// — `ρ_l = (h_l + h_{l+1})/T_l` (the two half-blends must fit in segment
-/// `l`) for `l = k − 1, k, k + 1`, and `e_i/δ` (the passing distance over the
+/// — `ρ_l = max_c (h_{l,c} + h_{l+1,c})/T_l` (the two half-blends of each
+/// joint must fit in segment `l`) and, where windows overlap, `b_l/δ`, for
+/// `l = k − 1, k, k + 1`, and `e_i/δ` (the passing distance over the
 /// tolerance) at both its ends — never below the first `T_k`: segments
 /// stretch where a ratio exceeds 1 and shrink where all have room. Once the
 /// sweeps settle (or run out), every segment is stretched by the worst
@@ -156,18 +245,25 @@ struct JerkBlends {
     vel: Vec<f64>,
     /// `Δv_i = V_i − V_{i−1}` (`(m + 1) × dof`).
     dv: Vec<f64>,
+    /// Blend shape per point and joint (`(m + 1) × dof`).
     shapes: Vec<Shape>,
+    /// `e_{i,c}` per point and joint (`(m + 1) × dof`; 0 but at interior
+    /// waypoints).
+    err: Vec<f64>,
+    /// Half-width of each blend's window: the largest `h` of its joints.
+    hmax: Vec<f64>,
     /// Velocity before the first blend (the start velocity; zeros at rest).
     start: Vec<f64>,
     /// Whether point `i` is a waypoint (else a point inserted on a segment).
     corner: Vec<bool>,
-    /// Nominal waypoint times `τ_i`, `τ_0 = h_0`.
+    /// Nominal waypoint times `τ_i`, `τ_0 = hmax_0`.
     tau: Vec<f64>,
 }
 
 impl JerkBlends {
     /// Times the path through `waypoints` (`n × dof`, finite, n ≥ 1) within
-    /// `lim`. `None` when no split keeps a moving start (see
+    /// `lim`: unsplit and split at the first of [`SPLITS`] that keeps a
+    /// moving start, the faster kept. `None` when none keeps it (see
     /// [`JerkBlends::with_splits`]).
     fn new(waypoints: &[f64], dof: usize, lim: Limits<'_>) -> Option<Self> {
         let mut merged: Vec<f64> = Vec::with_capacity(waypoints.len());
@@ -177,16 +273,14 @@ impl JerkBlends {
                 merged.extend_from_slice(row);
             }
         }
-        let mut best: Option<JerkBlends> = None;
-        for fracs in SPLITS {
-            let Some(tb) = Self::with_splits(&merged, dof, fracs, lim) else {
-                continue;
-            };
-            if best.as_ref().is_none_or(|b| tb.duration() < b.duration()) {
-                best = Some(tb);
-            }
+        let whole = Self::with_splits(&merged, dof, &[], lim);
+        let split = SPLITS
+            .iter()
+            .find_map(|fracs| Self::with_splits(&merged, dof, fracs, lim));
+        match (whole, split) {
+            (Some(a), Some(b)) => Some(if a.duration() < b.duration() { a } else { b }),
+            (a, b) => a.or(b),
         }
-        best
     }
 
     /// The timing with every segment split at `fracs` (increasing, in
@@ -224,7 +318,9 @@ impl JerkBlends {
             dof,
             vel: vec![0.0; m * dof],
             dv: vec![0.0; (m + 1) * dof],
-            shapes: vec![Shape::default(); m + 1],
+            shapes: vec![Shape::default(); (m + 1) * dof],
+            err: vec![0.0; (m + 1) * dof],
+            hmax: vec![0.0; m + 1],
             tau: vec![0.0; m + 1],
             start: if moving { start.to_vec() } else { vec![0.0; dof] },
             points,
@@ -246,23 +342,17 @@ impl JerkBlends {
             })
             .collect();
         let mut tmin = dur.clone();
+        let consts: Vec<JointConst> = (0..dof).map(|c| JointConst::new(a[c], j[c])).collect();
         let mut rho = vec![0.0; m];
         let mut dev = vec![0.0; m + 1];
         for _ in 0..SWEEPS {
             if moving {
                 tb.place_start(&w0, fracs, first, v, &mut tmin, &mut dur);
             }
-            tb.shape(&dur, a, j);
-            for k in 0..m {
-                rho[k] = (tb.shapes[k].h + tb.shapes[k + 1].h) / dur[k];
-            }
-            for (i, d) in dev.iter_mut().enumerate().take(m).skip(1) {
-                *d = if tb.corner[i] {
-                    tb.passing(i) / tolerance
-                } else {
-                    0.0
-                };
-            }
+            tb.shape(&dur, &consts);
+            tb.ratios(&dur, tolerance, &mut rho, &mut dev);
+            // settled once no segment changes by more than a part in 10³ (the
+            // uniform stretch below takes what ratios stay above 1)
             let mut settled = true;
             for k in 0..m {
                 // every ratio segment k's velocity enters
@@ -274,7 +364,7 @@ impl JerkBlends {
                     w = w.max(rho[k + 1]);
                 }
                 let next = (dur[k] * w.sqrt()).max(tmin[k]);
-                if w > 1.0 || (next - dur[k]).abs() > 1e-3 * dur[k] {
+                if (next - dur[k]).abs() > 1e-3 * dur[k] {
                     settled = false;
                 }
                 dur[k] = next;
@@ -291,8 +381,8 @@ impl JerkBlends {
             if moving {
                 tb.place_start(&w0, fracs, first, v, &mut tmin, &mut dur);
             }
-            tb.shape(&dur, a, j);
-            let worst = tb.worst(&dur, tolerance);
+            tb.shape(&dur, &consts);
+            let worst = tb.worst(&dur, tolerance, &mut rho, &mut dev);
             if worst > 1.0 {
                 let f = worst * (1.0 + 1e-12) * 1.5f64.powi(stretches / 8);
                 dur.iter_mut().for_each(|d| *d *= f);
@@ -301,11 +391,12 @@ impl JerkBlends {
                 break;
             }
         }
-        tb.shape(&dur, a, j);
-        if tb.worst(&dur, tolerance) > 1.0 || tb.start_gap(&w0) > 1e-9 * scale {
+        tb.shape(&dur, &consts);
+        if tb.worst(&dur, tolerance, &mut rho, &mut dev) > 1.0 || tb.start_gap(&w0) > 1e-9 * scale {
             return None;
         }
-        tb.tau[0] = tb.shapes[0].h;
+        tb.shapes.iter_mut().for_each(Shape::finish);
+        tb.tau[0] = tb.hmax[0];
         for (k, d) in dur.iter().enumerate() {
             tb.tau[k + 1] = tb.tau[k] + d;
         }
@@ -325,7 +416,7 @@ impl JerkBlends {
         dur: &mut [f64],
     ) {
         let dof = self.dof;
-        let h0 = self.shapes[0].h;
+        let h0 = self.hmax[0];
         for (c, w) in w0.iter().enumerate() {
             let corner = w + self.start[c] * h0;
             let next = self.points[first * dof + c];
@@ -344,7 +435,7 @@ impl JerkBlends {
 
     /// How far the motion's start, `corner − v₀ h₀`, is from `w₀`.
     fn start_gap(&self, w0: &[f64]) -> f64 {
-        let h0 = self.shapes[0].h;
+        let h0 = self.hmax[0];
         (0..self.dof)
             .map(|c| (self.points[c] - self.start[c] * h0 - w0[c]).abs())
             .fold(0.0, f64::max)
@@ -352,12 +443,13 @@ impl JerkBlends {
 
     /// Velocities, velocity changes and blend shapes for the durations
     /// `dur`.
-    fn shape(&mut self, dur: &[f64], a: &[f64], j: &[f64]) {
+    fn shape(&mut self, dur: &[f64], consts: &[JointConst]) {
         let dof = self.dof;
         let m = dur.len();
         for (k, d) in dur.iter().enumerate() {
+            let inv = 1.0 / d;
             for c in 0..dof {
-                self.vel[k * dof + c] = (self.points[(k + 1) * dof + c] - self.points[k * dof + c]) / d;
+                self.vel[k * dof + c] = (self.points[(k + 1) * dof + c] - self.points[k * dof + c]) * inv;
             }
         }
         for i in 0..=m {
@@ -370,71 +462,119 @@ impl JerkBlends {
                 };
                 self.dv[i * dof + c] = after - before;
             }
-            self.shapes[i] = Shape::for_change(&self.dv[i * dof..(i + 1) * dof], a, j);
-        }
-    }
-
-    /// How far the motion passes from waypoint `i`: `|Δv_i| · offset_i`.
-    fn passing(&self, i: usize) -> f64 {
-        let d = &self.dv[i * self.dof..(i + 1) * self.dof];
-        d.iter().map(|x| x * x).sum::<f64>().sqrt() * self.shapes[i].offset()
-    }
-
-    /// The largest of every `ρ_k` and `e_i/δ`.
-    fn worst(&self, dur: &[f64], tolerance: f64) -> f64 {
-        let m = dur.len();
-        let mut worst = 0.0f64;
-        for (k, d) in dur.iter().enumerate() {
-            worst = worst.max((self.shapes[k].h + self.shapes[k + 1].h) / d);
-        }
-        for i in 1..m {
-            if self.corner[i] {
-                worst = worst.max(self.passing(i) / tolerance);
+            let own = self.interior_corner(i);
+            let dv = &self.dv[i * dof..(i + 1) * dof];
+            let shapes = &mut self.shapes[i * dof..(i + 1) * dof];
+            if own {
+                let err = &mut self.err[i * dof..(i + 1) * dof];
+                for c in 0..dof {
+                    (shapes[c], err[c]) = consts[c].blend(dv[c]);
+                }
+            } else {
+                // one shape for all, from the limits' inverses
+                let (mut da, mut dj) = (0.0f64, 0.0f64);
+                for c in 0..dof {
+                    let x = dv[c].abs();
+                    da = da.max(x * consts[c].inv_a);
+                    dj = dj.max(x * consts[c].inv_j);
+                }
+                shapes.fill(Shape::from_bounds(da, dj));
             }
+            self.hmax[i] = shapes.iter().fold(0.0, |h, s| h.max(s.h));
         }
-        worst
+    }
+
+    /// Whether point `i` is a waypoint other than the first and last.
+    fn interior_corner(&self, i: usize) -> bool {
+        i > 0 && i + 1 < self.hmax.len() && self.corner[i]
+    }
+
+    /// How far the motion passes from waypoint `i`: `e_i = |(e_{i,c})_c|`
+    /// (0 but at interior waypoints: the blend there runs along the line).
+    fn passing(&self, i: usize) -> f64 {
+        if !self.interior_corner(i) {
+            return 0.0;
+        }
+        let err = &self.err[i * self.dof..(i + 1) * self.dof];
+        err.iter().map(|e| e * e).sum::<f64>().sqrt()
+    }
+
+    /// Into `seg[k]`: `ρ_k`, or `b_k/δ` where larger and the windows of
+    /// blends `k` and `k + 1` overlap; into `pt[i]`: `e_i/δ`.
+    fn ratios(&self, dur: &[f64], tolerance: f64, seg: &mut [f64], pt: &mut [f64]) {
+        let dof = self.dof;
+        for (i, p) in pt.iter_mut().enumerate() {
+            *p = self.passing(i) / tolerance;
+        }
+        for (k, d) in dur.iter().enumerate() {
+            let (here, next) = (k * dof, (k + 1) * dof);
+            let fit = (0..dof)
+                .map(|c| self.shapes[here + c].h + self.shapes[next + c].h)
+                .fold(0.0, f64::max);
+            let mut r = fit / d;
+            if self.hmax[k] + self.hmax[k + 1] > *d && pt[k] > 0.0 && pt[k + 1] > 0.0 {
+                let (e1, e2) = (&self.err[here..next], &self.err[next..next + dof]);
+                let b = (0..dof).map(|c| e1[c].max(e2[c]).powi(2)).sum::<f64>().sqrt();
+                r = r.max(b / tolerance);
+            }
+            seg[k] = r;
+        }
+    }
+
+    /// The largest of every `ρ_k`, `b_k/δ` and `e_i/δ` (`seg`, `pt`: scratch
+    /// of [`JerkBlends::ratios`]).
+    fn worst(&self, dur: &[f64], tolerance: f64, seg: &mut [f64], pt: &mut [f64]) -> f64 {
+        self.ratios(dur, tolerance, seg, pt);
+        seg.iter().chain(pt.iter()).fold(0.0, |w, x| w.max(*x))
     }
 
     /// Duration, s.
     pub fn duration(&self) -> f64 {
-        let m = self.shapes.len() - 1;
+        let m = self.hmax.len() - 1;
         if m == 0 {
             return 0.0;
         }
-        self.tau[m] + self.shapes[m].h
+        self.tau[m] + self.hmax[m]
     }
 
     /// How far the motion passes from each waypoint, rad (m): 0 at the ends.
     #[cfg(test)]
     pub fn passing_distances(&self) -> Vec<f64> {
-        let m = self.shapes.len() - 1;
+        let m = self.hmax.len() - 1;
         (0..=m)
             .filter(|&i| self.corner[i])
             .map(|i| if i == 0 || i == m { 0.0 } else { self.passing(i) })
             .collect()
     }
 
-    /// The motion at `times` (sorted): on segment `k` (`τ_k ≤ t ≤ τ_{k+1}`,
-    /// extended before `τ_0` and after `τ_m`), with `s = t − τ_k`,
-    /// `s' = t − τ_{k+1}`,
+    /// The motion at `times` (sorted, s from this piece's start) into the
+    /// rows of `q`, `q̇` and `q̈` (`times.len() × dof` each): on segment `k`
+    /// (`τ_k ≤ t ≤ τ_{k+1}`, extended before `τ_0` and after `τ_m`), with
+    /// `s = t − τ_k`, `s' = t − τ_{k+1}`, for each joint
     /// `q = w_k + V_k s + Δv_k (G₂,k(s) − s) + Δv_{k+1} G₂,k+1(s')`,
     /// `q̇ = V_k + Δv_k (G₁,k(s) − 1) + Δv_{k+1} G₁,k+1(s')`,
-    /// `q̈ = Δv_k g_k(s) + Δv_{k+1} g_{k+1}(s')`. `None` once the deadline
-    /// passes or the caller cancels (looked at every 4096 samples).
-    pub fn sample(&self, times: &[f64], deadline: Deadline<'_>) -> Option<TimedTrajectory> {
+    /// `q̈ = Δv_k g_k(s) + Δv_{k+1} g_{k+1}(s')` (each term 0 outside its
+    /// window). `None` once the deadline passes or the caller cancels
+    /// (looked at every 4096 samples).
+    fn sample_into(
+        &self,
+        times: &[f64],
+        [q, qd, qdd]: [&mut [f64]; 3],
+        deadline: Deadline<'_>,
+    ) -> Option<()> {
         let dof = self.dof;
-        let m = self.shapes.len() - 1;
-        let mut out = TimedTrajectory::with_capacity(dof, times.len());
+        let m = self.hmax.len() - 1;
         let mut k = 0;
         for (n, &t) in times.iter().enumerate() {
             if n % 4096 == 0 && deadline.expired() {
                 return None;
             }
-            out.t.push(t);
+            let row = n * dof..(n + 1) * dof;
+            let (q, qd, qdd) = (&mut q[row.clone()], &mut qd[row.clone()], &mut qdd[row]);
             if m == 0 {
-                out.q.extend_from_slice(&self.points[..dof]);
-                out.qd.extend(std::iter::repeat_n(0.0, dof));
-                out.qdd.extend(std::iter::repeat_n(0.0, dof));
+                q.copy_from_slice(&self.points[..dof]);
+                qd.fill(0.0);
+                qdd.fill(0.0);
                 continue;
             }
             while k + 1 < m && self.tau[k + 1] <= t {
@@ -442,18 +582,43 @@ impl JerkBlends {
             }
             let s = t - self.tau[k];
             let s2 = t - self.tau[k + 1];
-            let [p1, v1, a1] = self.shapes[k].at(s);
-            let [p2, v2, a2] = self.shapes[k + 1].at(s2);
-            let w = &self.points[k * dof..(k + 1) * dof];
-            let vk = &self.vel[k * dof..(k + 1) * dof];
-            let d1 = &self.dv[k * dof..(k + 1) * dof];
-            let d2 = &self.dv[(k + 1) * dof..(k + 2) * dof];
-            out.q
-                .extend((0..dof).map(|c| w[c] + vk[c] * s + d1[c] * (p1 - s) + d2[c] * p2));
-            out.qd
-                .extend((0..dof).map(|c| vk[c] + d1[c] * (v1 - 1.0) + d2[c] * v2));
-            out.qdd.extend((0..dof).map(|c| d1[c] * a1 + d2[c] * a2));
+            let (here, next) = (k * dof, (k + 1) * dof);
+            for c in 0..dof {
+                let vk = self.vel[here + c];
+                let (mut x, mut v, mut a) = (self.points[here + c] + vk * s, vk, 0.0);
+                let (b1, b2) = (&self.shapes[here + c], &self.shapes[next + c]);
+                if s < b1.h {
+                    let [p1, v1, a1] = b1.at(s);
+                    let d1 = self.dv[here + c];
+                    x += d1 * (p1 - s);
+                    v += d1 * (v1 - 1.0);
+                    a += d1 * a1;
+                }
+                if s2 > -b2.h {
+                    let [p2, v2, a2] = b2.at(s2);
+                    let d2 = self.dv[next + c];
+                    x += d2 * p2;
+                    v += d2 * v2;
+                    a += d2 * a2;
+                }
+                (q[c], qd[c], qdd[c]) = (x, v, a);
+            }
         }
+        Some(())
+    }
+
+    /// [`JerkBlends::sample_into`] a new trajectory.
+    #[cfg(test)]
+    fn sample(&self, times: &[f64], deadline: Deadline<'_>) -> Option<TimedTrajectory> {
+        let n = times.len() * self.dof;
+        let mut out = TimedTrajectory {
+            dof: self.dof,
+            t: times.to_vec(),
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+        };
+        self.sample_into(times, [&mut out.q, &mut out.qd, &mut out.qdd], deadline)?;
         Some(out)
     }
 }
@@ -568,20 +733,33 @@ impl JerkPath {
     /// The motion at `times` (sorted), each piece from its own start time;
     /// `None` once the deadline passes or the caller cancels.
     pub fn sample(&self, times: &[f64], deadline: Deadline<'_>) -> Option<TimedTrajectory> {
-        let mut out = TimedTrajectory::with_capacity(self.dof, times.len());
+        let dof = self.dof;
+        let n = times.len() * dof;
+        let mut out = TimedTrajectory {
+            dof,
+            t: times.to_vec(),
+            q: vec![0.0; n],
+            qd: vec![0.0; n],
+            qdd: vec![0.0; n],
+        };
         let mut from = 0;
+        // the piece's own clock, reused across pieces
+        let mut local = Vec::with_capacity(times.len());
         for (p, piece) in self.pieces.iter().enumerate() {
             let start = self.starts[p];
             let to = match self.starts.get(p + 1) {
                 Some(next) => from + times[from..].partition_point(|t| t < next),
                 None => times.len(),
             };
-            let local: Vec<f64> = times[from..to].iter().map(|t| t - start).collect();
-            let part = piece.sample(&local, deadline)?;
-            out.t.extend_from_slice(&times[from..to]);
-            out.q.extend_from_slice(&part.q);
-            out.qd.extend_from_slice(&part.qd);
-            out.qdd.extend_from_slice(&part.qdd);
+            local.clear();
+            local.extend(times[from..to].iter().map(|t| t - start));
+            let rows = from * dof..to * dof;
+            let out_rows = [
+                &mut out.q[rows.clone()],
+                &mut out.qd[rows.clone()],
+                &mut out.qdd[rows],
+            ];
+            piece.sample_into(&local, out_rows, deadline)?;
             from = to;
         }
         Some(out)
@@ -595,7 +773,8 @@ mod tests {
     #[test]
     fn the_shape_integrates_to_one_and_its_offset_matches_the_integral() {
         for (h, r) in [(0.35, 0.2), (0.3, 0.3), (0.5, 0.01)] {
-            let s = Shape { h, r };
+            let mut s = Shape { h, r, jerk: 0.0 };
+            s.finish();
             // G₁(h) = 1, G₂(h) = h (g even), g(±h) = 0
             let [p, v, a] = s.at(h - 1e-15);
             assert!((v - 1.0).abs() < 1e-9 && (p - h).abs() < 1e-9 && a.abs() < 1e-9);
@@ -623,6 +802,16 @@ mod tests {
         // at j = 1 the jerk binds: w = r = 1, h = 1
         let s = Shape::for_change(&[1.0], &[2.0], &[1.0]);
         assert!((s.h - 1.0).abs() < 1e-15 && (s.r - 1.0).abs() < 1e-15);
+        // one joint's blend is the shape of that joint alone, passing its
+        // corner at |Δv| times the integral's offset, on both sides of the
+        // knee a²/j (= 0.4 at a = 2, j = 10)
+        let k = JointConst::new(2.0, 10.0);
+        for dv in [-1.0, 0.7, 0.4, -0.25, 1e-3] {
+            let (s, e) = k.blend(dv);
+            let alone = Shape::for_change(&[dv], &[2.0], &[10.0]);
+            assert!((s.h - alone.h).abs() < 1e-15 && (s.r - alone.r).abs() < 1e-15);
+            assert!((e - dv.abs() * alone.offset()).abs() < 1e-15, "{dv}");
+        }
     }
 
     #[test]
@@ -658,5 +847,116 @@ mod tests {
         let tight = JerkBlends::new(&w, 2, limits(0.05)).unwrap();
         assert!(tight.passing_distances()[1] <= 0.05 + 1e-12);
         assert!(tight.duration() > 4.7);
+    }
+
+    #[test]
+    fn each_joint_blends_a_corner_over_its_own_window() {
+        // the right angle above with joint 1 at a = 8, j = 40: at the corner
+        // joint 0 still needs h = 0.35, r = 0.2, while joint 1 changes by
+        // 1 rad/s in a triangle: D_a = 1/8, D_j = 1/40 > D_a², so
+        // w = r = √(1/40), h = √(1/40) and its offset is h/6. The start
+        // blend (joint 0 alone) takes h = 0.35, the end blend (joint 1
+        // alone) h = √(1/40): 0.35 + 2 + 2 + √(1/40) s in all, where one
+        // shape for both joints would take the 0.35 of joint 0 at the corner.
+        let w = [0.0, 0.0, 2.0, 0.0, 2.0, 2.0];
+        let lim = Limits {
+            v: &[1.0, 1.0],
+            a: &[2.0, 8.0],
+            j: &[10.0, 40.0],
+            tolerance: 0.1,
+            start: &[],
+        };
+        let tb = JerkBlends::new(&w, 2, lim).unwrap();
+        let h1 = (1.0f64 / 40.0).sqrt();
+        assert!((tb.duration() - (4.35 + h1)).abs() < 1e-12, "{}", tb.duration());
+        let off0 = (0.15f64.powi(2) / 2.0 + 0.35 * 0.2 / 2.0 - 0.04 / 3.0) / 0.5;
+        let off1 = h1 / 6.0;
+        let tr = tb
+            .sample(&[0.35 + 2.0 - h1, 0.35 + 2.0], Deadline::none())
+            .unwrap();
+        // joint 1 still at rest where its window opens, joint 0 already
+        // slowing down
+        assert!(tr.q[1].abs() < 1e-12 && tr.qd[1].abs() < 1e-12);
+        assert!(tr.qd[0] < 1.0 - 1e-3);
+        // at the corner time: each joint off by its own offset
+        assert!(
+            (tr.q[2] - (2.0 - off0)).abs() < 1e-12 && (tr.q[3] - off1).abs() < 1e-12,
+            "{:?}",
+            tr.q
+        );
+        assert!((tb.passing_distances()[1] - off0.hypot(off1)).abs() < 1e-12);
+    }
+
+    /// Distance from `p` to the polyline through the rows of `w`.
+    fn polyline_distance(w: &[f64], dof: usize, p: &[f64]) -> f64 {
+        let mut best = f64::INFINITY;
+        for seg in w.chunks_exact(dof).collect::<Vec<_>>().windows(2) {
+            let d: Vec<f64> = (0..dof).map(|c| seg[1][c] - seg[0][c]).collect();
+            let dd: f64 = d.iter().map(|x| x * x).sum();
+            let t = if dd > 0.0 {
+                ((0..dof).map(|c| (p[c] - seg[0][c]) * d[c]).sum::<f64>() / dd).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let e: f64 = (0..dof).map(|c| (seg[0][c] + t * d[c] - p[c]).powi(2)).sum();
+            best = best.min(e.sqrt());
+        }
+        best
+    }
+
+    #[test]
+    fn overlapping_windows_of_two_corners_keep_the_motion_within_the_tolerance() {
+        // unsplit segments between corners of a random walk, joints with
+        // different limits: on some segments one joint is still leaving one
+        // corner while another has started into the next; every 1 ms sample
+        // stays within the tolerance of the polyline and within the limits
+        use rand::{Rng, SeedableRng};
+        let dof = 4;
+        let (v, a, j) = (
+            [1.0, 2.0, 1.5, 2.5],
+            [2.0, 9.0, 4.0, 12.0],
+            [20.0, 300.0, 60.0, 500.0],
+        );
+        let tolerance = 0.02;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut overlaps = 0;
+        for case in 0..20 {
+            let mut q = [0.0; 4];
+            let mut w = Vec::new();
+            for _ in 0..10 {
+                w.extend_from_slice(&q);
+                q.iter_mut().for_each(|x| *x += rng.random_range(-0.3..0.3));
+            }
+            let lim = Limits {
+                v: &v,
+                a: &a,
+                j: &j,
+                tolerance,
+                start: &[],
+            };
+            let tb = JerkBlends::with_splits(&w, dof, &[], lim).unwrap();
+            let m = tb.hmax.len() - 1;
+            for k in 1..m - 1 {
+                if tb.hmax[k] + tb.hmax[k + 1] > tb.tau[k + 1] - tb.tau[k] {
+                    overlaps += 1;
+                }
+            }
+            let times: Vec<f64> = (0..=(tb.duration() / 1e-3) as usize)
+                .map(|i| i as f64 * 1e-3)
+                .collect();
+            let tr = tb.sample(&times, Deadline::none()).unwrap();
+            for (p, (qd, qdd)) in
+                tr.q.chunks_exact(dof)
+                    .zip(tr.qd.chunks_exact(dof).zip(tr.qdd.chunks_exact(dof)))
+            {
+                let d = polyline_distance(&w, dof, p);
+                assert!(d <= tolerance + 1e-9, "case {case}: {d}");
+                for c in 0..dof {
+                    assert!(qd[c].abs() <= v[c] * (1.0 + 1e-9), "case {case}: v");
+                    assert!(qdd[c].abs() <= a[c] * (1.0 + 1e-9), "case {case}: a");
+                }
+            }
+        }
+        assert!(overlaps > 0, "no overlapping windows: the test misses its case");
     }
 }

@@ -74,7 +74,8 @@ impl TimedTrajectory {
 ///   the end. A start velocity must point along the first segment.
 /// - [`TimingMethod::JerkLimited`]: straight segments at constant velocity
 ///   joined at every waypoint by a blend in time of trapezoidal
-///   acceleration (an S-curve velocity change), passing each interior
+///   acceleration (an S-curve velocity change, each joint over its own
+///   window at an interior waypoint), passing each interior
 ///   waypoint within `path_tolerance` without stopping (except at corners
 ///   sharper than about 115°, or everywhere when stopping at every waypoint
 ///   is faster); every limit holds in closed form. Sampled every
