@@ -505,9 +505,13 @@ async fn planning_and_exploration(v: Values) -> Result<(), TestCaseError> {
     let free = [1.0, -1.2, 1.0, 0.0, 0.0, 0.0];
     let mut planning = PlanningServiceClient::new(channel());
     let mut exploration = ExplorationServiceClient::new(channel());
-    // a bad orientation of the box (slots 3–6) is absurd, or of no unit norm
+    // a bad orientation of the box (slots 3–6, w x y z) is absurd, or of no
+    // unit norm unless all zero (an unset quaternion is the identity)
+    let orientation: Vec<f64> = (3..7).map(|i| h.at(i, if i == 3 { 1.0 } else { 0.0 })).collect();
+    let norm = orientation.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let unset = orientation.iter().all(|c| *c == 0.0);
     let bad_scene = h.any_absurd(0..10)
-        || ((3..7).contains(&h.slot) && ((h.f[h.slot] - if h.slot == 3 { 1.0 } else { 0.0 }).abs() > 1e-6))
+        || ((3..7).contains(&h.slot) && !unset && !((norm - 1.0).abs() <= 1e-6))
         || ((7..10).contains(&h.slot) && h.f[h.slot] <= 0.0);
 
     // CheckState: the penetrating pair in either order, one hostile value
