@@ -31,6 +31,18 @@ pub trait StateChecker: Sync {
         (self.is_valid(q), self.clearance(q, max_distance))
     }
 
+    /// True when every state of `rows` (row-major, [`StateChecker::dof`]
+    /// values per row; a trailing partial row is ignored) is valid, as
+    /// [`StateChecker::is_valid`] says. Implementations may check several
+    /// rows at once, so which invalid row is found first is not specified;
+    /// the default asks `is_valid` row by row.
+    fn states_valid(&self, rows: &[f64]) -> bool {
+        match self.dof() {
+            0 => rows.is_empty() || self.is_valid(&[]),
+            dof => rows.chunks_exact(dof).all(|q| self.is_valid(q)),
+        }
+    }
+
     /// True when the straight joint-space motion from `a` to `b` is valid,
     /// as [`MotionCheck`] describes how it was checked.
     fn motion_valid(&self, a: &[f64], b: &[f64]) -> bool {

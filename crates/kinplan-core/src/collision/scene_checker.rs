@@ -17,12 +17,15 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::acm::AllowedCollisions;
 use super::bvh::Aabb;
+use super::lanes::{LANES, Lane, LaneFrame, Lanes, MAX_LANE_BODIES, MAX_LANE_DOF};
 use super::model::{JointAxis, MAX_BODIES, MAX_LINKS, RobotModel};
 use super::narrow::{
     Witness, body_body_contact, body_body_intersect, body_body_within, body_leaf_contact,
     body_leaf_intersect, body_leaf_within, shapes_intersect_leaf, sphere_center,
 };
+use super::spheres::{SphereModel, SphereParams};
 use super::sweep::SweepBound;
+use super::trig::in_reduced_range;
 use super::world::SceneGeometry;
 use super::{CollisionError, MotionCheck, PadVerdict, StateChecker};
 use crate::robot::JointKind;
@@ -177,6 +180,9 @@ pub struct SceneChecker {
     params: CheckerParams,
     /// How far bodies move per joint step (`None`: unbounded, cannot pad).
     sweep: Option<SweepBound>,
+    /// The sphere model and scene laid out for batches of states
+    /// ([`SceneChecker::states_valid`]); `None` beyond the batch limits.
+    lanes: Option<Lanes>,
 }
 
 impl SceneChecker {
@@ -202,6 +208,9 @@ impl SceneChecker {
             return Err(CollisionError::CannotPad);
         }
         let scene_bodies = scene_bodies(&model, &world, sweep.as_ref());
+        let lanes = SphereModel::build(&model, &SphereParams::default())
+            .ok()
+            .and_then(|spheres| Lanes::new(&model, &spheres, &world));
         Ok(SceneChecker {
             model,
             world,
@@ -209,6 +218,7 @@ impl SceneChecker {
             scene_bodies,
             params,
             sweep,
+            lanes,
         })
     }
 
@@ -241,6 +251,60 @@ impl SceneChecker {
             self.model.body_poses(q, &mut poses);
             self.hits(&poses)
         }
+    }
+
+    /// [`StateChecker::states_valid`] in batches of [`LANES`] states: the
+    /// limits, then forward kinematics and the sphere model against the
+    /// scene for the whole batch (`Lanes::unsure`); a state the spheres
+    /// leave unsure is checked exactly ([`SceneChecker::in_collision`]), so
+    /// the answer is the exact check's. `portable` forces the baseline
+    /// build of the batch code. `None` when the checker has no batched form
+    /// or a value is outside what it takes.
+    pub(crate) fn states_valid_in_lanes(&self, rows: &[f64], portable: bool) -> Option<bool> {
+        let lanes = self.lanes.as_ref()?;
+        let dof = lanes.dof();
+        if dof == 0 || rows.len() % dof != 0 || !rows.iter().all(|&v| in_reduced_range(v)) {
+            return None;
+        }
+        let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
+        for batch in rows.chunks(LANES * dof) {
+            let n = batch.len() / dof;
+            let mut q = [[0.0; LANES]; MAX_LANE_DOF];
+            for (l, row) in batch.chunks_exact(dof).enumerate() {
+                if !self.within_limits(row) {
+                    return Some(false);
+                }
+                for (j, &v) in row.iter().enumerate() {
+                    q[j][l] = v;
+                }
+            }
+            // unused lanes repeat the last state
+            for qj in q[..dof].iter_mut() {
+                let last = qj[n - 1];
+                qj[n..].fill(last);
+            }
+            let q: &[Lane] = &q[..dof];
+            let unsure = lanes.unsure(q, &self.scene_bodies, &self.self_pairs, &mut frames, portable);
+            for (l, row) in batch.chunks_exact(dof).enumerate() {
+                if unsure & (1 << l) != 0 && self.in_collision(row) {
+                    return Some(false);
+                }
+            }
+        }
+        Some(true)
+    }
+
+    /// The batched form (tests).
+    #[cfg(test)]
+    pub(crate) fn lanes(&self) -> Option<&Lanes> {
+        self.lanes.as_ref()
+    }
+
+    /// The bodies tested against the scene and the checked self pairs
+    /// (tests).
+    #[cfg(test)]
+    pub(crate) fn checked_parts(&self) -> (&[u16], &[(u16, u16)]) {
+        (&self.scene_bodies, &self.self_pairs)
     }
 
     /// The bodies' bounding-sphere centres at `poses` (`N` ≥ the body count).
@@ -601,6 +665,18 @@ impl StateChecker for SceneChecker {
 
     fn is_valid(&self, q: &[f64]) -> bool {
         self.within_limits(q) && !self.in_collision(q)
+    }
+
+    /// Batches of [`LANES`] states through the sphere model, the unsure
+    /// ones checked exactly (`SceneChecker::states_valid_in_lanes`).
+    fn states_valid(&self, rows: &[f64]) -> bool {
+        match self.states_valid_in_lanes(rows, false) {
+            Some(valid) => valid,
+            None => {
+                let dof = self.model.chain().dof();
+                dof > 0 && rows.chunks_exact(dof).all(|q| self.is_valid(q))
+            }
+        }
     }
 
     /// Signed clearance (m), capped at `max_distance`; `-inf` for a `q` of
