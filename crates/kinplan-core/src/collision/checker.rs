@@ -85,6 +85,17 @@ pub trait StateChecker: Sync {
         self.padded_verdict(q, half_step)
     }
 
+    /// Of the pieces of a straight motion with midpoints `rows` (row-major,
+    /// [`StateChecker::dof`] values per row, at most 32 rows) and the common
+    /// signed half vector `half_step`, those proved free at once as
+    /// [`StateChecker::padded_valid`] would (bit `i` for row `i`); a piece
+    /// left out is not proved either way and goes to the one-piece check.
+    /// `None` when the checker has no such batched proof (the default).
+    fn padded_free_batch(&self, rows: &[f64], half_step: &[f64]) -> Option<u32> {
+        let _ = (rows, half_step);
+        None
+    }
+
     /// How [`StateChecker::motion_valid`] checks a motion. Default: states
     /// interpolated at most 0.05 rad (or m) apart on every joint.
     fn motion_check(&self) -> MotionCheck {

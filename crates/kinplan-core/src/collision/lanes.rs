@@ -36,8 +36,13 @@
 //! never fuses a multiply and an add on its own, so both produce the same
 //! bits.
 
+// Lane loops index several arrays by lane and axis at once (`a[k][l] +
+// b[k][l]·c[k]`): written as index loops, which the vectoriser takes.
+#![allow(clippy::needless_range_loop)]
+
 use nalgebra::{Isometry3, Vector3};
 
+use super::bvh::{Aabb, Bvh};
 use super::fast::LeafFast;
 use super::model::{FkOp, RobotModel};
 use super::spheres::SphereModel;
@@ -141,7 +146,6 @@ struct LaneLeaf {
 pub(crate) struct Lanes {
     ops: Vec<Op>,
     dof: usize,
-    #[cfg_attr(not(test), allow(dead_code))]
     body_count: usize,
     /// Per body, its bounding sphere (joint frame).
     coarse: Vec<Ball>,
@@ -258,12 +262,42 @@ impl Lanes {
     }
 
     /// Unsure lanes (bit `l` for lane `l`) of the batch `q` (module doc):
-    /// the scene tested for `scene_bodies`, the bounding spheres of
+    /// the scene (`bvh`, over the leaves the lanes were built from) tested
+    /// for `scene_bodies`, the bounding spheres of
     /// `self_pairs`. `frames` is scratch of at least the body count.
     /// Dispatches to the AVX2 build when the CPU has it, unless `portable`.
     pub(crate) fn unsure(
         &self,
         q: &[Lane],
+        bvh: &Bvh,
+        scene_bodies: &[u16],
+        self_pairs: &[(u16, u16)],
+        frames: &mut [LaneFrame],
+        portable: bool,
+    ) -> u32 {
+        self.unsure_padded(
+            q,
+            &[0.0; MAX_LANE_BODIES],
+            bvh,
+            scene_bodies,
+            self_pairs,
+            frames,
+            portable,
+        )
+    }
+
+    /// [`Lanes::unsure`] with every sphere of body `b` grown by `pads[b]`
+    /// (m, ≥ 0; `pads` holds at least the body count): a lane found clear
+    /// has every state within those distances of its state clear — a point
+    /// of a body that moves at most `pads[b]` stays inside its sphere grown
+    /// by `pads[b]`, and of two bodies in a self pair, inside spheres grown
+    /// by both pads.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn unsure_padded(
+        &self,
+        q: &[Lane],
+        pads: &[f64],
+        bvh: &Bvh,
         scene_bodies: &[u16],
         self_pairs: &[(u16, u16)],
         frames: &mut [LaneFrame],
@@ -272,101 +306,148 @@ impl Lanes {
         #[cfg(target_arch = "x86_64")]
         if !portable && std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
             // SAFETY: the CPU has the features the function is built for.
-            return unsafe { self.unsure_avx2(q, scene_bodies, self_pairs, frames) };
+            return unsafe { self.unsure_avx2(q, pads, bvh, scene_bodies, self_pairs, frames) };
         }
         let _ = portable;
-        self.unsure_in(q, scene_bodies, self_pairs, frames)
+        self.unsure_in(q, pads, bvh, scene_bodies, self_pairs, frames)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma")]
+    #[allow(clippy::too_many_arguments)]
     unsafe fn unsure_avx2(
         &self,
         q: &[Lane],
+        pads: &[f64],
+        bvh: &Bvh,
         scene_bodies: &[u16],
         self_pairs: &[(u16, u16)],
         frames: &mut [LaneFrame],
     ) -> u32 {
-        self.unsure_in(q, scene_bodies, self_pairs, frames)
+        self.unsure_in(q, pads, bvh, scene_bodies, self_pairs, frames)
     }
 
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn unsure_in(
         &self,
         q: &[Lane],
+        pads: &[f64],
+        bvh: &Bvh,
         scene_bodies: &[u16],
         self_pairs: &[(u16, u16)],
         frames: &mut [LaneFrame],
     ) -> u32 {
         const ALL: u32 = (1 << LANES) - 1;
         self.fk(q, frames);
-        let mut unsure = [false; LANES];
-        let mut centres = [[[0.0; LANES]; 3]; MAX_FINE];
+        let mut unsure = 0u32;
+        // per body: the leaves its bounding sphere meets (and in which
+        // lanes), then each fine sphere placed once against those leaves
+        let mut near_leaves = [(0u16, 0u32); MAX_LANE_LEAVES];
         for &b in scene_bodies {
             let b = b as usize;
             let f = &frames[b];
             let coarse = self.coarse[b];
+            let pad = pads[b] + MARGIN;
             let c = place(f, &coarse.c);
-            let fine = &self.fine[self.start[b]..self.start[b + 1]];
-            let mut placed = false;
-            for leaf in &self.leaves {
-                let near = sphere_aabb(&c, coarse.r + MARGIN, &leaf.lo, &leaf.hi);
-                let near: [bool; LANES] = std::array::from_fn(|l| near[l] && !unsure[l]);
-                if !near.iter().any(|&n| n) {
-                    continue;
-                }
-                if !placed {
-                    for (slot, s) in centres.iter_mut().zip(fine) {
-                        *slot = place(f, &s.c);
-                    }
-                    placed = true;
-                }
-                for (x, s) in centres.iter().zip(fine) {
-                    let hit = sphere_prim(x, s.r + MARGIN, &leaf.prim);
-                    for l in 0..LANES {
-                        unsure[l] |= near[l] && hit[l];
-                    }
+            // the scene's hierarchy asked once for the batch: the box around
+            // the bounding sphere in every lane
+            let reach = coarse.r + pad;
+            let mut query = Aabb::empty();
+            for k in 0..3 {
+                for l in 0..LANES {
+                    query.min[k] = query.min[k].min(c[k][l] - reach);
+                    query.max[k] = query.max[k].max(c[k][l] + reach);
                 }
             }
-            if mask(&unsure) == ALL {
+            let mut count = 0;
+            bvh.for_each_overlap(&query, |i| {
+                let leaf = &self.leaves[i as usize];
+                let near = mask(&sphere_aabb(&c, reach, &leaf.lo, &leaf.hi)) & !unsure;
+                if near != 0 {
+                    near_leaves[count] = (i as u16, near);
+                    count += 1;
+                }
+                true
+            });
+            for s in &self.fine[self.start[b]..self.start[b + 1]] {
+                if count == 0 {
+                    break;
+                }
+                let x = place(f, &s.c);
+                for &(i, near) in &near_leaves[..count] {
+                    unsure |= mask(&sphere_prim(&x, s.r + pad, &self.leaves[i as usize].prim)) & near;
+                }
+            }
+            if unsure == ALL {
                 return ALL;
             }
         }
-        // self pairs: bounding spheres, then where they meet, each fine
-        // sphere of `a` near `b`'s bounding sphere against `b`'s fine ones
-        let mut others = [[[0.0; LANES]; 3]; MAX_FINE];
+        // self pairs: bounding spheres; where they meet, the fine spheres of
+        // each body near the other's bounding sphere, pairwise
         for &(a, b) in self_pairs {
             let (a, b) = (a as usize, b as usize);
             let (sa, sb) = (self.coarse[a], self.coarse[b]);
+            let pad = pads[a] + pads[b] + MARGIN;
             let (ca, cb) = (place(&frames[a], &sa.c), place(&frames[b], &sb.c));
-            let near = spheres_meet(&ca, &cb, sa.r + sb.r + MARGIN);
-            let near: [bool; LANES] = std::array::from_fn(|l| near[l] && !unsure[l]);
-            if !near.iter().any(|&n| n) {
+            let near = mask(&spheres_meet(&ca, &cb, sa.r + sb.r + pad)) & !unsure;
+            if near == 0 {
                 continue;
             }
-            let fine_b = &self.fine[self.start[b]..self.start[b + 1]];
-            for (slot, s) in others.iter_mut().zip(fine_b) {
-                *slot = place(&frames[b], &s.c);
-            }
-            for s in &self.fine[self.start[a]..self.start[a + 1]] {
-                let x = place(&frames[a], &s.c);
-                let close = spheres_meet(&x, &cb, s.r + sb.r + MARGIN);
-                let close: [bool; LANES] = std::array::from_fn(|l| close[l] && near[l]);
-                if !close.iter().any(|&n| n) {
-                    continue;
-                }
-                for (y, t) in others.iter().zip(fine_b) {
-                    let hit = spheres_meet(&x, y, s.r + t.r + MARGIN);
-                    for l in 0..LANES {
-                        unsure[l] |= close[l] && hit[l];
-                    }
-                }
-            }
-            if mask(&unsure) == ALL {
+            unsure |= self.fine_pairs_meet(&frames[a], a, &frames[b], b, &ca, &cb, pad) & near;
+            if unsure == ALL {
                 return ALL;
             }
         }
-        mask(&unsure)
+        unsure
+    }
+
+    /// Lanes where a fine sphere of body `a` (frame `fa`, bounding-sphere
+    /// centre `ca`) comes within `pad` of one of body `b`'s; up to
+    /// [`CLOSE`] spheres of `b` near `a`'s bounding sphere are kept, and
+    /// beyond that every lane counts as meeting (unsure, never wrong).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn fine_pairs_meet(
+        &self,
+        fa: &LaneFrame,
+        a: usize,
+        fb: &LaneFrame,
+        b: usize,
+        ca: &[Lane; 3],
+        cb: &[Lane; 3],
+        pad: f64,
+    ) -> u32 {
+        const CLOSE: usize = 24;
+        let (sa, sb) = (self.coarse[a], self.coarse[b]);
+        let mut kept = [([[0.0; LANES]; 3], 0.0, 0u32); CLOSE];
+        let mut count = 0;
+        for t in &self.fine[self.start[b]..self.start[b + 1]] {
+            let y = place(fb, &t.c);
+            let close = mask(&spheres_meet(&y, ca, t.r + sa.r + pad));
+            if close != 0 {
+                if count == CLOSE {
+                    return (1 << LANES) - 1;
+                }
+                kept[count] = (y, t.r, close);
+                count += 1;
+            }
+        }
+        let mut meet = 0u32;
+        for s in &self.fine[self.start[a]..self.start[a + 1]] {
+            if count == 0 {
+                break;
+            }
+            let x = place(fa, &s.c);
+            let close = mask(&spheres_meet(&x, cb, s.r + sb.r + pad));
+            if close == 0 {
+                continue;
+            }
+            for (y, r, near) in &kept[..count] {
+                meet |= mask(&spheres_meet(&x, y, s.r + r + pad)) & close & near;
+            }
+        }
+        meet
     }
 
     #[inline(always)]
@@ -443,7 +524,6 @@ impl Lanes {
     }
 
     /// Bodies.
-    #[cfg(test)]
     pub(crate) fn body_count(&self) -> usize {
         self.body_count
     }

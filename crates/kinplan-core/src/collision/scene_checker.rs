@@ -37,6 +37,14 @@ const SMALL_CHAIN: usize = 16;
 /// has about a dozen, and every check would otherwise fill four arrays of 63.
 const SMALL_MODEL: usize = 16;
 
+/// The sphere model of the batched checks: coarser than the default (few
+/// spheres per body keep the batch cheap; the exact check settles what they
+/// leave unsure).
+const LANE_SPHERES: SphereParams = SphereParams {
+    max_overshoot: 0.02,
+    max_per_shape: 16,
+};
+
 /// Options of a [`SceneChecker`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CheckerParams {
@@ -48,6 +56,12 @@ pub struct CheckerParams {
     /// `false` checks interpolated states as they are
     /// ([`MotionCheck::Interpolated`]).
     pub padded_motion: bool,
+    /// Check the states of a motion four at a time through the sphere model
+    /// in vector lanes, the states it leaves unsure exactly
+    /// ([`StateChecker::states_valid`]; the same verdicts). Default `false`:
+    /// on the MotionBenchMaker Panda problems it is not yet faster than the
+    /// state-by-state check (`benches/RESULTS.md`).
+    pub batched: bool,
 }
 
 impl Default for CheckerParams {
@@ -55,6 +69,7 @@ impl Default for CheckerParams {
         CheckerParams {
             motion_resolution: Self::MAX_MOTION_RESOLUTION,
             padded_motion: false,
+            batched: false,
         }
     }
 }
@@ -208,8 +223,10 @@ impl SceneChecker {
             return Err(CollisionError::CannotPad);
         }
         let scene_bodies = scene_bodies(&model, &world, sweep.as_ref());
-        let lanes = SphereModel::build(&model, &SphereParams::default())
-            .ok()
+        let lanes = params
+            .batched
+            .then(|| SphereModel::build(&model, &LANE_SPHERES).ok())
+            .flatten()
             .and_then(|spheres| Lanes::new(&model, &spheres, &world));
         Ok(SceneChecker {
             model,
@@ -263,7 +280,7 @@ impl SceneChecker {
     pub(crate) fn states_valid_in_lanes(&self, rows: &[f64], portable: bool) -> Option<bool> {
         let lanes = self.lanes.as_ref()?;
         let dof = lanes.dof();
-        if dof == 0 || rows.len() % dof != 0 || !rows.iter().all(|&v| in_reduced_range(v)) {
+        if dof == 0 || !rows.len().is_multiple_of(dof) || !rows.iter().all(|&v| in_reduced_range(v)) {
             return None;
         }
         let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
@@ -284,7 +301,14 @@ impl SceneChecker {
                 qj[n..].fill(last);
             }
             let q: &[Lane] = &q[..dof];
-            let unsure = lanes.unsure(q, &self.scene_bodies, &self.self_pairs, &mut frames, portable);
+            let unsure = lanes.unsure(
+                q,
+                &self.world.bvh,
+                &self.scene_bodies,
+                &self.self_pairs,
+                &mut frames,
+                portable,
+            );
             for (l, row) in batch.chunks_exact(dof).enumerate() {
                 if unsure & (1 << l) != 0 && self.in_collision(row) {
                     return Some(false);
@@ -728,6 +752,60 @@ impl StateChecker for SceneChecker {
         } else {
             self.padded_verdict_in::<MAX_BODIES>(q, half_step, proved)
         }
+    }
+
+    /// Batches of [`LANES`] midpoints through the sphere model, every
+    /// sphere of body `b` grown by its global pad over `half_step`
+    /// ([`SweepBound::pads`], never below the farthest any point of the body
+    /// moves within the piece), each self pair by both pads
+    /// (`Lanes::unsure_padded`): a piece whose grown spheres are clear is
+    /// free at every state. Pieces whose midpoint is outside the limits are
+    /// left out.
+    fn padded_free_batch(&self, rows: &[f64], half_step: &[f64]) -> Option<u32> {
+        let (lanes, sweep) = (self.lanes.as_ref()?, self.sweep.as_ref()?);
+        let dof = lanes.dof();
+        if dof == 0
+            || half_step.len() != dof
+            || !rows.len().is_multiple_of(dof)
+            || rows.len() / dof > 32
+            || !rows.iter().all(|&v| in_reduced_range(v))
+        {
+            return None;
+        }
+        let mut pads = [0.0; MAX_LANE_BODIES];
+        sweep.pads(half_step, &mut pads[..lanes.body_count()]);
+        if !pads.iter().all(|p| p.is_finite()) {
+            return None;
+        }
+        let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
+        let mut free = 0u32;
+        for (k, batch) in rows.chunks(LANES * dof).enumerate() {
+            let n = batch.len() / dof;
+            let mut q = [[0.0; LANES]; MAX_LANE_DOF];
+            let mut inside = 0u32;
+            for (l, row) in batch.chunks_exact(dof).enumerate() {
+                inside |= u32::from(self.within_limits(row)) << l;
+                for (j, &v) in row.iter().enumerate() {
+                    q[j][l] = v;
+                }
+            }
+            for qj in q[..dof].iter_mut() {
+                let last = qj[n - 1];
+                qj[n..].fill(last);
+            }
+            let unsure = lanes.unsure_padded(
+                &q[..dof],
+                &pads,
+                &self.world.bvh,
+                &self.scene_bodies,
+                &self.self_pairs,
+                &mut frames,
+                false,
+            );
+            let proved = !unsure & inside & ((1 << n) - 1);
+            free |= proved << (k * LANES);
+        }
+        Some(free)
     }
 
     fn motion_check(&self) -> MotionCheck {
