@@ -63,6 +63,9 @@ const MAX_FINE: usize = 128;
 /// Most scene leaves tested in the lanes: a larger scene (octree cells) is
 /// left to the bounding-volume hierarchy of the exact check.
 pub(crate) const MAX_LANE_LEAVES: usize = 128;
+/// Scenes of at most this many leaves are scanned leaf by leaf in the
+/// lanes; larger ones through their hierarchy, once per body and batch.
+const SCAN_LEAVES: usize = 24;
 /// Added to every sphere radius (m): covers rounding in the sums.
 pub(crate) const MARGIN: f64 = 1e-9;
 
@@ -341,6 +344,12 @@ impl Lanes {
         const ALL: u32 = (1 << LANES) - 1;
         self.fk(q, frames);
         let mut unsure = 0u32;
+        // every body's bounding-sphere centre, once for the scene and the
+        // self pairs
+        let mut centres = [[[0.0; LANES]; 3]; MAX_LANE_BODIES];
+        for (b, c) in centres.iter_mut().enumerate().take(self.body_count) {
+            *c = place(&frames[b], &self.coarse[b].c);
+        }
         // per body: the leaves its bounding sphere meets (and in which
         // lanes), then each fine sphere placed once against those leaves
         let mut near_leaves = [(0u16, 0u32); MAX_LANE_LEAVES];
@@ -349,27 +358,40 @@ impl Lanes {
             let f = &frames[b];
             let coarse = self.coarse[b];
             let pad = pads[b] + MARGIN;
-            let c = place(f, &coarse.c);
-            // the scene's hierarchy asked once for the batch: the box around
-            // the bounding sphere in every lane
+            let c = &centres[b];
             let reach = coarse.r + pad;
-            let mut query = Aabb::empty();
-            for k in 0..3 {
-                for l in 0..LANES {
-                    query.min[k] = query.min[k].min(c[k][l] - reach);
-                    query.max[k] = query.max[k].max(c[k][l] + reach);
-                }
-            }
             let mut count = 0;
-            bvh.for_each_overlap(&query, |i| {
-                let leaf = &self.leaves[i as usize];
-                let near = mask(&sphere_aabb(&c, reach, &leaf.lo, &leaf.hi)) & !unsure;
-                if near != 0 {
-                    near_leaves[count] = (i as u16, near);
-                    count += 1;
+            if self.leaves.len() <= SCAN_LEAVES {
+                // a plain loop, not the closure below: a closure is compiled
+                // apart, without this function's vector features
+                for (i, leaf) in self.leaves.iter().enumerate() {
+                    let near = mask(&sphere_aabb(c, reach, &leaf.lo, &leaf.hi)) & !unsure;
+                    if near != 0 {
+                        near_leaves[count] = (i as u16, near);
+                        count += 1;
+                    }
                 }
-                true
-            });
+            } else {
+                let visit = |i: u32| {
+                    let leaf = &self.leaves[i as usize];
+                    let near = mask(&sphere_aabb(c, reach, &leaf.lo, &leaf.hi)) & !unsure;
+                    if near != 0 {
+                        near_leaves[count] = (i as u16, near);
+                        count += 1;
+                    }
+                    true
+                };
+                // the scene's hierarchy asked once for the batch: the box
+                // around the bounding sphere in every lane
+                let mut query = Aabb::empty();
+                for k in 0..3 {
+                    for l in 0..LANES {
+                        query.min[k] = query.min[k].min(c[k][l] - reach);
+                        query.max[k] = query.max[k].max(c[k][l] + reach);
+                    }
+                }
+                bvh.for_each_overlap(&query, visit);
+            }
             for s in &self.fine[self.start[b]..self.start[b + 1]] {
                 if count == 0 {
                     break;
@@ -389,12 +411,12 @@ impl Lanes {
             let (a, b) = (a as usize, b as usize);
             let (sa, sb) = (self.coarse[a], self.coarse[b]);
             let pad = pads[a] + pads[b] + MARGIN;
-            let (ca, cb) = (place(&frames[a], &sa.c), place(&frames[b], &sb.c));
-            let near = mask(&spheres_meet(&ca, &cb, sa.r + sb.r + pad)) & !unsure;
+            let (ca, cb) = (&centres[a], &centres[b]);
+            let near = mask(&spheres_meet(ca, cb, sa.r + sb.r + pad)) & !unsure;
             if near == 0 {
                 continue;
             }
-            unsure |= self.fine_pairs_meet(&frames[a], a, &frames[b], b, &ca, &cb, pad) & near;
+            unsure |= self.fine_pairs_meet(&frames[a], a, &frames[b], b, ca, cb, pad) & near;
             if unsure == ALL {
                 return ALL;
             }
@@ -529,12 +551,25 @@ impl Lanes {
     }
 }
 
-/// Bit `l` set for each true lane.
+/// Bit `l` set for each true lane (plain loops here and below: closures
+/// are compiled apart from the vector-featured callers).
 #[inline(always)]
 fn mask(m: &[bool; LANES]) -> u32 {
-    m.iter()
-        .enumerate()
-        .fold(0, |acc, (l, &b)| acc | ((b as u32) << l))
+    let mut bits = 0;
+    for l in 0..LANES {
+        bits |= (m[l] as u32) << l;
+    }
+    bits
+}
+
+/// Lanes whose squared distance is at most `limit`.
+#[inline(always)]
+fn within(d2: &Lane, limit: f64) -> [bool; LANES] {
+    let mut out = [false; LANES];
+    for l in 0..LANES {
+        out[l] = d2[l] <= limit;
+    }
+    out
 }
 
 /// `sin_cos_reduced` in every lane.
@@ -588,7 +623,7 @@ fn spheres_meet(x: &[Lane; 3], y: &[Lane; 3], reach: f64) -> [bool; LANES] {
             d2[l] += d * d;
         }
     }
-    d2.map(|d| d <= reach * reach)
+    within(&d2, reach * reach)
 }
 
 /// Lanes whose sphere (centre `c`, radius `r`) meets the box `[lo, hi]`.
@@ -601,7 +636,7 @@ fn sphere_aabb(c: &[Lane; 3], r: f64, lo: &[f64; 3], hi: &[f64; 3]) -> [bool; LA
             d2[l] += e * e;
         }
     }
-    d2.map(|d| d <= r * r)
+    within(&d2, r * r)
 }
 
 /// Lanes whose sphere (centre `x`, radius `r`) meets the primitive.
@@ -618,7 +653,7 @@ fn sphere_prim(x: &[Lane; 3], r: f64, prim: &Prim) -> [bool; LANES] {
                     d2[l] += e * e;
                 }
             }
-            d2.map(|d| d <= r * r)
+            within(&d2, r * r)
         }
         Prim::Capsule { a, d, inv, r: rc } => {
             let reach = r + rc;
@@ -628,7 +663,7 @@ fn sphere_prim(x: &[Lane; 3], r: f64, prim: &Prim) -> [bool; LANES] {
                 let w = [v[0] - t * d[0], v[1] - t * d[1], v[2] - t * d[2]];
                 d2[l] = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
             }
-            d2.map(|d| d <= reach * reach)
+            within(&d2, reach * reach)
         }
     }
 }

@@ -42,7 +42,11 @@ const WINDOW: usize = 64;
 /// over a piece is clear over its halves). Pieces below [`MIN_PIECE`] or more than
 /// [`MAX_CHECKS_PER_PIECE`] checks per initial piece refuse the motion.
 /// Pieces are visited breadth first (all midpoints before any half), in
-/// windows of 64 pieces in bisection order.
+/// windows of 64 pieces in bisection order. A checker with a batched proof
+/// ([`StateChecker::padded_free_batch`]) first proves a window's pieces
+/// [`BATCH`] at a time; only the pieces it leaves go through the one-piece
+/// check above, so a batch-proved piece is free by the batch's own bound
+/// (the motion is accepted at least wherever the one-piece check accepts it).
 ///
 /// The ends are not checked here (a straight motion between two states
 /// within the limits stays within them). `None` when `deadline` expires
