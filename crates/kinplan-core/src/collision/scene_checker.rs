@@ -283,6 +283,15 @@ impl SceneChecker {
         if dof == 0 || !rows.len().is_multiple_of(dof) || !rows.iter().all(|&v| in_reduced_range(v)) {
             return None;
         }
+        // the first state alone and exactly: a motion that collides mostly
+        // does so at the first state asked (its new end, or its middle), which
+        // a batch would only find after testing all its lanes
+        let Some((first, rows)) = rows.split_at_checked(dof) else {
+            return Some(true);
+        };
+        if !StateChecker::is_valid(self, first) {
+            return Some(false);
+        }
         let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
         for batch in rows.chunks(LANES * dof) {
             let n = batch.len() / dof;
