@@ -91,6 +91,9 @@ pub trait StateChecker: Sync {
     /// [`StateChecker::padded_valid`] would (bit `i` for row `i`); a piece
     /// left out is not proved either way and goes to the one-piece check.
     /// `None` when the checker has no such batched proof (the default).
+    /// [`padded_motion`](super::padded_motion) does not use it: grown by
+    /// the global pads, the spheres proved too few of its pieces to pay on
+    /// the MotionBenchMaker problems (`benches/RESULTS.md`).
     fn padded_free_batch(&self, rows: &[f64], half_step: &[f64]) -> Option<u32> {
         let _ = (rows, half_step);
         None

@@ -42,11 +42,7 @@ const WINDOW: usize = 64;
 /// over a piece is clear over its halves). Pieces below [`MIN_PIECE`] or more than
 /// [`MAX_CHECKS_PER_PIECE`] checks per initial piece refuse the motion.
 /// Pieces are visited breadth first (all midpoints before any half), in
-/// windows of 64 pieces in bisection order. A checker with a batched proof
-/// ([`StateChecker::padded_free_batch`]) first proves a window's pieces
-/// [`BATCH`] at a time; only the pieces it leaves go through the one-piece
-/// check above, so a batch-proved piece is free by the batch's own bound
-/// (the motion is accepted at least wherever the one-piece check accepts it).
+/// windows of 64 pieces in bisection order.
 ///
 /// The ends are not checked here (a straight motion between two states
 /// within the limits stays within them). `None` when `deadline` expires
@@ -117,7 +113,6 @@ pub fn padded_motion<C: StateChecker + ?Sized>(
     let mut order = bisection_order(pieces).peekable();
     let mut queue = VecDeque::new();
     let mut spent = [0usize; WINDOW];
-    let mut batched = n > 0 && n <= BATCH_DOF;
     while order.peek().is_some() {
         spent.fill(0);
         queue.extend(
@@ -127,17 +122,6 @@ pub fn padded_motion<C: StateChecker + ?Sized>(
                 .enumerate()
                 .map(|(slot, i)| (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64, slot, 0)),
         );
-        if batched {
-            match prove_together(checker, a, delta, &mut queue) {
-                Some(count) => {
-                    if (checks + count) / 32 != checks / 32 && deadline.expired() {
-                        return PaddedMotion::Interrupted;
-                    }
-                    checks += count;
-                }
-                None => batched = false,
-            }
-        }
         while let Some((s, t, slot, mut proved)) = queue.pop_front() {
             checks += 1;
             let m = 0.5 * (s + t);
@@ -161,51 +145,6 @@ pub fn padded_motion<C: StateChecker + ?Sized>(
         }
     }
     PaddedMotion::Free
-}
-
-/// Pieces handed to [`StateChecker::padded_free_batch`] at once.
-const BATCH: usize = 4;
-/// Most joints of the batched proof (stack buffer).
-const BATCH_DOF: usize = 16;
-
-/// The first-level pieces of a window (`queue`, all `1/pieces` of the
-/// motion `a → a + delta` long up to rounding, nothing proved yet) proved together where
-/// the checker can ([`StateChecker::padded_free_batch`], [`BATCH`] at a
-/// time); the pieces proved free leave the queue, the rest stay in order
-/// for the one-piece check. The number of pieces offered, or `None` when the
-/// checker has no batched proof.
-fn prove_together<C: StateChecker + ?Sized>(
-    checker: &C,
-    a: &[f64],
-    delta: &[f64],
-    queue: &mut VecDeque<(f64, f64, usize, u64)>,
-) -> Option<usize> {
-    let n = a.len();
-    // the longest piece's half (the pieces are equal up to rounding)
-    let longest = queue.iter().fold(0.0f64, |m, (s, t, _, _)| m.max(t - s));
-    let mut half = [0.0; BATCH_DOF];
-    for (h, d) in half.iter_mut().zip(delta) {
-        *h = 0.5 * longest * d;
-    }
-    let mut rows = [0.0; BATCH * BATCH_DOF];
-    let mut free = 0u64;
-    for (k, group) in queue.make_contiguous().chunks(BATCH).enumerate() {
-        for (row, (s, t, _, _)) in rows.chunks_exact_mut(n).zip(group) {
-            let m = 0.5 * (s + t);
-            for ((v, x), d) in row.iter_mut().zip(a).zip(delta) {
-                *v = x + m * d;
-            }
-        }
-        let proved = checker.padded_free_batch(&rows[..group.len() * n], &half[..n])?;
-        free |= u64::from(proved) << (k * BATCH);
-    }
-    let offered = queue.len();
-    let mut i = 0;
-    queue.retain(|_| {
-        i += 1;
-        free & (1 << (i - 1)) == 0
-    });
-    Some(offered)
 }
 
 /// `0..count` (a power of two) in bisection order: 0, then the odd
