@@ -7,7 +7,7 @@
 //! tar xjf ../shared/bench/mbm/panda_problems.tar.bz2 -C target/mbm
 //! cargo build --release -p kinplan-core --example mbm_bench
 //! target/release/examples/mbm_bench target/mbm/problems [--passes 10] [--stomp 10]
-//!     [--clamp-fingers] [--padded] [--set NAME] [--problems 3,17,42] [--state-cost N]
+//!     [--clamp-fingers] [--padded] [--set NAME] [--problems 3,17,42] [--state-cost N] [--batched]
 //!     [--out target/mbm_bench]
 //! ```
 //!
@@ -15,7 +15,13 @@
 //! states drawn uniformly within the joint limits (ChaCha8, seed = problem
 //! number), `is_valid` on each (limits, forward kinematics, scene and self
 //! pairs), the whole loop timed once; reported as ns per state, median over
-//! the scenes of a set, with the fraction of valid states.
+//! the scenes of a set, with the fraction of valid states; and the same
+//! states through `states_valid` four at a time (the batched check the
+//! motion checks use; a batch stops at its first colliding state), per
+//! state.
+//!
+//! `--batched` checks the states of motions four at a time through the
+//! sphere model in vector lanes (`CheckerParams::batched`; same verdicts).
 //!
 //! `--problems` keeps only the listed problem numbers (say the band around a
 //! set's median, to profile what the median measures).
@@ -159,6 +165,8 @@ struct Row {
     state_ns: f64,
     /// Fraction of those states valid.
     state_valid: f64,
+    /// Time per state of `states_valid` over batches of 4 states (ns).
+    state_batch_ns: f64,
 }
 
 struct StompRow {
@@ -188,11 +196,13 @@ struct Args {
     only_problems: Option<Vec<usize>>,
     /// Random states per scene for the state-check timing (0: none).
     state_cost: usize,
+    /// Check motion states four at a time through the sphere model.
+    batched: bool,
     out: PathBuf,
 }
 
 fn args() -> Result<Args, String> {
-    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--problems N,N,...] [--state-cost N] [--out PREFIX]";
+    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--problems N,N,...] [--state-cost N] [--batched] [--out PREFIX]";
     let mut it = std::env::args().skip(1);
     let mut a = Args {
         root: PathBuf::new(),
@@ -206,6 +216,7 @@ fn args() -> Result<Args, String> {
         only_set: None,
         only_problems: None,
         state_cost: 0,
+        batched: false,
         out: PathBuf::from("target/mbm_bench"),
     };
     let mut root = None;
@@ -219,6 +230,7 @@ fn args() -> Result<Args, String> {
             "--passes" => a.passes = num("--passes")?.max(1),
             "--stomp" => a.stomp = num("--stomp")?,
             "--state-cost" => a.state_cost = num("--state-cost")?,
+            "--batched" => a.batched = true,
             "--clamp-fingers" => a.clamp = true,
             "--padded" => a.padded = true,
             "--shortcut-attempts" => a.shortcut_attempts = Some(num("--shortcut-attempts")?),
@@ -374,6 +386,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 CheckerParams {
                     motion_resolution: a.resolution,
                     padded_motion: a.padded,
+                    batched: a.batched,
                 },
             )?;
             let build_us = t.elapsed().as_secs_f64() * 1e6;
@@ -385,6 +398,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 start_ok: checker.is_valid(&start),
                 goal_ok: checker.is_valid(&goal),
                 state_ns: f64::NAN,
+                state_batch_ns: f64::NAN,
                 ..Row::default()
             };
             if a.state_cost > 0 {
@@ -402,6 +416,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let valid = states.chunks_exact(dof).filter(|q| checker.is_valid(q)).count();
                 row.state_ns = t.elapsed().as_secs_f64() * 1e9 / a.state_cost as f64;
                 row.state_valid = valid as f64 / a.state_cost as f64;
+                // the same states handed over four at a time, as the motion
+                // checks do (a batch stops at its first colliding state)
+                let t = Instant::now();
+                let batches = states.chunks(4 * dof).filter(|g| checker.states_valid(g)).count();
+                row.state_batch_ns = t.elapsed().as_secs_f64() * 1e9 / a.state_cost as f64;
+                std::hint::black_box(batches);
             }
             if row.start_ok && row.goal_ok {
                 let seed = k as u64;
@@ -595,6 +615,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "us_per_state_median": median(&solved.iter().map(|r| (r.search_us + r.shortcut_us) / r.states.max(1) as f64).collect::<Vec<_>>()),
                 "samples_median": median(&solved.iter().map(|r| r.samples as f64).collect::<Vec<_>>()),
                 "state_ns_median": median(&rows.iter().map(|r| r.state_ns).filter(|v| v.is_finite()).collect::<Vec<_>>()),
+                "state_batch_ns_median": median(&rows.iter().map(|r| r.state_batch_ns).filter(|v| v.is_finite()).collect::<Vec<_>>()),
                 "state_valid_median": median(&rows.iter().filter(|r| r.state_ns.is_finite()).map(|r| r.state_valid).collect::<Vec<_>>()),
             }),
         );

@@ -31,6 +31,18 @@ pub trait StateChecker: Sync {
         (self.is_valid(q), self.clearance(q, max_distance))
     }
 
+    /// True when every state of `rows` (row-major, [`StateChecker::dof`]
+    /// values per row; a trailing partial row is ignored) is valid, as
+    /// [`StateChecker::is_valid`] says. Implementations may check several
+    /// rows at once, so which invalid row is found first is not specified;
+    /// the default asks `is_valid` row by row.
+    fn states_valid(&self, rows: &[f64]) -> bool {
+        match self.dof() {
+            0 => rows.is_empty() || self.is_valid(&[]),
+            dof => rows.chunks_exact(dof).all(|q| self.is_valid(q)),
+        }
+    }
+
     /// True when the straight joint-space motion from `a` to `b` is valid,
     /// as [`MotionCheck`] describes how it was checked.
     fn motion_valid(&self, a: &[f64], b: &[f64]) -> bool {
@@ -71,6 +83,20 @@ pub trait StateChecker: Sync {
     fn padded_verdict_sparing(&self, q: &[f64], half_step: &[f64], proved: &mut u64) -> Option<PadVerdict> {
         let _ = proved;
         self.padded_verdict(q, half_step)
+    }
+
+    /// Of the pieces of a straight motion with midpoints `rows` (row-major,
+    /// [`StateChecker::dof`] values per row, at most 32 rows) and the common
+    /// signed half vector `half_step`, those proved free at once as
+    /// [`StateChecker::padded_valid`] would (bit `i` for row `i`); a piece
+    /// left out is not proved either way and goes to the one-piece check.
+    /// `None` when the checker has no such batched proof (the default).
+    /// [`padded_motion`](super::padded_motion) does not use it: grown by
+    /// the global pads, the spheres proved too few of its pieces to pay on
+    /// the MotionBenchMaker problems (`benches/RESULTS.md`).
+    fn padded_free_batch(&self, rows: &[f64], half_step: &[f64]) -> Option<u32> {
+        let _ = (rows, half_step);
+        None
     }
 
     /// How [`StateChecker::motion_valid`] checks a motion. Default: states

@@ -36,6 +36,7 @@ mod error;
 mod fast;
 mod fast_box;
 mod fixed_frame;
+mod lanes;
 mod mesh_dae;
 mod mesh_file;
 mod model;

@@ -346,6 +346,56 @@ impl RobotModel {
     }
 }
 
+/// One step of forward kinematics as [`RobotModel::fk_program`] lists it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum FkOp {
+    /// `t ← t · origin · M(q_joint)`, `M` the joint's motion about or along
+    /// the unit `axis` (joint frame).
+    Joint {
+        origin: Isometry3<f64>,
+        axis: Vector3<f64>,
+        kind: JointKind,
+    },
+    /// Body `body`'s pose is `t · offset` (the link's offset, then the
+    /// body's).
+    Body { body: usize, offset: Isometry3<f64> },
+}
+
+impl RobotModel {
+    /// The forward kinematics of [`RobotModel::body_poses`] as a flat list
+    /// of steps, in the order that pass applies them (joints down the chain,
+    /// each body posed as soon as its link's joints are applied).
+    pub(crate) fn fk_program(&self) -> Vec<FkOp> {
+        let links = self.chain.links();
+        let joints = self.chain.joints();
+        let mut ops = Vec::new();
+        let (mut applied, mut next) = (0, 0);
+        for (li, link) in links.iter().enumerate() {
+            if next == self.by_link.len() {
+                break;
+            }
+            if let Some(j) = link.after_joint {
+                while applied <= j && applied < joints.len() {
+                    let joint = &joints[applied];
+                    ops.push(FkOp::Joint {
+                        origin: joint.origin,
+                        axis: joint.axis.into_inner(),
+                        kind: joint.kind,
+                    });
+                    applied += 1;
+                }
+            }
+            while next < self.by_link.len() && self.bodies[self.by_link[next]].link == li {
+                let b = self.by_link[next];
+                let offset = links[li].offset * self.bodies[b].offset;
+                ops.push(FkOp::Body { body: b, offset });
+                next += 1;
+            }
+        }
+        ops
+    }
+}
+
 /// A joint's axis in the base frame: a point on it and its unit direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct JointAxis {

@@ -17,12 +17,15 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::acm::AllowedCollisions;
 use super::bvh::Aabb;
+use super::lanes::{LANES, Lane, LaneFrame, Lanes, MAX_LANE_BODIES, MAX_LANE_DOF};
 use super::model::{JointAxis, MAX_BODIES, MAX_LINKS, RobotModel};
 use super::narrow::{
     Witness, body_body_contact, body_body_intersect, body_body_within, body_leaf_contact,
     body_leaf_intersect, body_leaf_within, shapes_intersect_leaf, sphere_center,
 };
+use super::spheres::{SphereModel, SphereParams};
 use super::sweep::SweepBound;
+use super::trig::in_reduced_range;
 use super::world::SceneGeometry;
 use super::{CollisionError, MotionCheck, PadVerdict, StateChecker};
 use crate::robot::JointKind;
@@ -33,6 +36,14 @@ const SMALL_CHAIN: usize = 16;
 /// buffers of this size instead of [`MAX_BODIES`]: an arm with a gripper
 /// has about a dozen, and every check would otherwise fill four arrays of 63.
 const SMALL_MODEL: usize = 16;
+
+/// The sphere model of the batched checks: coarser than the default (few
+/// spheres per body keep the batch cheap; the exact check settles what they
+/// leave unsure).
+const LANE_SPHERES: SphereParams = SphereParams {
+    max_overshoot: 0.02,
+    max_per_shape: 16,
+};
 
 /// Options of a [`SceneChecker`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,6 +56,12 @@ pub struct CheckerParams {
     /// `false` checks interpolated states as they are
     /// ([`MotionCheck::Interpolated`]).
     pub padded_motion: bool,
+    /// Check the states of a motion four at a time through the sphere model
+    /// in vector lanes, the states it leaves unsure exactly
+    /// ([`StateChecker::states_valid`]; the same verdicts). Default `false`:
+    /// on the MotionBenchMaker Panda problems it is not yet faster than the
+    /// state-by-state check (`benches/RESULTS.md`).
+    pub batched: bool,
 }
 
 impl Default for CheckerParams {
@@ -52,6 +69,7 @@ impl Default for CheckerParams {
         CheckerParams {
             motion_resolution: Self::MAX_MOTION_RESOLUTION,
             padded_motion: false,
+            batched: false,
         }
     }
 }
@@ -177,6 +195,9 @@ pub struct SceneChecker {
     params: CheckerParams,
     /// How far bodies move per joint step (`None`: unbounded, cannot pad).
     sweep: Option<SweepBound>,
+    /// The sphere model and scene laid out for batches of states
+    /// ([`SceneChecker::states_valid`]); `None` beyond the batch limits.
+    lanes: Option<Lanes>,
 }
 
 impl SceneChecker {
@@ -202,6 +223,11 @@ impl SceneChecker {
             return Err(CollisionError::CannotPad);
         }
         let scene_bodies = scene_bodies(&model, &world, sweep.as_ref());
+        let lanes = params
+            .batched
+            .then(|| SphereModel::build(&model, &LANE_SPHERES).ok())
+            .flatten()
+            .and_then(|spheres| Lanes::new(&model, &spheres, &world));
         Ok(SceneChecker {
             model,
             world,
@@ -209,6 +235,7 @@ impl SceneChecker {
             scene_bodies,
             params,
             sweep,
+            lanes,
         })
     }
 
@@ -241,6 +268,76 @@ impl SceneChecker {
             self.model.body_poses(q, &mut poses);
             self.hits(&poses)
         }
+    }
+
+    /// [`StateChecker::states_valid`] in batches of [`LANES`] states: the
+    /// limits, then forward kinematics and the sphere model against the
+    /// scene for the whole batch (`Lanes::unsure`); a state the spheres
+    /// leave unsure is checked exactly ([`SceneChecker::in_collision`]), so
+    /// the answer is the exact check's. `portable` forces the baseline
+    /// build of the batch code. `None` when the checker has no batched form
+    /// or a value is outside what it takes.
+    pub(crate) fn states_valid_in_lanes(&self, rows: &[f64], portable: bool) -> Option<bool> {
+        let lanes = self.lanes.as_ref()?;
+        let dof = lanes.dof();
+        if dof == 0 || !rows.len().is_multiple_of(dof) || !rows.iter().all(|&v| in_reduced_range(v)) {
+            return None;
+        }
+        // the first state alone and exactly: a motion that collides mostly
+        // does so at the first state asked (its new end, or its middle), which
+        // a batch would only find after testing all its lanes
+        let Some((first, rows)) = rows.split_at_checked(dof) else {
+            return Some(true);
+        };
+        if !StateChecker::is_valid(self, first) {
+            return Some(false);
+        }
+        let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
+        for batch in rows.chunks(LANES * dof) {
+            let n = batch.len() / dof;
+            let mut q = [[0.0; LANES]; MAX_LANE_DOF];
+            for (l, row) in batch.chunks_exact(dof).enumerate() {
+                if !self.within_limits(row) {
+                    return Some(false);
+                }
+                for (j, &v) in row.iter().enumerate() {
+                    q[j][l] = v;
+                }
+            }
+            // unused lanes repeat the last state
+            for qj in q[..dof].iter_mut() {
+                let last = qj[n - 1];
+                qj[n..].fill(last);
+            }
+            let q: &[Lane] = &q[..dof];
+            let unsure = lanes.unsure(
+                q,
+                &self.world.bvh,
+                &self.scene_bodies,
+                &self.self_pairs,
+                &mut frames,
+                portable,
+            );
+            for (l, row) in batch.chunks_exact(dof).enumerate() {
+                if unsure & (1 << l) != 0 && self.in_collision(row) {
+                    return Some(false);
+                }
+            }
+        }
+        Some(true)
+    }
+
+    /// The batched form (tests).
+    #[cfg(test)]
+    pub(crate) fn lanes(&self) -> Option<&Lanes> {
+        self.lanes.as_ref()
+    }
+
+    /// The bodies tested against the scene and the checked self pairs
+    /// (tests).
+    #[cfg(test)]
+    pub(crate) fn checked_parts(&self) -> (&[u16], &[(u16, u16)]) {
+        (&self.scene_bodies, &self.self_pairs)
     }
 
     /// The bodies' bounding-sphere centres at `poses` (`N` ≥ the body count).
@@ -603,6 +700,18 @@ impl StateChecker for SceneChecker {
         self.within_limits(q) && !self.in_collision(q)
     }
 
+    /// Batches of [`LANES`] states through the sphere model, the unsure
+    /// ones checked exactly (`SceneChecker::states_valid_in_lanes`).
+    fn states_valid(&self, rows: &[f64]) -> bool {
+        match self.states_valid_in_lanes(rows, false) {
+            Some(valid) => valid,
+            None => {
+                let dof = self.model.chain().dof();
+                dof > 0 && rows.chunks_exact(dof).all(|q| self.is_valid(q))
+            }
+        }
+    }
+
     /// Signed clearance (m), capped at `max_distance`; `-inf` for a `q` of
     /// the wrong length or with non-finite values.
     fn clearance(&self, q: &[f64], max_distance: f64) -> f64 {
@@ -652,6 +761,60 @@ impl StateChecker for SceneChecker {
         } else {
             self.padded_verdict_in::<MAX_BODIES>(q, half_step, proved)
         }
+    }
+
+    /// Batches of [`LANES`] midpoints through the sphere model, every
+    /// sphere of body `b` grown by its global pad over `half_step`
+    /// ([`SweepBound::pads`], never below the farthest any point of the body
+    /// moves within the piece), each self pair by both pads
+    /// (`Lanes::unsure_padded`): a piece whose grown spheres are clear is
+    /// free at every state. Pieces whose midpoint is outside the limits are
+    /// left out.
+    fn padded_free_batch(&self, rows: &[f64], half_step: &[f64]) -> Option<u32> {
+        let (lanes, sweep) = (self.lanes.as_ref()?, self.sweep.as_ref()?);
+        let dof = lanes.dof();
+        if dof == 0
+            || half_step.len() != dof
+            || !rows.len().is_multiple_of(dof)
+            || rows.len() / dof > 32
+            || !rows.iter().all(|&v| in_reduced_range(v))
+        {
+            return None;
+        }
+        let mut pads = [0.0; MAX_LANE_BODIES];
+        sweep.pads(half_step, &mut pads[..lanes.body_count()]);
+        if !pads.iter().all(|p| p.is_finite()) {
+            return None;
+        }
+        let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
+        let mut free = 0u32;
+        for (k, batch) in rows.chunks(LANES * dof).enumerate() {
+            let n = batch.len() / dof;
+            let mut q = [[0.0; LANES]; MAX_LANE_DOF];
+            let mut inside = 0u32;
+            for (l, row) in batch.chunks_exact(dof).enumerate() {
+                inside |= u32::from(self.within_limits(row)) << l;
+                for (j, &v) in row.iter().enumerate() {
+                    q[j][l] = v;
+                }
+            }
+            for qj in q[..dof].iter_mut() {
+                let last = qj[n - 1];
+                qj[n..].fill(last);
+            }
+            let unsure = lanes.unsure_padded(
+                &q[..dof],
+                &pads,
+                &self.world.bvh,
+                &self.scene_bodies,
+                &self.self_pairs,
+                &mut frames,
+                false,
+            );
+            let proved = !unsure & inside & ((1 << n) - 1);
+            free |= proved << (k * LANES);
+        }
+        Some(free)
     }
 
     fn motion_check(&self) -> MotionCheck {

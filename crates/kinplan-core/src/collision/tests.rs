@@ -12,6 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use super::*;
 use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
+mod lanes;
 mod robot;
 mod spheres;
 mod sweep;

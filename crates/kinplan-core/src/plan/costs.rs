@@ -107,6 +107,50 @@ pub(crate) fn interior_valid_as<C: StateChecker + ?Sized>(
     if padded {
         return padded_motion_valid(checker, a, b, resolution, clock.deadline);
     }
+    states_between_valid(checker, a, b, resolution, false, buf, clock)
+}
+
+/// `b` valid and [`interior_valid_as`]: a tree edge from `a`, a node, to
+/// `b`, a new state. Interpolated, `b` is checked with the first interior
+/// states, in one batch ([`StateChecker::states_valid`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn edge_valid_as<C: StateChecker + ?Sized>(
+    checker: &C,
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+    padded: bool,
+    buf: &mut [f64],
+    clock: &Clock<'_>,
+) -> Option<bool> {
+    if padded {
+        if !checker.is_valid(b) {
+            return Some(false);
+        }
+        return padded_motion_valid(checker, a, b, resolution, clock.deadline);
+    }
+    states_between_valid(checker, a, b, resolution, true, buf, clock)
+}
+
+/// States handed to [`StateChecker::states_valid`] at once: the lanes of
+/// the batched check.
+const BATCH: usize = 4;
+/// Most joints batched here (stack buffer); longer chains go state by state.
+const BATCH_DOF: usize = 32;
+
+/// The interior states of `a → b` (and `b` first when `with_end`), in
+/// bisection order, [`BATCH`] at a time; `None` when `clock` was
+/// interrupted (asked every 32 states).
+#[allow(clippy::too_many_arguments)]
+fn states_between_valid<C: StateChecker + ?Sized>(
+    checker: &C,
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+    with_end: bool,
+    buf: &mut [f64],
+    clock: &Clock<'_>,
+) -> Option<bool> {
     let span = a
         .iter()
         .zip(b)
@@ -120,20 +164,53 @@ pub(crate) fn interior_valid_as<C: StateChecker + ?Sized>(
         return Some(false);
     }
     let steps = (steps.max(1.0) as usize).next_power_of_two();
-    // the interior states: every index but 0, in bisection order
-    for (visited, i) in bisection_order(steps).skip(1).enumerate() {
-        if (visited + 1).is_multiple_of(32) && clock.interrupted().is_some() {
+    let dof = a.len();
+    // the interior states: every index but 0, in bisection order; the end
+    // (index `steps`) first when asked
+    let end = with_end.then_some(steps);
+    let mut order = end.into_iter().chain(bisection_order(steps).skip(1));
+    if dof > BATCH_DOF || dof == 0 {
+        for (visited, i) in order.enumerate() {
+            if (visited + 1).is_multiple_of(32) && clock.interrupted().is_some() {
+                return None;
+            }
+            let s = i as f64 / steps as f64;
+            for ((v, x), y) in buf.iter_mut().zip(a).zip(b) {
+                *v = x + s * (y - x);
+            }
+            if !checker.is_valid(buf) {
+                return Some(false);
+            }
+        }
+        return Some(true);
+    }
+    let mut rows = [0.0; BATCH * BATCH_DOF];
+    let mut visited = 0usize;
+    loop {
+        let mut n = 0;
+        for i in order.by_ref().take(BATCH) {
+            let row = &mut rows[n * dof..(n + 1) * dof];
+            if i == steps {
+                row.copy_from_slice(b);
+            } else {
+                let s = i as f64 / steps as f64;
+                for ((v, x), y) in row.iter_mut().zip(a).zip(b) {
+                    *v = x + s * (y - x);
+                }
+            }
+            n += 1;
+        }
+        if n == 0 {
+            return Some(true);
+        }
+        if (visited + n) / 32 != visited / 32 && clock.interrupted().is_some() {
             return None;
         }
-        let s = i as f64 / steps as f64;
-        for ((v, x), y) in buf.iter_mut().zip(a).zip(b) {
-            *v = x + s * (y - x);
-        }
-        if !checker.is_valid(buf) {
+        visited += n;
+        if !checker.states_valid(&rows[..n * dof]) {
             return Some(false);
         }
     }
-    Some(true)
 }
 
 /// A whole path (`n × dof`, row-major) checked state by state and motion by

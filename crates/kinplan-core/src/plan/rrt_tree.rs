@@ -8,7 +8,7 @@ use rand_chacha::ChaCha8Rng;
 use super::RrtParams;
 use super::clock::Clock;
 use super::column_scan::ColumnScan;
-use super::costs::interior_valid_as;
+use super::costs::{edge_valid_as, interior_valid_as};
 use super::kd_index::KdIndex;
 use super::rrt_connect::{RrtStop, stop_of};
 use crate::collision::StateChecker;
@@ -107,16 +107,15 @@ impl<C: StateChecker + ?Sized> Search<'_, C> {
         if reached {
             self.q_new.copy_from_slice(target);
         }
-        if !self.checker.is_valid(&self.q_new)
-            || interior_valid_as(
-                self.checker,
-                from,
-                &self.q_new,
-                self.resolution,
-                self.padded,
-                &mut self.buf,
-                clock,
-            ) != Some(true)
+        if edge_valid_as(
+            self.checker,
+            from,
+            &self.q_new,
+            self.resolution,
+            self.padded,
+            &mut self.buf,
+            clock,
+        ) != Some(true)
         {
             return Extend::Trapped;
         }
