@@ -510,8 +510,9 @@ async fn planning_and_exploration(v: Values) -> Result<(), TestCaseError> {
     let orientation: Vec<f64> = (3..7).map(|i| h.at(i, if i == 3 { 1.0 } else { 0.0 })).collect();
     let norm = orientation.iter().map(|c| c * c).sum::<f64>().sqrt();
     let unset = orientation.iter().all(|c| *c == 0.0);
+    let unit = (norm - 1.0).abs() <= 1e-6; // false for a NaN norm
     let bad_scene = h.any_absurd(0..10)
-        || ((3..7).contains(&h.slot) && !unset && !((norm - 1.0).abs() <= 1e-6))
+        || ((3..7).contains(&h.slot) && !unset && !unit)
         || ((7..10).contains(&h.slot) && h.f[h.slot] <= 0.0);
 
     // CheckState: the penetrating pair in either order, one hostile value

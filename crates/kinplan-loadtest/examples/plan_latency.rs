@@ -8,9 +8,9 @@
 //! Three request shapes per problem, each sent `--passes` times (median per
 //! problem, then the median over the set's solved problems):
 //! - *default*: the Plan defaults (shortcutting, timing, the final check);
-//! - *search only*: `shortcut_attempts = 0`, so the server's `rrt_connect`
-//!   time is the search and its proof alone (what VAMP's planner timer and
-//!   `mbm_bench` measure);
+//! - *no random shortcuts*: `shortcut_attempts = 0`, so the server's
+//!   `rrt_connect` time is the search, its proof and the greedy vertex
+//!   passes;
 //! - *as URDF*: the default request with the same robot sent as URDF text
 //!   instead of by name, the path a user's own robot takes.
 //!
@@ -267,7 +267,7 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let mut client = PlanningServiceClient::new(connect(port).await?);
     println!(
-        "| set | solved / valid | default: wall | server total | of which RRT-Connect | overhead | search only: wall | server RRT-Connect | overhead | as URDF: wall | URDF / name |"
+        "| set | solved / valid | default: wall | server total | of which RRT-Connect | overhead | no random shortcuts: wall | server RRT-Connect | overhead | as URDF: wall | URDF / name |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let us = |v: f64| format!("{v:.0} µs");
@@ -276,7 +276,7 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
             continue;
         }
         let problems = load_set(&a.problems.join(format!("{set}_panda")))?;
-        // default wall, total, RRT-Connect, overhead; search-only wall,
+        // default wall, total, RRT-Connect, overhead; no-random-shortcut wall,
         // RRT-Connect, overhead; as-URDF wall
         let mut cols: [Vec<f64>; 8] = Default::default();
         let (mut valid, mut solved) = (0, 0);
