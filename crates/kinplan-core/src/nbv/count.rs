@@ -30,6 +30,40 @@ struct Entry {
     known: u64,
 }
 
+impl Entry {
+    /// A walk's stack with the root (block `root`, `known` known cells) on it,
+    /// every plane still to test.
+    fn stack_at_root(root: u32, known: u64) -> [Entry; STACK] {
+        let mut stack = [Entry {
+            key: [0; 3],
+            depth: 0,
+            mask: 0,
+            block: CountBlock::ABSENT,
+            known: 0,
+        }; STACK];
+        stack[0] = Entry {
+            mask: 0b11_1111,
+            block: root,
+            known,
+            ..stack[0]
+        };
+        stack
+    }
+
+    /// Whether the cube of `side` keys at this entry overlaps the key box
+    /// `lo..=hi`, and whether it lies wholly inside it.
+    #[inline(always)]
+    fn against_key_box(&self, side: u32, lo: &[u16; 3], hi: &[u16; 3]) -> (bool, bool) {
+        let (mut overlaps, mut within) = (true, true);
+        for i in 0..3 {
+            let (a, b) = (self.key[i] as u32, self.key[i] as u32 + side - 1);
+            overlaps &= a <= hi[i] as u32 && b >= lo[i] as u32;
+            within &= a >= lo[i] as u32 && b <= hi[i] as u32;
+        }
+        (overlaps, within)
+    }
+}
+
 /// Counts unknown depth-16 cells inside view frusta for one tree: the tree's per-node
 /// known-cell counts ([`KnownCellCounts`]) are built once in [`FrustumCounter::new`]
 /// (one pass over the nodes) and shared by every view (and thread) after that.
@@ -136,32 +170,14 @@ impl<'a> FrustumCounter<'a> {
         if root == CountBlock::LEAF || known.root() == 1u64 << (3 * TREE_DEPTH as u32) {
             return 0;
         }
-        let mut stack = [Entry {
-            key: [0; 3],
-            depth: 0,
-            mask: 0,
-            block: CountBlock::ABSENT,
-            known: 0,
-        }; STACK];
-        stack[0] = Entry {
-            key: [0; 3],
-            depth: 0,
-            mask: 0b11_1111,
-            block: root,
-            known: known.root(),
-        };
+        let mut stack = Entry::stack_at_root(root, known.root());
         let mut len = 1usize;
         let mut count = 0u64;
         while len > 0 {
             len -= 1;
             let e = stack[len];
             let side = 1u32 << (TREE_DEPTH - e.depth);
-            let (mut overlaps, mut within) = (true, true);
-            for i in 0..3 {
-                let (a, b) = (e.key[i] as u32, e.key[i] as u32 + side - 1);
-                overlaps &= a <= hi[i] as u32 && b >= lo[i] as u32;
-                within &= a >= lo[i] as u32 && b <= hi[i] as u32;
-            }
+            let (overlaps, within) = e.against_key_box(side, &lo, &hi);
             if !overlaps {
                 continue;
             }
@@ -243,32 +259,14 @@ impl<'a> FrustumCounter<'a> {
         if root == CountBlock::ABSENT {
             return 0;
         }
-        let mut stack = [Entry {
-            key: [0; 3],
-            depth: 0,
-            mask: 0,
-            block: CountBlock::ABSENT,
-            known: 0,
-        }; STACK];
-        stack[0] = Entry {
-            key: [0; 3],
-            depth: 0,
-            mask: 0b11_1111,
-            block: root,
-            known: known.root(),
-        };
+        let mut stack = Entry::stack_at_root(root, known.root());
         let mut len = 1usize;
         let mut count = 0u64;
         while len > 0 {
             len -= 1;
             let e = stack[len];
             let side = 1u32 << (TREE_DEPTH - e.depth);
-            let (mut overlaps, mut within) = (true, true);
-            for i in 0..3 {
-                let (a, b) = (e.key[i] as u32, e.key[i] as u32 + side - 1);
-                overlaps &= a <= hi[i] as u32 && b >= lo[i] as u32;
-                within &= a >= lo[i] as u32 && b <= hi[i] as u32;
-            }
+            let (overlaps, within) = e.against_key_box(side, &lo, &hi);
             if !overlaps {
                 continue;
             }
