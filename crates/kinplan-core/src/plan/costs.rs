@@ -104,16 +104,12 @@ pub(crate) fn interior_valid_as<C: StateChecker + ?Sized>(
     buf: &mut [f64],
     clock: &Clock<'_>,
 ) -> Option<bool> {
-    if padded {
-        return padded_motion_valid(checker, a, b, resolution, clock.deadline);
-    }
-    states_between_valid(checker, a, b, resolution, false, buf, clock)
+    motion_valid_as(checker, a, b, resolution, padded, false, buf, clock)
 }
 
 /// `b` valid and [`interior_valid_as`]: a tree edge from `a`, a node, to
 /// `b`, a new state. Interpolated, `b` is checked with the first interior
 /// states, in one batch ([`StateChecker::states_valid`]).
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn edge_valid_as<C: StateChecker + ?Sized>(
     checker: &C,
     a: &[f64],
@@ -123,13 +119,29 @@ pub(crate) fn edge_valid_as<C: StateChecker + ?Sized>(
     buf: &mut [f64],
     clock: &Clock<'_>,
 ) -> Option<bool> {
-    if padded {
-        if !checker.is_valid(b) {
-            return Some(false);
-        }
-        return padded_motion_valid(checker, a, b, resolution, clock.deadline);
+    motion_valid_as(checker, a, b, resolution, padded, true, buf, clock)
+}
+
+/// The interior of `a → b`, and `b` too when `with_end`, padded or by
+/// interpolated states.
+#[allow(clippy::too_many_arguments)]
+fn motion_valid_as<C: StateChecker + ?Sized>(
+    checker: &C,
+    a: &[f64],
+    b: &[f64],
+    resolution: f64,
+    padded: bool,
+    with_end: bool,
+    buf: &mut [f64],
+    clock: &Clock<'_>,
+) -> Option<bool> {
+    if !padded {
+        return states_between_valid(checker, a, b, resolution, with_end, buf, clock);
     }
-    states_between_valid(checker, a, b, resolution, true, buf, clock)
+    if with_end && !checker.is_valid(b) {
+        return Some(false);
+    }
+    padded_motion_valid(checker, a, b, resolution, clock.deadline)
 }
 
 /// States handed to [`StateChecker::states_valid`] at once: the lanes of

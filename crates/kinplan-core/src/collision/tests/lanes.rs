@@ -346,8 +346,7 @@ fn sphere_verdicts_never_clear_a_colliding_state_and_batches_give_the_exact_answ
             states.len()
         );
         assert!(colliding > 100, "{name}: {colliding} colliding");
-        // the test is not vacuous: the spheres clear most free states (88-91 %
-        // of them in these scenes)
+        // the test is not vacuous: the spheres clear most free states
         assert!(
             4 * clear > 3 * free_count,
             "{name}: {clear} of {free_count} cleared"

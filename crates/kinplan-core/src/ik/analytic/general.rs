@@ -10,7 +10,7 @@ use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 
 use super::family::{AnalyticArm, Axes6, Family, NotAnalytic, meet, normal_to, parallel};
 use super::solve::{Base, ConfigFlags, pick};
-use super::subproblems::{DEGENERATE, rot, sp1, wrap};
+use super::subproblems::{DEGENERATE, rot, rot_cs, sp1, wrap};
 
 /// Bisection steps that locate where a branch ends (2⁻³⁴ of a sample spacing).
 const BOUNDARY_STEPS: usize = 34;
@@ -83,24 +83,6 @@ impl SearchGeometry {
 
 /// An angle as its cosine and sine (no trigonometric call to get either).
 type Cs = (f64, f64);
-
-/// `rot(k, θ)` from `(cos θ, sin θ)` (Rodrigues, as [`rot`]).
-#[inline]
-fn rot_cs(k: &Vector3<f64>, (c, s): Cs) -> Matrix3<f64> {
-    let v = 1.0 - c;
-    let (x, y, z) = (k.x, k.y, k.z);
-    Matrix3::new(
-        c + x * x * v,
-        x * y * v - z * s,
-        x * z * v + y * s,
-        y * x * v + z * s,
-        c + y * y * v,
-        y * z * v - x * s,
-        z * x * v - y * s,
-        z * y * v + x * s,
-        c + z * z * v,
-    )
-}
 
 /// The two roots `φ ± acos(C/ρ)` of subproblem 4, `hᵀ rot(k, θ) p = d`
 /// (see [`sp4`](super::sp4)), as cosines and sines: with `cos φ = A/ρ`,

@@ -68,6 +68,12 @@ impl Angles {
 #[inline]
 pub fn rot(k: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
     let (s, c) = theta.sin_cos();
+    rot_cs(k, (c, s))
+}
+
+/// [`rot`] from `(cos θ, sin θ)`, for callers that have them without the angle.
+#[inline]
+pub(crate) fn rot_cs(k: &Vector3<f64>, (c, s): (f64, f64)) -> Matrix3<f64> {
     let v = 1.0 - c;
     let (x, y, z) = (k.x, k.y, k.z);
     Matrix3::new(

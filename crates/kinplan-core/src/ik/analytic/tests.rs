@@ -11,7 +11,7 @@ use super::*;
 use crate::ik::{IkMethod, IkParams, IkTarget, solve_ik};
 use crate::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
-fn pose_close(a: &Isometry3<f64>, b: &Isometry3<f64>, tol: f64) -> bool {
+pub(super) fn pose_close(a: &Isometry3<f64>, b: &Isometry3<f64>, tol: f64) -> bool {
     (a.translation.vector - b.translation.vector).norm() <= tol && a.rotation.angle_to(&b.rotation) <= tol
 }
 
@@ -23,7 +23,7 @@ fn random_q(chain: &Chain, rng: &mut ChaCha8Rng) -> [f64; 6] {
     })
 }
 
-fn same_angles(a: &[f64], b: &[f64], tol: f64) -> bool {
+pub(super) fn same_angles(a: &[f64], b: &[f64], tol: f64) -> bool {
     a.iter().zip(b).all(|(x, y)| wrap(x - y).abs() <= tol)
 }
 

@@ -6,6 +6,7 @@ use nalgebra::Isometry3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use super::tests::{pose_close, same_angles};
 use super::*;
 use crate::ik::{IkMethod, IkParams, IkTarget, solve_ik};
 use crate::robot::{Chain, ChainSpec, UrdfLimits, parse_chain};
@@ -108,14 +109,6 @@ fn reversed_only() -> Chain {
 
 fn chain(urdf: &str) -> Chain {
     parse_chain(urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap()
-}
-
-fn pose_close(a: &Isometry3<f64>, b: &Isometry3<f64>, tol: f64) -> bool {
-    (a.translation.vector - b.translation.vector).norm() <= tol && a.rotation.angle_to(&b.rotation) <= tol
-}
-
-fn same_angles(a: &[f64], b: &[f64], tol: f64) -> bool {
-    a.iter().zip(b).all(|(x, y)| wrap(x - y).abs() <= tol)
 }
 
 fn random_q(rng: &mut ChaCha8Rng) -> [f64; 6] {

@@ -7,6 +7,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::family::{meet, point_line_distance};
+use super::tests::pose_close;
 use super::*;
 use crate::ik::{IkMethod, IkParams, IkResult, IkTarget, solve_ik};
 use crate::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
@@ -40,10 +41,6 @@ fn random_q(chain: &Chain, rng: &mut ChaCha8Rng) -> Vec<f64> {
         .iter()
         .map(|j| rng.random_range(j.lower..=j.upper))
         .collect()
-}
-
-fn pose_close(a: &Isometry3<f64>, b: &Isometry3<f64>, tol: f64) -> bool {
-    (a.translation.vector - b.translation.vector).norm() <= tol && a.rotation.angle_to(&b.rotation) <= tol
 }
 
 fn dist2(a: &[f64], b: &[f64]) -> f64 {
