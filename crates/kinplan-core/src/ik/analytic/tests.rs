@@ -23,6 +23,31 @@ fn random_q(chain: &Chain, rng: &mut ChaCha8Rng) -> [f64; 6] {
     })
 }
 
+/// Analytic IK asking for every solution.
+pub(super) fn every_analytic_solution() -> IkParams {
+    IkParams {
+        method: IkMethod::Analytic,
+        num_solutions: 1000,
+        ..IkParams::default()
+    }
+}
+
+/// `solve_ik` at the pose `chain.fk(q)`, seeded at `q`.
+pub(super) fn solve_at(
+    chain: &Chain,
+    q: &[f64],
+    params: &IkParams,
+) -> Result<crate::ik::IkResult, crate::ik::IkError> {
+    solve_ik(
+        chain,
+        &IkTarget::Pose(chain.fk(q)),
+        Some(q),
+        params,
+        0,
+        crate::Deadline::none(),
+    )
+}
+
 pub(super) fn same_angles(a: &[f64], b: &[f64], tol: f64) -> bool {
     a.iter().zip(b).all(|(x, y)| wrap(x - y).abs() <= tol)
 }
@@ -308,20 +333,8 @@ fn not_analytic_says_why() {
 fn solve_ik_analytic_ranks_and_refuses() {
     let chain = builtin_chain("kuka_kr120_r2500_pro").unwrap();
     let q = [0.4, -0.9, 0.7, 1.0, 0.8, -0.5];
-    let params = IkParams {
-        method: IkMethod::Analytic,
-        num_solutions: 1000,
-        ..IkParams::default()
-    };
-    let r = solve_ik(
-        &chain,
-        &IkTarget::Pose(chain.fk(&q)),
-        Some(&q),
-        &params,
-        0,
-        crate::Deadline::none(),
-    )
-    .unwrap();
+    let params = every_analytic_solution();
+    let r = solve_at(&chain, &q, &params).unwrap();
     assert!(r.success());
     assert!(same_angles(&r.solutions[0].joints, &q, 1e-9));
     let d = |s: &crate::ik::IkSolution| s.joints.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum::<f64>();

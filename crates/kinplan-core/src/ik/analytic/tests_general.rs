@@ -6,9 +6,9 @@ use nalgebra::Isometry3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::tests::{pose_close, same_angles};
+use super::tests::{every_analytic_solution, pose_close, same_angles, solve_at};
 use super::*;
-use crate::ik::{IkMethod, IkParams, IkTarget, solve_ik};
+use crate::ik::{IkParams, IkTarget, solve_ik};
 use crate::robot::{Chain, ChainSpec, UrdfLimits, parse_chain};
 
 /// A 6R arm from `(origin xyz, axis xyz)` per joint (parent-frame origins,
@@ -240,20 +240,8 @@ fn numerical_search_finds_nothing_the_1d_search_missed() {
 fn searched_arm_through_solve_ik_and_its_refusals() {
     let chain = offset_wrist_56();
     let q = [0.4, -0.9, 0.7, 1.0, 0.8, -0.5];
-    let params = IkParams {
-        method: IkMethod::Analytic,
-        num_solutions: 1000,
-        ..IkParams::default()
-    };
-    let r = solve_ik(
-        &chain,
-        &IkTarget::Pose(chain.fk(&q)),
-        Some(&q),
-        &params,
-        0,
-        crate::Deadline::none(),
-    )
-    .unwrap();
+    let params = every_analytic_solution();
+    let r = solve_at(&chain, &q, &params).unwrap();
     assert!(r.success());
     assert!(same_angles(&r.solutions[0].joints, &q, 1e-8));
     assert!(
@@ -271,15 +259,7 @@ fn searched_arm_through_solve_ik_and_its_refusals() {
         },
         ..params
     };
-    let e = solve_ik(
-        &chain,
-        &IkTarget::Pose(chain.fk(&q)),
-        Some(&q),
-        &few,
-        0,
-        crate::Deadline::none(),
-    )
-    .unwrap_err();
+    let e = solve_at(&chain, &q, &few).unwrap_err();
     assert!(e.to_string().contains("search_samples"), "{e}");
     // an unreachable pose: none, and finite least-squares answers
     let arm = AnalyticArm::new(&chain, 1e-9).unwrap();
