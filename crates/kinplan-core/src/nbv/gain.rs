@@ -193,6 +193,33 @@ pub(crate) fn tree_state(tree: &Octree, key: &OcKey, cache: &mut SearchCache) ->
     }
 }
 
+/// The set-up of an Amanatides–Woo voxel walk from `start`, in cell `k`, at
+/// ray parameter `t0` along `dir` through cells of edge `res`: per axis the
+/// step (−1, 0, 1), the ray parameter of the first cell border crossed and
+/// the parameter between borders (infinite along an axis the ray does not move on).
+#[inline]
+pub(crate) fn dda_start(
+    k: &OcKey,
+    start: &Point3<f64>,
+    dir: &Vector3<f64>,
+    t0: f64,
+    res: f64,
+) -> ([i32; 3], [f64; 3], [f64; 3]) {
+    let mut step = [0i32; 3];
+    let mut t_max = [f64::INFINITY; 3];
+    let mut t_delta = [f64::INFINITY; 3];
+    for i in 0..3 {
+        if dir[i] != 0.0 {
+            step[i] = if dir[i] > 0.0 { 1 } else { -1 };
+            let lo = (k[i] as f64 - 32768.0) * res;
+            let border = if dir[i] > 0.0 { lo + res } else { lo };
+            t_max[i] = t0 + (border - start[i]) / dir[i];
+            t_delta[i] = res / dir[i].abs();
+        }
+    }
+    (step, t_max, t_delta)
+}
+
 /// [`walk`] reading each cell's state and log-odds from `lookup` instead of the tree
 /// (the tree gives the resolution and the key space).
 pub(crate) fn walk_with(
@@ -207,18 +234,7 @@ pub(crate) fn walk_with(
     let res = tree.resolution();
     let start = o + dir * t0;
     let Ok(mut k) = tree.key_of(&start) else { return 0 };
-    let mut step = [0i32; 3];
-    let mut t_max = [f64::INFINITY; 3];
-    let mut t_delta = [f64::INFINITY; 3];
-    for i in 0..3 {
-        if dir[i] != 0.0 {
-            step[i] = if dir[i] > 0.0 { 1 } else { -1 };
-            let lo = (k[i] as f64 - 32768.0) * res;
-            let border = if dir[i] > 0.0 { lo + res } else { lo };
-            t_max[i] = t0 + (border - start[i]) / dir[i];
-            t_delta[i] = res / dir[i].abs();
-        }
-    }
+    let (step, mut t_max, t_delta) = dda_start(&k, &start, dir, t0, res);
     let mut steps = 0u64;
     loop {
         steps += 1;

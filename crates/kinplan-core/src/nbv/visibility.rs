@@ -27,7 +27,7 @@ use nalgebra::{Isometry3, Point3};
 
 use super::NbvError;
 use super::camera::CameraModel;
-use super::gain::{tree_state, walk_with};
+use super::gain::{dda_start, tree_state, walk_with};
 use super::grid::{FREE, OCCUPIED, StateGrid, UNKNOWN};
 use crate::Deadline;
 use crate::octree::{CellState, OcKey, Octree, SearchCache, morton};
@@ -295,18 +295,7 @@ fn predict_on_grid(
             let t1 = camera.far / local.z;
             // the DDA set-up of `walk_with` from t0 = 0
             let mut k = k0;
-            let mut step = [0i32; 3];
-            let mut t_max = [f64::INFINITY; 3];
-            let mut t_delta = [f64::INFINITY; 3];
-            for i in 0..3 {
-                if dir[i] != 0.0 {
-                    step[i] = if dir[i] > 0.0 { 1 } else { -1 };
-                    let lo = (k[i] as f64 - 32768.0) * res;
-                    let border = if dir[i] > 0.0 { lo + res } else { lo };
-                    t_max[i] = (border - origin[i]) / dir[i];
-                    t_delta[i] = res / dir[i].abs();
-                }
-            }
+            let (step, mut t_max, t_delta) = dda_start(&k, &origin, &dir, 0.0, res);
             let mut unknown = 0usize;
             // phase 1: outside the grid, states from the tree, until the ray enters it
             let in_grid =
