@@ -243,17 +243,7 @@ fn redundant(label: &str, chain: &Chain, n: usize, out_dir: Option<&String>) {
         for (q, t) in fixed.iter().zip(&fixed_poses) {
             let r = analyse(chain, &params, Some(q)).unwrap();
             r.arm.solve_into(t, Some(&r.reduce(q)), &params, &mut out);
-            let g = t * m_inv;
-            let rot = g.rotation.to_rotation_matrix();
-            let m = rot.matrix();
-            let v: Vec<String> = q
-                .iter()
-                .copied()
-                .chain((0..3).flat_map(|i| (0..3).map(move |k| m[(i, k)])))
-                .chain(t.translation.vector.iter().copied())
-                .map(|x| format!("{x:.17e}"))
-                .collect();
-            writeln!(f, "{} {}", v.join(" "), out.len()).unwrap();
+            writeln!(f, "{} {}", pose_row(q, t, &m_inv), out.len()).unwrap();
         }
         let mut hp = std::fs::File::create(format!("{dir}/{label}_hp.txt")).unwrap();
         for h in &z.h {
@@ -486,17 +476,7 @@ fn main() {
         let m_inv = z.m.inverse();
         let mut f = std::io::BufWriter::new(std::fs::File::create(format!("{dir}/{label}.csv")).unwrap());
         for ((q, t), c) in configs.iter().zip(&poses).zip(&counts) {
-            let g = t * m_inv;
-            let r = g.rotation.to_rotation_matrix();
-            let m = r.matrix();
-            let v: Vec<String> = q
-                .iter()
-                .copied()
-                .chain((0..3).flat_map(|i| (0..3).map(move |j| m[(i, j)])))
-                .chain(t.translation.vector.iter().copied())
-                .map(|x| format!("{x:.17e}"))
-                .collect();
-            writeln!(f, "{} {c}", v.join(" ")).unwrap();
+            writeln!(f, "{} {c}", pose_row(q, t, &m_inv)).unwrap();
         }
         let mut hp = std::fs::File::create(format!("{dir}/{label}_hp.txt")).unwrap();
         for h in &z.h {
@@ -509,4 +489,20 @@ fn main() {
             prev = *p;
         }
     }
+}
+
+/// A CSV row for the anchor scripts: the joints, the rotation of `t · m_inv`
+/// row by row, and the position of `t`, all to 17 digits.
+fn pose_row(q: &[f64], t: &Isometry3<f64>, m_inv: &Isometry3<f64>) -> String {
+    let g = t * m_inv;
+    let r = g.rotation.to_rotation_matrix();
+    let m = r.matrix();
+    let v: Vec<String> = q
+        .iter()
+        .copied()
+        .chain((0..3).flat_map(|i| (0..3).map(move |j| m[(i, j)])))
+        .chain(t.translation.vector.iter().copied())
+        .map(|x| format!("{x:.17e}"))
+        .collect();
+    v.join(" ")
 }
