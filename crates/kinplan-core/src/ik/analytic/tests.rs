@@ -48,6 +48,43 @@ pub(super) fn solve_at(
     )
 }
 
+/// Levenberg–Marquardt (`lm`) at `t` from `runs` seeds drawn by `seed`: every
+/// answer it converges to is one of `ours` (angles within 1e-6, modulo whole
+/// turns). Returns how many runs converged.
+pub(super) fn lm_finds_none_missing(
+    chain: &Chain,
+    t: &Isometry3<f64>,
+    lm: &IkParams,
+    ours: &[AnalyticSolution],
+    runs: usize,
+    mut seed: impl FnMut() -> Vec<f64>,
+    what: &str,
+) -> usize {
+    let mut found = 0;
+    for _ in 0..runs {
+        let seed = seed();
+        let r = solve_ik(
+            chain,
+            &IkTarget::Pose(*t),
+            Some(&seed),
+            lm,
+            0,
+            crate::Deadline::none(),
+        )
+        .unwrap();
+        if let Some(s) = r.solutions.first() {
+            found += 1;
+            assert!(
+                ours.iter().any(|a| same_angles(&a.joints, &s.joints, 1e-6)),
+                "{what}: LM found {:?}, not among {:?}",
+                s.joints,
+                ours.iter().map(|a| a.joints).collect::<Vec<_>>()
+            );
+        }
+    }
+    found
+}
+
 pub(super) fn same_angles(a: &[f64], b: &[f64], tol: f64) -> bool {
     a.iter().zip(b).all(|(x, y)| wrap(x - y).abs() <= tol)
 }
@@ -375,25 +412,15 @@ fn numerical_search_finds_nothing_the_analytic_solver_missed() {
             let q = random_q(&chain, &mut rng);
             let t = chain.fk(&q);
             arm.solve_into(&t, None, &nearest_params(), &mut out);
-            for _ in 0..64 {
-                let seed = random_q(&chain, &mut rng);
-                let r = solve_ik(
-                    &chain,
-                    &IkTarget::Pose(t),
-                    Some(&seed),
-                    &lm,
-                    0,
-                    crate::Deadline::none(),
-                )
-                .unwrap();
-                if let Some(s) = r.solutions.first() {
-                    assert!(
-                        out.iter().any(|a| same_angles(&a.joints, &s.joints, 1e-6)),
-                        "{name}: LM found {:?}, not among the analytic solutions",
-                        s.joints
-                    );
-                }
-            }
+            lm_finds_none_missing(
+                &chain,
+                &t,
+                &lm,
+                &out,
+                64,
+                || random_q(&chain, &mut rng).to_vec(),
+                name,
+            );
         }
     }
 }

@@ -6,9 +6,9 @@ use nalgebra::Isometry3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::tests::{every_analytic_solution, pose_close, same_angles, solve_at};
+use super::tests::{every_analytic_solution, lm_finds_none_missing, pose_close, same_angles, solve_at};
 use super::*;
-use crate::ik::{IkParams, IkTarget, solve_ik};
+use crate::ik::IkParams;
 use crate::robot::{Chain, ChainSpec, UrdfLimits, parse_chain};
 
 /// A 6R arm from `(origin xyz, axis xyz)` per joint (parent-frame origins,
@@ -209,28 +209,15 @@ fn numerical_search_finds_nothing_the_1d_search_missed() {
             let q = random_q(&mut rng);
             let t = chain.fk(&q);
             arm.solve_into(&t, None, &nearest(), &mut out);
-            for _ in 0..64 {
-                let seed = random_q(&mut rng);
-                let r = solve_ik(
-                    &chain,
-                    &IkTarget::Pose(t),
-                    Some(&seed),
-                    &lm,
-                    0,
-                    crate::Deadline::none(),
-                )
-                .unwrap();
-                if let Some(s) = r.solutions.first() {
-                    found += 1;
-                    assert!(
-                        out.iter().any(|a| same_angles(&a.joints, &s.joints, 1e-6)),
-                        "{}: LM found {:?}, not among the searched solutions {:?}",
-                        chain.name(),
-                        s.joints,
-                        out.iter().map(|s| s.joints).collect::<Vec<_>>()
-                    );
-                }
-            }
+            found += lm_finds_none_missing(
+                &chain,
+                &t,
+                &lm,
+                &out,
+                64,
+                || random_q(&mut rng).to_vec(),
+                chain.name(),
+            );
         }
         assert!(found > 64, "{}: LM converged only {found} times", chain.name());
     }

@@ -7,7 +7,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::family::{meet, point_line_distance};
-use super::tests::pose_close;
+use super::tests::{lm_finds_none_missing, pose_close};
 use super::*;
 use crate::ik::{IkMethod, IkParams, IkResult, IkTarget, solve_ik};
 use crate::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, parse_chain};
@@ -179,35 +179,13 @@ fn numerical_search_finds_nothing_the_7_joint_closed_form_missed() {
             reduced.arm.nearest(&t, None, &wide, &mut ours);
             ours.retain(|s| s.exact);
             poses += 1;
-            for _ in 0..64 {
-                let seed: Vec<f64> = six
-                    .joints()
+            let draw = || {
+                six.joints()
                     .iter()
                     .map(|j| rng.random_range(j.lower..=j.upper))
-                    .collect();
-                let r = solve_ik(
-                    &six,
-                    &IkTarget::Pose(t),
-                    Some(&seed),
-                    &lm,
-                    0,
-                    crate::Deadline::none(),
-                )
-                .unwrap();
-                if let Some(s) = r.solutions.first() {
-                    found += 1;
-                    assert!(
-                        ours.iter().any(|a| a
-                            .joints
-                            .iter()
-                            .zip(&s.joints)
-                            .all(|(x, y)| wrap(x - y).abs() < 1e-6)),
-                        "{name}: LM found {:?}, not among {:?}",
-                        s.joints,
-                        ours.iter().map(|a| a.joints).collect::<Vec<_>>()
-                    );
-                }
-            }
+                    .collect()
+            };
+            found += lm_finds_none_missing(&six, &t, &lm, &ours, 64, draw, name);
         }
         assert!(found > 20, "{name}: LM converged only {found} times");
     }
