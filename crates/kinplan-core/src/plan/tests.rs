@@ -1199,7 +1199,7 @@ fn ccstomp_on_a_blocked_line_answers_by_its_deadline() {
     }
 }
 
-/// Regression: a MotionBenchMaker box problem (no. 5 of `../shared/bench/mbm/`,
+/// Regression: a MotionBenchMaker box problem (no. 5, read by `mbm_data`;
 /// fingers held at 40 mm) planned with padded motions and shortcuts came back
 /// NO_VALID_TRAJECTORY: the final re-check proved each edge again on pieces
 /// of its own, and a piece of a proved edge can fail a proof of its own
@@ -1218,18 +1218,18 @@ fn a_padded_rrt_connect_plan_with_shortcuts_is_valid_on_a_motionbenchmaker_box()
     let attached = attached_bodies(builtin_urdf("franka_panda_hand").unwrap(), &chain, &fingers).unwrap();
     let model = Arc::new(RobotModel::with_parts(chain.clone(), &attached, &[]).unwrap());
     let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
-    let scene = parse_planning_scene(
-        include_str!("fixtures/mbm_box_scene0005.yaml"),
-        &SceneLimits::default(),
-    )
-    .unwrap();
+    let Some(dir) = crate::mbm_data::problems() else {
+        return;
+    };
+    let (scene, request) = crate::mbm_data::problem(&dir, "box", 5);
+    let scene = parse_planning_scene(&scene, &SceneLimits::default()).unwrap();
     let world = Arc::new(SceneGeometry::build(&scene).unwrap());
     let params = CheckerParams {
         padded_motion: true,
         ..CheckerParams::default()
     };
     let checker = SceneChecker::new(model, &acm, world, params).unwrap();
-    let joints = parse_joint_request(include_str!("fixtures/mbm_box_request0005.yaml")).unwrap();
+    let joints = parse_joint_request(&request).unwrap();
     let arm = |state: &[(String, f64)]| -> Vec<f64> {
         (1..=7)
             .map(|i| {
