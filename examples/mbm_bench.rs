@@ -20,6 +20,13 @@
 //! motion checks use; a batch stops at its first colliding state), per
 //! state.
 //!
+//! `--states-from FILE` times `is_valid` on the states of `FILE` (rows of
+//! seven little-endian f64) in the first selected problem's scene instead
+//! of planning, the minimum of five passes over all states and over the
+//! ones it finds free, and counts the states whose verdict differs from
+//! `FILE.vamp` (one byte per state, 1 = free), then prints one JSON line
+//! and stops (`benches/mbm/state_cost_vamp.py` runs it beside VAMP).
+//!
 //! `--batched` checks the states of motions four at a time through the
 //! sphere model in vector lanes (`CheckerParams::batched`; same verdicts).
 //!
@@ -198,11 +205,13 @@ struct Args {
     state_cost: usize,
     /// Check motion states four at a time through the sphere model.
     batched: bool,
+    /// Time the state check on these states (and compare with VAMP's verdicts).
+    states_from: Option<PathBuf>,
     out: PathBuf,
 }
 
 fn args() -> Result<Args, String> {
-    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--problems N,N,...] [--state-cost N] [--batched] [--out PREFIX]";
+    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--problems N,N,...] [--state-cost N] [--states-from FILE] [--batched] [--out PREFIX]";
     let mut it = std::env::args().skip(1);
     let mut a = Args {
         root: PathBuf::new(),
@@ -217,6 +226,7 @@ fn args() -> Result<Args, String> {
         only_problems: None,
         state_cost: 0,
         batched: false,
+        states_from: None,
         out: PathBuf::from("target/mbm_bench"),
     };
     let mut root = None;
@@ -255,6 +265,7 @@ fn args() -> Result<Args, String> {
                     Some(numbers.map_err(|_| format!("--problems needs numbers like 3,17,42; {usage}"))?);
             }
             "--out" => a.out = PathBuf::from(it.next().ok_or(usage)?),
+            "--states-from" => a.states_from = Some(PathBuf::from(it.next().ok_or(usage)?)),
             _ if root.is_none() && !x.starts_with("--") => root = Some(PathBuf::from(x)),
             _ => return Err(usage.into()),
         }
@@ -401,6 +412,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 state_batch_ns: f64::NAN,
                 ..Row::default()
             };
+            if let Some(path) = &a.states_from {
+                println!("{}", states_from(&checker, path, dof)?);
+                return Ok(());
+            }
             if a.state_cost > 0 {
                 let mut rng = ChaCha8Rng::seed_from_u64(k as u64);
                 let states: Vec<f64> = (0..a.state_cost)
@@ -685,4 +700,46 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         a.out.with_extension("csv").display()
     );
     Ok(())
+}
+
+/// `--states-from`: our state check timed on the states of `path`, beside
+/// the verdicts VAMP's harness wrote to `path.vamp`.
+fn states_from(
+    checker: &SceneChecker,
+    path: &Path,
+    dof: usize,
+) -> Result<serde_json::Value, Box<dyn std::error::Error>> {
+    let bytes = std::fs::read(path)?;
+    let states: Vec<f64> = bytes
+        .chunks_exact(8)
+        .map(|b| f64::from_le_bytes(b.try_into().expect("eight bytes")))
+        .collect();
+    let vamp = std::fs::read(path.with_extension("bin.vamp"))?;
+    let n = states.len() / dof;
+    if vamp.len() != n {
+        return Err(format!("{}: {} verdicts for {n} states", path.display(), vamp.len()).into());
+    }
+    let ours: Vec<bool> = states.chunks_exact(dof).map(|q| checker.is_valid(q)).collect();
+    let free: Vec<f64> = states
+        .chunks_exact(dof)
+        .zip(&ours)
+        .filter(|(_, v)| **v)
+        .flat_map(|(q, _)| q.iter().copied())
+        .collect();
+    let time = |rows: &[f64]| -> f64 {
+        (0..5)
+            .map(|_| {
+                let t = Instant::now();
+                let valid = rows.chunks_exact(dof).filter(|q| checker.is_valid(q)).count();
+                std::hint::black_box(valid);
+                t.elapsed().as_secs_f64() * 1e9 / (rows.len() / dof).max(1) as f64
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    Ok(json!({
+        "ours_ns": time(&states),
+        "ours_free_ns": time(&free),
+        "ours_free": free.len() / dof,
+        "differ": ours.iter().zip(&vamp).filter(|(o, v)| **o != (**v == 1)).count(),
+    }))
 }
