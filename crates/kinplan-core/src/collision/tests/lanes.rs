@@ -261,17 +261,35 @@ fn scenes(rng: &mut ChaCha8Rng) -> Vec<(&'static str, Vec<Obstacle>)> {
     ]
 }
 
+/// The lanes' unsure mask (bit `l` set: the spheres do not clear state `l`)
+/// of up to [`LANES`] states, from the AVX2 build or the portable one.
+fn unsure(checker: &SceneChecker, batch: &[Vec<f64>], portable: bool) -> u32 {
+    let lanes = checker.lanes().expect("a batched checker");
+    let (scene_bodies, self_pairs) = checker.checked_parts();
+    let q = lanes_of(batch, lanes.dof());
+    let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
+    lanes.unsure(
+        &q[..lanes.dof()],
+        &checker.world().bvh,
+        scene_bodies,
+        self_pairs,
+        &mut frames,
+        portable,
+    )
+}
+
 #[test]
 fn sphere_verdicts_never_clear_a_colliding_state_and_batches_give_the_exact_answer() {
     let (chain, model, acm) = panda_with_hand();
-    let dof = chain.dof();
     let mut rng = ChaCha8Rng::seed_from_u64(25);
     for (name, obstacles) in scenes(&mut rng) {
         let world =
             Arc::new(SceneGeometry::build(&Scene::new(obstacles, &SceneLimits::default()).unwrap()).unwrap());
         let checker = SceneChecker::new(model.clone(), &acm, world, batched()).unwrap();
-        let lanes = checker.lanes().expect("the Panda in a small scene is batched");
-        let (scene_bodies, self_pairs) = checker.checked_parts();
+        assert!(
+            checker.lanes().is_some(),
+            "{name}: the Panda in a small scene is batched"
+        );
         // random states, then states within 1e-7 rad of the boundary between
         // a free and a colliding one (bisected along the line between them)
         let mut states: Vec<Vec<f64>> = (0..1200).map(|_| random_state(&chain, &mut rng)).collect();
@@ -303,24 +321,7 @@ fn sphere_verdicts_never_clear_a_colliding_state_and_batches_give_the_exact_answ
         }
         let (mut colliding, mut clear, mut free_count) = (0, 0, 0);
         for batch in states.chunks(LANES) {
-            let q = lanes_of(batch, dof);
-            let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
-            let simd = lanes.unsure(
-                &q[..dof],
-                &checker.world().bvh,
-                scene_bodies,
-                self_pairs,
-                &mut frames,
-                false,
-            );
-            let portable = lanes.unsure(
-                &q[..dof],
-                &checker.world().bvh,
-                scene_bodies,
-                self_pairs,
-                &mut frames,
-                true,
-            );
+            let (simd, portable) = (unsure(&checker, batch, false), unsure(&checker, batch, true));
             assert_eq!(simd, portable, "{name}: builds disagree on {batch:?}");
             for (l, s) in batch.iter().enumerate() {
                 let exact = checker.is_valid(s);
@@ -434,33 +435,23 @@ fn batched_verdicts_equal_the_exact_ones_on_every_motionbenchmaker_set() {
         return;
     };
     let (chain, model, acm) = panda_with_hand();
-    let dof = chain.dof();
     let mut rng = ChaCha8Rng::seed_from_u64(10_000);
     for set in crate::mbm_data::SETS {
         let (scene, _) = crate::mbm_data::problem(&dir, set, 1);
         let scene = parse_planning_scene(&scene, &SceneLimits::default()).unwrap();
         let world = Arc::new(SceneGeometry::build(&scene).unwrap());
         let checker = SceneChecker::new(model.clone(), &acm, world, batched()).unwrap();
-        let lanes = checker.lanes().unwrap_or_else(|| panic!("{set}: not batched"));
-        let (scene_bodies, self_pairs) = checker.checked_parts();
+        assert!(checker.lanes().is_some(), "{set}: not batched");
         let states: Vec<Vec<f64>> = (0..10_000).map(|_| random_state(&chain, &mut rng)).collect();
         let exact: Vec<bool> = states.iter().map(|q| checker.is_valid(q)).collect();
         let (mut cleared, mut free) = (0, 0);
         for (batch, exact) in states.chunks(LANES).zip(exact.chunks(LANES)) {
-            let q = lanes_of(batch, dof);
-            let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
-            let mut unsure = |portable| {
-                lanes.unsure(
-                    &q[..dof],
-                    &checker.world().bvh,
-                    scene_bodies,
-                    self_pairs,
-                    &mut frames,
-                    portable,
-                )
-            };
-            let simd = unsure(false);
-            assert_eq!(simd, unsure(true), "{set}: the builds disagree on {batch:?}");
+            let simd = unsure(&checker, batch, false);
+            assert_eq!(
+                simd,
+                unsure(&checker, batch, true),
+                "{set}: the builds disagree on {batch:?}"
+            );
             for (l, (s, &exact)) in batch.iter().zip(exact).enumerate() {
                 let sure = simd & (1 << l) == 0;
                 let batched = sure || !checker.in_collision(s);
