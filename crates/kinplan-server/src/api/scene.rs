@@ -5,7 +5,7 @@
 use nalgebra::Point3;
 use tonic::Status;
 
-use crate::api::convert::{finite, pose_in, vec3_in};
+use crate::api::convert::{finite, pose_at, vec3_at};
 use crate::pb::{self, collision_object::Shape};
 use crate::status::invalid;
 use kinplan_core::collision::{self, Geometry, Obstacle, Scene, SceneLimits};
@@ -34,26 +34,27 @@ pub fn scene_in(field: &str, scene: Option<&pb::Scene>, limits: &SceneLimits) ->
     }
     let mut obstacles = Vec::with_capacity(scene.objects.len());
     for (i, object) in scene.objects.iter().enumerate() {
-        let path = format!("{field}.objects[{i}]");
+        // field names are formatted only for an error
+        let path = || format!("{field}.objects[{i}]");
         let name = if object.id.is_empty() {
             format!("object {i}")
         } else {
             object.id.chars().take(64).collect()
         };
-        let pose = pose_in(
-            &format!("{path}.pose"),
+        let pose = pose_at(
+            &|| format!("{}.pose", path()),
             object.pose.as_ref().or(Some(&pb::Pose::default())),
         )?;
         let Some(shape) = &object.shape else {
             return Err(invalid(
-                path,
+                path(),
                 "one of box, sphere, cylinder, capsule, mesh or octree is required",
             ));
         };
         match shape {
             Shape::Octree(tree) => {
                 for geometry in octree_cells(
-                    &format!("{path}.octree"),
+                    &format!("{}.octree", path()),
                     tree,
                     object.unknown_as_obstacle,
                     limits,
@@ -67,41 +68,42 @@ pub fn scene_in(field: &str, scene: Option<&pb::Scene>, limits: &SceneLimits) ->
     Scene::new(obstacles, limits).map_err(|e| invalid(field, e.to_string()))
 }
 
-fn positive(field: &str, value: f64) -> Result<f64, Status> {
-    let v = finite(field, value)?;
-    if v > 0.0 {
-        Ok(v)
-    } else {
-        Err(invalid(field, format!("must be > 0, got {v}")))
+/// `value` when finite and > 0; the error names `field()`, made only then.
+fn positive(field: impl FnOnce() -> String, value: f64) -> Result<f64, Status> {
+    if value.is_finite() && value > 0.0 {
+        return Ok(value);
     }
+    let field = field();
+    let v = finite(&field, value)?;
+    Err(invalid(field, format!("must be > 0, got {v}")))
 }
 
-fn primitive_in(path: &str, shape: &Shape) -> Result<Geometry, Status> {
+fn primitive_in(path: &dyn Fn() -> String, shape: &Shape) -> Result<Geometry, Status> {
     Ok(match shape {
         Shape::Box(b) => {
-            let size = vec3_in(&format!("{path}.box.size"), b.size.as_ref())?;
+            let size = vec3_at(&|| format!("{}.box.size", path()), b.size.as_ref())?;
             for (axis, v) in ["x", "y", "z"].iter().zip(size.iter()) {
-                positive(&format!("{path}.box.size.{axis}"), *v)?;
+                positive(|| format!("{}.box.size.{axis}", path()), *v)?;
             }
             Geometry::Box {
                 half_extents: size / 2.0,
             }
         }
         Shape::Sphere(s) => Geometry::Sphere {
-            radius: positive(&format!("{path}.sphere.radius"), s.radius)?,
+            radius: positive(|| format!("{}.sphere.radius", path()), s.radius)?,
         },
         Shape::Cylinder(c) => Geometry::Cylinder {
-            radius: positive(&format!("{path}.cylinder.radius"), c.radius)?,
-            length: positive(&format!("{path}.cylinder.length"), c.length)?,
+            radius: positive(|| format!("{}.cylinder.radius", path()), c.radius)?,
+            length: positive(|| format!("{}.cylinder.length", path()), c.length)?,
         },
         Shape::Capsule(c) => Geometry::Capsule {
-            radius: positive(&format!("{path}.capsule.radius"), c.radius)?,
-            length: finite(&format!("{path}.capsule.length"), c.length)?.max(0.0),
+            radius: positive(|| format!("{}.capsule.radius", path()), c.radius)?,
+            length: finite(&format!("{}.capsule.length", path()), c.length)?.max(0.0),
         },
         Shape::Mesh(m) => {
             if m.indices.len() % 3 != 0 {
                 return Err(invalid(
-                    format!("{path}.mesh.indices"),
+                    format!("{}.mesh.indices", path()),
                     format!("{} indices is not a multiple of 3", m.indices.len()),
                 ));
             }
@@ -109,11 +111,13 @@ fn primitive_in(path: &str, shape: &Shape) -> Result<Geometry, Status> {
                 .vertices
                 .iter()
                 .enumerate()
-                .map(|(k, v)| vec3_in(&format!("{path}.mesh.vertices[{k}]"), Some(v)).map(Point3::from))
+                .map(|(k, v)| {
+                    vec3_at(&|| format!("{}.mesh.vertices[{k}]", path()), Some(v)).map(Point3::from)
+                })
                 .collect::<Result<Vec<_>, _>>()?;
             if let Some(k) = m.indices.iter().position(|&i| i as usize >= vertices.len()) {
                 return Err(invalid(
-                    format!("{path}.mesh.indices[{k}]"),
+                    format!("{}.mesh.indices[{k}]", path()),
                     format!(
                         "{} is out of range: the mesh has {} vertices",
                         m.indices[k],
