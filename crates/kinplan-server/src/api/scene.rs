@@ -163,3 +163,151 @@ fn octree_cells(
             )
         })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn object(shape: Shape, pose: Option<pb::Pose>) -> pb::CollisionObject {
+        pb::CollisionObject {
+            id: "o".into(),
+            pose,
+            shape: Some(shape),
+            unknown_as_obstacle: false,
+        }
+    }
+
+    fn pose(p: [f64; 3], q: [f64; 4]) -> Option<pb::Pose> {
+        Some(pb::Pose {
+            position: Some(pb::Vec3 {
+                x: p[0],
+                y: p[1],
+                z: p[2],
+            }),
+            orientation: Some(pb::Quaternion {
+                x: q[0],
+                y: q[1],
+                z: q[2],
+                w: q[3],
+            }),
+        })
+    }
+
+    fn unit_box() -> Shape {
+        Shape::Box(pb::Box {
+            size: Some(pb::Vec3 {
+                x: 1.0,
+                y: 1.0,
+                z: 1.0,
+            }),
+        })
+    }
+
+    /// The message of converting `objects`, which must be refused.
+    fn refusal(objects: Vec<pb::CollisionObject>) -> String {
+        let scene = pb::Scene { objects };
+        let e = scene_in("scene", Some(&scene), &SceneLimits::default()).expect_err("refused");
+        assert_eq!(e.code(), tonic::Code::InvalidArgument);
+        e.message().to_string()
+    }
+
+    #[test]
+    fn a_refused_value_is_named_by_its_full_path() {
+        let fine = object(unit_box(), None);
+        let cases = [
+            (
+                object(
+                    Shape::Box(pb::Box {
+                        size: Some(pb::Vec3 {
+                            x: 1.0,
+                            y: 0.0,
+                            z: 1.0,
+                        }),
+                    }),
+                    None,
+                ),
+                "scene.objects[1].box.size.y: must be > 0, got 0",
+            ),
+            (
+                object(unit_box(), pose([0.0, 0.0, f64::NAN], [0.0, 0.0, 0.0, 1.0])),
+                "scene.objects[1].pose.position.z: must be finite, got NaN",
+            ),
+            (
+                object(unit_box(), pose([0.0; 3], [0.0, 0.0, 0.0, 2.0])),
+                "scene.objects[1].pose.orientation: quaternion must have norm 1",
+            ),
+            (
+                object(
+                    Shape::Cylinder(pb::Cylinder {
+                        radius: 0.1,
+                        length: -1.0,
+                    }),
+                    None,
+                ),
+                "scene.objects[1].cylinder.length: must be > 0, got -1",
+            ),
+            (
+                object(
+                    Shape::Capsule(pb::Capsule {
+                        radius: f64::INFINITY,
+                        length: 1.0,
+                    }),
+                    None,
+                ),
+                "scene.objects[1].capsule.radius: must be finite, got inf",
+            ),
+        ];
+        for (bad, expected) in cases {
+            let message = refusal(vec![fine.clone(), bad]);
+            assert!(
+                message.starts_with(expected),
+                "{message:?} should start with {expected:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn accepted_objects_keep_their_values() {
+        let (s, c) = (0.5f64.sqrt(), 0.5f64.sqrt());
+        let scene = pb::Scene {
+            objects: vec![
+                object(
+                    Shape::Box(pb::Box {
+                        size: Some(pb::Vec3 {
+                            x: 0.2,
+                            y: 0.4,
+                            z: 0.6,
+                        }),
+                    }),
+                    pose([1.0, -2.0, 3.0], [0.0, 0.0, s, c]),
+                ),
+                object(
+                    Shape::Cylinder(pb::Cylinder {
+                        radius: 0.1,
+                        length: 0.3,
+                    }),
+                    None,
+                ),
+            ],
+        };
+        let out = scene_in("scene", Some(&scene), &SceneLimits::default()).unwrap();
+        let o = out.obstacles();
+        assert_eq!(o.len(), 2);
+        match &o[0].geometry {
+            Geometry::Box { half_extents } => assert_eq!(half_extents.as_slice(), &[0.1, 0.2, 0.3]),
+            g => panic!("a box, got {g:?}"),
+        }
+        assert_eq!(o[0].pose.translation.vector.as_slice(), &[1.0, -2.0, 3.0]);
+        // a quarter turn about z: x goes to y
+        let x = o[0].pose.rotation * nalgebra::Vector3::x();
+        assert!((x - nalgebra::Vector3::y()).norm() < 1e-12, "{x}");
+        assert_eq!(
+            o[1].geometry,
+            Geometry::Cylinder {
+                radius: 0.1,
+                length: 0.3
+            }
+        );
+        assert_eq!(o[1].pose, nalgebra::Isometry3::identity());
+    }
+}
