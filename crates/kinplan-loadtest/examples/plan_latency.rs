@@ -14,6 +14,10 @@
 //! - *as URDF*: the default request with the same robot sent as URDF text
 //!   instead of by name, the path a user's own robot takes.
 //!
+//! Before the problems, an idle round trip on the same connection for
+//! reference: `ForwardKinematics` of the same built-in robot at its zero
+//! state, [`FK_CALLS`] calls (the first 100 not counted), median printed.
+//!
 //! Per shape: the client's wall time; the server's `timings.total` (from the
 //! call's arrival in the handler to its answer: validation, conversion, the
 //! model and scene lookups and builds, the planner, timing) and of it
@@ -38,6 +42,7 @@ use kinplan_core::robot::builtin_urdf;
 use kinplan_loadtest::pose_msg;
 use kinplan_proto as pb;
 use pb::planning_service_client::PlanningServiceClient;
+use pb::robot_service_client::RobotServiceClient;
 use tonic::transport::{Channel, Endpoint};
 
 // the problem sets and the arm joints of a MoveIt state, as the in-process
@@ -50,6 +55,8 @@ use mbm_panda::{SETS, arm};
 const ROBOT: &str = "franka_panda_hand";
 const FINGERS: [&str; 2] = ["panda_finger_joint1", "panda_finger_joint2"];
 const FINGER_OPENING: f64 = 0.04;
+/// Idle round trips timed for reference.
+const FK_CALLS: usize = 2000;
 
 struct KillOnDrop(std::process::Child);
 
@@ -187,8 +194,9 @@ async fn time_request(
 ) -> Result<Option<[f64; 3]>, tonic::Status> {
     let (mut wall, mut total, mut rrt) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..passes {
+        let sent = req.clone();
         let started = Instant::now();
-        let answer = client.plan(req.clone()).await?.into_inner();
+        let answer = client.plan(sent).await?.into_inner();
         wall.push(started.elapsed().as_secs_f64() * 1e6);
         if std::env::var_os("PLAN_LATENCY_DEBUG").is_some() {
             use pb::prost::Message;
@@ -265,7 +273,27 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
             .stderr(std::process::Stdio::null())
             .spawn()?,
     );
-    let mut client = PlanningServiceClient::new(connect(port).await?);
+    let channel = connect(port).await?;
+    let mut robot = RobotServiceClient::new(channel.clone());
+    let fk = pb::ForwardKinematicsRequest {
+        robot: Some(robot_ref(false)),
+        joint_positions: vec![0.0; 7],
+        include_links: false,
+    };
+    let mut round_trips = Vec::with_capacity(FK_CALLS);
+    for i in 0..FK_CALLS + 100 {
+        let sent = fk.clone();
+        let started = Instant::now();
+        robot.forward_kinematics(sent).await?;
+        if i >= 100 {
+            round_trips.push(started.elapsed().as_secs_f64() * 1e6);
+        }
+    }
+    println!(
+        "idle round trip (ForwardKinematics, {FK_CALLS} calls, same connection): median {:.0} µs\n",
+        median(&mut round_trips)
+    );
+    let mut client = PlanningServiceClient::new(channel);
     println!(
         "| set | solved / valid | default: wall | server total | of which RRT-Connect | overhead | no random shortcuts: wall | server RRT-Connect | overhead | as URDF: wall | URDF / name |"
     );

@@ -146,7 +146,10 @@ fn check_pose(p: &Isometry3<f64>, field: &str, limits: &SceneLimits) -> Result<(
             field: format!("{field}.pose"),
         });
     }
-    coordinate(t.amax(), &format!("{field}.pose.position"), limits)
+    if t.amax() > limits.max_coordinate {
+        return coordinate(t.amax(), &format!("{field}.pose.position"), limits);
+    }
+    Ok(())
 }
 
 fn coordinate(value: f64, field: &str, limits: &SceneLimits) -> Result<(), CollisionError> {
@@ -160,8 +163,17 @@ fn coordinate(value: f64, field: &str, limits: &SceneLimits) -> Result<(), Colli
     Ok(())
 }
 
-/// A size: finite, > 0 and within the coordinate limit.
-pub(crate) fn positive(value: f64, field: String, limits: &SceneLimits) -> Result<(), CollisionError> {
+/// A size: finite, > 0 and within the coordinate limit. The field's name is
+/// made by `field` only for an error (a scene's many sizes format no text).
+pub(crate) fn positive(
+    value: f64,
+    field: impl FnOnce() -> String,
+    limits: &SceneLimits,
+) -> Result<(), CollisionError> {
+    if value.is_finite() && value > 0.0 && value <= limits.max_coordinate {
+        return Ok(());
+    }
+    let field = field();
     if !value.is_finite() {
         return Err(CollisionError::NonFinite { field });
     }
@@ -179,19 +191,21 @@ fn validate_geometry(g: &Geometry, field: &str, limits: &SceneLimits) -> Result<
             for (k, axis) in ["x", "y", "z"].iter().enumerate() {
                 positive(
                     half_extents[k],
-                    format!("{field}.box.half_extents.{axis}"),
+                    || format!("{field}.box.half_extents.{axis}"),
                     limits,
                 )?;
             }
             Ok(1)
         }
-        Geometry::Sphere { radius } => positive(*radius, format!("{field}.sphere.radius"), limits).map(|_| 1),
+        Geometry::Sphere { radius } => {
+            positive(*radius, || format!("{field}.sphere.radius"), limits).map(|_| 1)
+        }
         Geometry::Cylinder { radius, length } => {
-            positive(*radius, format!("{field}.cylinder.radius"), limits)?;
-            positive(*length, format!("{field}.cylinder.length"), limits).map(|_| 1)
+            positive(*radius, || format!("{field}.cylinder.radius"), limits)?;
+            positive(*length, || format!("{field}.cylinder.length"), limits).map(|_| 1)
         }
         Geometry::Capsule { radius, length } => {
-            positive(*radius, format!("{field}.capsule.radius"), limits)?;
+            positive(*radius, || format!("{field}.capsule.radius"), limits)?;
             // A capsule of length 0 is a sphere: allowed.
             if !length.is_finite() {
                 return Err(CollisionError::NonFinite {
@@ -208,7 +222,7 @@ fn validate_geometry(g: &Geometry, field: &str, limits: &SceneLimits) -> Result<
         }
         Geometry::Mesh { vertices, indices } => validate_mesh(vertices, indices, field, limits),
         Geometry::OccupiedCells { size, centers } => {
-            positive(*size, format!("{field}.cells.size"), limits)?;
+            positive(*size, || format!("{field}.cells.size"), limits)?;
             if centers.len() > limits.max_total_elements {
                 return Err(CollisionError::TooMany {
                     field: format!("{field}.cells.centers"),

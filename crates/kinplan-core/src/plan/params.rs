@@ -249,7 +249,11 @@ pub struct RrtParams {
     pub range: f64,
     /// Random samples before giving up (≥ 1). Default 100 000.
     pub max_samples: usize,
-    /// Random shortcut attempts after the greedy pass (≥ 0). Default 100.
+    /// Random shortcut attempts after the greedy vertex pass (≥ 0). Default
+    /// 100. Each draws a stretch of at most a third of the path's length and
+    /// replaces it by the chord between its ends when that is valid; an
+    /// attempt whose chord would shorten the path by at most 0.01 rad (or m)
+    /// costs no check (docs/planning.md#rrt-connect).
     pub shortcut_attempts: usize,
     /// Resolution (rad or m, in (0, 1]) at which shortcutting checks the
     /// motions it tries, when finer than the checker's; `None` (default):

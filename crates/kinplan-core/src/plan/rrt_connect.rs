@@ -322,10 +322,21 @@ fn dist(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Least shortening (joint-space path length: rad, or m for prismatic
-/// joints) a random shortcut must bring to be checked at all: converged paths
-/// draw many shortcuts that are valid but change nothing, each costing a
-/// motion check.
-const MIN_SHORTCUT_GAIN: f64 = 1e-3;
+/// joints) a random shortcut must bring to be checked at all. A shortcut's
+/// cost is the proof of its chord whatever it gains, and converged paths draw
+/// many chords that gain almost nothing. On the MotionBenchMaker Panda
+/// problems the shortcuts below this gain took a large share of the
+/// checking time for a few percent of the total shortening
+/// (`benches/RESULTS.md`, shortcutting under a Plan call).
+const MIN_SHORTCUT_GAIN: f64 = 0.01;
+
+/// Longest stretch of path, as a fraction of its length, a random shortcut
+/// may replace: the second point is drawn within this arc length of the
+/// first (OMPL's shortcutting bounds its chords by a range ratio of the path
+/// in a similar way). Chords across most of a path are mostly blocked and
+/// cost a check each; shorter ones are accepted more often, and several of
+/// them straighten a path as far.
+const SHORTCUT_SPAN: f64 = 1.0 / 3.0;
 
 /// Greedy vertex shortcut: from each kept vertex, jump to the farthest
 /// later vertex reachable by a valid straight motion.
@@ -362,20 +373,27 @@ fn greedy_pass<C: StateChecker + ?Sized>(
     *path = out;
 }
 
-/// Shortens a valid path in place: a greedy vertex pass, `attempts` random
-/// partial shortcuts (two points `p1`, `p2` drawn uniformly by arc length on
-/// different segments replace the path between them when the motions
-/// `v_{s1} → p1 → p2 → v_{s2+1}` are valid), and a final greedy pass.
+/// Shortens a valid path in place: a greedy vertex pass, then `attempts`
+/// random partial shortcuts. An attempt draws a point `u1` uniformly by arc
+/// length on the path (length `L`) and a second `u2` uniformly within
+/// [`SHORTCUT_SPAN`]` · L` of it (clamped to the path); when they fall on
+/// different segments `s1 < s2`, the points `p1`, `p2` there replace the
+/// path between them if the motions `v_{s1} → p1 → p2 → v_{s2+1}` are valid.
 ///
 /// Under interpolated checks the pieces of old segments (`v_{s1} → p1`,
 /// `p2 → v_{s2+1}`) are re-checked, since an interpolated check of a piece
 /// visits other states. Under padded checks they are not: every state of a
 /// proved motion is free, so its pieces are too, and only the chord
-/// `p1 → p2` needs a proof. An attempt that would shorten the path by at
-/// most [`MIN_SHORTCUT_GAIN`] is skipped without a check. The ends are kept
-/// exactly; every edge of the result is checked at `resolution` (or lies on
-/// an edge that was). Stops early when `clock` is interrupted (the path
-/// stays valid).
+/// `p1 → p2` needs a proof. An attempt whose chord would shorten the path
+/// (`(u2 − u1) − |p2 − p1|`) by at most [`MIN_SHORTCUT_GAIN`] is skipped
+/// without a check. The ends are kept exactly; every edge of the result is
+/// checked at `resolution` (or lies on an edge that was). Stops early when
+/// `clock` is interrupted (the path stays valid).
+///
+/// No greedy pass follows the random ones: on the MotionBenchMaker Panda
+/// problems it only ever removed single vertices, shortening the median
+/// path by about one percent for a fifth or more of the shortcutting time
+/// (`benches/RESULTS.md`).
 pub(crate) fn shortcut<C: StateChecker + ?Sized>(
     checker: &C,
     path: &mut Vec<f64>,
@@ -409,7 +427,9 @@ pub(crate) fn shortcut<C: StateChecker + ?Sized>(
         if total <= 0.0 {
             break;
         }
-        let (mut u1, mut u2) = (rng.random::<f64>() * total, rng.random::<f64>() * total);
+        let mut u1 = rng.random::<f64>() * total;
+        let reach = SHORTCUT_SPAN * total;
+        let mut u2 = (u1 + (2.0 * rng.random::<f64>() - 1.0) * reach).clamp(0.0, total);
         if u1 > u2 {
             std::mem::swap(&mut u1, &mut u2);
         }
@@ -453,7 +473,6 @@ pub(crate) fn shortcut<C: StateChecker + ?Sized>(
             *path = out;
         }
     }
-    greedy_pass(checker, path, dof, resolution, clock);
 }
 
 /// `n ≥ 2` waypoints on a piecewise-linear path (row-major): every vertex is

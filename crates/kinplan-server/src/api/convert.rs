@@ -40,19 +40,37 @@ pub fn finite_slice(field: &str, values: &[f64]) -> Result<(), Status> {
 }
 
 pub fn vec3_in(field: &str, v: Option<&pb::Vec3>) -> Result<Vector3<f64>, Status> {
+    vec3_at(&|| field.to_owned(), v)
+}
+
+/// [`vec3_in`] with the field's name made by `field` only when a value is
+/// refused: the conversions of a request's many poses and shapes format no
+/// text on success.
+pub fn vec3_at(field: &dyn Fn() -> String, v: Option<&pb::Vec3>) -> Result<Vector3<f64>, Status> {
     let v = v.cloned().unwrap_or_default();
-    Ok(Vector3::new(
-        finite(&format!("{field}.x"), v.x)?,
-        finite(&format!("{field}.y"), v.y)?,
-        finite(&format!("{field}.z"), v.z)?,
-    ))
+    for (name, value) in [("x", v.x), ("y", v.y), ("z", v.z)] {
+        if !value.is_finite() {
+            finite(&format!("{}.{name}", field()), value)?;
+        }
+    }
+    Ok(Vector3::new(v.x, v.y, v.z))
 }
 
 /// An unset (all-zero) quaternion is the identity; otherwise it must be unit.
 pub fn quaternion_in(field: &str, q: Option<&pb::Quaternion>) -> Result<UnitQuaternion<f64>, Status> {
+    quaternion_at(&|| field.to_owned(), q)
+}
+
+/// [`quaternion_in`], the field's name made only when the value is refused.
+pub fn quaternion_at(
+    field: &dyn Fn() -> String,
+    q: Option<&pb::Quaternion>,
+) -> Result<UnitQuaternion<f64>, Status> {
     let q = q.cloned().unwrap_or_default();
     for (name, value) in [("x", q.x), ("y", q.y), ("z", q.z), ("w", q.w)] {
-        finite(&format!("{field}.{name}"), value)?;
+        if !value.is_finite() {
+            finite(&format!("{}.{name}", field()), value)?;
+        }
     }
     let raw = Quaternion::new(q.w, q.x, q.y, q.z);
     if [q.w, q.x, q.y, q.z].iter().all(|c| *c == 0.0) {
@@ -64,7 +82,7 @@ pub fn quaternion_in(field: &str, q: Option<&pb::Quaternion>) -> Result<UnitQuat
     let norm = largest * (raw / largest).norm();
     if (norm - 1.0).abs() > UNIT_TOLERANCE {
         return Err(invalid(
-            field,
+            field(),
             format!("quaternion must have norm 1 (within {UNIT_TOLERANCE}), got {norm}"),
         ));
     }
@@ -72,11 +90,16 @@ pub fn quaternion_in(field: &str, q: Option<&pb::Quaternion>) -> Result<UnitQuat
 }
 
 pub fn pose_in(field: &str, p: Option<&pb::Pose>) -> Result<Isometry3<f64>, Status> {
+    pose_at(&|| field.to_owned(), p)
+}
+
+/// [`pose_in`], the field's name made only when a value is refused.
+pub fn pose_at(field: &dyn Fn() -> String, p: Option<&pb::Pose>) -> Result<Isometry3<f64>, Status> {
     let Some(p) = p else {
-        return Err(invalid(field, "is required"));
+        return Err(invalid(field(), "is required"));
     };
-    let t = vec3_in(&format!("{field}.position"), p.position.as_ref())?;
-    let r = quaternion_in(&format!("{field}.orientation"), p.orientation.as_ref())?;
+    let t = vec3_at(&|| format!("{}.position", field()), p.position.as_ref())?;
+    let r = quaternion_at(&|| format!("{}.orientation", field()), p.orientation.as_ref())?;
     Ok(Isometry3::from_parts(Translation3::from(t), r))
 }
 
