@@ -5,6 +5,7 @@ mod batch;
 mod counts;
 mod error;
 mod frame;
+mod grid;
 mod header;
 mod io;
 mod key;

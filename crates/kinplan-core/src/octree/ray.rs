@@ -104,6 +104,21 @@ impl Dda {
     }
 }
 
+/// Addresses of the cells a walk visits: a cell's address is `Σ_a term(a, k_a)`.
+pub(crate) trait CellAddress {
+    fn term(&self, axis: usize, k: u16) -> usize;
+}
+
+/// Every cell at address 0 (walks that need keys only).
+pub(crate) struct NoAddress;
+
+impl CellAddress for NoAddress {
+    #[inline]
+    fn term(&self, _: usize, _: u16) -> usize {
+        0
+    }
+}
+
 #[inline]
 fn f32_norm(v: &[f32; 3]) -> f64 {
     ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) as f64).sqrt()
@@ -141,22 +156,21 @@ impl Octree {
         end: &[f32; 3],
         mut visit: impl FnMut(&OcKey),
     ) -> bool {
-        self.visit_ray_cells(origin, end, &[0; 3], [0; 3], |k, _| visit(k))
+        self.visit_ray_cells(origin, end, &NoAddress, |k, _| visit(k))
     }
 
-    /// [`visit_ray_keys`](Self::visit_ray_keys) handing each key with its linear index
-    /// `Σ (k_i − lo_i)·strides_i` into a dense grid over a key box starting at `lo`,
-    /// kept up to date by one add per step (the beam must lie inside that box).
+    /// [`visit_ray_keys`](Self::visit_ray_keys) handing each key with its address
+    /// `Σ_a addr.term(a, k_a)`, kept up to date by one term per step (the beam must lie
+    /// where `addr` is defined).
     #[inline]
     pub(crate) fn visit_ray_cells(
         &self,
         origin: &[f32; 3],
         end: &[f32; 3],
-        lo: &OcKey,
-        strides: [usize; 3],
+        addr: &impl CellAddress,
         visit: impl FnMut(&OcKey, usize),
     ) -> bool {
-        self.visit_ray_cells_from(origin, end, 0.0, lo, strides, visit)
+        self.visit_ray_cells_from(origin, end, 0.0, addr, visit)
     }
 
     /// [`visit_ray_cells`](Self::visit_ray_cells) from the ray parameter `t_start`
@@ -173,8 +187,7 @@ impl Octree {
         origin: &[f32; 3],
         end: &[f32; 3],
         t_start: f64,
-        lo: &OcKey,
-        strides: [usize; 3],
+        addr: &impl CellAddress,
         mut visit: impl FnMut(&OcKey, usize),
     ) -> bool {
         let mut dir = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
@@ -189,15 +202,6 @@ impl Octree {
             *v /= length;
         }
         let length = length as f64;
-        let index_of = |k: &OcKey| {
-            (0..3).fold(0usize, |a, i| {
-                a.wrapping_add(
-                    (k[i] as usize)
-                        .wrapping_sub(lo[i] as usize)
-                        .wrapping_mul(strides[i]),
-                )
-            })
-        };
         let (ks, dda) = if t_start > 0.0 {
             let f = self.resolution_factor;
             let at = |i: usize| coord_to_key_axis(origin[i] as f64 + t_start * dir[i] as f64, f);
@@ -226,16 +230,14 @@ impl Octree {
             }
             (ko, Dda::new(&ko, origin, &dir, self.resolution, true))
         };
-        let mut idx = index_of(&ks);
-        visit(&ks, idx);
+        let [mut ax, mut ay, mut az] = [0, 1, 2].map(|a| addr.term(a, ks[a]));
+        visit(&ks, ax + ay + az);
         // the DDA state in scalar locals (registers): an array indexed by the axis made
         // each step wait on a partial store-to-load forward of the key
         let [mut kx, mut ky, mut kz] = ks;
         let [mut tx, mut ty, mut tz] = dda.t_max;
         let [dx, dy, dz] = dda.t_delta;
         let [sx, sy, sz] = dda.step.map(|s| s as u16); // ±1 as a wrapping u16 step
-        // index change per step along each axis (±stride, wrapping)
-        let [ix, iy, iz] = [0, 1, 2].map(|i| (dda.step[i] as isize as usize).wrapping_mul(strides[i]));
         // a beam between two keys in the cube crosses at most 3 · 65536 borders
         for _ in 0..3 * 65536 {
             // axis of the smallest t_max, ties as in `Dda::axis`
@@ -243,20 +245,20 @@ impl Octree {
                 if tx < tz {
                     kx = kx.wrapping_add(sx);
                     tx += dx;
-                    idx = idx.wrapping_add(ix);
+                    ax = addr.term(0, kx);
                 } else {
                     kz = kz.wrapping_add(sz);
                     tz += dz;
-                    idx = idx.wrapping_add(iz);
+                    az = addr.term(2, kz);
                 }
             } else if ty < tz {
                 ky = ky.wrapping_add(sy);
                 ty += dy;
-                idx = idx.wrapping_add(iy);
+                ay = addr.term(1, ky);
             } else {
                 kz = kz.wrapping_add(sz);
                 tz += dz;
-                idx = idx.wrapping_add(iz);
+                az = addr.term(2, kz);
             }
             if kx == ke[0] && ky == ke[1] && kz == ke[2] {
                 break;
@@ -266,7 +268,7 @@ impl Octree {
             if dist > length {
                 break;
             }
-            visit(&[kx, ky, kz], idx);
+            visit(&[kx, ky, kz], ax + ay + az);
         }
         true
     }

@@ -7,9 +7,13 @@ use std::time::Instant;
 use nalgebra::Isometry3;
 use rayon::prelude::*;
 
+use std::ops::ControlFlow;
+
 use super::batch::BatchUpdate;
 use super::frame::{PixelBeam, near_field_starts};
+use super::grid::{BLOCK_WORDS, BlockGrid};
 use super::key::{OcKey, morton, unmorton};
+use super::ray::NoAddress;
 use super::{Octree, OctreeError, OctreeLimits};
 use crate::Deadline;
 
@@ -22,9 +26,10 @@ pub struct ScanParams {
     /// Merge end points falling into the same cell first and cast from its centre
     /// (OctoMap's `discretize`). Default false.
     pub discretize: bool,
-    /// Largest key box (cells) traced into dense bitsets (one bit per cell and set,
-    /// per worker); larger scans collect sorted key vectors. Default 2^27
-    /// (16 MiB per bitset).
+    /// Largest key box (cells, once widened to whole blocks of 32³ cells aligned to
+    /// multiples of 32 keys) traced into dense bitsets (one bit per cell and set, per
+    /// worker); larger scans collect sorted key vectors. Default 2^27 (16 MiB per
+    /// bitset).
     pub dense_limit_cells: usize,
     /// Most cells the beams may cross in all, counted before any is traced as
     /// `Σ_beams min(‖key(p) − key(o)‖₁ + 1, 3·max_range/resolution + 4)` — the
@@ -135,50 +140,66 @@ pub struct PinholeIntrinsics {
 /// Free cells, end-point cells (Morton codes) and skipped points of one chunk of beams.
 type ChunkKeys = (Vec<u64>, Vec<u64>, usize);
 
-/// A scan's cells to update: bits over the key box starting at `lo` with `dims`
-/// cells per axis (x fastest), or sorted Morton codes.
-enum CellSet {
+/// The cells one scan updates, free (end points removed) and occupied (end points):
+/// two bitsets over a [`BlockGrid`], or two sorted, disjoint vectors of Morton codes.
+enum CellSets {
     Dense {
-        bits: Vec<u64>,
-        lo: OcKey,
-        dims: [usize; 3],
+        grid: BlockGrid,
+        free: Vec<u64>,
+        occupied: Vec<u64>,
     },
-    Sorted(Vec<u64>),
+    Sorted {
+        free: Vec<u64>,
+        occupied: Vec<u64>,
+    },
 }
 
-impl CellSet {
-    /// The keys in ascending bit or Morton order.
-    fn iter(&self) -> Box<dyn Iterator<Item = OcKey> + '_> {
-        match self {
-            CellSet::Dense { bits, lo, dims } => {
-                let (lo, dx, dy) = (*lo, dims[0], dims[1]);
-                // the row (y, z) of the last bit: a division only when the row changes
-                let mut row = (usize::MAX, 0u16, 0u16);
-                Box::new(bits.iter().enumerate().flat_map(move |(w, &word)| {
-                    let mut b = word;
-                    std::iter::from_fn(move || {
-                        (b != 0).then(|| {
-                            let i = w * 64 + b.trailing_zeros() as usize;
-                            b &= b - 1;
-                            if i < row.0 || i >= row.0 + dx {
-                                let r = i / dx;
-                                row = (r * dx, lo[1] + (r % dy) as u16, lo[2] + (r / dy) as u16);
-                            }
-                            [lo[0] + (i - row.0) as u16, row.1, row.2]
-                        })
-                    })
-                }))
-            }
-            CellSet::Sorted(codes) => Box::new(codes.iter().map(|&m| unmorton(m))),
-        }
-    }
-}
-
-/// The cells one scan updates: free (end points removed) and occupied.
+/// The cells one scan updates and the points it skipped.
 struct ScanCells {
-    free: CellSet,
-    occupied: CellSet,
+    sets: CellSets,
     skipped: usize,
+}
+
+impl CellSets {
+    /// Hands every cell with `true` for free, `false` for occupied to `each` in
+    /// ascending Morton order inside each 32³ block (dense) or in ascending Morton
+    /// order (sorted), until `each` breaks.
+    fn for_each<B>(&self, mut each: impl FnMut(&OcKey, bool) -> ControlFlow<B>) -> ControlFlow<B> {
+        match self {
+            CellSets::Dense { grid, free, occupied } => {
+                let blocks = free
+                    .chunks_exact(BLOCK_WORDS)
+                    .zip(occupied.chunks_exact(BLOCK_WORDS));
+                for (b, (f, o)) in blocks.enumerate() {
+                    if f.iter().chain(o).all(|&w| w == 0) {
+                        continue;
+                    }
+                    let base = grid.block_base(b);
+                    for (w, (&f, &o)) in f.iter().zip(o).enumerate() {
+                        let mut bits = f | o;
+                        while bits != 0 {
+                            let i = bits.trailing_zeros() as usize;
+                            bits &= bits - 1;
+                            each(&grid.key_in_block(&base, w * 64 + i), o >> i & 1 == 0)?;
+                        }
+                    }
+                }
+            }
+            CellSets::Sorted { free, occupied } => {
+                let (mut i, mut j) = (0, 0);
+                while i < free.len() || j < occupied.len() {
+                    if j == occupied.len() || (i < free.len() && free[i] < occupied[j]) {
+                        each(&unmorton(free[i]), true)?;
+                        i += 1;
+                    } else {
+                        each(&unmorton(occupied[j]), false)?;
+                        j += 1;
+                    }
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
 }
 
 /// The union of two sorted, deduplicated vectors, sorted and deduplicated.
@@ -226,9 +247,10 @@ const DENSE_BUDGET_BYTES: usize = 256 << 20;
 /// What a scan will trace, worked out before any beam is: the beams' key box,
 /// the chunks of beams with their cell counts, and the total.
 struct ScanPlan {
-    /// Key box of the origin and every usable end point: all beams lie inside it.
+    /// Key box of the origin and every usable end point (inclusive): all beams lie
+    /// inside it.
     lo: OcKey,
-    dims: [usize; 3],
+    hi: OcKey,
     /// Consecutive point ranges of at most [`CHUNK_CELLS`] cells each (a single
     /// longer beam is a chunk of its own), with their cell counts.
     chunks: Vec<(std::ops::Range<usize>, u64)>,
@@ -321,10 +343,8 @@ impl Octree {
             trace_us: 0,
             update_us: 0,
         };
-        let cells = plan.dims[0]
-            .saturating_mul(plan.dims[1])
-            .saturating_mul(plan.dims[2]);
-        let traced = if cells <= params.dense_limit_cells {
+        let dense = BlockGrid::cells_for(&plan.lo, &plan.hi).is_some_and(|c| c <= params.dense_limit_cells);
+        let traced = if dense {
             self.trace_dense(pts, origin, starts, params.max_range, &plan, deadline)
         } else {
             self.trace_sorted(pts, origin, starts, params, &plan, deadline)?
@@ -338,36 +358,34 @@ impl Octree {
         let (hit, miss) = (self.model.hit, self.model.miss);
         let mut updates = 0usize;
         let mut batch = BatchUpdate::new();
-        for (keys, delta, is_free) in [(&cells.free, miss, true), (&cells.occupied, hit, false)] {
-            for key in keys.iter() {
-                if updates.is_multiple_of(UPDATES_PER_CHECK) {
-                    if self.num_nodes > params.max_nodes {
-                        batch.finish(self);
-                        return Err(OctreeError::TreeGrewTooLarge {
-                            limit: params.max_nodes,
-                        });
-                    }
-                    if deadline.expired() {
-                        batch.finish(self);
-                        stats.update_us = t1.elapsed().as_micros() as u64;
-                        stats.nodes = self.num_nodes;
-                        return Ok(stats);
-                    }
+        let stopped = cells.sets.for_each(|key, is_free| {
+            if updates.is_multiple_of(UPDATES_PER_CHECK) {
+                if self.num_nodes > params.max_nodes {
+                    return ControlFlow::Break(true);
                 }
-                batch.update(self, &key, delta);
-                if is_free {
-                    stats.free_cells += 1;
-                } else {
-                    stats.occupied_cells += 1;
+                if deadline.expired() {
+                    return ControlFlow::Break(false);
                 }
-                updates += 1;
             }
-        }
+            batch.update(self, key, if is_free { miss } else { hit });
+            if is_free {
+                stats.free_cells += 1;
+            } else {
+                stats.occupied_cells += 1;
+            }
+            updates += 1;
+            ControlFlow::Continue(())
+        });
         batch.finish(self);
-        if self.num_nodes > params.max_nodes {
+        if matches!(stopped, ControlFlow::Break(true)) || self.num_nodes > params.max_nodes {
             return Err(OctreeError::TreeGrewTooLarge {
                 limit: params.max_nodes,
             });
+        }
+        if stopped.is_break() {
+            stats.update_us = t1.elapsed().as_micros() as u64;
+            stats.nodes = self.num_nodes;
+            return Ok(stats);
         }
         stats.update_us = t1.elapsed().as_micros() as u64;
         stats.nodes = self.num_nodes;
@@ -439,8 +457,7 @@ impl Octree {
                 hi[a] = hi[a].max(ko[a].saturating_add(reach));
             }
         }
-        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a]) as usize + 1);
-        Ok(ScanPlan { lo, dims, chunks })
+        Ok(ScanPlan { lo, hi, chunks })
     }
 
     /// Traces every beam into two bitsets over the key box (free, end points), one
@@ -455,12 +472,9 @@ impl Octree {
         plan: &ScanPlan,
         deadline: Deadline<'_>,
     ) -> Option<ScanCells> {
-        let (lo, dims) = (plan.lo, plan.dims);
-        let words = (dims[0] * dims[1] * dims[2]).div_ceil(64);
-        let index = |k: &OcKey| {
-            ((k[2] - lo[2]) as usize * dims[1] + (k[1] - lo[1]) as usize) * dims[0] + (k[0] - lo[0]) as usize
-        };
-        let strides = [1, dims[0], dims[0] * dims[1]];
+        let grid = BlockGrid::new(&plan.lo, &plan.hi);
+        let words = grid.cells() / 64;
+        let index = |k: &OcKey| grid.index(k);
         let workers = rayon::current_num_threads()
             .min((DENSE_BUDGET_BYTES / (16 * words)).max(1))
             .min(plan.chunks.len())
@@ -497,7 +511,7 @@ impl Octree {
                                 }
                             }
                         } else if max_range < 0.0 || norm <= max_range {
-                            self.visit_ray_cells_from(origin, p, t0, &lo, strides, &mut mark);
+                            self.visit_ray_cells_from(origin, p, t0, &grid, &mut mark);
                             match self.key_of_f32(p) {
                                 Some(k) => {
                                     let i = index(&k);
@@ -508,7 +522,7 @@ impl Octree {
                         } else {
                             let (n, m) = (norm as f32, max_range as f32);
                             let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                            self.visit_ray_cells_from(origin, &e, t0, &lo, strides, &mut mark);
+                            self.visit_ray_cells_from(origin, &e, t0, &grid, &mut mark);
                         }
                     }
                 }
@@ -527,8 +541,11 @@ impl Octree {
             *f &= !o;
         }
         Some(ScanCells {
-            free: CellSet::Dense { bits: free, lo, dims },
-            occupied: CellSet::Dense { bits: occ, lo, dims },
+            sets: CellSets::Dense {
+                grid,
+                free,
+                occupied: occ,
+            },
             skipped,
         })
     }
@@ -574,7 +591,7 @@ impl Octree {
                         let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
                         let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
                         if max_range < 0.0 || norm <= max_range {
-                            self.visit_ray_cells_from(origin, p, t0, &[0; 3], [0; 3], &mut push);
+                            self.visit_ray_cells_from(origin, p, t0, &NoAddress, &mut push);
                             match self.key_of_f32(p) {
                                 Some(k) => chunk_occ.push(morton(&k)),
                                 None => chunk_skipped += 1,
@@ -583,7 +600,7 @@ impl Octree {
                             let n = norm as f32;
                             let m = max_range as f32;
                             let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                            self.visit_ray_cells_from(origin, &e, t0, &[0; 3], [0; 3], &mut push);
+                            self.visit_ray_cells_from(origin, &e, t0, &NoAddress, &mut push);
                         }
                     }
                     chunk_free.sort_unstable();
@@ -624,8 +641,7 @@ impl Octree {
             !(j < occ.len() && occ[j] == *m)
         });
         Ok(Some(ScanCells {
-            free: CellSet::Sorted(free),
-            occupied: CellSet::Sorted(occ),
+            sets: CellSets::Sorted { free, occupied: occ },
             skipped,
         }))
     }
