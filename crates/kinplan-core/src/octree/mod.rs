@@ -10,6 +10,7 @@ mod header;
 mod io;
 mod key;
 mod params;
+mod plan;
 mod query;
 mod ray;
 mod scan;

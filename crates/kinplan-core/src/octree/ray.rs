@@ -65,6 +65,7 @@ struct Dda {
 
 impl Dda {
     /// `float_border`: `computeRayKeys` rounds the half cell to f32, `castRay` does not.
+    #[inline]
     fn new(key: &OcKey, origin: &[f32; 3], dir: &[f32; 3], res: f64, float_border: bool) -> Self {
         let mut d = Dda {
             step: [0; 3],
@@ -119,8 +120,9 @@ impl CellAddress for NoAddress {
     }
 }
 
+/// `‖v‖` as OctoMap's `norm()`: the squares summed in f32, the root in f64.
 #[inline]
-fn f32_norm(v: &[f32; 3]) -> f64 {
+pub(crate) fn f32_norm(v: &[f32; 3]) -> f64 {
     ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) as f64).sqrt()
 }
 
@@ -188,19 +190,40 @@ impl Octree {
         end: &[f32; 3],
         t_start: f64,
         addr: &impl CellAddress,
-        mut visit: impl FnMut(&OcKey, usize),
+        visit: impl FnMut(&OcKey, usize),
     ) -> bool {
-        let mut dir = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
-        let length = f32_norm(&dir) as f32;
-        if t_start > 0.0 && t_start >= length as f64 {
+        let diff = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
+        let norm = f32_norm(&diff);
+        if t_start > 0.0 && t_start >= norm as f32 as f64 {
             return true;
         }
         let Some(ke) = self.key_of_f32(end) else {
             return false;
         };
-        for v in dir.iter_mut() {
-            *v /= length;
+        self.walk_beam(origin, &diff, norm, &ke, t_start, addr, visit)
+    }
+
+    /// The walk of [`visit_ray_cells_from`](Self::visit_ray_cells_from) given the
+    /// beam's difference `end − origin` (f32), its norm `f32_norm(diff)` and the end
+    /// point's key (in the tree).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn walk_beam(
+        &self,
+        origin: &[f32; 3],
+        diff: &[f32; 3],
+        norm: f64,
+        ke: &OcKey,
+        t_start: f64,
+        addr: &impl CellAddress,
+        mut visit: impl FnMut(&OcKey, usize),
+    ) -> bool {
+        let ke = *ke;
+        let length = norm as f32;
+        if t_start > 0.0 && t_start >= length as f64 {
+            return true;
         }
+        let dir = diff.map(|v| v / length);
         let length = length as f64;
         let (ks, dda) = if t_start > 0.0 {
             let f = self.resolution_factor;
@@ -230,8 +253,17 @@ impl Octree {
             }
             (ko, Dda::new(&ko, origin, &dir, self.resolution, true))
         };
-        let [mut ax, mut ay, mut az] = [0, 1, 2].map(|a| addr.term(a, ks[a]));
-        visit(&ks, ax + ay + az);
+        visit(
+            &ks,
+            addr.term(0, ks[0]) + addr.term(1, ks[1]) + addr.term(2, ks[2]),
+        );
+        // Steps until the key can equal the end key: the walk moves each axis by its
+        // sign only, so it meets `ke` exactly after Σ_a (ke_a − ks_a)·step_a steps if
+        // every term is ≥ 0 (and 0 on a still axis), or never.
+        let mut to_end = (0..3).try_fold(0i64, |n, a| {
+            let r = (ke[a] as i64 - ks[a] as i64) * dda.step[a] as i64;
+            (r >= 0 && (dda.step[a] != 0 || r == 0)).then_some(n + r)
+        });
         // the DDA state in scalar locals (registers): an array indexed by the axis made
         // each step wait on a partial store-to-load forward of the key
         let [mut kx, mut ky, mut kz] = ks;
@@ -245,30 +277,32 @@ impl Octree {
                 if tx < tz {
                     kx = kx.wrapping_add(sx);
                     tx += dx;
-                    ax = addr.term(0, kx);
                 } else {
                     kz = kz.wrapping_add(sz);
                     tz += dz;
-                    az = addr.term(2, kz);
                 }
             } else if ty < tz {
                 ky = ky.wrapping_add(sy);
                 ty += dy;
-                ay = addr.term(1, ky);
             } else {
                 kz = kz.wrapping_add(sz);
                 tz += dz;
-                az = addr.term(2, kz);
             }
-            if kx == ke[0] && ky == ke[1] && kz == ke[2] {
-                break;
+            if let Some(n) = to_end.as_mut() {
+                *n -= 1;
+                if *n == 0 && kx == ke[0] && ky == ke[1] && kz == ke[2] {
+                    break;
+                }
             }
             let m = if tx < ty { tx } else { ty };
             let dist = if m < tz { m } else { tz };
             if dist > length {
                 break;
             }
-            visit(&[kx, ky, kz], ax + ay + az);
+            visit(
+                &[kx, ky, kz],
+                addr.term(0, kx) + addr.term(1, ky) + addr.term(2, kz),
+            );
         }
         true
     }

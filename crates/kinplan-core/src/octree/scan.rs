@@ -13,7 +13,8 @@ use super::batch::BatchUpdate;
 use super::frame::{PixelBeam, near_field_starts};
 use super::grid::{BLOCK_WORDS, BlockGrid};
 use super::key::{OcKey, morton, unmorton};
-use super::ray::NoAddress;
+use super::plan::{Beam, EndPoint, PlanBuilder, ScanPlan};
+use super::ray::{CellAddress, NoAddress};
 use super::{Octree, OctreeError, OctreeLimits};
 use crate::Deadline;
 
@@ -228,10 +229,6 @@ fn merge_sorted(a: &[u64], b: &[u64]) -> Vec<u64> {
     out
 }
 
-/// Cells traced between two looks at the stop flag (a chunk of beams), so a
-/// stop is seen within about a millisecond of tracing.
-const CHUNK_CELLS: u64 = 1 << 16;
-
 /// Cells traced per batch on the sorted path before the batch's keys are
 /// merged into the scan's sets and their size is checked against the node
 /// limit: bounds the keys held at once.
@@ -243,18 +240,6 @@ const UPDATES_PER_CHECK: usize = 4096;
 /// Memory the dense path's per-worker bitsets may take in all (bytes); fewer
 /// workers trace a large key box.
 const DENSE_BUDGET_BYTES: usize = 256 << 20;
-
-/// What a scan will trace, worked out before any beam is: the beams' key box,
-/// the chunks of beams with their cell counts, and the total.
-struct ScanPlan {
-    /// Key box of the origin and every usable end point (inclusive): all beams lie
-    /// inside it.
-    lo: OcKey,
-    hi: OcKey,
-    /// Consecutive point ranges of at most [`CHUNK_CELLS`] cells each (a single
-    /// longer beam is a chunk of its own), with their cell counts.
-    chunks: Vec<(std::ops::Range<usize>, u64)>,
-}
 
 impl Octree {
     /// Integrates a point cloud measured from `origin` (m, map frame; coordinates are
@@ -291,27 +276,10 @@ impl Octree {
         params: &ScanParams,
         deadline: Deadline<'_>,
     ) -> Result<ScanStats, OctreeError> {
-        self.insert_beams(points, origin, None, params, deadline)
-    }
-
-    /// [`insert_scan`](Self::insert_scan) with, optionally, the ray parameter (m) at
-    /// which each beam's free cells start (one per point; the end point is always
-    /// occupied).
-    fn insert_beams(
-        &mut self,
-        points: &[[f32; 3]],
-        origin: &[f32; 3],
-        starts: Option<&[f32]>,
-        params: &ScanParams,
-        deadline: Deadline<'_>,
-    ) -> Result<ScanStats, OctreeError> {
         params.validate()?;
-        debug_assert!(starts.is_none_or(|s| s.len() == points.len() && !params.discretize));
         if origin.iter().any(|v| !v.is_finite()) {
             return Err(OctreeError::NonFinite { field: "origin" });
         }
-        self.key_of_f32(origin)
-            .ok_or(OctreeError::OutOfBounds { field: "origin" })?;
         let t0 = Instant::now();
         let discrete: Vec<[f32; 3]>;
         let pts: &[[f32; 3]] = if params.discretize {
@@ -332,10 +300,33 @@ impl Octree {
         } else {
             points
         };
-        let plan = self.plan_scan(pts, origin, params)?;
+        let mut builder = PlanBuilder::new(self, origin, params, pts.len())?;
+        for p in pts {
+            builder.push(p);
+        }
+        let plan = builder.finish(params)?;
+        self.insert_planned(&plan, origin, None, points.len(), params, t0, deadline)
+    }
+
+    /// Traces the beams of `plan` from `origin` and updates their cells, optionally
+    /// with the ray parameter (m) at which each beam's free cells start (one per
+    /// beam; the end point is always occupied). `points` is the count reported in
+    /// the stats, `t0` when the scan's work started.
+    #[allow(clippy::too_many_arguments)]
+    fn insert_planned(
+        &mut self,
+        plan: &ScanPlan,
+        origin: &[f32; 3],
+        starts: Option<&[f32]>,
+        points: usize,
+        params: &ScanParams,
+        t0: Instant,
+        deadline: Deadline<'_>,
+    ) -> Result<ScanStats, OctreeError> {
+        debug_assert!(starts.is_none_or(|s| s.len() == plan.beams.len() && !params.discretize));
         let mut stats = ScanStats {
             status: ScanStatus::Cancelled,
-            points: points.len(),
+            points,
             skipped_points: 0,
             free_cells: 0,
             occupied_cells: 0,
@@ -345,9 +336,9 @@ impl Octree {
         };
         let dense = BlockGrid::cells_for(&plan.lo, &plan.hi).is_some_and(|c| c <= params.dense_limit_cells);
         let traced = if dense {
-            self.trace_dense(pts, origin, starts, params.max_range, &plan, deadline)
+            self.trace_dense(origin, starts, params.max_range, plan, deadline)
         } else {
-            self.trace_sorted(pts, origin, starts, params, &plan, deadline)?
+            self.trace_sorted(origin, starts, params, plan, deadline)?
         };
         stats.trace_us = t0.elapsed().as_micros() as u64;
         let Some(cells) = traced else {
@@ -393,71 +384,41 @@ impl Octree {
         Ok(stats)
     }
 
-    /// Counts the cells each beam can cross (`‖Δkey‖₁ + 1`, at most the cut beam's
-    /// `3·max_range/resolution + 4`; 0 for a point that is skipped), refuses the scan
-    /// when the total passes `max_traced_cells`, and cuts the points into chunks.
-    fn plan_scan(
+    /// Traces one beam from `origin` (free cells from the ray parameter `t0` on to
+    /// `free` with their address, its end cell to `end`) with `insertPointCloud`'s
+    /// rule: a beam longer than `max_range > 0` is cut there and has no end cell.
+    /// False when the point is skipped (not finite, or outside the tree's cube and not
+    /// cut).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn trace_beam(
         &self,
-        pts: &[[f32; 3]],
+        beam: &Beam,
         origin: &[f32; 3],
-        params: &ScanParams,
-    ) -> Result<ScanPlan, OctreeError> {
-        let max_range = params.max_range;
-        let cut_bound = if max_range > 0.0 {
-            3 * (max_range * self.resolution_factor).min(1e15) as u64 + 4
-        } else {
-            u64::MAX
-        };
-        let ko = self
-            .key_of_f32(origin)
-            .ok_or(OctreeError::OutOfBounds { field: "origin" })?;
-        let (mut lo, mut hi) = (ko, ko);
-        let mut chunks = Vec::new();
-        let (mut total, mut chunk_cells, mut chunk_start) = (0u64, 0u64, 0usize);
-        for (i, p) in pts.iter().enumerate() {
-            let finite = p.iter().all(|v| v.is_finite());
-            let cost = match finite.then(|| self.key_of_f32(p)).flatten() {
-                Some(k) => {
-                    for a in 0..3 {
-                        lo[a] = lo[a].min(k[a]);
-                        hi[a] = hi[a].max(k[a]);
-                    }
-                    let l1: u64 = (0..3).map(|a| (k[a] as i64 - ko[a] as i64).unsigned_abs()).sum();
-                    (l1 + 1).min(cut_bound)
-                }
-                // a far point still casts its cut beam
-                None if finite && max_range > 0.0 => cut_bound,
-                None => 0,
-            };
-            total = total.saturating_add(cost);
-            if chunk_cells > 0 && chunk_cells + cost > CHUNK_CELLS {
-                chunks.push((chunk_start..i, chunk_cells));
-                (chunk_start, chunk_cells) = (i, 0);
+        t0: f64,
+        max_range: f64,
+        addr: &impl CellAddress,
+        mut free: impl FnMut(&OcKey, usize),
+        end: impl FnOnce(&OcKey),
+    ) -> bool {
+        if beam.kind == EndPoint::NonFinite {
+            return false;
+        }
+        let norm = beam.norm();
+        if max_range < 0.0 || norm <= max_range {
+            if beam.kind != EndPoint::InTree {
+                return false;
             }
-            chunk_cells += cost;
-        }
-        if chunk_start < pts.len() {
-            chunks.push((chunk_start..pts.len(), chunk_cells));
-        }
-        if total > params.max_traced_cells {
-            return Err(OctreeError::ScanTooLarge {
-                cells: total,
-                limit: params.max_traced_cells,
-            });
-        }
-        // a cut beam of a far point can leave the end points' box: widen it by the cut
-        if max_range > 0.0
-            && pts
-                .iter()
-                .any(|p| p.iter().all(|v| v.is_finite()) && self.key_of_f32(p).is_none())
-        {
-            let reach = (cut_bound / 3).min(65535) as u16;
-            for a in 0..3 {
-                lo[a] = lo[a].min(ko[a].saturating_sub(reach));
-                hi[a] = hi[a].max(ko[a].saturating_add(reach));
+            if t0 < norm {
+                self.walk_beam(origin, &beam.diff, norm, &beam.end, t0, addr, &mut free);
             }
+            end(&beam.end);
+        } else if t0 < max_range {
+            let (n, m) = (norm as f32, max_range as f32);
+            let e = [0, 1, 2].map(|i| origin[i] + beam.diff[i] / n * m);
+            self.visit_ray_cells_from(origin, &e, t0, addr, free);
         }
-        Ok(ScanPlan { lo, hi, chunks })
+        true
     }
 
     /// Traces every beam into two bitsets over the key box (free, end points), one
@@ -465,7 +426,6 @@ impl Octree {
     /// `None` when `deadline` fired.
     fn trace_dense(
         &self,
-        pts: &[[f32; 3]],
         origin: &[f32; 3],
         starts: Option<&[f32]>,
         max_range: f64,
@@ -474,7 +434,6 @@ impl Octree {
     ) -> Option<ScanCells> {
         let grid = BlockGrid::new(&plan.lo, &plan.hi);
         let words = grid.cells() / 64;
-        let index = |k: &OcKey| grid.index(k);
         let workers = rayon::current_num_threads()
             .min((DENSE_BUDGET_BYTES / (16 * words)).max(1))
             .min(plan.chunks.len())
@@ -488,41 +447,15 @@ impl Octree {
                     if deadline.expired() {
                         return None;
                     }
-                    for (j, p) in pts[range.clone()].iter().enumerate() {
-                        if p.iter().any(|v| !v.is_finite()) {
-                            skipped += 1;
-                            continue;
-                        }
-                        let t0 = starts.map_or(0.0, |s| s[range.start + j] as f64);
-                        let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-                        let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
-                        let mut mark = |_: &OcKey, i: usize| {
-                            free[i >> 6] |= 1 << (i & 63);
+                    for i in range.clone() {
+                        let t0 = starts.map_or(0.0, |s| s[i] as f64);
+                        let mark = |_: &OcKey, i: usize| free[i >> 6] |= 1 << (i & 63);
+                        let end = |k: &OcKey| {
+                            let i = grid.index(k);
+                            occ[i >> 6] |= 1 << (i & 63);
                         };
-                        if t0 >= norm.min(if max_range < 0.0 { f64::MAX } else { max_range }) {
-                            // no free cell after the start: the end point only
-                            if norm <= max_range || max_range < 0.0 {
-                                match self.key_of_f32(p) {
-                                    Some(k) => {
-                                        let i = index(&k);
-                                        occ[i >> 6] |= 1 << (i & 63);
-                                    }
-                                    None => skipped += 1,
-                                }
-                            }
-                        } else if max_range < 0.0 || norm <= max_range {
-                            self.visit_ray_cells_from(origin, p, t0, &grid, &mut mark);
-                            match self.key_of_f32(p) {
-                                Some(k) => {
-                                    let i = index(&k);
-                                    occ[i >> 6] |= 1 << (i & 63);
-                                }
-                                None => skipped += 1,
-                            }
-                        } else {
-                            let (n, m) = (norm as f32, max_range as f32);
-                            let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                            self.visit_ray_cells_from(origin, &e, t0, &grid, &mut mark);
+                        if !self.trace_beam(&plan.beams[i], origin, t0, max_range, &grid, mark, end) {
+                            skipped += 1;
                         }
                     }
                 }
@@ -555,7 +488,6 @@ impl Octree {
     /// more than `max_nodes` cells. `Ok(None)` when `deadline` fired.
     fn trace_sorted(
         &self,
-        pts: &[[f32; 3]],
         origin: &[f32; 3],
         starts: Option<&[f32]>,
         params: &ScanParams,
@@ -581,26 +513,12 @@ impl Octree {
                     }
                     let mut chunk_free = Vec::with_capacity(*cells as usize);
                     let (mut chunk_occ, mut chunk_skipped) = (Vec::with_capacity(range.len()), 0usize);
-                    for (j, p) in pts[range.clone()].iter().enumerate() {
-                        if p.iter().any(|v| !v.is_finite()) {
+                    for i in range.clone() {
+                        let t0 = starts.map_or(0.0, |s| s[i] as f64);
+                        let mark = |k: &OcKey, _: usize| chunk_free.push(morton(k));
+                        let end = |k: &OcKey| chunk_occ.push(morton(k));
+                        if !self.trace_beam(&plan.beams[i], origin, t0, max_range, &NoAddress, mark, end) {
                             chunk_skipped += 1;
-                            continue;
-                        }
-                        let t0 = starts.map_or(0.0, |s| s[range.start + j] as f64);
-                        let mut push = |k: &OcKey, _: usize| chunk_free.push(morton(k));
-                        let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-                        let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
-                        if max_range < 0.0 || norm <= max_range {
-                            self.visit_ray_cells_from(origin, p, t0, &NoAddress, &mut push);
-                            match self.key_of_f32(p) {
-                                Some(k) => chunk_occ.push(morton(&k)),
-                                None => chunk_skipped += 1,
-                            }
-                        } else {
-                            let n = norm as f32;
-                            let m = max_range as f32;
-                            let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                            self.visit_ray_cells_from(origin, &e, t0, &NoAddress, &mut push);
                         }
                     }
                     chunk_free.sort_unstable();
@@ -669,40 +587,58 @@ impl Octree {
             let pts = depth_image_points(depth, width, height, intrinsics, camera_pose)?;
             return self.insert_scan(&pts, &origin, params, deadline);
         }
-        let mut pts = Vec::with_capacity(depth.len());
-        let mut beams = vec![
+        let t0 = Instant::now();
+        let mut builder = match PlanBuilder::new(self, &origin, params, depth.len()) {
+            Ok(b) => b,
+            Err(e) => {
+                // the image's own errors first
+                back_project(depth, width, height, intrinsics, camera_pose, |_, _| {})?;
+                return Err(e);
+            }
+        };
+        let mut pixels = vec![
             PixelBeam {
                 covered: 0.0,
                 point: u32::MAX,
             };
             depth.len()
         ];
+        let mut points = 0u32;
         back_project(depth, width, height, intrinsics, camera_pose, |i, p| {
-            let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-            let range = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
+            let beam = builder.push(&p);
+            let range = beam.norm();
             let covered = if params.max_range > 0.0 && range > params.max_range {
                 params.max_range
-            } else if p.iter().all(|v| v.is_finite()) && self.key_of_f32(&p).is_some() {
+            } else if beam.kind == EndPoint::InTree {
                 range
             } else {
                 0.0
             };
-            beams[i] = PixelBeam {
+            pixels[i] = PixelBeam {
                 covered: covered as f32,
-                point: pts.len() as u32,
+                point: points,
             };
-            pts.push(p);
+            points += 1;
         })?;
         let starts = near_field_starts(
-            &beams,
+            &pixels,
             width,
             height,
-            pts.len(),
+            points as usize,
             intrinsics.fx.min(intrinsics.fy),
             params.near_ray_spacing * self.resolution,
             self.near_field_margin(),
         );
-        self.insert_beams(&pts, &origin, Some(&starts), params, deadline)
+        let plan = builder.finish(params)?;
+        self.insert_planned(
+            &plan,
+            &origin,
+            Some(&starts),
+            points as usize,
+            params,
+            t0,
+            deadline,
+        )
     }
 }
 
