@@ -121,6 +121,8 @@ pub struct ScanStats {
     pub occupied_cells: usize,
     /// Tree nodes after the insert.
     pub nodes: usize,
+    /// Free-cell visits of the beams' walks, repeats included: the trace's work.
+    pub traced_cells: u64,
     /// Wall time of tracing the beams (µs) and of updating the tree (µs).
     pub trace_us: u64,
     pub update_us: u64,
@@ -138,8 +140,9 @@ pub struct PinholeIntrinsics {
     pub cy: f64,
 }
 
-/// Free cells, end-point cells (Morton codes) and skipped points of one chunk of beams.
-type ChunkKeys = (Vec<u64>, Vec<u64>, usize);
+/// Free cells, end-point cells (Morton codes), skipped points and free-cell visits
+/// of one chunk of beams.
+type ChunkKeys = (Vec<u64>, Vec<u64>, usize, u64);
 
 /// The cells one scan updates, free (end points removed) and occupied (end points):
 /// two bitsets over a [`BlockGrid`], or two sorted, disjoint vectors of Morton codes.
@@ -155,10 +158,12 @@ enum CellSets {
     },
 }
 
-/// The cells one scan updates and the points it skipped.
+/// The cells one scan updates, the points it skipped and the free-cell visits of
+/// its walks.
 struct ScanCells {
     sets: CellSets,
     skipped: usize,
+    traced: u64,
 }
 
 impl CellSets {
@@ -331,6 +336,7 @@ impl Octree {
             free_cells: 0,
             occupied_cells: 0,
             nodes: self.num_nodes,
+            traced_cells: 0,
             trace_us: 0,
             update_us: 0,
         };
@@ -345,6 +351,7 @@ impl Octree {
             return Ok(stats);
         };
         stats.skipped_points = cells.skipped;
+        stats.traced_cells = cells.traced;
         let t1 = Instant::now();
         let (hit, miss) = (self.model.hit, self.model.miss);
         let mut updates = 0usize;
@@ -438,18 +445,22 @@ impl Octree {
             .min((DENSE_BUDGET_BYTES / (16 * words)).max(1))
             .min(plan.chunks.len())
             .max(1);
-        type Acc = (Vec<u64>, Vec<u64>, usize);
+        type Acc = (Vec<u64>, Vec<u64>, usize, u64);
         let traced: Vec<Option<Acc>> = (0..workers)
             .into_par_iter()
             .map(|w| {
                 let (mut free, mut occ, mut skipped) = (vec![0u64; words], vec![0u64; words], 0usize);
+                let mut traced = 0u64;
                 for (range, _) in plan.chunks.iter().skip(w).step_by(workers) {
                     if deadline.expired() {
                         return None;
                     }
                     for i in range.clone() {
                         let t0 = starts.map_or(0.0, |s| s[i] as f64);
-                        let mark = |_: &OcKey, i: usize| free[i >> 6] |= 1 << (i & 63);
+                        let mark = |_: &OcKey, i: usize| {
+                            traced += 1;
+                            free[i >> 6] |= 1 << (i & 63);
+                        };
                         let end = |k: &OcKey| {
                             let i = grid.index(k);
                             occ[i >> 6] |= 1 << (i & 63);
@@ -459,13 +470,14 @@ impl Octree {
                         }
                     }
                 }
-                Some((free, occ, skipped))
+                Some((free, occ, skipped, traced))
             })
             .collect();
         let mut traced = traced.into_iter();
-        let (mut free, mut occ, mut skipped) = traced.next()??;
+        let (mut free, mut occ, mut skipped, mut visits) = traced.next()??;
         for acc in traced {
-            let (f, o, s) = acc?;
+            let (f, o, s, v) = acc?;
+            visits += v;
             free.iter_mut().zip(&f).for_each(|(x, y)| *x |= y);
             occ.iter_mut().zip(&o).for_each(|(x, y)| *x |= y);
             skipped += s;
@@ -480,6 +492,7 @@ impl Octree {
                 occupied: occ,
             },
             skipped,
+            traced: visits,
         })
     }
 
@@ -496,7 +509,7 @@ impl Octree {
     ) -> Result<Option<ScanCells>, OctreeError> {
         let max_range = params.max_range;
         let (mut free, mut occ, mut skipped) = (Vec::<u64>::new(), Vec::<u64>::new(), 0usize);
-        let mut next = 0;
+        let (mut traced, mut next) = (0u64, 0);
         while next < plan.chunks.len() {
             let mut end = next;
             let mut batch_cells = 0u64;
@@ -505,7 +518,7 @@ impl Octree {
                 batch_cells += plan.chunks[end].1;
                 end += 1;
             }
-            let traced: Vec<Option<ChunkKeys>> = plan.chunks[next..end]
+            let chunks: Vec<Option<ChunkKeys>> = plan.chunks[next..end]
                 .par_iter()
                 .map(|(range, cells)| {
                     if deadline.expired() {
@@ -521,21 +534,23 @@ impl Octree {
                             chunk_skipped += 1;
                         }
                     }
+                    let visits = chunk_free.len() as u64;
                     chunk_free.sort_unstable();
                     chunk_free.dedup();
                     chunk_occ.sort_unstable();
                     chunk_occ.dedup();
-                    Some((chunk_free, chunk_occ, chunk_skipped))
+                    Some((chunk_free, chunk_occ, chunk_skipped, visits))
                 })
                 .collect();
             let (mut batch_free, mut batch_occ) = (Vec::new(), Vec::new());
-            for chunk in traced {
-                let Some((f, o, s)) = chunk else {
+            for chunk in chunks {
+                let Some((f, o, s, v)) = chunk else {
                     return Ok(None);
                 };
                 batch_free.extend_from_slice(&f);
                 batch_occ.extend_from_slice(&o);
                 skipped += s;
+                traced += v;
             }
             for (set, batch) in [(&mut free, &mut batch_free), (&mut occ, &mut batch_occ)] {
                 batch.par_sort_unstable();
@@ -561,6 +576,7 @@ impl Octree {
         Ok(Some(ScanCells {
             sets: CellSets::Sorted { free, occupied: occ },
             skipped,
+            traced,
         }))
     }
 
