@@ -75,42 +75,57 @@ pub(crate) fn near_field_starts(
     if width < 3 || height < 3 {
         return starts;
     }
-    let mut clear: Vec<f32> = beams.iter().map(|b| b.covered).collect();
-    let mut set = |u: usize, v: usize, corners: [(usize, usize); 4], nominal: f64| {
-        let at = |x: usize, y: usize| y.min(height - 1) * width + x.min(width - 1);
-        let (mut direct, mut c) = (f32::INFINITY, f32::INFINITY);
-        for &(x, y) in &corners {
-            direct = direct.min(beams[at(x, y)].covered);
-            c = c.min(clear[at(x, y)]);
-        }
-        let i = v * width + u;
-        clear[i] = clear[i].min(direct);
-        let p = beams[i].point;
-        if p != u32::MAX {
-            starts[p as usize] = nominal.min(c as f64).max(0.0) as f32;
-        }
-    };
+    // per pixel its length and its clear range, side by side
+    let mut lc: Vec<[f32; 2]> = beams.iter().map(|b| [b.covered; 2]).collect();
+    let (w, last_u, last_v) = (width, width - 1, height - 1);
     for l in (0..LEVELS).rev() {
         let (a, big) = (1usize << l, 1usize << (l + 1));
         // diagonal pixels (u/a, v/a both odd): the centres of the squares of L_(l+1)
         let nominal = spacing * focal / big as f64 - margin;
-        for v in (a..height - 1).step_by(big) {
-            for u in (a..width - 1).step_by(big) {
-                let corners = [(u - a, v - a), (u + a, v - a), (u - a, v + a), (u + a, v + a)];
-                set(u, v, corners, nominal);
+        for v in (a..last_v).step_by(big) {
+            let (r0, r1) = ((v - a) * w, (v + a).min(last_v) * w);
+            for u in (a..last_u).step_by(big) {
+                let (u0, u1) = (u - a, (u + a).min(last_u));
+                let corners = [r0 + u0, r0 + u1, r1 + u0, r1 + u1];
+                settle(&mut lc, beams, &mut starts, v * w + u, corners, nominal);
             }
         }
         // edge pixels (one of u/a, v/a odd): the centres of the diamonds of Q_l
         let nominal = spacing * focal / (std::f64::consts::SQRT_2 * a as f64) - margin;
-        for v in (a..height - 1).step_by(a) {
+        for v in (a..last_v).step_by(a) {
             let u_first = if (v / a) % 2 == 1 { big } else { a };
-            for u in (u_first..width - 1).step_by(big) {
-                let corners = [(u - a, v), (u + a, v), (u, v - a), (u, v + a)];
-                set(u, v, corners, nominal);
+            let (r, r0, r1) = (v * w, (v - a) * w, (v + a).min(last_v) * w);
+            for u in (u_first..last_u).step_by(big) {
+                let corners = [r + u - a, r + (u + a).min(last_u), r0 + u, r1 + u];
+                settle(&mut lc, beams, &mut starts, r + u, corners, nominal);
             }
         }
     }
     starts
+}
+
+/// Pixel `i`'s start from its four `corners` (pixel indices) and the nominal start
+/// of its kind, and its clear range: its length lowered to its corners' lengths.
+#[inline(always)]
+fn settle(
+    lc: &mut [[f32; 2]],
+    beams: &[PixelBeam],
+    starts: &mut [f32],
+    i: usize,
+    corners: [usize; 4],
+    nominal: f64,
+) {
+    let (mut direct, mut c) = (f32::INFINITY, f32::INFINITY);
+    for j in corners {
+        let [length, clear] = lc[j];
+        direct = direct.min(length);
+        c = c.min(clear);
+    }
+    lc[i][1] = lc[i][1].min(direct);
+    let p = beams[i].point;
+    if p != u32::MAX {
+        starts[p as usize] = nominal.min(c as f64).max(0.0) as f32;
+    }
 }
 
 impl Octree {
