@@ -270,39 +270,46 @@ impl Octree {
         let [mut tx, mut ty, mut tz] = dda.t_max;
         let [dx, dy, dz] = dda.t_delta;
         let [sx, sy, sz] = dda.step.map(|s| s as u16); // ±1 as a wrapping u16 step
+        let [mut ax, mut ay, mut az] = [0, 1, 2].map(|a| addr.term(a, ks[a]));
+        // The walk visits the cell it enters unless it is the end cell or the segment
+        // ends before leaving it (`min t_max > length`). That minimum is the `t_max`
+        // the next step picks, so the test waits for the next axis choice: each
+        // branch first checks its own `t_max`, then visits the cell, then steps.
+        let mut entered = false;
         // a beam between two keys in the cube crosses at most 3 · 65536 borders
-        for _ in 0..3 * 65536 {
+        for _ in 0..3 * 65536 + 1 {
             // axis of the smallest t_max, ties as in `Dda::axis`
+            macro_rules! step {
+                ($t:ident, $d:ident, $k:ident, $s:ident, $a:ident, $axis:expr) => {{
+                    if entered {
+                        if $t > length {
+                            break;
+                        }
+                        visit(&[kx, ky, kz], ax + ay + az);
+                    }
+                    $k = $k.wrapping_add($s);
+                    $t += $d;
+                    $a = addr.term($axis, $k);
+                }};
+            }
             if tx < ty {
                 if tx < tz {
-                    kx = kx.wrapping_add(sx);
-                    tx += dx;
+                    step!(tx, dx, kx, sx, ax, 0)
                 } else {
-                    kz = kz.wrapping_add(sz);
-                    tz += dz;
+                    step!(tz, dz, kz, sz, az, 2)
                 }
             } else if ty < tz {
-                ky = ky.wrapping_add(sy);
-                ty += dy;
+                step!(ty, dy, ky, sy, ay, 1)
             } else {
-                kz = kz.wrapping_add(sz);
-                tz += dz;
+                step!(tz, dz, kz, sz, az, 2)
             }
+            entered = true;
             if let Some(n) = to_end.as_mut() {
                 *n -= 1;
                 if *n == 0 && kx == ke[0] && ky == ke[1] && kz == ke[2] {
                     break;
                 }
             }
-            let m = if tx < ty { tx } else { ty };
-            let dist = if m < tz { m } else { tz };
-            if dist > length {
-                break;
-            }
-            visit(
-                &[kx, ky, kz],
-                addr.term(0, kx) + addr.term(1, ky) + addr.term(2, kz),
-            );
         }
         true
     }
