@@ -163,12 +163,7 @@ mod tests {
         assert_eq!(at(39, 5), 0.0);
         assert_eq!(at(5, 39), 0.0);
         let diagonal = [1.9, 0.9, 0.4, 0.15];
-        let edge = [
-            2.828_427_1 - 0.1,
-            1.414_213_6 - 0.1,
-            0.707_106_8 - 0.1,
-            0.353_553_4 - 0.1,
-        ];
+        let edge = [2.728_427_1, 1.314_213_6, 0.607_106_8, 0.253_553_4];
         for (u, v, want) in [
             (1, 1, diagonal[0]),
             (3, 5, diagonal[0]),
@@ -207,7 +202,7 @@ mod tests {
         // level 3 diagonal (8, 8): square corners (0|16, 0|16): min(0.15, 0.5)
         assert!(near(at(8, 8), 0.15) && near(at(24, 24), 0.15));
         // level 3 edge (16, 8): diamond corners (8, 8), (24, 8), (16, 0), (16, 16)
-        assert!(near(at(16, 8), 0.353_553_4 - 0.1));
+        assert!(near(at(16, 8), 0.253_553_4));
         // level 2 diagonal (12, 12): min(0.4, 0.5); edge (16, 12): min(0.607, 0.5)
         assert!(near(at(12, 12), 0.4) && near(at(20, 20), 0.4));
         assert!(near(at(16, 12), 0.5) && near(at(20, 16), 0.5));

@@ -118,9 +118,9 @@ impl<'a> PlanBuilder<'a> {
         let (kind, end, cost) = match key {
             Some(k) => {
                 let plan = &mut self.plan;
-                for a in 0..3 {
-                    plan.lo[a] = plan.lo[a].min(k[a]);
-                    plan.hi[a] = plan.hi[a].max(k[a]);
+                for ((lo, hi), &k) in plan.lo.iter_mut().zip(plan.hi.iter_mut()).zip(&k) {
+                    *lo = (*lo).min(k);
+                    *hi = (*hi).max(k);
                 }
                 let l1: u64 = (0..3)
                     .map(|a| (k[a] as i64 - self.ko[a] as i64).unsigned_abs())
@@ -167,10 +167,10 @@ impl<'a> PlanBuilder<'a> {
         // a cut beam of a far point can leave the end points' box: widen it by the cut
         if self.max_range > 0.0 && self.any_outside {
             let reach = (self.cut_bound / 3).min(65535) as u16;
-            let (ko, plan) = (self.ko, &mut self.plan);
-            for a in 0..3 {
-                plan.lo[a] = plan.lo[a].min(ko[a].saturating_sub(reach));
-                plan.hi[a] = plan.hi[a].max(ko[a].saturating_add(reach));
+            let plan = &mut self.plan;
+            for ((lo, hi), &k) in plan.lo.iter_mut().zip(plan.hi.iter_mut()).zip(&self.ko) {
+                *lo = (*lo).min(k.saturating_sub(reach));
+                *hi = (*hi).max(k.saturating_add(reach));
             }
         }
         Ok(self.plan)
