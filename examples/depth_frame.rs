@@ -97,7 +97,7 @@ fn compare(ot: &str, runs: usize, mode: Mode) {
         .unwrap_or(NEAR_RAY_SPACING);
     let mut ms = Vec::new();
     let mut cpu_ms = Vec::new();
-    let mut split = (0u64, 0u64);
+    let mut split = (0u64, 0u64, 0u64);
     let mut ours = Octree::new(RES).unwrap();
     for _ in 0..runs.max(1) {
         ours = Octree::new(RES).unwrap();
@@ -126,7 +126,7 @@ fn compare(ot: &str, runs: usize, mode: Mode) {
         if let (Some(a), Some(b)) = (c0, sched::sched_ns()) {
             cpu_ms.push((b.0 - a.0) as f64 / 1e6);
         }
-        split = (stats.trace_us, stats.update_us);
+        split = (stats.trace_us, stats.update_us, stats.traced_cells);
     }
     let mut sorted = ms.clone();
     sorted.sort_by(f64::total_cmp);
@@ -147,9 +147,10 @@ fn compare(ot: &str, runs: usize, mode: Mode) {
         );
     }
     println!(
-        "  last run: trace {:.1} ms, update {:.1} ms",
+        "  last run: trace {:.1} ms, update {:.1} ms, {} free-cell visits",
         split.0 as f64 / 1e3,
-        split.1 as f64 / 1e3
+        split.1 as f64 / 1e3,
+        split.2
     );
     let theirs = Octree::read_ot(&std::fs::read(ot).unwrap(), &OctreeLimits::default()).unwrap();
     let lo = ours

@@ -26,10 +26,12 @@ pub fn coord_to_key_axis(c: f64, resolution_factor: f64) -> Option<u16> {
     if !(s >= -(TREE_MAX_VAL as f64) && s < TREE_MAX_VAL as f64) {
         return None;
     }
-    // ⌊s⌋ by truncation, one less for a negative non-integer (no libm call)
-    let t = s as i32;
-    let floor = if (t as f64) > s { t - 1 } else { t };
-    Some((floor + TREE_MAX_VAL) as u16)
+    // ⌊s⌋ without a libm call: adding and removing 1.5·2^52 rounds s to the nearest
+    // integer (exact for |s| < 2^51), one less where that rounded up
+    const ROUND: f64 = 6_755_399_441_055_744.0;
+    let r = (s + ROUND) - ROUND;
+    let floor = if r > s { r - 1.0 } else { r };
+    Some((floor as i32 + TREE_MAX_VAL) as u16)
 }
 
 /// Centre of a depth-16 key along one axis (m): `(k − 32768 + ½) · res`.
@@ -141,6 +143,32 @@ mod tests {
         assert_eq!(coord_to_key_axis(f64::NAN, f), None);
         assert!((key_to_coord_axis(32780, 0.1) - 1.25).abs() < 1e-12);
         assert!((key_to_coord_axis(32767, 0.1) + 0.05).abs() < 1e-12);
+    }
+
+    #[test]
+    fn keys_floor_like_libm_at_halves_integers_and_tiny_negatives() {
+        // the key is ⌊c·f⌋ + 32768; f64::floor (libm) is the reference
+        let f = 20.0;
+        let mut cs: Vec<f64> = vec![
+            0.0,
+            -0.0,
+            1e-300,
+            -1e-300,
+            -1e-30,
+            2.5 / f,
+            3.5 / f,
+            -2.5 / f,
+            -3.5 / f,
+        ];
+        for k in -40..40 {
+            let c = k as f64 / f;
+            cs.extend([c, c.next_up(), c.next_down(), (c as f32) as f64]);
+        }
+        cs.extend([-1638.4, 1638.3999, -1638.3999]);
+        for c in cs {
+            let want = ((c * f).floor() as i32 + TREE_MAX_VAL) as u16;
+            assert_eq!(coord_to_key_axis(c, f), Some(want), "c = {c:e}");
+        }
     }
 
     #[test]

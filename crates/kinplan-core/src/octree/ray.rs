@@ -65,6 +65,7 @@ struct Dda {
 
 impl Dda {
     /// `float_border`: `computeRayKeys` rounds the half cell to f32, `castRay` does not.
+    #[inline]
     fn new(key: &OcKey, origin: &[f32; 3], dir: &[f32; 3], res: f64, float_border: bool) -> Self {
         let mut d = Dda {
             step: [0; 3],
@@ -104,8 +105,24 @@ impl Dda {
     }
 }
 
+/// Addresses of the cells a walk visits: a cell's address is `Σ_a term(a, k_a)`.
+pub(crate) trait CellAddress {
+    fn term(&self, axis: usize, k: u16) -> usize;
+}
+
+/// Every cell at address 0 (walks that need keys only).
+pub(crate) struct NoAddress;
+
+impl CellAddress for NoAddress {
+    #[inline]
+    fn term(&self, _: usize, _: u16) -> usize {
+        0
+    }
+}
+
+/// `‖v‖` as OctoMap's `norm()`: the squares summed in f32, the root in f64.
 #[inline]
-fn f32_norm(v: &[f32; 3]) -> f64 {
+pub(crate) fn f32_norm(v: &[f32; 3]) -> f64 {
     ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) as f64).sqrt()
 }
 
@@ -141,22 +158,21 @@ impl Octree {
         end: &[f32; 3],
         mut visit: impl FnMut(&OcKey),
     ) -> bool {
-        self.visit_ray_cells(origin, end, &[0; 3], [0; 3], |k, _| visit(k))
+        self.visit_ray_cells(origin, end, &NoAddress, |k, _| visit(k))
     }
 
-    /// [`visit_ray_keys`](Self::visit_ray_keys) handing each key with its linear index
-    /// `Σ (k_i − lo_i)·strides_i` into a dense grid over a key box starting at `lo`,
-    /// kept up to date by one add per step (the beam must lie inside that box).
+    /// [`visit_ray_keys`](Self::visit_ray_keys) handing each key with its address
+    /// `Σ_a addr.term(a, k_a)`, kept up to date by one term per step (the beam must lie
+    /// where `addr` is defined).
     #[inline]
     pub(crate) fn visit_ray_cells(
         &self,
         origin: &[f32; 3],
         end: &[f32; 3],
-        lo: &OcKey,
-        strides: [usize; 3],
+        addr: &impl CellAddress,
         visit: impl FnMut(&OcKey, usize),
     ) -> bool {
-        self.visit_ray_cells_from(origin, end, 0.0, lo, strides, visit)
+        self.visit_ray_cells_from(origin, end, 0.0, addr, visit)
     }
 
     /// [`visit_ray_cells`](Self::visit_ray_cells) from the ray parameter `t_start`
@@ -173,31 +189,42 @@ impl Octree {
         origin: &[f32; 3],
         end: &[f32; 3],
         t_start: f64,
-        lo: &OcKey,
-        strides: [usize; 3],
-        mut visit: impl FnMut(&OcKey, usize),
+        addr: &impl CellAddress,
+        visit: impl FnMut(&OcKey, usize),
     ) -> bool {
-        let mut dir = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
-        let length = f32_norm(&dir) as f32;
-        if t_start > 0.0 && t_start >= length as f64 {
+        let diff = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
+        let norm = f32_norm(&diff);
+        if t_start > 0.0 && t_start >= norm as f32 as f64 {
             return true;
         }
         let Some(ke) = self.key_of_f32(end) else {
             return false;
         };
-        for v in dir.iter_mut() {
-            *v /= length;
+        self.walk_beam(origin, &diff, norm, &ke, t_start, addr, visit)
+    }
+
+    /// The walk of [`visit_ray_cells_from`](Self::visit_ray_cells_from) given the
+    /// beam's difference `end − origin` (f32), its norm `f32_norm(diff)` and the end
+    /// point's key (in the tree).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn walk_beam(
+        &self,
+        origin: &[f32; 3],
+        diff: &[f32; 3],
+        norm: f64,
+        ke: &OcKey,
+        t_start: f64,
+        addr: &impl CellAddress,
+        mut visit: impl FnMut(&OcKey, usize),
+    ) -> bool {
+        let ke = *ke;
+        let length = norm as f32;
+        if t_start > 0.0 && t_start >= length as f64 {
+            return true;
         }
+        let dir = diff.map(|v| v / length);
         let length = length as f64;
-        let index_of = |k: &OcKey| {
-            (0..3).fold(0usize, |a, i| {
-                a.wrapping_add(
-                    (k[i] as usize)
-                        .wrapping_sub(lo[i] as usize)
-                        .wrapping_mul(strides[i]),
-                )
-            })
-        };
         let (ks, dda) = if t_start > 0.0 {
             let f = self.resolution_factor;
             let at = |i: usize| coord_to_key_axis(origin[i] as f64 + t_start * dir[i] as f64, f);
@@ -226,47 +253,63 @@ impl Octree {
             }
             (ko, Dda::new(&ko, origin, &dir, self.resolution, true))
         };
-        let mut idx = index_of(&ks);
-        visit(&ks, idx);
+        visit(
+            &ks,
+            addr.term(0, ks[0]) + addr.term(1, ks[1]) + addr.term(2, ks[2]),
+        );
+        // Steps until the key can equal the end key: the walk moves each axis by its
+        // sign only, so it meets `ke` exactly after Σ_a (ke_a − ks_a)·step_a steps if
+        // every term is ≥ 0 (and 0 on a still axis), or never.
+        let mut to_end = (0..3).try_fold(0i64, |n, a| {
+            let r = (ke[a] as i64 - ks[a] as i64) * dda.step[a] as i64;
+            (r >= 0 && (dda.step[a] != 0 || r == 0)).then_some(n + r)
+        });
         // the DDA state in scalar locals (registers): an array indexed by the axis made
         // each step wait on a partial store-to-load forward of the key
         let [mut kx, mut ky, mut kz] = ks;
         let [mut tx, mut ty, mut tz] = dda.t_max;
         let [dx, dy, dz] = dda.t_delta;
         let [sx, sy, sz] = dda.step.map(|s| s as u16); // ±1 as a wrapping u16 step
-        // index change per step along each axis (±stride, wrapping)
-        let [ix, iy, iz] = [0, 1, 2].map(|i| (dda.step[i] as isize as usize).wrapping_mul(strides[i]));
+        let [mut ax, mut ay, mut az] = [0, 1, 2].map(|a| addr.term(a, ks[a]));
+        // The walk visits the cell it enters unless it is the end cell or the segment
+        // ends before leaving it (`min t_max > length`). That minimum is the `t_max`
+        // the next step picks, so the test waits for the next axis choice: each
+        // branch first checks its own `t_max`, then visits the cell, then steps.
+        let mut entered = false;
         // a beam between two keys in the cube crosses at most 3 · 65536 borders
-        for _ in 0..3 * 65536 {
+        for _ in 0..3 * 65536 + 1 {
             // axis of the smallest t_max, ties as in `Dda::axis`
+            macro_rules! step {
+                ($t:ident, $d:ident, $k:ident, $s:ident, $a:ident, $axis:expr) => {{
+                    if entered {
+                        if $t > length {
+                            break;
+                        }
+                        visit(&[kx, ky, kz], ax + ay + az);
+                    }
+                    $k = $k.wrapping_add($s);
+                    $t += $d;
+                    $a = addr.term($axis, $k);
+                }};
+            }
             if tx < ty {
                 if tx < tz {
-                    kx = kx.wrapping_add(sx);
-                    tx += dx;
-                    idx = idx.wrapping_add(ix);
+                    step!(tx, dx, kx, sx, ax, 0)
                 } else {
-                    kz = kz.wrapping_add(sz);
-                    tz += dz;
-                    idx = idx.wrapping_add(iz);
+                    step!(tz, dz, kz, sz, az, 2)
                 }
             } else if ty < tz {
-                ky = ky.wrapping_add(sy);
-                ty += dy;
-                idx = idx.wrapping_add(iy);
+                step!(ty, dy, ky, sy, ay, 1)
             } else {
-                kz = kz.wrapping_add(sz);
-                tz += dz;
-                idx = idx.wrapping_add(iz);
+                step!(tz, dz, kz, sz, az, 2)
             }
-            if kx == ke[0] && ky == ke[1] && kz == ke[2] {
-                break;
+            entered = true;
+            if let Some(n) = to_end.as_mut() {
+                *n -= 1;
+                if *n == 0 && kx == ke[0] && ky == ke[1] && kz == ke[2] {
+                    break;
+                }
             }
-            let m = if tx < ty { tx } else { ty };
-            let dist = if m < tz { m } else { tz };
-            if dist > length {
-                break;
-            }
-            visit(&[kx, ky, kz], idx);
         }
         true
     }

@@ -7,9 +7,14 @@ use std::time::Instant;
 use nalgebra::Isometry3;
 use rayon::prelude::*;
 
+use std::ops::ControlFlow;
+
 use super::batch::BatchUpdate;
 use super::frame::{PixelBeam, near_field_starts};
+use super::grid::{BLOCK_WORDS, BlockGrid};
 use super::key::{OcKey, morton, unmorton};
+use super::plan::{Beam, EndPoint, PlanBuilder, ScanPlan};
+use super::ray::{CellAddress, NoAddress};
 use super::{Octree, OctreeError, OctreeLimits};
 use crate::Deadline;
 
@@ -22,9 +27,10 @@ pub struct ScanParams {
     /// Merge end points falling into the same cell first and cast from its centre
     /// (OctoMap's `discretize`). Default false.
     pub discretize: bool,
-    /// Largest key box (cells) traced into dense bitsets (one bit per cell and set,
-    /// per worker); larger scans collect sorted key vectors. Default 2^27
-    /// (16 MiB per bitset).
+    /// Largest key box (cells, once widened to whole blocks of 32³ cells aligned to
+    /// multiples of 32 keys) traced into dense bitsets (one bit per cell and set, per
+    /// worker); larger scans collect sorted key vectors. Default 2^27 (16 MiB per
+    /// bitset).
     pub dense_limit_cells: usize,
     /// Most cells the beams may cross in all, counted before any is traced as
     /// `Σ_beams min(‖key(p) − key(o)‖₁ + 1, 3·max_range/resolution + 4)` — the
@@ -115,6 +121,8 @@ pub struct ScanStats {
     pub occupied_cells: usize,
     /// Tree nodes after the insert.
     pub nodes: usize,
+    /// Free-cell visits of the beams' walks, repeats included: the trace's work.
+    pub traced_cells: u64,
     /// Wall time of tracing the beams (µs) and of updating the tree (µs).
     pub trace_us: u64,
     pub update_us: u64,
@@ -132,53 +140,72 @@ pub struct PinholeIntrinsics {
     pub cy: f64,
 }
 
-/// Free cells, end-point cells (Morton codes) and skipped points of one chunk of beams.
-type ChunkKeys = (Vec<u64>, Vec<u64>, usize);
+/// Free cells, end-point cells (Morton codes), skipped points and free-cell visits
+/// of one chunk of beams.
+type ChunkKeys = (Vec<u64>, Vec<u64>, usize, u64);
 
-/// A scan's cells to update: bits over the key box starting at `lo` with `dims`
-/// cells per axis (x fastest), or sorted Morton codes.
-enum CellSet {
+/// The cells one scan updates, free (end points removed) and occupied (end points):
+/// two bitsets over a [`BlockGrid`], or two sorted, disjoint vectors of Morton codes.
+enum CellSets {
     Dense {
-        bits: Vec<u64>,
-        lo: OcKey,
-        dims: [usize; 3],
+        grid: BlockGrid,
+        free: Vec<u64>,
+        occupied: Vec<u64>,
     },
-    Sorted(Vec<u64>),
+    Sorted {
+        free: Vec<u64>,
+        occupied: Vec<u64>,
+    },
 }
 
-impl CellSet {
-    /// The keys in ascending bit or Morton order.
-    fn iter(&self) -> Box<dyn Iterator<Item = OcKey> + '_> {
-        match self {
-            CellSet::Dense { bits, lo, dims } => {
-                let (lo, dx, dy) = (*lo, dims[0], dims[1]);
-                // the row (y, z) of the last bit: a division only when the row changes
-                let mut row = (usize::MAX, 0u16, 0u16);
-                Box::new(bits.iter().enumerate().flat_map(move |(w, &word)| {
-                    let mut b = word;
-                    std::iter::from_fn(move || {
-                        (b != 0).then(|| {
-                            let i = w * 64 + b.trailing_zeros() as usize;
-                            b &= b - 1;
-                            if i < row.0 || i >= row.0 + dx {
-                                let r = i / dx;
-                                row = (r * dx, lo[1] + (r % dy) as u16, lo[2] + (r / dy) as u16);
-                            }
-                            [lo[0] + (i - row.0) as u16, row.1, row.2]
-                        })
-                    })
-                }))
-            }
-            CellSet::Sorted(codes) => Box::new(codes.iter().map(|&m| unmorton(m))),
-        }
-    }
-}
-
-/// The cells one scan updates: free (end points removed) and occupied.
+/// The cells one scan updates, the points it skipped and the free-cell visits of
+/// its walks.
 struct ScanCells {
-    free: CellSet,
-    occupied: CellSet,
+    sets: CellSets,
     skipped: usize,
+    traced: u64,
+}
+
+impl CellSets {
+    /// Hands every cell with `true` for free, `false` for occupied to `each` in
+    /// ascending Morton order inside each 32³ block (dense) or in ascending Morton
+    /// order (sorted), until `each` breaks.
+    fn for_each<B>(&self, mut each: impl FnMut(&OcKey, bool) -> ControlFlow<B>) -> ControlFlow<B> {
+        match self {
+            CellSets::Dense { grid, free, occupied } => {
+                let blocks = free
+                    .chunks_exact(BLOCK_WORDS)
+                    .zip(occupied.chunks_exact(BLOCK_WORDS));
+                for (b, (f, o)) in blocks.enumerate() {
+                    if f.iter().chain(o).all(|&w| w == 0) {
+                        continue;
+                    }
+                    let base = grid.block_base(b);
+                    for (w, (&f, &o)) in f.iter().zip(o).enumerate() {
+                        let mut bits = f | o;
+                        while bits != 0 {
+                            let i = bits.trailing_zeros() as usize;
+                            bits &= bits - 1;
+                            each(&grid.key_in_block(&base, w * 64 + i), o >> i & 1 == 0)?;
+                        }
+                    }
+                }
+            }
+            CellSets::Sorted { free, occupied } => {
+                let (mut i, mut j) = (0, 0);
+                while i < free.len() || j < occupied.len() {
+                    if j == occupied.len() || (i < free.len() && free[i] < occupied[j]) {
+                        each(&unmorton(free[i]), true)?;
+                        i += 1;
+                    } else {
+                        each(&unmorton(occupied[j]), false)?;
+                        j += 1;
+                    }
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
 }
 
 /// The union of two sorted, deduplicated vectors, sorted and deduplicated.
@@ -207,10 +234,6 @@ fn merge_sorted(a: &[u64], b: &[u64]) -> Vec<u64> {
     out
 }
 
-/// Cells traced between two looks at the stop flag (a chunk of beams), so a
-/// stop is seen within about a millisecond of tracing.
-const CHUNK_CELLS: u64 = 1 << 16;
-
 /// Cells traced per batch on the sorted path before the batch's keys are
 /// merged into the scan's sets and their size is checked against the node
 /// limit: bounds the keys held at once.
@@ -222,17 +245,6 @@ const UPDATES_PER_CHECK: usize = 4096;
 /// Memory the dense path's per-worker bitsets may take in all (bytes); fewer
 /// workers trace a large key box.
 const DENSE_BUDGET_BYTES: usize = 256 << 20;
-
-/// What a scan will trace, worked out before any beam is: the beams' key box,
-/// the chunks of beams with their cell counts, and the total.
-struct ScanPlan {
-    /// Key box of the origin and every usable end point: all beams lie inside it.
-    lo: OcKey,
-    dims: [usize; 3],
-    /// Consecutive point ranges of at most [`CHUNK_CELLS`] cells each (a single
-    /// longer beam is a chunk of its own), with their cell counts.
-    chunks: Vec<(std::ops::Range<usize>, u64)>,
-}
 
 impl Octree {
     /// Integrates a point cloud measured from `origin` (m, map frame; coordinates are
@@ -269,27 +281,10 @@ impl Octree {
         params: &ScanParams,
         deadline: Deadline<'_>,
     ) -> Result<ScanStats, OctreeError> {
-        self.insert_beams(points, origin, None, params, deadline)
-    }
-
-    /// [`insert_scan`](Self::insert_scan) with, optionally, the ray parameter (m) at
-    /// which each beam's free cells start (one per point; the end point is always
-    /// occupied).
-    fn insert_beams(
-        &mut self,
-        points: &[[f32; 3]],
-        origin: &[f32; 3],
-        starts: Option<&[f32]>,
-        params: &ScanParams,
-        deadline: Deadline<'_>,
-    ) -> Result<ScanStats, OctreeError> {
         params.validate()?;
-        debug_assert!(starts.is_none_or(|s| s.len() == points.len() && !params.discretize));
         if origin.iter().any(|v| !v.is_finite()) {
             return Err(OctreeError::NonFinite { field: "origin" });
         }
-        self.key_of_f32(origin)
-            .ok_or(OctreeError::OutOfBounds { field: "origin" })?;
         let t0 = Instant::now();
         let discrete: Vec<[f32; 3]>;
         let pts: &[[f32; 3]] = if params.discretize {
@@ -310,64 +305,85 @@ impl Octree {
         } else {
             points
         };
-        let plan = self.plan_scan(pts, origin, params)?;
+        let mut builder = PlanBuilder::new(self, origin, params, pts.len())?;
+        for p in pts {
+            builder.push(p);
+        }
+        let plan = builder.finish(params)?;
+        self.insert_planned(&plan, origin, None, points.len(), params, t0, deadline)
+    }
+
+    /// Traces the beams of `plan` from `origin` and updates their cells, optionally
+    /// with the ray parameter (m) at which each beam's free cells start (one per
+    /// beam; the end point is always occupied). `points` is the count reported in
+    /// the stats, `t0` when the scan's work started.
+    #[allow(clippy::too_many_arguments)]
+    fn insert_planned(
+        &mut self,
+        plan: &ScanPlan,
+        origin: &[f32; 3],
+        starts: Option<&[f32]>,
+        points: usize,
+        params: &ScanParams,
+        t0: Instant,
+        deadline: Deadline<'_>,
+    ) -> Result<ScanStats, OctreeError> {
+        debug_assert!(starts.is_none_or(|s| s.len() == plan.beams.len() && !params.discretize));
         let mut stats = ScanStats {
             status: ScanStatus::Cancelled,
-            points: points.len(),
+            points,
             skipped_points: 0,
             free_cells: 0,
             occupied_cells: 0,
             nodes: self.num_nodes,
+            traced_cells: 0,
             trace_us: 0,
             update_us: 0,
         };
-        let cells = plan.dims[0]
-            .saturating_mul(plan.dims[1])
-            .saturating_mul(plan.dims[2]);
-        let traced = if cells <= params.dense_limit_cells {
-            self.trace_dense(pts, origin, starts, params.max_range, &plan, deadline)
+        let dense = BlockGrid::cells_for(&plan.lo, &plan.hi).is_some_and(|c| c <= params.dense_limit_cells);
+        let traced = if dense {
+            self.trace_dense(origin, starts, params.max_range, plan, deadline)
         } else {
-            self.trace_sorted(pts, origin, starts, params, &plan, deadline)?
+            self.trace_sorted(origin, starts, params, plan, deadline)?
         };
         stats.trace_us = t0.elapsed().as_micros() as u64;
         let Some(cells) = traced else {
             return Ok(stats);
         };
         stats.skipped_points = cells.skipped;
+        stats.traced_cells = cells.traced;
         let t1 = Instant::now();
         let (hit, miss) = (self.model.hit, self.model.miss);
         let mut updates = 0usize;
         let mut batch = BatchUpdate::new();
-        for (keys, delta, is_free) in [(&cells.free, miss, true), (&cells.occupied, hit, false)] {
-            for key in keys.iter() {
-                if updates.is_multiple_of(UPDATES_PER_CHECK) {
-                    if self.num_nodes > params.max_nodes {
-                        batch.finish(self);
-                        return Err(OctreeError::TreeGrewTooLarge {
-                            limit: params.max_nodes,
-                        });
-                    }
-                    if deadline.expired() {
-                        batch.finish(self);
-                        stats.update_us = t1.elapsed().as_micros() as u64;
-                        stats.nodes = self.num_nodes;
-                        return Ok(stats);
-                    }
+        let stopped = cells.sets.for_each(|key, is_free| {
+            if updates.is_multiple_of(UPDATES_PER_CHECK) {
+                if self.num_nodes > params.max_nodes {
+                    return ControlFlow::Break(true);
                 }
-                batch.update(self, &key, delta);
-                if is_free {
-                    stats.free_cells += 1;
-                } else {
-                    stats.occupied_cells += 1;
+                if deadline.expired() {
+                    return ControlFlow::Break(false);
                 }
-                updates += 1;
             }
-        }
+            batch.update(self, key, if is_free { miss } else { hit });
+            if is_free {
+                stats.free_cells += 1;
+            } else {
+                stats.occupied_cells += 1;
+            }
+            updates += 1;
+            ControlFlow::Continue(())
+        });
         batch.finish(self);
-        if self.num_nodes > params.max_nodes {
+        if matches!(stopped, ControlFlow::Break(true)) || self.num_nodes > params.max_nodes {
             return Err(OctreeError::TreeGrewTooLarge {
                 limit: params.max_nodes,
             });
+        }
+        if stopped.is_break() {
+            stats.update_us = t1.elapsed().as_micros() as u64;
+            stats.nodes = self.num_nodes;
+            return Ok(stats);
         }
         stats.update_us = t1.elapsed().as_micros() as u64;
         stats.nodes = self.num_nodes;
@@ -375,72 +391,41 @@ impl Octree {
         Ok(stats)
     }
 
-    /// Counts the cells each beam can cross (`‖Δkey‖₁ + 1`, at most the cut beam's
-    /// `3·max_range/resolution + 4`; 0 for a point that is skipped), refuses the scan
-    /// when the total passes `max_traced_cells`, and cuts the points into chunks.
-    fn plan_scan(
+    /// Traces one beam from `origin` (free cells from the ray parameter `t0` on to
+    /// `free` with their address, its end cell to `end`) with `insertPointCloud`'s
+    /// rule: a beam longer than `max_range > 0` is cut there and has no end cell.
+    /// False when the point is skipped (not finite, or outside the tree's cube and not
+    /// cut).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn trace_beam(
         &self,
-        pts: &[[f32; 3]],
+        beam: &Beam,
         origin: &[f32; 3],
-        params: &ScanParams,
-    ) -> Result<ScanPlan, OctreeError> {
-        let max_range = params.max_range;
-        let cut_bound = if max_range > 0.0 {
-            3 * (max_range * self.resolution_factor).min(1e15) as u64 + 4
-        } else {
-            u64::MAX
-        };
-        let ko = self
-            .key_of_f32(origin)
-            .ok_or(OctreeError::OutOfBounds { field: "origin" })?;
-        let (mut lo, mut hi) = (ko, ko);
-        let mut chunks = Vec::new();
-        let (mut total, mut chunk_cells, mut chunk_start) = (0u64, 0u64, 0usize);
-        for (i, p) in pts.iter().enumerate() {
-            let finite = p.iter().all(|v| v.is_finite());
-            let cost = match finite.then(|| self.key_of_f32(p)).flatten() {
-                Some(k) => {
-                    for a in 0..3 {
-                        lo[a] = lo[a].min(k[a]);
-                        hi[a] = hi[a].max(k[a]);
-                    }
-                    let l1: u64 = (0..3).map(|a| (k[a] as i64 - ko[a] as i64).unsigned_abs()).sum();
-                    (l1 + 1).min(cut_bound)
-                }
-                // a far point still casts its cut beam
-                None if finite && max_range > 0.0 => cut_bound,
-                None => 0,
-            };
-            total = total.saturating_add(cost);
-            if chunk_cells > 0 && chunk_cells + cost > CHUNK_CELLS {
-                chunks.push((chunk_start..i, chunk_cells));
-                (chunk_start, chunk_cells) = (i, 0);
+        t0: f64,
+        max_range: f64,
+        addr: &impl CellAddress,
+        mut free: impl FnMut(&OcKey, usize),
+        end: impl FnOnce(&OcKey),
+    ) -> bool {
+        if beam.kind == EndPoint::NonFinite {
+            return false;
+        }
+        let norm = beam.norm();
+        if max_range < 0.0 || norm <= max_range {
+            if beam.kind != EndPoint::InTree {
+                return false;
             }
-            chunk_cells += cost;
-        }
-        if chunk_start < pts.len() {
-            chunks.push((chunk_start..pts.len(), chunk_cells));
-        }
-        if total > params.max_traced_cells {
-            return Err(OctreeError::ScanTooLarge {
-                cells: total,
-                limit: params.max_traced_cells,
-            });
-        }
-        // a cut beam of a far point can leave the end points' box: widen it by the cut
-        if max_range > 0.0
-            && pts
-                .iter()
-                .any(|p| p.iter().all(|v| v.is_finite()) && self.key_of_f32(p).is_none())
-        {
-            let reach = (cut_bound / 3).min(65535) as u16;
-            for a in 0..3 {
-                lo[a] = lo[a].min(ko[a].saturating_sub(reach));
-                hi[a] = hi[a].max(ko[a].saturating_add(reach));
+            if t0 < norm {
+                self.walk_beam(origin, &beam.diff, norm, &beam.end, t0, addr, &mut free);
             }
+            end(&beam.end);
+        } else if t0 < max_range {
+            let (n, m) = (norm as f32, max_range as f32);
+            let e = [0, 1, 2].map(|i| origin[i] + beam.diff[i] / n * m);
+            self.visit_ray_cells_from(origin, &e, t0, addr, free);
         }
-        let dims = [0, 1, 2].map(|a| (hi[a] - lo[a]) as usize + 1);
-        Ok(ScanPlan { lo, dims, chunks })
+        true
     }
 
     /// Traces every beam into two bitsets over the key box (free, end points), one
@@ -448,77 +433,51 @@ impl Octree {
     /// `None` when `deadline` fired.
     fn trace_dense(
         &self,
-        pts: &[[f32; 3]],
         origin: &[f32; 3],
         starts: Option<&[f32]>,
         max_range: f64,
         plan: &ScanPlan,
         deadline: Deadline<'_>,
     ) -> Option<ScanCells> {
-        let (lo, dims) = (plan.lo, plan.dims);
-        let words = (dims[0] * dims[1] * dims[2]).div_ceil(64);
-        let index = |k: &OcKey| {
-            ((k[2] - lo[2]) as usize * dims[1] + (k[1] - lo[1]) as usize) * dims[0] + (k[0] - lo[0]) as usize
-        };
-        let strides = [1, dims[0], dims[0] * dims[1]];
+        let grid = BlockGrid::new(&plan.lo, &plan.hi);
+        let words = grid.cells() / 64;
         let workers = rayon::current_num_threads()
             .min((DENSE_BUDGET_BYTES / (16 * words)).max(1))
             .min(plan.chunks.len())
             .max(1);
-        type Acc = (Vec<u64>, Vec<u64>, usize);
+        type Acc = (Vec<u64>, Vec<u64>, usize, u64);
         let traced: Vec<Option<Acc>> = (0..workers)
             .into_par_iter()
             .map(|w| {
                 let (mut free, mut occ, mut skipped) = (vec![0u64; words], vec![0u64; words], 0usize);
+                let mut traced = 0u64;
                 for (range, _) in plan.chunks.iter().skip(w).step_by(workers) {
                     if deadline.expired() {
                         return None;
                     }
-                    for (j, p) in pts[range.clone()].iter().enumerate() {
-                        if p.iter().any(|v| !v.is_finite()) {
-                            skipped += 1;
-                            continue;
-                        }
-                        let t0 = starts.map_or(0.0, |s| s[range.start + j] as f64);
-                        let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-                        let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
-                        let mut mark = |_: &OcKey, i: usize| {
+                    for i in range.clone() {
+                        let t0 = starts.map_or(0.0, |s| s[i] as f64);
+                        let mark = |_: &OcKey, i: usize| {
+                            traced += 1;
                             free[i >> 6] |= 1 << (i & 63);
                         };
-                        if t0 >= norm.min(if max_range < 0.0 { f64::MAX } else { max_range }) {
-                            // no free cell after the start: the end point only
-                            if norm <= max_range || max_range < 0.0 {
-                                match self.key_of_f32(p) {
-                                    Some(k) => {
-                                        let i = index(&k);
-                                        occ[i >> 6] |= 1 << (i & 63);
-                                    }
-                                    None => skipped += 1,
-                                }
-                            }
-                        } else if max_range < 0.0 || norm <= max_range {
-                            self.visit_ray_cells_from(origin, p, t0, &lo, strides, &mut mark);
-                            match self.key_of_f32(p) {
-                                Some(k) => {
-                                    let i = index(&k);
-                                    occ[i >> 6] |= 1 << (i & 63);
-                                }
-                                None => skipped += 1,
-                            }
-                        } else {
-                            let (n, m) = (norm as f32, max_range as f32);
-                            let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                            self.visit_ray_cells_from(origin, &e, t0, &lo, strides, &mut mark);
+                        let end = |k: &OcKey| {
+                            let i = grid.index(k);
+                            occ[i >> 6] |= 1 << (i & 63);
+                        };
+                        if !self.trace_beam(&plan.beams[i], origin, t0, max_range, &grid, mark, end) {
+                            skipped += 1;
                         }
                     }
                 }
-                Some((free, occ, skipped))
+                Some((free, occ, skipped, traced))
             })
             .collect();
         let mut traced = traced.into_iter();
-        let (mut free, mut occ, mut skipped) = traced.next()??;
+        let (mut free, mut occ, mut skipped, mut visits) = traced.next()??;
         for acc in traced {
-            let (f, o, s) = acc?;
+            let (f, o, s, v) = acc?;
+            visits += v;
             free.iter_mut().zip(&f).for_each(|(x, y)| *x |= y);
             occ.iter_mut().zip(&o).for_each(|(x, y)| *x |= y);
             skipped += s;
@@ -527,9 +486,13 @@ impl Octree {
             *f &= !o;
         }
         Some(ScanCells {
-            free: CellSet::Dense { bits: free, lo, dims },
-            occupied: CellSet::Dense { bits: occ, lo, dims },
+            sets: CellSets::Dense {
+                grid,
+                free,
+                occupied: occ,
+            },
             skipped,
+            traced: visits,
         })
     }
 
@@ -538,7 +501,6 @@ impl Octree {
     /// more than `max_nodes` cells. `Ok(None)` when `deadline` fired.
     fn trace_sorted(
         &self,
-        pts: &[[f32; 3]],
         origin: &[f32; 3],
         starts: Option<&[f32]>,
         params: &ScanParams,
@@ -547,7 +509,7 @@ impl Octree {
     ) -> Result<Option<ScanCells>, OctreeError> {
         let max_range = params.max_range;
         let (mut free, mut occ, mut skipped) = (Vec::<u64>::new(), Vec::<u64>::new(), 0usize);
-        let mut next = 0;
+        let (mut traced, mut next) = (0u64, 0);
         while next < plan.chunks.len() {
             let mut end = next;
             let mut batch_cells = 0u64;
@@ -556,7 +518,7 @@ impl Octree {
                 batch_cells += plan.chunks[end].1;
                 end += 1;
             }
-            let traced: Vec<Option<ChunkKeys>> = plan.chunks[next..end]
+            let chunks: Vec<Option<ChunkKeys>> = plan.chunks[next..end]
                 .par_iter()
                 .map(|(range, cells)| {
                     if deadline.expired() {
@@ -564,43 +526,31 @@ impl Octree {
                     }
                     let mut chunk_free = Vec::with_capacity(*cells as usize);
                     let (mut chunk_occ, mut chunk_skipped) = (Vec::with_capacity(range.len()), 0usize);
-                    for (j, p) in pts[range.clone()].iter().enumerate() {
-                        if p.iter().any(|v| !v.is_finite()) {
+                    for i in range.clone() {
+                        let t0 = starts.map_or(0.0, |s| s[i] as f64);
+                        let mark = |k: &OcKey, _: usize| chunk_free.push(morton(k));
+                        let end = |k: &OcKey| chunk_occ.push(morton(k));
+                        if !self.trace_beam(&plan.beams[i], origin, t0, max_range, &NoAddress, mark, end) {
                             chunk_skipped += 1;
-                            continue;
-                        }
-                        let t0 = starts.map_or(0.0, |s| s[range.start + j] as f64);
-                        let mut push = |k: &OcKey, _: usize| chunk_free.push(morton(k));
-                        let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-                        let norm = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
-                        if max_range < 0.0 || norm <= max_range {
-                            self.visit_ray_cells_from(origin, p, t0, &[0; 3], [0; 3], &mut push);
-                            match self.key_of_f32(p) {
-                                Some(k) => chunk_occ.push(morton(&k)),
-                                None => chunk_skipped += 1,
-                            }
-                        } else {
-                            let n = norm as f32;
-                            let m = max_range as f32;
-                            let e = [0, 1, 2].map(|i| origin[i] + d[i] / n * m);
-                            self.visit_ray_cells_from(origin, &e, t0, &[0; 3], [0; 3], &mut push);
                         }
                     }
+                    let visits = chunk_free.len() as u64;
                     chunk_free.sort_unstable();
                     chunk_free.dedup();
                     chunk_occ.sort_unstable();
                     chunk_occ.dedup();
-                    Some((chunk_free, chunk_occ, chunk_skipped))
+                    Some((chunk_free, chunk_occ, chunk_skipped, visits))
                 })
                 .collect();
             let (mut batch_free, mut batch_occ) = (Vec::new(), Vec::new());
-            for chunk in traced {
-                let Some((f, o, s)) = chunk else {
+            for chunk in chunks {
+                let Some((f, o, s, v)) = chunk else {
                     return Ok(None);
                 };
                 batch_free.extend_from_slice(&f);
                 batch_occ.extend_from_slice(&o);
                 skipped += s;
+                traced += v;
             }
             for (set, batch) in [(&mut free, &mut batch_free), (&mut occ, &mut batch_occ)] {
                 batch.par_sort_unstable();
@@ -624,9 +574,9 @@ impl Octree {
             !(j < occ.len() && occ[j] == *m)
         });
         Ok(Some(ScanCells {
-            free: CellSet::Sorted(free),
-            occupied: CellSet::Sorted(occ),
+            sets: CellSets::Sorted { free, occupied: occ },
             skipped,
+            traced,
         }))
     }
 
@@ -653,40 +603,58 @@ impl Octree {
             let pts = depth_image_points(depth, width, height, intrinsics, camera_pose)?;
             return self.insert_scan(&pts, &origin, params, deadline);
         }
-        let mut pts = Vec::with_capacity(depth.len());
-        let mut beams = vec![
+        let t0 = Instant::now();
+        let mut builder = match PlanBuilder::new(self, &origin, params, depth.len()) {
+            Ok(b) => b,
+            Err(e) => {
+                // the image's own errors first
+                back_project(depth, width, height, intrinsics, camera_pose, |_, _| {})?;
+                return Err(e);
+            }
+        };
+        let mut pixels = vec![
             PixelBeam {
                 covered: 0.0,
                 point: u32::MAX,
             };
             depth.len()
         ];
+        let mut points = 0u32;
         back_project(depth, width, height, intrinsics, camera_pose, |i, p| {
-            let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-            let range = ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) as f64).sqrt();
+            let beam = builder.push(&p);
+            let range = beam.norm();
             let covered = if params.max_range > 0.0 && range > params.max_range {
                 params.max_range
-            } else if p.iter().all(|v| v.is_finite()) && self.key_of_f32(&p).is_some() {
+            } else if beam.kind == EndPoint::InTree {
                 range
             } else {
                 0.0
             };
-            beams[i] = PixelBeam {
+            pixels[i] = PixelBeam {
                 covered: covered as f32,
-                point: pts.len() as u32,
+                point: points,
             };
-            pts.push(p);
+            points += 1;
         })?;
         let starts = near_field_starts(
-            &beams,
+            &pixels,
             width,
             height,
-            pts.len(),
+            points as usize,
             intrinsics.fx.min(intrinsics.fy),
             params.near_ray_spacing * self.resolution,
             self.near_field_margin(),
         );
-        self.insert_beams(&pts, &origin, Some(&starts), params, deadline)
+        let plan = builder.finish(params)?;
+        self.insert_planned(
+            &plan,
+            &origin,
+            Some(&starts),
+            points as usize,
+            params,
+            t0,
+            deadline,
+        )
     }
 }
 
