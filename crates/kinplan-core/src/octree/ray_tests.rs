@@ -189,6 +189,20 @@ fn insert_of_a_tiny_scan_by_hand() {
         .insert_scan(&pts[..1], &[0.05, 0.05, 0.05], &p, Deadline::none())
         .unwrap();
     assert_eq!((s.free_cells, s.occupied_cells), (2, 0));
+    // max range 0 is no limit, as a negative one (the documented contract):
+    // the same tree as the default
+    let (mut unlimited, mut zero) = (Octree::new(0.1).unwrap(), Octree::new(0.1).unwrap());
+    let origin = [0.05, 0.05, 0.05];
+    unlimited
+        .insert_scan(&pts, &origin, &ScanParams::default(), Deadline::none())
+        .unwrap();
+    let p = ScanParams {
+        max_range: 0.0,
+        ..ScanParams::default()
+    };
+    let s = zero.insert_scan(&pts, &origin, &p, Deadline::none()).unwrap();
+    assert!(s.occupied_cells > 0);
+    assert_eq!(zero.write_ot(), unlimited.write_ot());
     // cancellation leaves the tree unchanged
     let before = t.write_ot();
     let s = t

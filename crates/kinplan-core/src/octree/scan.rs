@@ -412,7 +412,7 @@ impl Octree {
             return false;
         }
         let norm = beam.norm();
-        if max_range < 0.0 || norm <= max_range {
+        if max_range <= 0.0 || norm <= max_range {
             if beam.kind != EndPoint::InTree {
                 return false;
             }
