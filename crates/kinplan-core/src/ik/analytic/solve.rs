@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::family::{AnalyticArm, Family};
 use super::params::{AnalyticParams, Turns};
-use super::subproblems::{Angles, ceil_i, floor_i, rot, round_f, sp1, sp2, sp3, sp4, wrap};
+use super::subproblems::{Angles, rot, sp1, sp2, sp3, sp4, wrap};
 
 /// Most whole-turn variants returned per joint with [`Turns::All`].
 pub const MAX_TURNS: usize = 4;
@@ -157,8 +157,10 @@ impl AnalyticArm {
             false,
             (params.solve_tolerance, f64::INFINITY, params.search_samples),
         );
-        for s in &base.sols[..base.n] {
-            self.push_turns(s, seed, params.turns, out);
+        let base = &base.sols[..base.n];
+        match params.turns {
+            Turns::All => self.push_all_turns(base, out),
+            Turns::NearestSeed => out.extend(base.iter().filter_map(|s| self.nearest_turn(s, seed))),
         }
     }
 
@@ -435,90 +437,6 @@ impl AnalyticArm {
                     }
                     let singular = a1.free || a5.free || a6.free || a3.free || a2.free;
                     out.push([q1, q2, q3, q4, q5, q6], self.flags(&yw, q3, q5), singular, exact);
-                }
-            }
-        }
-    }
-
-    /// Appends the whole-turn variants of `s` that lie inside the limits.
-    fn push_turns(
-        &self,
-        s: &AnalyticSolution,
-        seed: Option<&[f64]>,
-        turns: Turns,
-        out: &mut Vec<AnalyticSolution>,
-    ) {
-        use std::f64::consts::TAU;
-        let eps = 1e-9;
-        let mut cand = [[0.0f64; MAX_TURNS]; 6];
-        let mut count = [0usize; 6];
-        for i in 0..6 {
-            let q = s.joints[i];
-            let (lo, hi) = self.limits[i];
-            if self.continuous[i] {
-                let v = match (turns, seed) {
-                    (Turns::NearestSeed, Some(sd)) => q + TAU * round_f((sd[i] - q) / TAU),
-                    _ => q,
-                };
-                cand[i][0] = v;
-                count[i] = 1;
-                continue;
-            }
-            let k_lo = ceil_i((lo - eps - q) / TAU);
-            let k_hi = floor_i((hi + eps - q) / TAU);
-            if k_lo > k_hi {
-                return; // outside the limits at every turn
-            }
-            let clampq = |k: i64| (q + TAU * k as f64).clamp(lo, hi);
-            match turns {
-                Turns::NearestSeed => {
-                    let target = seed.map_or(0.0, |sd| sd[i]);
-                    let k = (round_f((target - q) / TAU) as i64).clamp(k_lo, k_hi);
-                    cand[i][0] = clampq(k);
-                    count[i] = 1;
-                }
-                Turns::All => {
-                    // nearest zero first when there are more than MAX_TURNS
-                    let k0 = (round_f(-q / TAU) as i64).clamp(k_lo, k_hi);
-                    let mut n = 0;
-                    let mut step = 0i64;
-                    while n < MAX_TURNS && (k0 - step >= k_lo || k0 + step <= k_hi) {
-                        for k in if step == 0 {
-                            [k0, k0]
-                        } else {
-                            [k0 - step, k0 + step]
-                        } {
-                            if n < MAX_TURNS
-                                && (k_lo..=k_hi).contains(&k)
-                                && (step != 0 || n == 0)
-                                && !cand[i][..n].contains(&clampq(k))
-                            {
-                                cand[i][n] = clampq(k);
-                                n += 1;
-                            }
-                        }
-                        step += 1;
-                    }
-                    count[i] = n;
-                }
-            }
-        }
-        // the first variant, then for each joint the block so far copied once
-        // per further value of that joint (joint 1 varies fastest): whole
-        // solutions move by block copies, and each copy writes one joint
-        let start = out.len();
-        out.reserve(count.iter().product());
-        let mut first = *s;
-        for (j, c) in first.joints.iter_mut().zip(&cand) {
-            *j = c[0];
-        }
-        out.push(first);
-        for i in 0..6 {
-            let block = out.len() - start;
-            for (c, &v) in cand[i][..count[i]].iter().enumerate().skip(1) {
-                out.extend_from_within(start..start + block);
-                for sol in &mut out[start + c * block..] {
-                    sol.joints[i] = v;
                 }
             }
         }

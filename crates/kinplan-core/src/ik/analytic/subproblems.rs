@@ -89,31 +89,43 @@ pub(crate) fn rot_cs(k: &Vector3<f64>, (c, s): (f64, f64)) -> Matrix3<f64> {
     )
 }
 
-/// `⌊x⌋`, `⌈x⌉` and `x` rounded half up, as integers, by truncation: the
-/// baseline x86-64 target has no rounding instruction and calls the C
-/// library for `f64::floor` and friends. Exact for `|x| < 2⁵²`; larger or
-/// non-finite values saturate (the callers keep those out).
+/// Above this magnitude every `f64` is an integer (2⁵²).
+const INTEGRAL: f64 = 4_503_599_627_370_496.0;
+
+/// `x` rounded to the nearest integer, ties to even, in floating point:
+/// adding and subtracting `2⁵²` to `|x| < 2⁵²` leaves no fraction bits (IEEE
+/// 754 round-to-nearest), and the sign is put back. The baseline x86-64
+/// target has no rounding instruction and calls the C library for
+/// `f64::floor` and friends; this takes a few additions. Larger magnitudes
+/// (integers already) and non-finite values are returned as they are.
 #[inline]
-pub(crate) fn floor_i(x: f64) -> i64 {
-    let t = x as i64;
-    t - i64::from(x < t as f64)
+fn round_even(x: f64) -> f64 {
+    let a = x.abs();
+    if a < INTEGRAL {
+        ((a + INTEGRAL) - INTEGRAL).copysign(x)
+    } else {
+        x
+    }
 }
 
+/// `⌊x⌋` (see [`round_even`]).
 #[inline]
-pub(crate) fn ceil_i(x: f64) -> i64 {
-    let t = x as i64;
-    t + i64::from(x > t as f64)
+pub(crate) fn floor_f(x: f64) -> f64 {
+    let r = round_even(x);
+    if r > x { r - 1.0 } else { r }
 }
 
-/// `x` rounded half up (as `f64`), falling back to `f64::round` where
-/// truncation is not exact.
+/// `⌈x⌉` (see [`round_even`]).
+#[inline]
+pub(crate) fn ceil_f(x: f64) -> f64 {
+    let r = round_even(x);
+    if r < x { r + 1.0 } else { r }
+}
+
+/// `x` rounded half up, `⌊x + ½⌋` (see [`round_even`]).
 #[inline]
 pub(crate) fn round_f(x: f64) -> f64 {
-    if x.abs() < 4.0e15 {
-        floor_i(x + 0.5) as f64
-    } else {
-        x.round()
-    }
+    floor_f(x + 0.5)
 }
 
 /// Wraps an angle into (−π, π].
@@ -290,8 +302,8 @@ mod tests {
     }
 
     #[test]
-    fn truncating_floor_ceil_round_match_the_c_library() {
-        for x in [
+    fn floating_floor_ceil_round_match_the_c_library() {
+        let mut xs = vec![
             -3.5f64,
             -3.0,
             -2.7,
@@ -307,17 +319,28 @@ mod tests {
             3.2,
             1e15 + 0.5,
             -1e15 - 0.5,
+            2.0f64.powi(51) - 0.5,
+            -(2.0f64.powi(51) - 0.5),
+            2.0f64.powi(51) + 0.5,
+            2.0f64.powi(52) - 0.5,
+            -(2.0f64.powi(52) - 0.5),
+            2.0f64.powi(52),
             1e17,
             -1e17,
-        ] {
-            if x.abs() < 4.0e15 {
-                assert_eq!(floor_i(x), x.floor() as i64, "{x}");
-                assert_eq!(ceil_i(x), x.ceil() as i64, "{x}");
-                assert_eq!(round_f(x), (x + 0.5).floor(), "{x}");
-            } else {
-                assert_eq!(round_f(x), x.round(), "{x}");
-            }
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        // every value next to an integer, both sides
+        for k in -40..=40 {
+            let k = f64::from(k) * 0.5;
+            xs.extend([k, k.next_up(), k.next_down()]);
         }
+        for x in xs {
+            assert_eq!(floor_f(x), x.floor(), "{x}");
+            assert_eq!(ceil_f(x), x.ceil(), "{x}");
+            assert_eq!(round_f(x), (x + 0.5).floor(), "{x}");
+        }
+        assert!(floor_f(f64::NAN).is_nan() && ceil_f(f64::NAN).is_nan() && round_f(f64::NAN).is_nan());
     }
 
     #[test]
