@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::family::{AnalyticArm, Family};
 use super::params::{AnalyticParams, Turns};
-use super::subproblems::{Angles, rot, sp1, sp2, sp3, sp4, wrap};
+use super::subproblems::{Angles, AnglesCs, rot, rot_cs, sp1, sp1_cs, sp2, sp3, sp3_cs, sp4, sp4_cs, wrap};
 
 /// Most whole-turn variants returned per joint with [`Turns::All`].
 pub const MAX_TURNS: usize = 4;
@@ -44,6 +44,15 @@ pub(super) fn pick(a: Angles, seed: f64) -> Angles {
             angles: [wrap(seed), wrap(seed)],
             ..a
         }
+    } else {
+        a
+    }
+}
+
+/// [`pick`] keeping each angle's cosine and sine.
+fn pick_cs(a: AnglesCs, seed: f64) -> AnglesCs {
+    if a.angles.free {
+        AnglesCs::of(pick(a.angles, seed))
     } else {
         a
     }
@@ -387,56 +396,84 @@ impl AnalyticArm {
         }
     }
 
+    /// Three parallel: see [`AnalyticArm::solve_into`]. The subproblems give
+    /// each angle's cosine and sine with it ([`sp4_cs`], [`sp1_cs`]), so the
+    /// rotations are built without trigonometric calls; `R₂₃₄ x₂` is applied
+    /// as four matrix–vector products; `E₃ (p₄ − p₃)` by Rodrigues on the
+    /// vector; the flags are signs of `sin(q − q_ref) = sin q cos q_ref −
+    /// cos q sin q_ref`.
     fn three_parallel(&self, g: &Isometry3<f64>, seed: &[f64; 6], keep: bool, tol: f64, out: &mut Base) {
         let (h, p) = (&self.h, &self.p);
         let rg = *g.rotation.to_rotation_matrix().matrix();
         let w = (g * nalgebra::Point3::from(self.wrist)).coords;
-        let a1 = pick(
-            sp4(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
+        let a1 = pick_cs(
+            sp4_cs(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
             seed[0],
         );
-        if !a1.exact && !keep {
+        if !a1.angles.exact && !keep {
             return;
         }
+        let (s3s, c3s) = self.q3_stretched.sin_cos();
+        let (s5s, c5s) = self.q5_singular.sin_cos();
+        // E₃ (p₄ − p₃) − p₂ = p₃ − p₂ + u∥ + cos q₃ u⊥ + sin q₃ (h₃ × u), u = p₄ − p₃
+        let u = p[3] - p[2];
+        let u_par = h[2] * h[2].dot(&u);
+        let (u_perp, u_cross) = (u - u_par, h[2].cross(&u));
+        let e3_fixed = p[2] - p[1] + u_par;
         let rg6 = rg * h[5];
-        for &q1 in a1.as_slice() {
-            let r1 = rot(&h[0], q1);
+        for (q1, cs1) in a1.iter() {
+            let r1 = rot_cs(&h[0], cs1);
             let r1h2 = r1 * h[1];
-            let a5 = pick(sp4(&h[1], &h[4], &h[5], r1h2.dot(&rg6), tol), seed[4]);
-            if !a5.exact && !keep {
+            let a5 = pick_cs(sp4_cs(&h[1], &h[4], &h[5], r1h2.dot(&rg6), tol), seed[4]);
+            if !a5.angles.exact && !keep {
                 continue;
             }
             let yw = self.inv_apply(0, &r1, &w) - p[0];
-            for &q5 in a5.as_slice() {
-                let r5 = rot(&h[4], q5);
-                let a6 = pick(sp1(&h[5], &rg.tr_mul(&r1h2), &r5.tr_mul(&h[1]), tol), seed[5]);
-                let q6 = a6.angles[0];
-                let r6 = rot(&h[5], q6);
-                let r234 = r1.tr_mul(&rg) * r6.transpose() * r5.transpose();
-                let theta = sp1(&h[1], &self.x2, &(r234 * self.x2), tol);
+            let shoulder_back = yw.dot(&self.forward) < 0.0;
+            let rg_r1h2 = rg.tr_mul(&r1h2);
+            for (q5, cs5) in a5.iter() {
+                let r5 = rot_cs(&h[4], cs5);
+                let a6 = pick_cs(sp1_cs(&h[5], &rg_r1h2, &r5.tr_mul(&h[1]), tol), seed[5]);
+                let (q6, cs6) = (a6.angles.angles[0], a6.cs[0]);
+                let r6 = rot_cs(&h[5], cs6);
+                // R₂₃₄ x₂ = R₁ᵀ R_G R₆ᵀ R₅ᵀ x₂
+                let r234x2 = r1.tr_mul(&(rg * r6.tr_mul(&r5.tr_mul(&self.x2))));
+                let theta = sp1(&h[1], &self.x2, &r234x2, tol);
                 // y = E₁⁻¹ G E₆⁻¹ E₅⁻¹ p₄
                 let a = self.inv_apply(4, &r5, &p[3]);
                 let b = self.inv_apply(5, &r6, &a);
                 let c = g * nalgebra::Point3::from(b);
                 let y = self.inv_apply(0, &r1, &c.coords);
-                let a3 = pick(
-                    sp3(&h[2], &(p[3] - p[2]), &(p[1] - p[2]), (y - p[1]).norm(), tol),
+                let a3 = pick_cs(
+                    sp3_cs(&h[2], &(p[3] - p[2]), &(p[1] - p[2]), (y - p[1]).norm(), tol),
                     seed[2],
                 );
-                if !a3.exact && !keep {
+                if !a3.angles.exact && !keep {
                     continue;
                 }
-                for &q3 in a3.as_slice() {
-                    let e3 = rot(&h[2], q3) * (p[3] - p[2]) + p[2];
-                    let a2 = pick(sp1(&h[1], &(e3 - p[1]), &(y - p[1]), tol), seed[1]);
+                let wrist_flipped = cs5.1 * c5s - cs5.0 * s5s < 0.0;
+                for (q3, (c3, s3)) in a3.iter() {
+                    let e3 = e3_fixed + u_perp * c3 + u_cross * s3;
+                    let a2 = pick(sp1(&h[1], &e3, &(y - p[1]), tol), seed[1]);
                     let q2 = a2.angles[0];
                     let q4 = wrap(self.s4 * (theta.angles[0] - q2 - self.s3 * q3));
-                    let exact = a1.exact && a5.exact && a6.exact && theta.exact && a3.exact && a2.exact;
+                    let exact = a1.angles.exact
+                        && a5.angles.exact
+                        && a6.angles.exact
+                        && theta.exact
+                        && a3.angles.exact
+                        && a2.exact;
                     if !exact && !keep {
                         continue;
                     }
-                    let singular = a1.free || a5.free || a6.free || a3.free || a2.free;
-                    out.push([q1, q2, q3, q4, q5, q6], self.flags(&yw, q3, q5), singular, exact);
+                    let singular =
+                        a1.angles.free || a5.angles.free || a6.angles.free || a3.angles.free || a2.free;
+                    let config = ConfigFlags {
+                        shoulder_back,
+                        elbow_down: s3 * c3s - c3 * s3s < 0.0,
+                        wrist_flipped,
+                    };
+                    out.push([q1, q2, q3, q4, q5, q6], config, singular, exact);
                 }
             }
         }
