@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::family::{AnalyticArm, Family};
 use super::params::{AnalyticParams, Turns};
-use super::subproblems::{Angles, AnglesCs, rot, rot_cs, sp1, sp1_cs, sp2, sp3, sp3_cs, sp4, sp4_cs, wrap};
+use super::subproblems::{Angles, AnglesCs, rot, rot_cs, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, wrap};
 
 /// Most whole-turn variants returned per joint with [`Turns::All`].
 pub const MAX_TURNS: usize = 4;
@@ -49,6 +49,25 @@ pub(super) fn pick(a: Angles, seed: f64) -> Angles {
     }
 }
 
+/// `(cos, sin)` of the reference angles of the elbow and wrist flags
+/// (`q₃ˢ`, `q₅ˢ`): `sin(q − q_ref) = sin q cos q_ref − cos q sin q_ref`.
+struct FlagRefs {
+    q3: (f64, f64),
+    q5: (f64, f64),
+}
+
+impl FlagRefs {
+    /// `sin(q₃ − q₃ˢ) < 0` from `(cos q₃, sin q₃)`.
+    fn elbow_down(&self, (c, s): (f64, f64)) -> bool {
+        s * self.q3.0 - c * self.q3.1 < 0.0
+    }
+
+    /// `sin(q₅ − q₅ˢ) < 0` from `(cos q₅, sin q₅)`.
+    fn wrist_flipped(&self, (c, s): (f64, f64)) -> bool {
+        s * self.q5.0 - c * self.q5.1 < 0.0
+    }
+}
+
 /// [`pick`] keeping each angle's cosine and sine.
 fn pick_cs(a: AnglesCs, seed: f64) -> AnglesCs {
     if a.angles.free {
@@ -89,11 +108,18 @@ impl AnalyticArm {
         r.tr_mul(&(x - self.p[i])) + self.p[i]
     }
 
+    /// The flags of a configuration whose wrist point with joint 1 undone,
+    /// less `p₁`, is `y_minus_p1` (the same formulas as the solvers').
     fn flags(&self, y_minus_p1: &Vector3<f64>, q3: f64, q5: f64) -> ConfigFlags {
+        let refs = self.flag_refs();
+        let cs = |q: f64| {
+            let (s, c) = q.sin_cos();
+            (c, s)
+        };
         ConfigFlags {
             shoulder_back: y_minus_p1.dot(&self.forward) < 0.0,
-            elbow_down: (q3 - self.q3_stretched).sin() < 0.0,
-            wrist_flipped: (q5 - self.q5_singular).sin() < 0.0,
+            elbow_down: refs.elbow_down(cs(q3)),
+            wrist_flipped: refs.wrist_flipped(cs(q5)),
         }
     }
 
@@ -272,23 +298,27 @@ impl AnalyticArm {
         base
     }
 
+    /// Spherical wrist: see [`AnalyticArm::solve_into`]; rotations from the
+    /// subproblems' cosines and sines as in [`Self::three_parallel`].
     fn spherical(&self, g: &Isometry3<f64>, seed: &[f64; 6], keep: bool, tol: f64, out: &mut Base) {
         let (h, p) = (&self.h, &self.p);
         let rg = *g.rotation.to_rotation_matrix().matrix();
         let w = g * nalgebra::Point3::from(self.wrist);
         let w = w.coords;
-        let a1 = pick(
-            sp4(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
+        let a1 = pick_cs(
+            sp4_cs(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
             seed[0],
         );
-        if !a1.exact && !keep {
+        if !a1.angles.exact && !keep {
             return;
         }
-        for &q1 in a1.as_slice() {
-            let r1 = rot(&h[0], q1);
+        let refs = self.flag_refs();
+        for (q1, cs1) in a1.iter() {
+            let r1 = rot_cs(&h[0], cs1);
             let y = self.inv_apply(0, &r1, &w);
-            let a3 = pick(
-                sp3(
+            let shoulder_back = (y - p[0]).dot(&self.forward) < 0.0;
+            let a3 = pick_cs(
+                sp3_cs(
                     &h[2],
                     &(self.wrist - p[2]),
                     &(p[1] - p[2]),
@@ -297,35 +327,70 @@ impl AnalyticArm {
                 ),
                 seed[2],
             );
-            if !a3.exact && !keep {
+            if !a3.angles.exact && !keep {
                 continue;
             }
-            for &q3 in a3.as_slice() {
-                let r3 = rot(&h[2], q3);
+            for (q3, cs3) in a3.iter() {
+                let r3 = rot_cs(&h[2], cs3);
                 let e3w = r3 * (self.wrist - p[2]) + p[2];
-                let a2 = pick(sp1(&h[1], &(e3w - p[1]), &(y - p[1]), tol), seed[1]);
-                let q2 = a2.angles[0];
-                let r123 = r1 * rot(&h[1], q2) * r3;
+                let a2 = pick_cs(sp1_cs(&h[1], &(e3w - p[1]), &(y - p[1]), tol), seed[1]);
+                let q2 = a2.angles.angles[0];
+                let r123 = r1 * rot_cs(&h[1], a2.cs[0]) * r3;
                 let r36 = r123.tr_mul(&rg);
-                let a5 = pick(sp4(&h[3], &h[4], &h[5], h[3].dot(&(r36 * h[5])), tol), seed[4]);
-                if !a5.exact && !keep {
-                    continue;
-                }
-                for &q5 in a5.as_slice() {
-                    let r5 = rot(&h[4], q5);
-                    let a4 = pick(sp1(&h[3], &(r5 * h[5]), &(r36 * h[5]), tol), seed[3]);
-                    let q4 = a4.angles[0];
-                    let r45 = rot(&h[3], q4) * r5;
-                    let a6 = pick(sp1(&h[5], &self.x6, &(r45.tr_mul(&r36) * self.x6), tol), seed[5]);
-                    let exact = a1.exact && a3.exact && a2.exact && a5.exact && a4.exact && a6.exact;
-                    if !exact && !keep {
-                        continue;
-                    }
-                    let singular = a1.free || a3.free || a2.free || a5.free || a4.free || a6.free;
-                    let q = [q1, q2, q3, q4, q5, a6.angles[0]];
-                    out.push(q, self.flags(&(y - p[0]), q3, q5), singular, exact);
-                }
+                let exact = a1.angles.exact && a3.angles.exact && a2.angles.exact;
+                let singular = a1.angles.free || a3.angles.free || a2.angles.free;
+                let arm = ([q1, q2, q3], shoulder_back, refs.elbow_down(cs3));
+                self.wrist_into(&r36, seed, (keep, tol), (arm, exact, singular), &refs, out);
             }
+        }
+    }
+
+    /// The cosines and sines of the flags' reference angles.
+    fn flag_refs(&self) -> FlagRefs {
+        let (s3, c3) = self.q3_stretched.sin_cos();
+        let (s5, c5) = self.q5_singular.sin_cos();
+        FlagRefs {
+            q3: (c3, s3),
+            q5: (c5, s5),
+        }
+    }
+
+    /// The spherical wrist for `R₃₆ = R₄R₅R₆`: `q₅` by subproblem 4 from
+    /// `h₄ᵀ R₅ h₆ = h₄ᵀ R₃₆ h₆`, `q₄` and `q₆` by subproblem 1; pushes each
+    /// solution with the arm's joints, flags and state.
+    #[allow(clippy::type_complexity)]
+    fn wrist_into(
+        &self,
+        r36: &Matrix3<f64>,
+        seed: &[f64; 6],
+        (keep, tol): (bool, f64),
+        ((arm, shoulder_back, elbow_down), exact, singular): (([f64; 3], bool, bool), bool, bool),
+        refs: &FlagRefs,
+        out: &mut Base,
+    ) {
+        let h = &self.h;
+        let r36h6 = r36 * h[5];
+        let a5 = pick_cs(sp4_cs(&h[3], &h[4], &h[5], h[3].dot(&r36h6), tol), seed[4]);
+        if !a5.angles.exact && !keep {
+            return;
+        }
+        for (q5, cs5) in a5.iter() {
+            let r5 = rot_cs(&h[4], cs5);
+            let a4 = pick_cs(sp1_cs(&h[3], &(r5 * h[5]), &r36h6, tol), seed[3]);
+            let r45 = rot_cs(&h[3], a4.cs[0]) * r5;
+            let a6 = pick(sp1(&h[5], &self.x6, &(r45.tr_mul(r36) * self.x6), tol), seed[5]);
+            let exact = exact && a5.angles.exact && a4.angles.exact && a6.exact;
+            if !exact && !keep {
+                continue;
+            }
+            let singular = singular || a5.angles.free || a4.angles.free || a6.free;
+            let q = [arm[0], arm[1], arm[2], a4.angles.angles[0], q5, a6.angles[0]];
+            let config = ConfigFlags {
+                shoulder_back,
+                elbow_down,
+                wrist_flipped: refs.wrist_flipped(cs5),
+            };
+            out.push(q, config, singular, exact);
         }
     }
 
@@ -344,15 +409,16 @@ impl AnalyticArm {
         let (h, p, s) = (&self.h, &self.p, self.shoulder);
         let rg = *g.rotation.to_rotation_matrix().matrix();
         let w = (g * nalgebra::Point3::from(self.wrist)).coords;
-        let a3 = pick(
-            sp3(&h[2], &(self.wrist - p[2]), &(s - p[2]), (w - s).norm(), tol),
+        let a3 = pick_cs(
+            sp3_cs(&h[2], &(self.wrist - p[2]), &(s - p[2]), (w - s).norm(), tol),
             seed[2],
         );
-        if !a3.exact && !keep {
+        if !a3.angles.exact && !keep {
             return;
         }
-        for &q3 in a3.as_slice() {
-            let r3 = rot(&h[2], q3);
+        let refs = self.flag_refs();
+        for (q3, cs3) in a3.iter() {
+            let r3 = rot_cs(&h[2], cs3);
             let v = r3 * (self.wrist - p[2]) + p[2] - s;
             let pairs = sp2(&h[0], &h[1], &v, &(w - s), tol);
             if !pairs.exact && !keep {
@@ -375,23 +441,14 @@ impl AnalyticArm {
                 let r1 = rot(&h[0], q1);
                 let y = self.inv_apply(0, &r1, &w);
                 let r36 = (r1 * rot(&h[1], q2) * r3).tr_mul(&rg);
-                let a5 = pick(sp4(&h[3], &h[4], &h[5], h[3].dot(&(r36 * h[5])), tol), seed[4]);
-                if !a5.exact && !keep {
-                    continue;
-                }
-                for &q5 in a5.as_slice() {
-                    let r5 = rot(&h[4], q5);
-                    let a4 = pick(sp1(&h[3], &(r5 * h[5]), &(r36 * h[5]), tol), seed[3]);
-                    let r45 = rot(&h[3], a4.angles[0]) * r5;
-                    let a6 = pick(sp1(&h[5], &self.x6, &(r45.tr_mul(&r36) * self.x6), tol), seed[5]);
-                    let exact = a3.exact && pairs.exact && a5.exact && a4.exact && a6.exact;
-                    if !exact && !keep {
-                        continue;
-                    }
-                    let singular = a3.free || pairs.free.0 || pairs.free.1 || a5.free || a4.free || a6.free;
-                    let q = [q1, q2, q3, a4.angles[0], q5, a6.angles[0]];
-                    out.push(q, self.flags(&(y - p[0]), q3, q5), singular, exact);
-                }
+                let arm = (
+                    [q1, q2, q3],
+                    (y - p[0]).dot(&self.forward) < 0.0,
+                    refs.elbow_down(cs3),
+                );
+                let exact = a3.angles.exact && pairs.exact;
+                let singular = a3.angles.free || pairs.free.0 || pairs.free.1;
+                self.wrist_into(&r36, seed, (keep, tol), (arm, exact, singular), &refs, out);
             }
         }
     }
@@ -413,8 +470,7 @@ impl AnalyticArm {
         if !a1.angles.exact && !keep {
             return;
         }
-        let (s3s, c3s) = self.q3_stretched.sin_cos();
-        let (s5s, c5s) = self.q5_singular.sin_cos();
+        let refs = self.flag_refs();
         // E₃ (p₄ − p₃) − p₂ = p₃ − p₂ + u∥ + cos q₃ u⊥ + sin q₃ (h₃ × u), u = p₄ − p₃
         let u = p[3] - p[2];
         let u_par = h[2] * h[2].dot(&u);
@@ -451,7 +507,7 @@ impl AnalyticArm {
                 if !a3.angles.exact && !keep {
                     continue;
                 }
-                let wrist_flipped = cs5.1 * c5s - cs5.0 * s5s < 0.0;
+                let wrist_flipped = refs.wrist_flipped(cs5);
                 for (q3, (c3, s3)) in a3.iter() {
                     let e3 = e3_fixed + u_perp * c3 + u_cross * s3;
                     let a2 = pick(sp1(&h[1], &e3, &(y - p[1]), tol), seed[1]);
@@ -470,7 +526,7 @@ impl AnalyticArm {
                         a1.angles.free || a5.angles.free || a6.angles.free || a3.angles.free || a2.free;
                     let config = ConfigFlags {
                         shoulder_back,
-                        elbow_down: s3 * c3s - c3 * s3s < 0.0,
+                        elbow_down: refs.elbow_down((c3, s3)),
                         wrist_flipped,
                     };
                     out.push([q1, q2, q3, q4, q5, q6], config, singular, exact);
