@@ -9,8 +9,8 @@
 //! block of variants so far is copied once per further alternative of that
 //! joint, writing only that joint in the copy. Whole rows move by block
 //! copies (wide vector moves in the C library's `memcpy`), which on the
-//! benchmark host costs several times less per row than writing each row's
-//! seven fields.
+//! benchmark host is cheaper per row than writing each row's seven fields
+//! (benches/RESULTS.md, "Analytic IK").
 
 use std::cmp::Ordering;
 use std::f64::consts::{PI, TAU};
