@@ -7,10 +7,12 @@
 //! their joints: the alternatives of each joint are tabled once per
 //! configuration; the first variant is written, and then for each joint the
 //! block of variants so far is copied once per further alternative of that
-//! joint, writing only that joint in the copy. Whole rows move by block
-//! copies (wide vector moves in the C library's `memcpy`), which on the
-//! benchmark host is cheaper per row than writing each row's seven fields
-//! (benches/RESULTS.md, "Analytic IK").
+//! joint, writing only that joint in the copy. When the configurations of a
+//! pose have the same number of alternatives per joint they are expanded
+//! together, so that each alternative costs one block copy for the whole
+//! pose. Whole rows move by block copies (wide vector moves in the C
+//! library's `memcpy`), which on the benchmark host is cheaper per row than
+//! writing each row's seven fields (benches/RESULTS.md, "Analytic IK").
 
 use std::cmp::Ordering;
 use std::f64::consts::{PI, TAU};
@@ -32,6 +34,10 @@ const INV_TAU: f64 = 1.0 / TAU;
 fn some_turn_inside(k_lo: f64, k_hi: f64) -> bool {
     matches!(k_lo.partial_cmp(&k_hi), Some(Ordering::Less | Ordering::Equal))
 }
+
+/// Most configurations expanded together (the closed-form families have up
+/// to 8; more, from the searched family, are expanded one by one).
+const GROUP: usize = 8;
 
 /// The whole-turn alternatives of the six joints of one configuration:
 /// joint `i` takes `values[i][..count[i]]` (nearest zero first). A count of
@@ -151,31 +157,87 @@ impl AnalyticArm {
     }
 
     /// Appends every whole-turn variant inside the limits of each solution of
-    /// `base` (configurations in order; within one, joint 1's turn varying
-    /// fastest, so that row `i₁ + c₁(i₂ + c₂(i₃ + …))` has joint `j` at its
-    /// alternative `iⱼ`).
+    /// `base`. When every configuration with variants has the same number of
+    /// alternatives per joint (always, but at a limit's edge, for joints whose
+    /// range is a whole number of turns such as the UR arms' ±2π), and there
+    /// are at most [`GROUP`] of them, they are expanded together, so
+    /// that each joint costs one block copy per further alternative for the
+    /// whole pose: row `c + n(i₁ + c₁(i₂ + …))` is configuration `c` of the `n`
+    /// with joint `j` at its alternative `iⱼ`. Otherwise each configuration is
+    /// expanded in turn ([`Self::push_turns_of`]).
     pub(super) fn push_all_turns(&self, base: &[AnalyticSolution], out: &mut Vec<AnalyticSolution>) {
-        for s in base {
-            let t = self.turn_table(s);
-            let rows = t.rows();
-            if rows == 0 {
-                continue;
+        if base.len() > GROUP {
+            for s in base {
+                Self::push_turns_of(&self.turn_table(s), s, out);
             }
-            out.reserve(rows);
-            let start = out.len();
-            let mut first = *s;
-            for (j, v) in first.joints.iter_mut().zip(&t.values) {
+            return;
+        }
+        let tables: [TurnTable; GROUP] =
+            std::array::from_fn(|k| base.get(k).map_or(TurnTable::EMPTY, |s| self.turn_table(s)));
+        // the configurations with variants, in order
+        let mut live = [0usize; GROUP];
+        let mut n = 0;
+        for (k, t) in tables.iter().enumerate() {
+            if t.rows() > 0 {
+                live[n] = k;
+                n += 1;
+            }
+        }
+        let live = &live[..n];
+        let Some(&k0) = live.first() else {
+            return;
+        };
+        let counts = tables[k0].count;
+        if live.iter().any(|&k| tables[k].count != counts) {
+            for &k in live {
+                Self::push_turns_of(&tables[k], &base[k], out);
+            }
+            return;
+        }
+        out.reserve(n * tables[k0].rows());
+        let start = out.len();
+        out.extend(live.iter().map(|&k| {
+            let mut first = base[k];
+            for (j, v) in first.joints.iter_mut().zip(&tables[k].values) {
                 *j = v[0];
             }
-            out.push(first);
-            for (i, values) in t.values.iter().enumerate() {
-                let block = out.len() - start;
-                for &v in &values[1..t.count[i]] {
-                    out.extend_from_within(start..start + block);
-                    let end = out.len();
-                    for sol in &mut out[end - block..] {
+            first
+        }));
+        for (i, &count) in counts.iter().enumerate() {
+            let block = out.len() - start;
+            for m in 1..count {
+                // joint i's m-th alternative of each configuration, in row order
+                let column: [f64; GROUP] =
+                    std::array::from_fn(|c| live.get(c).map_or(0.0, |&k| tables[k].values[i][m]));
+                out.extend_from_within(start..start + block);
+                let end = out.len();
+                for rows in out[end - block..].chunks_exact_mut(n) {
+                    for (sol, &v) in rows.iter_mut().zip(&column) {
                         sol.joints[i] = v;
                     }
+                }
+            }
+        }
+    }
+
+    /// The variants of one configuration `s` with table `t`: the first, then
+    /// for each joint the block so far copied once per further alternative,
+    /// writing that joint (joint 1's turn varying fastest).
+    fn push_turns_of(t: &TurnTable, s: &AnalyticSolution, out: &mut Vec<AnalyticSolution>) {
+        out.reserve(t.rows());
+        let start = out.len();
+        let mut first = *s;
+        for (j, v) in first.joints.iter_mut().zip(&t.values) {
+            *j = v[0];
+        }
+        out.push(first);
+        for (i, values) in t.values.iter().enumerate() {
+            let block = out.len() - start;
+            for &v in &values[1..t.count[i]] {
+                out.extend_from_within(start..start + block);
+                let end = out.len();
+                for sol in &mut out[end - block..] {
+                    sol.joints[i] = v;
                 }
             }
         }
