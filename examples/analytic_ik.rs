@@ -7,7 +7,7 @@
 //! (modulo 2π), and Levenberg–Marquardt from `LM_SEEDS` random seeds per pose
 //! (default 64, on the first `LM_POSES` poses, default all) finds no solution
 //! the analytic solver missed.
-//! Timing: best of 5 passes over all poses, µs per pose, for the 8-configuration
+//! Timing: best of 5 passes (`PASSES`) over all poses, µs per pose, for the 8-configuration
 //! answer (`Turns::NearestSeed`, no seed: each joint's turn nearest zero) and
 //! for every whole-turn variant (`Turns::All`).
 //!
@@ -65,7 +65,7 @@ fn time_passes(arm: &AnalyticArm, poses: &[Isometry3<f64>], params: &AnalyticPar
     let mut out: Vec<AnalyticSolution> = Vec::with_capacity(4096);
     let mut best = f64::INFINITY;
     let mut count = 0;
-    for _ in 0..5 {
+    for _ in 0..passes() {
         count = 0;
         let t0 = Instant::now();
         for p in poses {
@@ -75,6 +75,12 @@ fn time_passes(arm: &AnalyticArm, poses: &[Isometry3<f64>], params: &AnalyticPar
         best = best.min(t0.elapsed().as_secs_f64() * 1e6 / poses.len() as f64);
     }
     (best, count)
+}
+
+/// Timed passes over the poses, the best taken: `PASSES` (default 5; more
+/// catch a pass without interruption on a shared host).
+fn passes() -> usize {
+    std::env::var("PASSES").map_or(5, |s| s.parse().expect("PASSES"))
 }
 
 fn random_7(chain: &Chain, rng: &mut ChaCha8Rng) -> Vec<f64> {

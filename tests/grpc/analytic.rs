@@ -403,4 +403,77 @@ async fn offset_wrist_arm_is_searched_and_its_solutions_reach_the_pose() {
         assert!((got.translation.vector - target.translation.vector).norm() < 1e-9);
         assert!(got.rotation.angle_to(&target.rotation) < 1e-9);
     }
+    // the searched joint's sampling density: denser sampling finds the same
+    // solutions here, a count below 8 is refused naming the field
+    let with_samples = |n: u32| pb::SolveIkRequest {
+        robot: robot.clone(),
+        target: pose,
+        seed: q.clone(),
+        options: Some(pb::IkOptions {
+            search_samples: Some(n),
+            ..analytic(1000).unwrap()
+        }),
+    };
+    let dense = ik.solve_ik(with_samples(1024)).await.unwrap().into_inner();
+    assert_eq!(dense.solutions.len(), reply.solutions.len());
+    for (a, b) in dense.solutions.iter().zip(&reply.solutions) {
+        assert!(a.joints.iter().zip(&b.joints).all(|(x, y)| (x - y).abs() < 1e-9));
+    }
+    for bad in [4, 5000] {
+        let status = ik.solve_ik(with_samples(bad)).await.unwrap_err();
+        assert_eq!(status.code(), Code::InvalidArgument);
+        assert!(
+            status.message().starts_with("options.search_samples"),
+            "{}",
+            status.message()
+        );
+    }
+}
+
+/// A general 6R arm (the offset-wrist arm with axis 5 moved off axis 4: no
+/// two consecutive wrist axes meet, from either end) has no analytic family;
+/// DescribeRobot says why and the analytic method refuses it by name.
+#[tokio::test]
+async fn general_6r_arm_is_not_analytic() {
+    let server = start(ServerConfig::default()).await;
+    let mut ik = KinematicsServiceClient::new(server.channel.clone());
+    let mut robots = RobotServiceClient::new(server.channel.clone());
+    let urdf = include_str!("../../benches/analytic_ik/offset_wrist_45.urdf").replace(
+        r#"<origin xyz="0.6 0 0"/><axis xyz="0 1 0"/>"#,
+        r#"<origin xyz="0.6 0 0.07"/><axis xyz="0 1 0"/>"#,
+    );
+    assert!(urdf.contains("0.6 0 0.07"));
+    let robot = Some(pb::RobotRef {
+        source: Some(pb::robot_ref::Source::Urdf(urdf)),
+        ..Default::default()
+    });
+    let d = robots
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: robot.clone(),
+            ..Default::default()
+        })
+        .await
+        .unwrap()
+        .into_inner();
+    assert_eq!(d.analytic_family, "");
+    assert!(
+        d.analytic_reason.contains("2-D search is not implemented"),
+        "{}",
+        d.analytic_reason
+    );
+    let status = ik
+        .solve_ik(pb::SolveIkRequest {
+            robot,
+            target: Some(pose_pb(&Isometry3::translation(0.5, 0.1, 0.6))),
+            seed: vec![],
+            options: analytic(8),
+        })
+        .await
+        .unwrap_err();
+    assert_eq!(status.code(), Code::InvalidArgument);
+    assert!(
+        status.message().starts_with("options.method") && status.message().contains("chain is not analytic"),
+        "{}",
+        status.message()
+    );
 }

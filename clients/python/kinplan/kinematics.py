@@ -157,6 +157,7 @@ def ik_options(
     analytic_start: bool = False,
     search_redundant: bool = False,
     redundant_samples: Optional[int] = None,
+    search_samples: Optional[int] = None,
 ) -> kinematics_pb2.IkOptions:
     """IkOptions from Python values; ``None`` means the server's documented
     default. Values are checked by the server, which names a bad field.
@@ -164,7 +165,7 @@ def ik_options(
     key: Any = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
            damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
            max_step, distinct_tolerance, rlxa_max_iterations, history, hold_configuration, nearest_turn_only,
-           redundant_joint, analytic_start, search_redundant, redundant_samples)
+           redundant_joint, analytic_start, search_redundant, redundant_samples, search_samples)
     try:
         cached = _IK_OPTIONS_CACHE.get(key)
     except TypeError:  # an unhashable argument: build without the cache
@@ -177,7 +178,7 @@ def ik_options(
                           max_iterations, damping, max_restarts, num_solutions, rng_seed, joint_limits,
                           time_budget, adaptive_damping, max_step, distinct_tolerance, rlxa_max_iterations, history,
                           hold_configuration, nearest_turn_only, redundant_joint, analytic_start,
-                          search_redundant, redundant_samples)
+                          search_redundant, redundant_samples, search_samples)
     if key is not None and len(_IK_OPTIONS_CACHE) < 256:
         _IK_OPTIONS_CACHE[key] = kinematics_pb2.IkOptions()
         _IK_OPTIONS_CACHE[key].CopyFrom(o)
@@ -193,7 +194,7 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
                       adaptive_damping: Any, max_step: Any, distinct_tolerance: Any, rlxa_max_iterations: Any,
                       history: Any, hold_configuration: Any = None, nearest_turn_only: Any = False,
                       redundant_joint: Any = None, analytic_start: Any = False, search_redundant: Any = False,
-                      redundant_samples: Any = None) -> kinematics_pb2.IkOptions:
+                      redundant_samples: Any = None, search_samples: Any = None) -> kinematics_pb2.IkOptions:
     o = kinematics_pb2.IkOptions(
         method=_choice(METHODS, method, "method"),
         linear_solver=_choice(LINEAR_SOLVERS, linear_solver, "linear_solver"),
@@ -220,6 +221,7 @@ def _build_ik_options(method: Any, linear_solver: Any, position_tolerance: Any, 
         ("hold_configuration", hold_configuration, bool),
         ("redundant_joint", redundant_joint, int),
         ("redundant_samples", redundant_samples, int),
+        ("search_samples", search_samples, int),
     ):
         if value is not None:
             setattr(o, name, kind(value))
@@ -232,7 +234,7 @@ IK_OPTION_FIELDS = ("method", "linear_solver", "position_tolerance", "orientatio
                     "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits",
                     "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations",
                     "return_history", "hold_configuration", "nearest_turn_only", "redundant_joint", "analytic_start",
-                    "search_redundant", "redundant_samples")
+                    "search_redundant", "redundant_samples", "search_samples")
 #: The keyword shortcuts of ``robot.ik`` and friends, in the same order.
 IK_SHORTCUTS = tuple("history" if f == "return_history" else f for f in IK_OPTION_FIELDS)
 
@@ -260,7 +262,11 @@ class IkOptions:
     whole-turn variant per joint; the joint of a 7-joint arm held at the
     seed's value); ``search_redundant`` searches that joint's value (within
     its limits, ``redundant_samples`` samples then a refinement) for the
-    solution nearest the seed instead; ``analytic_start`` starts the
+    solution nearest the seed instead; ``search_samples`` (8 to 4096,
+    default 128) is how densely ``method="analytic"`` samples the searched
+    wrist joint of an offset-wrist arm (family ``searched_6r``: two solutions
+    of one branch closer than 2π/search_samples rad in that joint can be
+    missed); ``analytic_start`` starts the
     iterative methods from the closed-form solution nearest the seed.
 
     Pass it as ``robot.ik(T, options=IkOptions(...))`` (also ``ik_batch``,
@@ -292,6 +298,7 @@ class IkOptions:
     analytic_start: bool = False
     search_redundant: bool = False
     redundant_samples: Optional[int] = None
+    search_samples: Optional[int] = None
 
     def __post_init__(self) -> None:
         _choice(METHODS, self.method, "method")

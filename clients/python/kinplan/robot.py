@@ -209,6 +209,7 @@ class Robot(RobotRefs):
         analytic_start: bool = False,
         search_redundant: bool = False,
         redundant_samples: Optional[int] = None,
+        search_samples: Optional[int] = None,
         timeout: Optional[float] = None,
     ) -> IkResult:
         """Joints that put the tool at ``T`` (4x4, or (position, quaternion
@@ -240,7 +241,7 @@ class Robot(RobotRefs):
         args = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
                 damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
                 max_step, distinct_tolerance, rlxa_max_iterations, history, hold_configuration, nearest_turn_only,
-                redundant_joint, analytic_start, search_redundant, redundant_samples)
+                redundant_joint, analytic_start, search_redundant, redundant_samples, search_samples)
         if options is not None:
             args = resolve_ik_args(options, args)
         if not matrix:

@@ -348,3 +348,13 @@ def test_analytic_ik_offset_wrist_is_searched(client):
     for s in r.solutions:
         assert np.abs(robot.fk(s.q) - T).max() <= 1e-9
         assert isinstance(s.config, kinplan.ConfigFlags)
+    # the searched joint's sampling density: denser finds the same solutions
+    # here (also through IkOptions); below 8 is refused, naming the field
+    dense = robot.ik(T, seed=q, method="analytic", num_solutions=1000, search_samples=1024)
+    assert len(dense.solutions) == len(r.solutions)
+    assert all(np.allclose(a.q, b.q, atol=1e-9) for a, b in zip(dense.solutions, r.solutions))
+    opts = kinplan.IkOptions(method="analytic", num_solutions=1000, search_samples=1024)
+    assert len(robot.ik(T, seed=q, options=opts).solutions) == len(r.solutions)
+    with pytest.raises(kinplan.InvalidArgument) as e:
+        robot.ik(T, seed=q, method="analytic", search_samples=4)
+    assert "search_samples" in str(e.value)

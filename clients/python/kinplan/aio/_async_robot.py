@@ -139,13 +139,14 @@ class AsyncRobot(RobotRefs):
         analytic_start: bool = False,
         search_redundant: bool = False,
         redundant_samples: Optional[int] = None,
+        search_samples: Optional[int] = None,
         timeout: Optional[float] = None,
     ) -> IkResult:
         """As :meth:`kinplan.Robot.ik`."""
         args = (method, linear_solver, position_tolerance, orientation_tolerance, position_only, max_iterations,
                 damping, max_restarts, num_solutions, rng_seed, joint_limits, time_budget, adaptive_damping,
                 max_step, distinct_tolerance, rlxa_max_iterations, history, hold_configuration, nearest_turn_only,
-                redundant_joint, analytic_start, search_redundant, redundant_samples)
+                redundant_joint, analytic_start, search_redundant, redundant_samples, search_samples)
         T, args = _kinematics.ik_target(T, resolve_ik_args(options, args))
         out: IkResult = await self._run(_kinematics.ik(T, seed, args), timeout)
         return out

@@ -72,7 +72,7 @@ LINEAR_SOLVE_STATUS_CONVERGED: LinearSolveStatus
 LINEAR_SOLVE_STATUS_ITERATION_CAP: LinearSolveStatus
 
 class IkOptions(_message.Message):
-    __slots__ = ("method", "linear_solver", "position_tolerance", "orientation_tolerance", "position_only", "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits", "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations", "return_history", "hold_configuration", "nearest_turn_only", "redundant_joint", "analytic_start", "search_redundant", "redundant_samples")
+    __slots__ = ("method", "linear_solver", "position_tolerance", "orientation_tolerance", "position_only", "max_iterations", "damping", "max_restarts", "num_solutions", "rng_seed", "joint_limits", "time_budget", "adaptive_damping", "max_step", "distinct_tolerance", "rlxa_max_iterations", "return_history", "hold_configuration", "nearest_turn_only", "redundant_joint", "analytic_start", "search_redundant", "redundant_samples", "search_samples")
     METHOD_FIELD_NUMBER: _ClassVar[int]
     LINEAR_SOLVER_FIELD_NUMBER: _ClassVar[int]
     POSITION_TOLERANCE_FIELD_NUMBER: _ClassVar[int]
@@ -96,6 +96,7 @@ class IkOptions(_message.Message):
     ANALYTIC_START_FIELD_NUMBER: _ClassVar[int]
     SEARCH_REDUNDANT_FIELD_NUMBER: _ClassVar[int]
     REDUNDANT_SAMPLES_FIELD_NUMBER: _ClassVar[int]
+    SEARCH_SAMPLES_FIELD_NUMBER: _ClassVar[int]
     method: IkMethod
     linear_solver: LinearSolver
     position_tolerance: float
@@ -119,7 +120,8 @@ class IkOptions(_message.Message):
     analytic_start: bool
     search_redundant: bool
     redundant_samples: int
-    def __init__(self, method: _Optional[_Union[IkMethod, str]] = ..., linear_solver: _Optional[_Union[LinearSolver, str]] = ..., position_tolerance: _Optional[float] = ..., orientation_tolerance: _Optional[float] = ..., position_only: _Optional[bool] = ..., max_iterations: _Optional[int] = ..., damping: _Optional[float] = ..., max_restarts: _Optional[int] = ..., num_solutions: _Optional[int] = ..., rng_seed: _Optional[int] = ..., joint_limits: _Optional[_Union[JointLimitMode, str]] = ..., time_budget: _Optional[float] = ..., adaptive_damping: _Optional[bool] = ..., max_step: _Optional[float] = ..., distinct_tolerance: _Optional[float] = ..., rlxa_max_iterations: _Optional[int] = ..., return_history: _Optional[bool] = ..., hold_configuration: _Optional[bool] = ..., nearest_turn_only: _Optional[bool] = ..., redundant_joint: _Optional[int] = ..., analytic_start: _Optional[bool] = ..., search_redundant: _Optional[bool] = ..., redundant_samples: _Optional[int] = ...) -> None: ...
+    search_samples: int
+    def __init__(self, method: _Optional[_Union[IkMethod, str]] = ..., linear_solver: _Optional[_Union[LinearSolver, str]] = ..., position_tolerance: _Optional[float] = ..., orientation_tolerance: _Optional[float] = ..., position_only: _Optional[bool] = ..., max_iterations: _Optional[int] = ..., damping: _Optional[float] = ..., max_restarts: _Optional[int] = ..., num_solutions: _Optional[int] = ..., rng_seed: _Optional[int] = ..., joint_limits: _Optional[_Union[JointLimitMode, str]] = ..., time_budget: _Optional[float] = ..., adaptive_damping: _Optional[bool] = ..., max_step: _Optional[float] = ..., distinct_tolerance: _Optional[float] = ..., rlxa_max_iterations: _Optional[int] = ..., return_history: _Optional[bool] = ..., hold_configuration: _Optional[bool] = ..., nearest_turn_only: _Optional[bool] = ..., redundant_joint: _Optional[int] = ..., analytic_start: _Optional[bool] = ..., search_redundant: _Optional[bool] = ..., redundant_samples: _Optional[int] = ..., search_samples: _Optional[int] = ...) -> None: ...
 
 class ConfigFlags(_message.Message):
     __slots__ = ("shoulder_back", "elbow_down", "wrist_flipped")

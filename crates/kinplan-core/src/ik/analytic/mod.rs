@@ -11,6 +11,7 @@ mod search;
 mod solve;
 mod subproblems;
 mod turned;
+mod whole_turns;
 
 #[cfg(test)]
 mod tests;

@@ -5,7 +5,7 @@ use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::family::{AnalyticArm, Family};
 use super::params::{AnalyticParams, Turns};
-use super::subproblems::{Angles, ceil_i, floor_i, rot, round_f, sp1, sp2, sp3, sp4, wrap};
+use super::subproblems::{Angles, AnglesCs, rot, rot_cs, sp1, sp1_cs, sp2, sp3_cs, sp4_cs, wrap};
 
 /// Most whole-turn variants returned per joint with [`Turns::All`].
 pub const MAX_TURNS: usize = 4;
@@ -49,6 +49,34 @@ pub(super) fn pick(a: Angles, seed: f64) -> Angles {
     }
 }
 
+/// `(cos, sin)` of the reference angles of the elbow and wrist flags
+/// (`q₃ˢ`, `q₅ˢ`): `sin(q − q_ref) = sin q cos q_ref − cos q sin q_ref`.
+struct FlagRefs {
+    q3: (f64, f64),
+    q5: (f64, f64),
+}
+
+impl FlagRefs {
+    /// `sin(q₃ − q₃ˢ) < 0` from `(cos q₃, sin q₃)`.
+    fn elbow_down(&self, (c, s): (f64, f64)) -> bool {
+        s * self.q3.0 - c * self.q3.1 < 0.0
+    }
+
+    /// `sin(q₅ − q₅ˢ) < 0` from `(cos q₅, sin q₅)`.
+    fn wrist_flipped(&self, (c, s): (f64, f64)) -> bool {
+        s * self.q5.0 - c * self.q5.1 < 0.0
+    }
+}
+
+/// [`pick`] keeping each angle's cosine and sine.
+fn pick_cs(a: AnglesCs, seed: f64) -> AnglesCs {
+    if a.angles.free {
+        AnglesCs::of(pick(a.angles, seed))
+    } else {
+        a
+    }
+}
+
 /// Most base solutions of one pose: 8 for the closed-form families, 16 for a
 /// general 6-joint arm (the degree of its characteristic polynomial).
 const MAX_BASE: usize = 16;
@@ -80,11 +108,18 @@ impl AnalyticArm {
         r.tr_mul(&(x - self.p[i])) + self.p[i]
     }
 
+    /// The flags of a configuration whose wrist point with joint 1 undone,
+    /// less `p₁`, is `y_minus_p1` (the same formulas as the solvers').
     fn flags(&self, y_minus_p1: &Vector3<f64>, q3: f64, q5: f64) -> ConfigFlags {
+        let refs = self.flag_refs();
+        let cs = |q: f64| {
+            let (s, c) = q.sin_cos();
+            (c, s)
+        };
         ConfigFlags {
             shoulder_back: y_minus_p1.dot(&self.forward) < 0.0,
-            elbow_down: (q3 - self.q3_stretched).sin() < 0.0,
-            wrist_flipped: (q5 - self.q5_singular).sin() < 0.0,
+            elbow_down: refs.elbow_down(cs(q3)),
+            wrist_flipped: refs.wrist_flipped(cs(q5)),
         }
     }
 
@@ -157,8 +192,10 @@ impl AnalyticArm {
             false,
             (params.solve_tolerance, f64::INFINITY, params.search_samples),
         );
-        for s in &base.sols[..base.n] {
-            self.push_turns(s, seed, params.turns, out);
+        let base = &base.sols[..base.n];
+        match params.turns {
+            Turns::All => self.push_all_turns(base, out),
+            Turns::NearestSeed => out.extend(base.iter().filter_map(|s| self.nearest_turn(s, seed))),
         }
     }
 
@@ -261,23 +298,27 @@ impl AnalyticArm {
         base
     }
 
+    /// Spherical wrist: see [`AnalyticArm::solve_into`]; rotations from the
+    /// subproblems' cosines and sines as in [`Self::three_parallel`].
     fn spherical(&self, g: &Isometry3<f64>, seed: &[f64; 6], keep: bool, tol: f64, out: &mut Base) {
         let (h, p) = (&self.h, &self.p);
         let rg = *g.rotation.to_rotation_matrix().matrix();
         let w = g * nalgebra::Point3::from(self.wrist);
         let w = w.coords;
-        let a1 = pick(
-            sp4(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
+        let a1 = pick_cs(
+            sp4_cs(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
             seed[0],
         );
-        if !a1.exact && !keep {
+        if !a1.angles.exact && !keep {
             return;
         }
-        for &q1 in a1.as_slice() {
-            let r1 = rot(&h[0], q1);
+        let refs = self.flag_refs();
+        for (q1, cs1) in a1.iter() {
+            let r1 = rot_cs(&h[0], cs1);
             let y = self.inv_apply(0, &r1, &w);
-            let a3 = pick(
-                sp3(
+            let shoulder_back = (y - p[0]).dot(&self.forward) < 0.0;
+            let a3 = pick_cs(
+                sp3_cs(
                     &h[2],
                     &(self.wrist - p[2]),
                     &(p[1] - p[2]),
@@ -286,35 +327,70 @@ impl AnalyticArm {
                 ),
                 seed[2],
             );
-            if !a3.exact && !keep {
+            if !a3.angles.exact && !keep {
                 continue;
             }
-            for &q3 in a3.as_slice() {
-                let r3 = rot(&h[2], q3);
+            for (q3, cs3) in a3.iter() {
+                let r3 = rot_cs(&h[2], cs3);
                 let e3w = r3 * (self.wrist - p[2]) + p[2];
-                let a2 = pick(sp1(&h[1], &(e3w - p[1]), &(y - p[1]), tol), seed[1]);
-                let q2 = a2.angles[0];
-                let r123 = r1 * rot(&h[1], q2) * r3;
+                let a2 = pick_cs(sp1_cs(&h[1], &(e3w - p[1]), &(y - p[1]), tol), seed[1]);
+                let q2 = a2.angles.angles[0];
+                let r123 = r1 * rot_cs(&h[1], a2.cs[0]) * r3;
                 let r36 = r123.tr_mul(&rg);
-                let a5 = pick(sp4(&h[3], &h[4], &h[5], h[3].dot(&(r36 * h[5])), tol), seed[4]);
-                if !a5.exact && !keep {
-                    continue;
-                }
-                for &q5 in a5.as_slice() {
-                    let r5 = rot(&h[4], q5);
-                    let a4 = pick(sp1(&h[3], &(r5 * h[5]), &(r36 * h[5]), tol), seed[3]);
-                    let q4 = a4.angles[0];
-                    let r45 = rot(&h[3], q4) * r5;
-                    let a6 = pick(sp1(&h[5], &self.x6, &(r45.tr_mul(&r36) * self.x6), tol), seed[5]);
-                    let exact = a1.exact && a3.exact && a2.exact && a5.exact && a4.exact && a6.exact;
-                    if !exact && !keep {
-                        continue;
-                    }
-                    let singular = a1.free || a3.free || a2.free || a5.free || a4.free || a6.free;
-                    let q = [q1, q2, q3, q4, q5, a6.angles[0]];
-                    out.push(q, self.flags(&(y - p[0]), q3, q5), singular, exact);
-                }
+                let exact = a1.angles.exact && a3.angles.exact && a2.angles.exact;
+                let singular = a1.angles.free || a3.angles.free || a2.angles.free;
+                let arm = ([q1, q2, q3], shoulder_back, refs.elbow_down(cs3));
+                self.wrist_into(&r36, seed, (keep, tol), (arm, exact, singular), &refs, out);
             }
+        }
+    }
+
+    /// The cosines and sines of the flags' reference angles.
+    fn flag_refs(&self) -> FlagRefs {
+        let (s3, c3) = self.q3_stretched.sin_cos();
+        let (s5, c5) = self.q5_singular.sin_cos();
+        FlagRefs {
+            q3: (c3, s3),
+            q5: (c5, s5),
+        }
+    }
+
+    /// The spherical wrist for `R₃₆ = R₄R₅R₆`: `q₅` by subproblem 4 from
+    /// `h₄ᵀ R₅ h₆ = h₄ᵀ R₃₆ h₆`, `q₄` and `q₆` by subproblem 1; pushes each
+    /// solution with the arm's joints, flags and state.
+    #[allow(clippy::type_complexity)]
+    fn wrist_into(
+        &self,
+        r36: &Matrix3<f64>,
+        seed: &[f64; 6],
+        (keep, tol): (bool, f64),
+        ((arm, shoulder_back, elbow_down), exact, singular): (([f64; 3], bool, bool), bool, bool),
+        refs: &FlagRefs,
+        out: &mut Base,
+    ) {
+        let h = &self.h;
+        let r36h6 = r36 * h[5];
+        let a5 = pick_cs(sp4_cs(&h[3], &h[4], &h[5], h[3].dot(&r36h6), tol), seed[4]);
+        if !a5.angles.exact && !keep {
+            return;
+        }
+        for (q5, cs5) in a5.iter() {
+            let r5 = rot_cs(&h[4], cs5);
+            let a4 = pick_cs(sp1_cs(&h[3], &(r5 * h[5]), &r36h6, tol), seed[3]);
+            let r45 = rot_cs(&h[3], a4.cs[0]) * r5;
+            let a6 = pick(sp1(&h[5], &self.x6, &(r45.tr_mul(r36) * self.x6), tol), seed[5]);
+            let exact = exact && a5.angles.exact && a4.angles.exact && a6.exact;
+            if !exact && !keep {
+                continue;
+            }
+            let singular = singular || a5.angles.free || a4.angles.free || a6.free;
+            let q = [arm[0], arm[1], arm[2], a4.angles.angles[0], q5, a6.angles[0]];
+            let config = ConfigFlags {
+                shoulder_back,
+                elbow_down,
+                wrist_flipped: refs.wrist_flipped(cs5),
+            };
+            out.push(q, config, singular, exact);
         }
     }
 
@@ -333,15 +409,16 @@ impl AnalyticArm {
         let (h, p, s) = (&self.h, &self.p, self.shoulder);
         let rg = *g.rotation.to_rotation_matrix().matrix();
         let w = (g * nalgebra::Point3::from(self.wrist)).coords;
-        let a3 = pick(
-            sp3(&h[2], &(self.wrist - p[2]), &(s - p[2]), (w - s).norm(), tol),
+        let a3 = pick_cs(
+            sp3_cs(&h[2], &(self.wrist - p[2]), &(s - p[2]), (w - s).norm(), tol),
             seed[2],
         );
-        if !a3.exact && !keep {
+        if !a3.angles.exact && !keep {
             return;
         }
-        for &q3 in a3.as_slice() {
-            let r3 = rot(&h[2], q3);
+        let refs = self.flag_refs();
+        for (q3, cs3) in a3.iter() {
+            let r3 = rot_cs(&h[2], cs3);
             let v = r3 * (self.wrist - p[2]) + p[2] - s;
             let pairs = sp2(&h[0], &h[1], &v, &(w - s), tol);
             if !pairs.exact && !keep {
@@ -364,161 +441,95 @@ impl AnalyticArm {
                 let r1 = rot(&h[0], q1);
                 let y = self.inv_apply(0, &r1, &w);
                 let r36 = (r1 * rot(&h[1], q2) * r3).tr_mul(&rg);
-                let a5 = pick(sp4(&h[3], &h[4], &h[5], h[3].dot(&(r36 * h[5])), tol), seed[4]);
-                if !a5.exact && !keep {
-                    continue;
-                }
-                for &q5 in a5.as_slice() {
-                    let r5 = rot(&h[4], q5);
-                    let a4 = pick(sp1(&h[3], &(r5 * h[5]), &(r36 * h[5]), tol), seed[3]);
-                    let r45 = rot(&h[3], a4.angles[0]) * r5;
-                    let a6 = pick(sp1(&h[5], &self.x6, &(r45.tr_mul(&r36) * self.x6), tol), seed[5]);
-                    let exact = a3.exact && pairs.exact && a5.exact && a4.exact && a6.exact;
-                    if !exact && !keep {
-                        continue;
-                    }
-                    let singular = a3.free || pairs.free.0 || pairs.free.1 || a5.free || a4.free || a6.free;
-                    let q = [q1, q2, q3, a4.angles[0], q5, a6.angles[0]];
-                    out.push(q, self.flags(&(y - p[0]), q3, q5), singular, exact);
-                }
+                let arm = (
+                    [q1, q2, q3],
+                    (y - p[0]).dot(&self.forward) < 0.0,
+                    refs.elbow_down(cs3),
+                );
+                let exact = a3.angles.exact && pairs.exact;
+                let singular = a3.angles.free || pairs.free.0 || pairs.free.1;
+                self.wrist_into(&r36, seed, (keep, tol), (arm, exact, singular), &refs, out);
             }
         }
     }
 
+    /// Three parallel: see [`AnalyticArm::solve_into`]. The subproblems give
+    /// each angle's cosine and sine with it ([`sp4_cs`], [`sp1_cs`]), so the
+    /// rotations are built without trigonometric calls; `R₂₃₄ x₂` is applied
+    /// as four matrix–vector products; `E₃ (p₄ − p₃)` by Rodrigues on the
+    /// vector; the flags are signs of `sin(q − q_ref) = sin q cos q_ref −
+    /// cos q sin q_ref`.
     fn three_parallel(&self, g: &Isometry3<f64>, seed: &[f64; 6], keep: bool, tol: f64, out: &mut Base) {
         let (h, p) = (&self.h, &self.p);
         let rg = *g.rotation.to_rotation_matrix().matrix();
         let w = (g * nalgebra::Point3::from(self.wrist)).coords;
-        let a1 = pick(
-            sp4(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
+        let a1 = pick_cs(
+            sp4_cs(&(w - p[0]), &h[0], &h[1], h[1].dot(&(self.wrist - p[0])), tol),
             seed[0],
         );
-        if !a1.exact && !keep {
+        if !a1.angles.exact && !keep {
             return;
         }
+        let refs = self.flag_refs();
+        // E₃ (p₄ − p₃) − p₂ = p₃ − p₂ + u∥ + cos q₃ u⊥ + sin q₃ (h₃ × u), u = p₄ − p₃
+        let u = p[3] - p[2];
+        let u_par = h[2] * h[2].dot(&u);
+        let (u_perp, u_cross) = (u - u_par, h[2].cross(&u));
+        let e3_fixed = p[2] - p[1] + u_par;
         let rg6 = rg * h[5];
-        for &q1 in a1.as_slice() {
-            let r1 = rot(&h[0], q1);
+        for (q1, cs1) in a1.iter() {
+            let r1 = rot_cs(&h[0], cs1);
             let r1h2 = r1 * h[1];
-            let a5 = pick(sp4(&h[1], &h[4], &h[5], r1h2.dot(&rg6), tol), seed[4]);
-            if !a5.exact && !keep {
+            let a5 = pick_cs(sp4_cs(&h[1], &h[4], &h[5], r1h2.dot(&rg6), tol), seed[4]);
+            if !a5.angles.exact && !keep {
                 continue;
             }
             let yw = self.inv_apply(0, &r1, &w) - p[0];
-            for &q5 in a5.as_slice() {
-                let r5 = rot(&h[4], q5);
-                let a6 = pick(sp1(&h[5], &rg.tr_mul(&r1h2), &r5.tr_mul(&h[1]), tol), seed[5]);
-                let q6 = a6.angles[0];
-                let r6 = rot(&h[5], q6);
-                let r234 = r1.tr_mul(&rg) * r6.transpose() * r5.transpose();
-                let theta = sp1(&h[1], &self.x2, &(r234 * self.x2), tol);
+            let shoulder_back = yw.dot(&self.forward) < 0.0;
+            let rg_r1h2 = rg.tr_mul(&r1h2);
+            for (q5, cs5) in a5.iter() {
+                let r5 = rot_cs(&h[4], cs5);
+                let a6 = pick_cs(sp1_cs(&h[5], &rg_r1h2, &r5.tr_mul(&h[1]), tol), seed[5]);
+                let (q6, cs6) = (a6.angles.angles[0], a6.cs[0]);
+                let r6 = rot_cs(&h[5], cs6);
+                // R₂₃₄ x₂ = R₁ᵀ R_G R₆ᵀ R₅ᵀ x₂
+                let r234x2 = r1.tr_mul(&(rg * r6.tr_mul(&r5.tr_mul(&self.x2))));
+                let theta = sp1(&h[1], &self.x2, &r234x2, tol);
                 // y = E₁⁻¹ G E₆⁻¹ E₅⁻¹ p₄
                 let a = self.inv_apply(4, &r5, &p[3]);
                 let b = self.inv_apply(5, &r6, &a);
                 let c = g * nalgebra::Point3::from(b);
                 let y = self.inv_apply(0, &r1, &c.coords);
-                let a3 = pick(
-                    sp3(&h[2], &(p[3] - p[2]), &(p[1] - p[2]), (y - p[1]).norm(), tol),
+                let a3 = pick_cs(
+                    sp3_cs(&h[2], &(p[3] - p[2]), &(p[1] - p[2]), (y - p[1]).norm(), tol),
                     seed[2],
                 );
-                if !a3.exact && !keep {
+                if !a3.angles.exact && !keep {
                     continue;
                 }
-                for &q3 in a3.as_slice() {
-                    let e3 = rot(&h[2], q3) * (p[3] - p[2]) + p[2];
-                    let a2 = pick(sp1(&h[1], &(e3 - p[1]), &(y - p[1]), tol), seed[1]);
+                let wrist_flipped = refs.wrist_flipped(cs5);
+                for (q3, (c3, s3)) in a3.iter() {
+                    let e3 = e3_fixed + u_perp * c3 + u_cross * s3;
+                    let a2 = pick(sp1(&h[1], &e3, &(y - p[1]), tol), seed[1]);
                     let q2 = a2.angles[0];
                     let q4 = wrap(self.s4 * (theta.angles[0] - q2 - self.s3 * q3));
-                    let exact = a1.exact && a5.exact && a6.exact && theta.exact && a3.exact && a2.exact;
+                    let exact = a1.angles.exact
+                        && a5.angles.exact
+                        && a6.angles.exact
+                        && theta.exact
+                        && a3.angles.exact
+                        && a2.exact;
                     if !exact && !keep {
                         continue;
                     }
-                    let singular = a1.free || a5.free || a6.free || a3.free || a2.free;
-                    out.push([q1, q2, q3, q4, q5, q6], self.flags(&yw, q3, q5), singular, exact);
-                }
-            }
-        }
-    }
-
-    /// Appends the whole-turn variants of `s` that lie inside the limits.
-    fn push_turns(
-        &self,
-        s: &AnalyticSolution,
-        seed: Option<&[f64]>,
-        turns: Turns,
-        out: &mut Vec<AnalyticSolution>,
-    ) {
-        use std::f64::consts::TAU;
-        let eps = 1e-9;
-        let mut cand = [[0.0f64; MAX_TURNS]; 6];
-        let mut count = [0usize; 6];
-        for i in 0..6 {
-            let q = s.joints[i];
-            let (lo, hi) = self.limits[i];
-            if self.continuous[i] {
-                let v = match (turns, seed) {
-                    (Turns::NearestSeed, Some(sd)) => q + TAU * round_f((sd[i] - q) / TAU),
-                    _ => q,
-                };
-                cand[i][0] = v;
-                count[i] = 1;
-                continue;
-            }
-            let k_lo = ceil_i((lo - eps - q) / TAU);
-            let k_hi = floor_i((hi + eps - q) / TAU);
-            if k_lo > k_hi {
-                return; // outside the limits at every turn
-            }
-            let clampq = |k: i64| (q + TAU * k as f64).clamp(lo, hi);
-            match turns {
-                Turns::NearestSeed => {
-                    let target = seed.map_or(0.0, |sd| sd[i]);
-                    let k = (round_f((target - q) / TAU) as i64).clamp(k_lo, k_hi);
-                    cand[i][0] = clampq(k);
-                    count[i] = 1;
-                }
-                Turns::All => {
-                    // nearest zero first when there are more than MAX_TURNS
-                    let k0 = (round_f(-q / TAU) as i64).clamp(k_lo, k_hi);
-                    let mut n = 0;
-                    let mut step = 0i64;
-                    while n < MAX_TURNS && (k0 - step >= k_lo || k0 + step <= k_hi) {
-                        for k in if step == 0 {
-                            [k0, k0]
-                        } else {
-                            [k0 - step, k0 + step]
-                        } {
-                            if n < MAX_TURNS
-                                && (k_lo..=k_hi).contains(&k)
-                                && (step != 0 || n == 0)
-                                && !cand[i][..n].contains(&clampq(k))
-                            {
-                                cand[i][n] = clampq(k);
-                                n += 1;
-                            }
-                        }
-                        step += 1;
-                    }
-                    count[i] = n;
-                }
-            }
-        }
-        // the first variant, then for each joint the block so far copied once
-        // per further value of that joint (joint 1 varies fastest): whole
-        // solutions move by block copies, and each copy writes one joint
-        let start = out.len();
-        out.reserve(count.iter().product());
-        let mut first = *s;
-        for (j, c) in first.joints.iter_mut().zip(&cand) {
-            *j = c[0];
-        }
-        out.push(first);
-        for i in 0..6 {
-            let block = out.len() - start;
-            for (c, &v) in cand[i][..count[i]].iter().enumerate().skip(1) {
-                out.extend_from_within(start..start + block);
-                for sol in &mut out[start + c * block..] {
-                    sol.joints[i] = v;
+                    let singular =
+                        a1.angles.free || a5.angles.free || a6.angles.free || a3.angles.free || a2.free;
+                    let config = ConfigFlags {
+                        shoulder_back,
+                        elbow_down: refs.elbow_down((c3, s3)),
+                        wrist_flipped,
+                    };
+                    out.push([q1, q2, q3, q4, q5, q6], config, singular, exact);
                 }
             }
         }

@@ -89,31 +89,43 @@ pub(crate) fn rot_cs(k: &Vector3<f64>, (c, s): (f64, f64)) -> Matrix3<f64> {
     )
 }
 
-/// `⌊x⌋`, `⌈x⌉` and `x` rounded half up, as integers, by truncation: the
-/// baseline x86-64 target has no rounding instruction and calls the C
-/// library for `f64::floor` and friends. Exact for `|x| < 2⁵²`; larger or
-/// non-finite values saturate (the callers keep those out).
+/// Above this magnitude every `f64` is an integer (2⁵²).
+const INTEGRAL: f64 = 4_503_599_627_370_496.0;
+
+/// `x` rounded to the nearest integer, ties to even, in floating point:
+/// adding and subtracting `2⁵²` to `|x| < 2⁵²` leaves no fraction bits (IEEE
+/// 754 round-to-nearest), and the sign is put back. The baseline x86-64
+/// target has no rounding instruction and calls the C library for
+/// `f64::floor` and friends; this takes a few additions. Larger magnitudes
+/// (integers already) and non-finite values are returned as they are.
 #[inline]
-pub(crate) fn floor_i(x: f64) -> i64 {
-    let t = x as i64;
-    t - i64::from(x < t as f64)
+fn round_even(x: f64) -> f64 {
+    let a = x.abs();
+    if a < INTEGRAL {
+        ((a + INTEGRAL) - INTEGRAL).copysign(x)
+    } else {
+        x
+    }
 }
 
+/// `⌊x⌋` (see [`round_even`]).
 #[inline]
-pub(crate) fn ceil_i(x: f64) -> i64 {
-    let t = x as i64;
-    t + i64::from(x > t as f64)
+pub(crate) fn floor_f(x: f64) -> f64 {
+    let r = round_even(x);
+    if r > x { r - 1.0 } else { r }
 }
 
-/// `x` rounded half up (as `f64`), falling back to `f64::round` where
-/// truncation is not exact.
+/// `⌈x⌉` (see [`round_even`]).
+#[inline]
+pub(crate) fn ceil_f(x: f64) -> f64 {
+    let r = round_even(x);
+    if r < x { r + 1.0 } else { r }
+}
+
+/// `x` rounded half up, `⌊x + ½⌋` (see [`round_even`]).
 #[inline]
 pub(crate) fn round_f(x: f64) -> f64 {
-    if x.abs() < 4.0e15 {
-        floor_i(x + 0.5) as f64
-    } else {
-        x.round()
-    }
+    floor_f(x + 0.5)
 }
 
 /// Wraps an angle into (−π, π].
@@ -139,6 +151,13 @@ pub fn wrap(a: f64) -> f64 {
 /// assert!(a.exact && (a.angles[0] + std::f64::consts::FRAC_PI_2).abs() < 1e-15);
 /// ```
 pub fn sp1(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>, tol: f64) -> Angles {
+    sp1_cs(k, p, q, tol).angles
+}
+
+/// [`sp1`] with the angle's cosine and sine: `(p′ᵀq′, kᵀ(p′ × q′))` divided
+/// by `‖p′‖ ‖q′‖`.
+#[inline]
+pub(crate) fn sp1_cs(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>, tol: f64) -> AnglesCs {
     let kp = k.dot(p);
     let kq = k.dot(q);
     let pp = p - k * kp;
@@ -146,9 +165,57 @@ pub fn sp1(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>, tol: f64) -> An
     let (np, nq) = (pp.norm(), qp.norm());
     let exact = (kp - kq).abs() <= tol && (np - nq).abs() <= tol;
     if np <= DEGENERATE || nq <= DEGENERATE {
-        return Angles::free(exact);
+        return AnglesCs::of(Angles::free(exact));
     }
-    Angles::one(k.dot(&pp.cross(&qp)).atan2(pp.dot(&qp)), exact)
+    let (c, s) = (pp.dot(&qp), k.dot(&pp.cross(&qp)));
+    let n = 1.0 / (np * nq);
+    AnglesCs::one(atan2_half_open(s, c), (c * n, s * n), exact)
+}
+
+/// `atan2(s, c)` in (−π, π] (`atan2(−0, c < 0)` is −π).
+#[inline]
+fn atan2_half_open(s: f64, c: f64) -> f64 {
+    let t = s.atan2(c);
+    if t == -std::f64::consts::PI {
+        std::f64::consts::PI
+    } else {
+        t
+    }
+}
+
+/// A subproblem's answer with the cosine and sine of each angle, so that a
+/// caller turning by it needs no trigonometric call.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct AnglesCs {
+    pub angles: Angles,
+    /// `(cos, sin)` of `angles.angles[i]`.
+    pub cs: [(f64, f64); 2],
+}
+
+impl AnglesCs {
+    /// From angles alone (cosines and sines computed).
+    pub(crate) fn of(angles: Angles) -> Self {
+        let cs = |a: f64| {
+            let (s, c) = a.sin_cos();
+            (c, s)
+        };
+        Self {
+            angles,
+            cs: [cs(angles.angles[0]), cs(angles.angles[1])],
+        }
+    }
+
+    fn one(a: f64, cs: (f64, f64), exact: bool) -> Self {
+        Self {
+            angles: Angles::one(a, exact),
+            cs: [cs, cs],
+        }
+    }
+
+    /// Each angle with its `(cos, sin)`.
+    pub(crate) fn iter(&self) -> impl Iterator<Item = (f64, (f64, f64))> + '_ {
+        self.angles.as_slice().iter().copied().zip(self.cs)
+    }
 }
 
 /// Subproblem 4: the angles `θ` with `hᵀ rot(k, θ) p = d` (`k` a unit axis,
@@ -171,35 +238,48 @@ pub fn sp1(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>, tol: f64) -> An
 /// assert!(deg.iter().any(|t| (t - 30.0).abs() < 1e-12) && deg.iter().any(|t| (t - 150.0).abs() < 1e-12));
 /// ```
 pub fn sp4(h: &Vector3<f64>, k: &Vector3<f64>, p: &Vector3<f64>, d: f64, tol: f64) -> Angles {
+    sp4_cs(h, k, p, d, tol).angles
+}
+
+/// [`sp4`] with each angle's cosine and sine, from `cos φ = A/ρ`,
+/// `sin φ = B/ρ`, `cos α = C/ρ`, `sin α = S/ρ` with `S = √((ρ − |C|)(ρ + |C|))`:
+/// `cos(φ ± α) = (AC ∓ BS)/ρ²`, `sin(φ ± α) = (BC ± AS)/ρ²`, and the angles by
+/// `atan2` of those (no `acos`, no wrapping).
+#[inline]
+pub(crate) fn sp4_cs(h: &Vector3<f64>, k: &Vector3<f64>, p: &Vector3<f64>, d: f64, tol: f64) -> AnglesCs {
     let kp = k.dot(p);
     let perp = p - k * kp;
     let a = h.dot(&perp);
     let b = h.dot(&k.cross(p));
     let c = d - h.dot(k) * kp;
-    let rho = a.hypot(b);
+    // √ rather than hypot: the terms are lengths of a robot's size
+    let rho2 = a * a + b * b;
+    let rho = rho2.sqrt();
     if rho <= DEGENERATE * (1.0 + h.norm() * p.norm()) {
-        return Angles::free(c.abs() <= tol);
+        return AnglesCs::of(Angles::free(c.abs() <= tol));
     }
-    let phi = b.atan2(a);
     let ratio = c / rho;
     if ratio.abs() >= 1.0 - TANGENT {
         // tangent (the two roots closer than ≈ √(2·TANGENT) rad merge into one,
         // so that a singular pose gives its exact singular angle), or out of
-        // range: the nearest angle
+        // range: the nearest angle, φ or φ + π
         let exact = (c.abs() - rho) <= tol;
-        let theta = if ratio > 0.0 {
-            phi
-        } else {
-            phi + std::f64::consts::PI
-        };
-        return Angles::one(wrap(theta), exact);
+        let sign = if ratio > 0.0 { 1.0 } else { -1.0 };
+        let (cp, sp) = (sign * a / rho, sign * b / rho);
+        return AnglesCs::one(atan2_half_open(sp, cp), (cp, sp), exact);
     }
-    let alpha = ratio.acos();
-    Angles {
-        angles: [wrap(phi + alpha), wrap(phi - alpha)],
-        count: 2,
-        exact: true,
-        free: false,
+    let sa = ((rho - c.abs()) * (rho + c.abs())).sqrt();
+    let inv = 1.0 / rho2;
+    let plus = ((a * c - b * sa) * inv, (b * c + a * sa) * inv);
+    let minus = ((a * c + b * sa) * inv, (b * c - a * sa) * inv);
+    AnglesCs {
+        angles: Angles {
+            angles: [atan2_half_open(plus.1, plus.0), atan2_half_open(minus.1, minus.0)],
+            count: 2,
+            exact: true,
+            free: false,
+        },
+        cs: [plus, minus],
     }
 }
 
@@ -219,9 +299,15 @@ pub fn sp4(h: &Vector3<f64>, k: &Vector3<f64>, p: &Vector3<f64>, d: f64, tol: f6
 /// assert!(a.exact && a.count == 1 && a.angles[0].abs() < 1e-12);
 /// ```
 pub fn sp3(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>, delta: f64, tol: f64) -> Angles {
+    sp3_cs(k, p, q, delta, tol).angles
+}
+
+/// [`sp3`] with each angle's cosine and sine (see [`sp4_cs`]).
+#[inline]
+pub(crate) fn sp3_cs(k: &Vector3<f64>, p: &Vector3<f64>, q: &Vector3<f64>, delta: f64, tol: f64) -> AnglesCs {
     let d = 0.5 * (p.norm_squared() + q.norm_squared() - delta * delta);
     // tolerance on the distance δ becomes ≈ δ·tol on δ²/2
-    sp4(q, k, p, d, tol * (1.0 + delta))
+    sp4_cs(q, k, p, d, tol * (1.0 + delta))
 }
 
 /// Subproblem 2: the angle pairs `(θ₁, θ₂)` about unit axes `k₁`, `k₂` (through
@@ -290,8 +376,8 @@ mod tests {
     }
 
     #[test]
-    fn truncating_floor_ceil_round_match_the_c_library() {
-        for x in [
+    fn floating_floor_ceil_round_match_the_c_library() {
+        let mut xs = vec![
             -3.5f64,
             -3.0,
             -2.7,
@@ -307,17 +393,28 @@ mod tests {
             3.2,
             1e15 + 0.5,
             -1e15 - 0.5,
+            2.0f64.powi(51) - 0.5,
+            -(2.0f64.powi(51) - 0.5),
+            2.0f64.powi(51) + 0.5,
+            2.0f64.powi(52) - 0.5,
+            -(2.0f64.powi(52) - 0.5),
+            2.0f64.powi(52),
             1e17,
             -1e17,
-        ] {
-            if x.abs() < 4.0e15 {
-                assert_eq!(floor_i(x), x.floor() as i64, "{x}");
-                assert_eq!(ceil_i(x), x.ceil() as i64, "{x}");
-                assert_eq!(round_f(x), (x + 0.5).floor(), "{x}");
-            } else {
-                assert_eq!(round_f(x), x.round(), "{x}");
-            }
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        // every value next to an integer, both sides
+        for k in -40..=40 {
+            let k = f64::from(k) * 0.5;
+            xs.extend([k, k.next_up(), k.next_down()]);
         }
+        for x in xs {
+            assert_eq!(floor_f(x), x.floor(), "{x}");
+            assert_eq!(ceil_f(x), x.ceil(), "{x}");
+            assert_eq!(round_f(x), (x + 0.5).floor(), "{x}");
+        }
+        assert!(floor_f(f64::NAN).is_nan() && ceil_f(f64::NAN).is_nan() && round_f(f64::NAN).is_nan());
     }
 
     #[test]

@@ -594,40 +594,109 @@ fn the_analytic_method_stops_at_the_deadline_and_on_cancellation() {
     assert_eq!(cancelled.stop_reason, IkStatus::Cancelled);
 }
 
-#[test]
-fn every_whole_turn_is_enumerated_once() {
-    // the all-turns answer of a UR5 pose is, per configuration in (−π, π],
-    // the product over joints of every q + 2πk inside the limits (counted
-    // here by brute force over k = −3..=3)
-    let chain = builtin_chain("ur5").unwrap();
-    let arm = AnalyticArm::new(&chain, 1e-9).unwrap();
-    let t = chain.fk(&[0.3, -1.2, 1.4, -0.8, 1.1, 0.2]);
-    let (mut base, mut all) = (Vec::new(), Vec::new());
-    arm.solve_into(&t, None, &nearest_params(), &mut base);
-    arm.solve_into(&t, None, &AnalyticParams::default(), &mut all);
+/// Every whole-turn variant of `base` by brute force: per joint, each
+/// `q + 2πk` (k = −12..=12) within 1e-9 of the limits, clamped onto them; when
+/// more than `MAX_TURNS` lie inside, the one nearest zero and then alternately
+/// the next below and above it. A continuous joint keeps its angle.
+fn brute_force_turns(chain: &Chain, base: &[AnalyticSolution]) -> Vec<AnalyticSolution> {
     let mut want = Vec::new();
-    for s in &base {
-        let mut partial = vec![Vec::new()];
+    for s in base {
+        let mut rows = vec![*s];
         for (i, j) in chain.joints().iter().enumerate() {
-            let values: Vec<f64> = (-3..=3)
-                .map(|k| wrap(s.joints[i]) + 2.0 * PI * k as f64)
-                .filter(|v| *v >= j.lower - 1e-9 && *v <= j.upper + 1e-9)
-                .collect();
-            partial = partial
+            let q = wrap(s.joints[i]);
+            let mut ks: Vec<i32> = if j.kind == crate::robot::JointKind::Continuous {
+                vec![0]
+            } else {
+                (-12..=12)
+                    .filter(|&k| {
+                        let v = q + 2.0 * PI * f64::from(k);
+                        v >= j.lower - 1e-9 && v <= j.upper + 1e-9
+                    })
+                    .collect()
+            };
+            if let Some(&k0) = ks.iter().min_by(|a, b| {
+                let v = |k: i32| (q + 2.0 * PI * f64::from(k)).abs();
+                v(**a).total_cmp(&v(**b))
+            }) {
+                ks.sort_by_key(|&k| ((k - k0).abs(), k > k0));
+            }
+            ks.truncate(MAX_TURNS);
+            let values: Vec<f64> = ks
                 .iter()
-                .flat_map(|p: &Vec<f64>| values.iter().map(move |v| [p.clone(), vec![*v]].concat()))
+                .map(|&k| (q + 2.0 * PI * f64::from(k)).clamp(j.lower, j.upper))
+                .collect();
+            rows = rows
+                .iter()
+                .flat_map(|r| {
+                    values.iter().map(move |&v| {
+                        let mut r = *r;
+                        r.joints[i] = v;
+                        r
+                    })
+                })
                 .collect();
         }
-        want.extend(partial);
+        want.extend(rows);
     }
-    assert_eq!(all.len(), want.len());
-    for w in &want {
-        assert_eq!(
-            all.iter()
-                .filter(|s| s.joints.iter().zip(w).all(|(a, b)| (a - b).abs() < 1e-9))
-                .count(),
-            1,
-            "{w:?}"
+    want
+}
+
+#[test]
+fn every_whole_turn_is_enumerated_once() {
+    // the all-turns answer is, per configuration in (−π, π], the product over
+    // joints of every q + 2πk inside the limits (brute force above), each
+    // variant once and with its configuration's flags: the UR5 (±2π on every
+    // joint) and a hand-made three-parallel arm with many turns (capped at
+    // MAX_TURNS), narrow, one-sided and continuous joints
+    let ur5 = builtin_chain("ur5").unwrap();
+    let mut wide = PARALLEL_ARM.to_string();
+    for (joint, lo, hi) in [
+        ("j1", "-23.5", "23.5"),
+        ("j3", "-6.2832", "6.2832"),
+        ("j5", "-0.5", "9.0"),
+        ("j6", "-1.0", "1.0"),
+    ] {
+        let from = format!("<joint name=\"{joint}\" type=\"revolute\">");
+        let at = wide.find(&from).unwrap();
+        let tail = &wide[at..];
+        let old = tail[..tail.find("</joint>").unwrap()].to_string();
+        let new = old.replace(
+            "lower=\"-3.2\" upper=\"3.2\"",
+            &format!("lower=\"{lo}\" upper=\"{hi}\""),
         );
+        wide = wide.replacen(&old, &new, 1);
+    }
+    let wide = wide.replacen(
+        "<joint name=\"j4\" type=\"revolute\">",
+        "<joint name=\"j4\" type=\"continuous\">",
+        1,
+    );
+    let wide = parse_chain(&wide, &ChainSpec::default(), UrdfLimits::default()).unwrap();
+    assert_eq!(wide.joints()[3].kind, crate::robot::JointKind::Continuous);
+    let mut rng = ChaCha8Rng::seed_from_u64(29);
+    for chain in [&*ur5, &wide] {
+        let arm = AnalyticArm::new(chain, 1e-9).unwrap();
+        let (mut base, mut all) = (Vec::new(), Vec::new());
+        let mut rows = 0;
+        for _ in 0..60 {
+            let t = chain.fk(&random_q(chain, &mut rng));
+            arm.solve_into(&t, None, &nearest_params(), &mut base);
+            arm.solve_into(&t, None, &AnalyticParams::default(), &mut all);
+            let want = brute_force_turns(chain, &base);
+            assert_eq!(all.len(), want.len());
+            rows += all.len();
+            for w in &want {
+                let found: Vec<_> = all
+                    .iter()
+                    .filter(|s| s.joints.iter().zip(&w.joints).all(|(a, b)| (a - b).abs() < 1e-9))
+                    .collect();
+                assert_eq!(found.len(), 1, "{w:?}");
+                assert_eq!(
+                    (found[0].config, found[0].singular, found[0].exact),
+                    (w.config, w.singular, w.exact)
+                );
+            }
+        }
+        assert!(rows >= 60 * 16, "{rows}");
     }
 }

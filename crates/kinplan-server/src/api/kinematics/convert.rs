@@ -153,6 +153,10 @@ impl Options {
                     None | Some(0) => d.analytic.redundant_samples,
                     Some(n) => n as usize,
                 },
+                search_samples: match o.search_samples {
+                    None | Some(0) => d.analytic.search_samples,
+                    Some(n) => n as usize,
+                },
                 ..d.analytic
             },
             ..d
