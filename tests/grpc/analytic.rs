@@ -23,6 +23,18 @@ fn analytic(num_solutions: u32) -> Option<pb::IkOptions> {
     })
 }
 
+/// The robot's description (its analytic family and why not).
+async fn describe(server: &crate::TestServer, robot: Option<pb::RobotRef>) -> pb::DescribeRobotResponse {
+    RobotServiceClient::new(server.channel.clone())
+        .describe_robot(pb::DescribeRobotRequest {
+            robot,
+            ..Default::default()
+        })
+        .await
+        .unwrap()
+        .into_inner()
+}
+
 #[tokio::test]
 async fn analytic_ik_returns_every_solution_ranked_with_flags() {
     let server = start(ServerConfig::default()).await;
@@ -114,14 +126,7 @@ async fn describe_robot_names_the_family_and_refusals_name_the_reason() {
         ("franka_panda", "spherical_two_intersecting"),
         ("planar_7", ""),
     ] {
-        let d = robots
-            .describe_robot(pb::DescribeRobotRequest {
-                robot: named(name),
-                ..Default::default()
-            })
-            .await
-            .unwrap()
-            .into_inner();
+        let d = describe(&server, named(name)).await;
         assert_eq!(d.analytic_family, family, "{name}");
         assert_eq!(
             d.analytic_reason.is_empty(),
@@ -349,14 +354,7 @@ async fn offset_wrist_arm_is_searched_and_its_solutions_reach_the_pose() {
         )),
         ..Default::default()
     });
-    let d = robots
-        .describe_robot(pb::DescribeRobotRequest {
-            robot: robot.clone(),
-            ..Default::default()
-        })
-        .await
-        .unwrap()
-        .into_inner();
+    let d = describe(&server, robot.clone()).await;
     assert_eq!(d.analytic_family, "searched_6r");
     assert!(d.analytic_reason.is_empty(), "{}", d.analytic_reason);
     assert!(!d.analytic_reversed);
@@ -437,7 +435,6 @@ async fn offset_wrist_arm_is_searched_and_its_solutions_reach_the_pose() {
 async fn general_6r_arm_is_not_analytic() {
     let server = start(ServerConfig::default()).await;
     let mut ik = KinematicsServiceClient::new(server.channel.clone());
-    let mut robots = RobotServiceClient::new(server.channel.clone());
     let urdf = include_str!("../../benches/analytic_ik/offset_wrist_45.urdf").replace(
         r#"<origin xyz="0.6 0 0"/><axis xyz="0 1 0"/>"#,
         r#"<origin xyz="0.6 0 0.07"/><axis xyz="0 1 0"/>"#,
@@ -447,14 +444,7 @@ async fn general_6r_arm_is_not_analytic() {
         source: Some(pb::robot_ref::Source::Urdf(urdf)),
         ..Default::default()
     });
-    let d = robots
-        .describe_robot(pb::DescribeRobotRequest {
-            robot: robot.clone(),
-            ..Default::default()
-        })
-        .await
-        .unwrap()
-        .into_inner();
+    let d = describe(&server, robot.clone()).await;
     assert_eq!(d.analytic_family, "");
     assert!(
         d.analytic_reason.contains("2-D search is not implemented"),
