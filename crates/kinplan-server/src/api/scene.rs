@@ -193,14 +193,14 @@ mod tests {
         })
     }
 
-    fn unit_box() -> Shape {
+    fn box_of(x: f64, y: f64, z: f64) -> Shape {
         Shape::Box(pb::Box {
-            size: Some(pb::Vec3 {
-                x: 1.0,
-                y: 1.0,
-                z: 1.0,
-            }),
+            size: Some(pb::Vec3 { x, y, z }),
         })
+    }
+
+    fn unit_box() -> Shape {
+        box_of(1.0, 1.0, 1.0)
     }
 
     /// The message of converting `objects`, which must be refused.
@@ -216,16 +216,7 @@ mod tests {
         let fine = object(unit_box(), None);
         let cases = [
             (
-                object(
-                    Shape::Box(pb::Box {
-                        size: Some(pb::Vec3 {
-                            x: 1.0,
-                            y: 0.0,
-                            z: 1.0,
-                        }),
-                    }),
-                    None,
-                ),
+                object(box_of(1.0, 0.0, 1.0), None),
                 "scene.objects[1].box.size.y: must be > 0, got 0",
             ),
             (
@@ -271,16 +262,7 @@ mod tests {
         let (s, c) = (0.5f64.sqrt(), 0.5f64.sqrt());
         let scene = pb::Scene {
             objects: vec![
-                object(
-                    Shape::Box(pb::Box {
-                        size: Some(pb::Vec3 {
-                            x: 0.2,
-                            y: 0.4,
-                            z: 0.6,
-                        }),
-                    }),
-                    pose([1.0, -2.0, 3.0], [0.0, 0.0, s, c]),
-                ),
+                object(box_of(0.2, 0.4, 0.6), pose([1.0, -2.0, 3.0], [0.0, 0.0, s, c])),
                 object(
                     Shape::Cylinder(pb::Cylinder {
                         radius: 0.1,
