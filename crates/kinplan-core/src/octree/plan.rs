@@ -25,9 +25,10 @@ pub(crate) enum EndPoint {
 pub(crate) struct Beam {
     /// `p − o` in f32 (OctoMap's `point3d` arithmetic).
     pub diff: [f32; 3],
-    /// `diff · diff` summed in f32; the beam's length is its f64 square root, as
-    /// OctoMap's `norm()`.
-    pub sumsq: f32,
+    /// The beam's length (m): `√(diff · diff)` with the squares summed in f32 and
+    /// the root in f64, as OctoMap's `norm()`; worked out once here, where the
+    /// points stream by, rather than on each walk's chain of dependent operations.
+    pub norm: f64,
     /// Key of `p` when `kind` is [`EndPoint::InTree`].
     pub end: OcKey,
     pub kind: EndPoint,
@@ -37,7 +38,7 @@ impl Beam {
     /// The beam's length (m): `√(diff · diff)` with the squares summed in f32.
     #[inline]
     pub(crate) fn norm(&self) -> f64 {
-        (self.sumsq as f64).sqrt()
+        self.norm
     }
 }
 
@@ -144,7 +145,7 @@ impl<'a> PlanBuilder<'a> {
         self.chunk_cells += cost;
         let beam = Beam {
             diff,
-            sumsq,
+            norm: (sumsq as f64).sqrt(),
             end,
             kind,
         };
