@@ -118,11 +118,6 @@ impl<'a> PlanBuilder<'a> {
         let key = if finite { self.tree.key_of_f32(p) } else { None };
         let (kind, end, cost) = match key {
             Some(k) => {
-                let plan = &mut self.plan;
-                for ((lo, hi), &k) in plan.lo.iter_mut().zip(plan.hi.iter_mut()).zip(&k) {
-                    *lo = (*lo).min(k);
-                    *hi = (*hi).max(k);
-                }
                 let l1: u64 = (0..3)
                     .map(|a| (k[a] as i64 - self.ko[a] as i64).unsigned_abs())
                     .sum();
@@ -165,6 +160,22 @@ impl<'a> PlanBuilder<'a> {
                 limit: params.max_traced_cells,
             });
         }
+        // the key box of the origin and the end points, in one pass over the beams
+        // (kept in registers, where per point it was a load and store of the box
+        // each point's update had to wait for)
+        let (mut lo, mut hi) = (self.ko, self.ko);
+        for b in &self.plan.beams {
+            let k = if b.kind == EndPoint::InTree {
+                b.end
+            } else {
+                self.ko
+            };
+            for a in 0..3 {
+                lo[a] = lo[a].min(k[a]);
+                hi[a] = hi[a].max(k[a]);
+            }
+        }
+        (self.plan.lo, self.plan.hi) = (lo, hi);
         // a cut beam of a far point can leave the end points' box: widen it by the cut
         if self.max_range > 0.0 && self.any_outside {
             let reach = (self.cut_bound / 3).min(65535) as u16;
