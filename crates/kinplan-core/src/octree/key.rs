@@ -26,12 +26,16 @@ pub fn coord_to_key_axis(c: f64, resolution_factor: f64) -> Option<u16> {
     if !(s >= -(TREE_MAX_VAL as f64) && s < TREE_MAX_VAL as f64) {
         return None;
     }
-    // ⌊s⌋ without a libm call: adding and removing 1.5·2^52 rounds s to the nearest
-    // integer (exact for |s| < 2^51), one less where that rounded up
+    // ⌊s⌋ without a libm call: adding 1.5·2^52 rounds s to the nearest integer n
+    // (exact for |s| < 2^51) and leaves n in the low bits of the sum's mantissa, in
+    // two's complement (the mantissa is 2^51 + n); removing it again gives n as a
+    // float, and ⌊s⌋ is one less where n > s. Reading n from the bits spares the
+    // saturating float-to-int conversion.
     const ROUND: f64 = 6_755_399_441_055_744.0;
-    let r = (s + ROUND) - ROUND;
-    let floor = if r > s { r - 1.0 } else { r };
-    Some((floor as i32 + TREE_MAX_VAL) as u16)
+    let y = s + ROUND;
+    let n = y.to_bits() as u32 as i32;
+    let floor = n - ((y - ROUND > s) as i32);
+    Some((floor + TREE_MAX_VAL) as u16)
 }
 
 /// Centre of a depth-16 key along one axis (m): `(k − 32768 + ½) · res`.
@@ -165,6 +169,15 @@ mod tests {
             cs.extend([c, c.next_up(), c.next_down(), (c as f32) as f64]);
         }
         cs.extend([-1638.4, 1638.3999, -1638.3999]);
+        // and a spread over the whole cube, fractions of every size (a fixed LCG)
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..20_000 {
+            x = x
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            let u = (x >> 11) as f64 / (1u64 << 53) as f64;
+            cs.push((u * 2.0 - 1.0) * 1638.39);
+        }
         for c in cs {
             let want = ((c * f).floor() as i32 + TREE_MAX_VAL) as u16;
             assert_eq!(coord_to_key_axis(c, f), Some(want), "c = {c:e}");

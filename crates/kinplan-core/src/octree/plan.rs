@@ -25,9 +25,10 @@ pub(crate) enum EndPoint {
 pub(crate) struct Beam {
     /// `p − o` in f32 (OctoMap's `point3d` arithmetic).
     pub diff: [f32; 3],
-    /// `diff · diff` summed in f32; the beam's length is its f64 square root, as
-    /// OctoMap's `norm()`.
-    pub sumsq: f32,
+    /// The beam's length (m): `√(diff · diff)` with the squares summed in f32 and
+    /// the root in f64, as OctoMap's `norm()`; worked out once here, where the
+    /// points stream by, rather than on each walk's chain of dependent operations.
+    pub norm: f64,
     /// Key of `p` when `kind` is [`EndPoint::InTree`].
     pub end: OcKey,
     pub kind: EndPoint,
@@ -37,7 +38,7 @@ impl Beam {
     /// The beam's length (m): `√(diff · diff)` with the squares summed in f32.
     #[inline]
     pub(crate) fn norm(&self) -> f64 {
-        (self.sumsq as f64).sqrt()
+        self.norm
     }
 }
 
@@ -117,11 +118,6 @@ impl<'a> PlanBuilder<'a> {
         let key = if finite { self.tree.key_of_f32(p) } else { None };
         let (kind, end, cost) = match key {
             Some(k) => {
-                let plan = &mut self.plan;
-                for ((lo, hi), &k) in plan.lo.iter_mut().zip(plan.hi.iter_mut()).zip(&k) {
-                    *lo = (*lo).min(k);
-                    *hi = (*hi).max(k);
-                }
                 let l1: u64 = (0..3)
                     .map(|a| (k[a] as i64 - self.ko[a] as i64).unsigned_abs())
                     .sum();
@@ -144,7 +140,7 @@ impl<'a> PlanBuilder<'a> {
         self.chunk_cells += cost;
         let beam = Beam {
             diff,
-            sumsq,
+            norm: (sumsq as f64).sqrt(),
             end,
             kind,
         };
@@ -164,6 +160,22 @@ impl<'a> PlanBuilder<'a> {
                 limit: params.max_traced_cells,
             });
         }
+        // the key box of the origin and the end points, in one pass over the beams
+        // (kept in registers, where per point it was a load and store of the box
+        // each point's update had to wait for)
+        let (mut lo, mut hi) = (self.ko, self.ko);
+        for b in &self.plan.beams {
+            let k = if b.kind == EndPoint::InTree {
+                b.end
+            } else {
+                self.ko
+            };
+            for a in 0..3 {
+                lo[a] = lo[a].min(k[a]);
+                hi[a] = hi[a].max(k[a]);
+            }
+        }
+        (self.plan.lo, self.plan.hi) = (lo, hi);
         // a cut beam of a far point can leave the end points' box: widen it by the cut
         if self.max_range > 0.0 && self.any_outside {
             let reach = (self.cut_bound / 3).min(65535) as u16;

@@ -57,6 +57,7 @@ pub struct RayHit {
 
 /// The per-axis DDA state of OctoMap: step sign, parameter of the next border,
 /// parameter increment per cell.
+#[derive(Clone, Copy)]
 struct Dda {
     step: [i32; 3],
     t_max: [f64; 3],
@@ -103,6 +104,25 @@ impl Dda {
             2
         }
     }
+}
+
+/// Where a walk starts (see [`Octree::walk_start`]).
+pub(crate) enum WalkStart {
+    /// A point lies outside the tree's cube (the walk reports false).
+    Outside,
+    /// No cell to visit.
+    Empty,
+    From(Walk),
+}
+
+/// A started walk: its first cell `ks`, end cell `ke`, DDA state there and the
+/// segment's length (m).
+#[derive(Clone, Copy)]
+pub(crate) struct Walk {
+    ks: OcKey,
+    ke: OcKey,
+    dda: Dda,
+    length: f64,
 }
 
 /// Addresses of the cells a walk visits: a cell's address is `Σ_a term(a, k_a)`.
@@ -192,15 +212,28 @@ impl Octree {
         addr: &impl CellAddress,
         visit: impl FnMut(&OcKey, usize),
     ) -> bool {
+        match self.ray_walk_start(origin, end, t_start) {
+            WalkStart::Outside => false,
+            WalkStart::Empty => true,
+            WalkStart::From(w) => {
+                self.walk(&w, addr, visit);
+                true
+            }
+        }
+    }
+
+    /// Where the walk of [`visit_ray_cells_from`](Self::visit_ray_cells_from) starts.
+    #[inline]
+    pub(crate) fn ray_walk_start(&self, origin: &[f32; 3], end: &[f32; 3], t_start: f64) -> WalkStart {
         let diff = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
         let norm = f32_norm(&diff);
         if t_start > 0.0 && t_start >= norm as f32 as f64 {
-            return true;
+            return WalkStart::Empty;
         }
         let Some(ke) = self.key_of_f32(end) else {
-            return false;
+            return WalkStart::Outside;
         };
-        self.walk_beam(origin, &diff, norm, &ke, t_start, addr, visit)
+        self.walk_start(origin, &diff, norm, &ke, t_start)
     }
 
     /// The walk of [`visit_ray_cells_from`](Self::visit_ray_cells_from) given the
@@ -216,12 +249,35 @@ impl Octree {
         ke: &OcKey,
         t_start: f64,
         addr: &impl CellAddress,
-        mut visit: impl FnMut(&OcKey, usize),
+        visit: impl FnMut(&OcKey, usize),
     ) -> bool {
+        match self.walk_start(origin, diff, norm, ke, t_start) {
+            WalkStart::Outside => false,
+            WalkStart::Empty => true,
+            WalkStart::From(w) => {
+                self.walk(&w, addr, visit);
+                true
+            }
+        }
+    }
+
+    /// The start of [`walk_beam`](Self::walk_beam): its first cell and DDA state, or
+    /// why it visits nothing. Apart from the walk itself, so that a scan can work out
+    /// the starts of many beams in a row (independent of each other) before it walks
+    /// them.
+    #[inline]
+    pub(crate) fn walk_start(
+        &self,
+        origin: &[f32; 3],
+        diff: &[f32; 3],
+        norm: f64,
+        ke: &OcKey,
+        t_start: f64,
+    ) -> WalkStart {
         let ke = *ke;
         let length = norm as f32;
         if t_start > 0.0 && t_start >= length as f64 {
-            return true;
+            return WalkStart::Empty;
         }
         let dir = diff.map(|v| v / length);
         let length = length as f64;
@@ -229,41 +285,56 @@ impl Octree {
             let f = self.resolution_factor;
             let at = |i: usize| coord_to_key_axis(origin[i] as f64 + t_start * dir[i] as f64, f);
             let (Some(x), Some(y), Some(z)) = (at(0), at(1), at(2)) else {
-                return true;
+                return WalkStart::Empty;
             };
             let ks = [x, y, z];
             if ks == ke {
-                return true;
+                return WalkStart::Empty;
             }
             let dda = Dda::new(&ks, origin, &dir, self.resolution, true);
             // the whole walk visits this cell only when it leaves it before the end
             let exit = dda.t_max[0].min(dda.t_max[1]).min(dda.t_max[2]);
             if exit > length {
-                return true;
+                return WalkStart::Empty;
             }
             (ks, dda)
         } else {
             // a start inside the segment lies in the end cell when the origin does
             // (cells are convex), so only the whole walk checks the origin's cell
             let Some(ko) = self.key_of_f32(origin) else {
-                return false;
+                return WalkStart::Outside;
             };
             if ko == ke {
-                return true;
+                return WalkStart::Empty;
             }
             (ko, Dda::new(&ko, origin, &dir, self.resolution, true))
         };
+        WalkStart::From(Walk { ks, ke, dda, length })
+    }
+
+    /// Visits the cells of a started walk (see [`walk_beam`](Self::walk_beam)).
+    #[inline]
+    pub(crate) fn walk(&self, w: &Walk, addr: &impl CellAddress, mut visit: impl FnMut(&OcKey, usize)) {
+        let Walk {
+            ks,
+            ke,
+            ref dda,
+            length,
+        } = *w;
         visit(
             &ks,
             addr.term(0, ks[0]) + addr.term(1, ks[1]) + addr.term(2, ks[2]),
         );
         // Steps until the key can equal the end key: the walk moves each axis by its
         // sign only, so it meets `ke` exactly after Σ_a (ke_a − ks_a)·step_a steps if
-        // every term is ≥ 0 (and 0 on a still axis), or never.
-        let mut to_end = (0..3).try_fold(0i64, |n, a| {
-            let r = (ke[a] as i64 - ks[a] as i64) * dda.step[a] as i64;
-            (r >= 0 && (dda.step[a] != 0 || r == 0)).then_some(n + r)
-        });
+        // every term is ≥ 0 (and 0 on a still axis), or never (−1: the count only
+        // falls and never meets 0).
+        let mut to_end = (0..3)
+            .try_fold(0i64, |n, a| {
+                let r = (ke[a] as i64 - ks[a] as i64) * dda.step[a] as i64;
+                (r >= 0 && (dda.step[a] != 0 || r == 0)).then_some(n + r)
+            })
+            .unwrap_or(-1);
         // the DDA state in scalar locals (registers): an array indexed by the axis made
         // each step wait on a partial store-to-load forward of the key
         let [mut kx, mut ky, mut kz] = ks;
@@ -274,44 +345,49 @@ impl Octree {
         // The walk visits the cell it enters unless it is the end cell or the segment
         // ends before leaving it (`min t_max > length`). That minimum is the `t_max`
         // the next step picks, so the test waits for the next axis choice: each
-        // branch first checks its own `t_max`, then visits the cell, then steps.
-        let mut entered = false;
-        // a beam between two keys in the cube crosses at most 3 · 65536 borders
-        for _ in 0..3 * 65536 + 1 {
-            // axis of the smallest t_max, ties as in `Dda::axis`
-            macro_rules! step {
-                ($t:ident, $d:ident, $k:ident, $s:ident, $a:ident, $axis:expr) => {{
-                    if entered {
-                        if $t > length {
-                            break;
-                        }
-                        visit(&[kx, ky, kz], ax + ay + az);
+        // branch first checks its own `t_max` (not for the first step, out of the
+        // start cell, visited above), then visits the cell, then steps.
+        macro_rules! step {
+            ($t:ident, $d:ident, $k:ident, $s:ident, $a:ident, $axis:expr, $first:expr) => {{
+                if !$first {
+                    if $t > length {
+                        break;
                     }
-                    $k = $k.wrapping_add($s);
-                    $t += $d;
-                    $a = addr.term($axis, $k);
-                }};
-            }
-            if tx < ty {
-                if tx < tz {
-                    step!(tx, dx, kx, sx, ax, 0)
-                } else {
-                    step!(tz, dz, kz, sz, az, 2)
+                    visit(&[kx, ky, kz], ax + ay + az);
                 }
-            } else if ty < tz {
-                step!(ty, dy, ky, sy, ay, 1)
-            } else {
-                step!(tz, dz, kz, sz, az, 2)
-            }
-            entered = true;
-            if let Some(n) = to_end.as_mut() {
-                *n -= 1;
-                if *n == 0 && kx == ke[0] && ky == ke[1] && kz == ke[2] {
+                $k = $k.wrapping_add($s);
+                $t += $d;
+                $a = addr.term($axis, $k);
+            }};
+        }
+        // axis of the smallest t_max, ties as in `Dda::axis`
+        macro_rules! choose_and_step {
+            ($first:expr) => {{
+                if tx < ty {
+                    if tx < tz {
+                        step!(tx, dx, kx, sx, ax, 0, $first)
+                    } else {
+                        step!(tz, dz, kz, sz, az, 2, $first)
+                    }
+                } else if ty < tz {
+                    step!(ty, dy, ky, sy, ay, 1, $first)
+                } else {
+                    step!(tz, dz, kz, sz, az, 2, $first)
+                }
+                to_end -= 1;
+                if to_end == 0 && kx == ke[0] && ky == ke[1] && kz == ke[2] {
                     break;
                 }
+            }};
+        }
+        // a beam between two keys in the cube crosses at most 3 · 65536 borders
+        #[allow(clippy::never_loop)]
+        for _ in 0..1 {
+            choose_and_step!(true);
+            for _ in 0..3 * 65536 {
+                choose_and_step!(false);
             }
         }
-        true
     }
 
     /// Casts a ray from `origin` along `direction` (m, map frame; both rounded to f32)

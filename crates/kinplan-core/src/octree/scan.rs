@@ -14,7 +14,7 @@ use super::frame::{PixelBeam, near_field_starts};
 use super::grid::{BLOCK_WORDS, BlockGrid};
 use super::key::{OcKey, morton, unmorton};
 use super::plan::{Beam, EndPoint, PlanBuilder, ScanPlan};
-use super::ray::{CellAddress, NoAddress};
+use super::ray::{CellAddress, NoAddress, Walk, WalkStart};
 use super::{Octree, OctreeError, OctreeLimits};
 use crate::Deadline;
 
@@ -239,6 +239,9 @@ fn merge_sorted(a: &[u64], b: &[u64]) -> Vec<u64> {
 /// limit: bounds the keys held at once.
 const BATCH_CELLS: u64 = 1 << 22;
 
+/// Beams whose walks are started in a row before they are walked (dense path).
+const WALK_GROUP: usize = 64;
+
 /// Cell updates between two looks at the stop flag and the node count.
 const UPDATES_PER_CHECK: usize = 4096;
 
@@ -428,6 +431,38 @@ impl Octree {
         true
     }
 
+    /// [`trace_beam`](Self::trace_beam) up to the start of its walk: the end cell
+    /// (if any) goes to `end` and the walk, not yet taken, is returned with false
+    /// when the point is skipped.
+    #[inline]
+    fn beam_start(
+        &self,
+        beam: &Beam,
+        origin: &[f32; 3],
+        t0: f64,
+        max_range: f64,
+        end: impl FnOnce(&OcKey),
+    ) -> (bool, WalkStart) {
+        if beam.kind == EndPoint::NonFinite {
+            return (false, WalkStart::Empty);
+        }
+        let norm = beam.norm();
+        if max_range <= 0.0 || norm <= max_range {
+            if beam.kind != EndPoint::InTree {
+                return (false, WalkStart::Empty);
+            }
+            end(&beam.end);
+            if t0 < norm {
+                return (true, self.walk_start(origin, &beam.diff, norm, &beam.end, t0));
+            }
+        } else if t0 < max_range {
+            let (n, m) = (norm as f32, max_range as f32);
+            let e = [0, 1, 2].map(|i| origin[i] + beam.diff[i] / n * m);
+            return (true, self.ray_walk_start(origin, &e, t0));
+        }
+        (true, WalkStart::Empty)
+    }
+
     /// Traces every beam into two bitsets over the key box (free, end points), one
     /// pair per worker, merges them by OR and clears free bits that are end points.
     /// `None` when `deadline` fired.
@@ -451,22 +486,38 @@ impl Octree {
             .map(|w| {
                 let (mut free, mut occ, mut skipped) = (vec![0u64; words], vec![0u64; words], 0usize);
                 let mut traced = 0u64;
+                // The starts of a group of beams are worked out first, then the
+                // group is walked: each start is a chain of dependent float
+                // operations (norm, direction, start key, border parameters), and
+                // worked out in a row they overlap instead of each waiting for the
+                // previous walk's last, mispredicted step.
+                let mut walks: Vec<Walk> = Vec::with_capacity(WALK_GROUP);
                 for (range, _) in plan.chunks.iter().skip(w).step_by(workers) {
                     if deadline.expired() {
                         return None;
                     }
-                    for i in range.clone() {
-                        let t0 = starts.map_or(0.0, |s| s[i] as f64);
-                        let mark = |_: &OcKey, i: usize| {
-                            traced += 1;
-                            free[i >> 6] |= 1 << (i & 63);
-                        };
-                        let end = |k: &OcKey| {
-                            let i = grid.index(k);
-                            occ[i >> 6] |= 1 << (i & 63);
-                        };
-                        if !self.trace_beam(&plan.beams[i], origin, t0, max_range, &grid, mark, end) {
-                            skipped += 1;
+                    for first in range.clone().step_by(WALK_GROUP) {
+                        walks.clear();
+                        for i in first..(first + WALK_GROUP).min(range.end) {
+                            let t0 = starts.map_or(0.0, |s| s[i] as f64);
+                            let end = |k: &OcKey| {
+                                let i = grid.index(k);
+                                occ[i >> 6] |= 1 << (i & 63);
+                            };
+                            let (counted, start) =
+                                self.beam_start(&plan.beams[i], origin, t0, max_range, end);
+                            if !counted {
+                                skipped += 1;
+                            }
+                            if let WalkStart::From(walk) = start {
+                                walks.push(walk);
+                            }
+                        }
+                        for walk in &walks {
+                            self.walk(walk, &grid, |_, i| {
+                                traced += 1;
+                                free[i >> 6] |= 1 << (i & 63);
+                            });
                         }
                     }
                 }
