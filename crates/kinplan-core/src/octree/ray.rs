@@ -212,7 +212,13 @@ impl Octree {
         addr: &impl CellAddress,
         visit: impl FnMut(&OcKey, usize),
     ) -> bool {
-        match self.ray_walk_start(origin, end, t_start) {
+        self.walk_from(self.ray_walk_start(origin, end, t_start), addr, visit)
+    }
+
+    /// Walks from `start`: false when the beam lies outside the tree's cube.
+    #[inline]
+    fn walk_from(&self, start: WalkStart, addr: &impl CellAddress, visit: impl FnMut(&OcKey, usize)) -> bool {
+        match start {
             WalkStart::Outside => false,
             WalkStart::Empty => true,
             WalkStart::From(w) => {
@@ -251,14 +257,7 @@ impl Octree {
         addr: &impl CellAddress,
         visit: impl FnMut(&OcKey, usize),
     ) -> bool {
-        match self.walk_start(origin, diff, norm, ke, t_start) {
-            WalkStart::Outside => false,
-            WalkStart::Empty => true,
-            WalkStart::From(w) => {
-                self.walk(&w, addr, visit);
-                true
-            }
-        }
+        self.walk_from(self.walk_start(origin, diff, norm, ke, t_start), addr, visit)
     }
 
     /// The start of [`walk_beam`](Self::walk_beam): its first cell and DDA state, or
