@@ -50,6 +50,18 @@ impl Entry {
         stack
     }
 
+    /// Its child `i`, planes `mask` still to test, in `block` with `known` known cells.
+    #[inline(always)]
+    fn child(&self, i: usize, mask: u8, block: u32, known: u64) -> Entry {
+        Entry {
+            key: child_key(&self.key, self.depth, i),
+            depth: self.depth + 1,
+            mask,
+            block,
+            known,
+        }
+    }
+
     /// Whether the cube of `side` keys at this entry overlaps the key box
     /// `lo..=hi`, and whether it lies wholly inside it.
     #[inline(always)]
@@ -216,13 +228,7 @@ impl<'a> FrustumCounter<'a> {
                     continue;
                 }
                 for i in 0..8 {
-                    stack[len] = Entry {
-                        key: child_key(&e.key, e.depth, i),
-                        depth: e.depth + 1,
-                        mask,
-                        block: CountBlock::ABSENT,
-                        known: 0,
-                    };
+                    stack[len] = e.child(i, mask, CountBlock::ABSENT, 0);
                     len += 1;
                 }
                 continue;
@@ -234,13 +240,7 @@ impl<'a> FrustumCounter<'a> {
                 if b.child[i] == CountBlock::LEAF || b.known[i] == full {
                     continue;
                 }
-                stack[len] = Entry {
-                    key: child_key(&e.key, e.depth, i),
-                    depth: e.depth + 1,
-                    mask,
-                    block: b.child[i],
-                    known: b.known[i],
-                };
+                stack[len] = e.child(i, mask, b.child[i], b.known[i]);
                 len += 1;
             }
         }
@@ -283,13 +283,7 @@ impl<'a> FrustumCounter<'a> {
                     count += rows.count(&e.key, side, mask);
                 } else {
                     for i in 0..8 {
-                        stack[len] = Entry {
-                            key: child_key(&e.key, e.depth, i),
-                            depth: e.depth + 1,
-                            mask,
-                            block: CountBlock::LEAF,
-                            known: e.known / 8,
-                        };
+                        stack[len] = e.child(i, mask, CountBlock::LEAF, e.known / 8);
                         len += 1;
                     }
                 }
@@ -300,13 +294,7 @@ impl<'a> FrustumCounter<'a> {
                 if b.known[i] == 0 {
                     continue;
                 }
-                stack[len] = Entry {
-                    key: child_key(&e.key, e.depth, i),
-                    depth: e.depth + 1,
-                    mask,
-                    block: b.child[i],
-                    known: b.known[i],
-                };
+                stack[len] = e.child(i, mask, b.child[i], b.known[i]);
                 len += 1;
             }
         }
