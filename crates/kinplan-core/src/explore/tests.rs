@@ -391,31 +391,37 @@ fn cells_of(t: &crate::octree::Octree) -> Vec<([u16; 3], bool)> {
     out
 }
 
-#[test]
-fn a_depth_image_from_the_simulated_camera_inserts_like_its_points() {
-    use crate::octree::{Octree, ScanParams, depth_from_millimetres};
-    // a wall 3 m ahead, a box and a ball before it
-    let world = geometry(vec![
+/// A wall (0.2 m thick, 10 m square) across x at `wall_x`, a box (0.4 × 0.5 ×
+/// 0.6 m) at `box_at` and a ball of `ball_r` at `ball_at` before it (m).
+fn wall_box_ball(wall_x: f64, box_at: [f64; 3], ball_at: [f64; 3], ball_r: f64) -> Arc<SceneGeometry> {
+    geometry(vec![
         Obstacle::new(
             "wall",
-            Isometry3::translation(3.1, 0.0, 0.0),
+            Isometry3::translation(wall_x, 0.0, 0.0),
             Geometry::Box {
                 half_extents: Vector3::new(0.1, 5.0, 5.0),
             },
         ),
         Obstacle::new(
             "box",
-            Isometry3::translation(1.6, 0.3, -0.2),
+            Isometry3::translation(box_at[0], box_at[1], box_at[2]),
             Geometry::Box {
                 half_extents: Vector3::new(0.2, 0.25, 0.3),
             },
         ),
         Obstacle::new(
             "ball",
-            Isometry3::translation(2.0, -0.5, 0.3),
-            Geometry::Sphere { radius: 0.3 },
+            Isometry3::translation(ball_at[0], ball_at[1], ball_at[2]),
+            Geometry::Sphere { radius: ball_r },
         ),
-    ]);
+    ])
+}
+
+#[test]
+fn a_depth_image_from_the_simulated_camera_inserts_like_its_points() {
+    use crate::octree::{Octree, ScanParams, depth_from_millimetres};
+    // a wall 3 m ahead, a box and a ball before it
+    let world = wall_box_ball(3.1, [1.6, 0.3, -0.2], [2.0, -0.5, 0.3], 0.3);
     let cam = CameraModel {
         width: 96,
         height: 72,
@@ -488,27 +494,7 @@ fn a_strided_image_with_the_shared_near_field_inserts_like_its_points() {
     use crate::octree::{NEAR_RAY_SPACING, Octree, ScanParams};
     // the explore loop's scan: a Kinect v2 image at stride 4, 0.1 m cells; a wall,
     // a box close to the camera and a ball
-    let world = geometry(vec![
-        Obstacle::new(
-            "wall",
-            Isometry3::translation(3.6, 0.0, 0.0),
-            Geometry::Box {
-                half_extents: Vector3::new(0.1, 5.0, 5.0),
-            },
-        ),
-        Obstacle::new(
-            "box",
-            Isometry3::translation(0.9, 0.3, -0.2),
-            Geometry::Box {
-                half_extents: Vector3::new(0.2, 0.25, 0.3),
-            },
-        ),
-        Obstacle::new(
-            "ball",
-            Isometry3::translation(2.2, -0.6, 0.4),
-            Geometry::Sphere { radius: 0.35 },
-        ),
-    ]);
+    let world = wall_box_ball(3.6, [0.9, 0.3, -0.2], [2.2, -0.6, 0.4], 0.35);
     let cam = CameraModel::default();
     let stride = SensorParams::default().pixel_stride;
     let pose = look_along(&Point3::new(0.02, 0.03, 0.01), &Vector3::new(1.0, 0.05, -0.1)).unwrap();

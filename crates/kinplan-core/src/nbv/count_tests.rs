@@ -155,16 +155,21 @@ proptest! {
     }
 }
 
-#[test]
-fn counts_on_trees_with_no_nodes_one_leaf_and_axis_aligned_views() {
-    let cam = CameraModel {
+/// A narrow camera of 8 × 6 pixels seeing 0.05–1.5 m.
+fn small_camera() -> CameraModel {
+    CameraModel {
         hfov: 1.0,
         vfov: 0.8,
         near: 0.05,
         far: 1.5,
         width: 8,
         height: 6,
-    };
+    }
+}
+
+#[test]
+fn counts_on_trees_with_no_nodes_one_leaf_and_axis_aligned_views() {
+    let cam = small_camera();
     // axis-aligned views put plane normals with zero components along the row axes
     let dirs = [Vector3::x(), -Vector3::y(), Vector3::z(), -Vector3::z()];
     let empty = Octree::new(0.1).unwrap();
@@ -355,14 +360,7 @@ fn a_view_leaving_the_key_space_counts_like_every_cell() {
             }
         }
     }
-    let cam = CameraModel {
-        hfov: 1.0,
-        vfov: 0.8,
-        near: 0.05,
-        far: 1.5,
-        width: 8,
-        height: 6,
-    };
+    let cam = small_camera();
     let pose = look_along(&Point3::new(3276.05, 0.03, 0.02), &Vector3::new(1.0, 0.1, -0.05)).unwrap();
     let f = Frustum::new(&cam, &pose);
     assert!(f.corners.iter().any(|c| t.key_of(c).is_err()));
