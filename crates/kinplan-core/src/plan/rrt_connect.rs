@@ -326,8 +326,8 @@ fn dist(a: &[f64], b: &[f64]) -> f64 {
 /// cost is the proof of its chord whatever it gains, and converged paths draw
 /// many chords that gain almost nothing. On the MotionBenchMaker Panda
 /// problems the shortcuts below this gain took a large share of the
-/// checking time for a few percent of the total shortening
-/// (`benches/RESULTS.md`, shortcutting under a Plan call).
+/// checking time for little of the total shortening (`benches/RESULTS.md`,
+/// shortcutting under a Plan call).
 const MIN_SHORTCUT_GAIN: f64 = 0.01;
 
 /// Longest stretch of path, as a fraction of its length, a random shortcut
@@ -391,9 +391,8 @@ fn greedy_pass<C: StateChecker + ?Sized>(
 /// `clock` is interrupted (the path stays valid).
 ///
 /// No greedy pass follows the random ones: on the MotionBenchMaker Panda
-/// problems it only ever removed single vertices, shortening the median
-/// path by about one percent for a fifth or more of the shortcutting time
-/// (`benches/RESULTS.md`).
+/// problems it only ever removed single vertices, shortening the paths
+/// little for a large share of the shortcutting time (`benches/RESULTS.md`).
 pub(crate) fn shortcut<C: StateChecker + ?Sized>(
     checker: &C,
     path: &mut Vec<f64>,
