@@ -98,7 +98,11 @@ fn primitive_in(path: &dyn Fn() -> String, shape: &Shape) -> Result<Geometry, St
         },
         Shape::Capsule(c) => Geometry::Capsule {
             radius: positive(|| format!("{}.capsule.radius", path()), c.radius)?,
-            length: finite(&format!("{}.capsule.length", path()), c.length)?.max(0.0),
+            length: if c.length.is_finite() {
+                c.length.max(0.0)
+            } else {
+                finite(&format!("{}.capsule.length", path()), c.length)?
+            },
         },
         Shape::Mesh(m) => {
             if m.indices.len() % 3 != 0 {
@@ -246,6 +250,16 @@ mod tests {
                     None,
                 ),
                 "scene.objects[1].capsule.radius: must be finite, got inf",
+            ),
+            (
+                object(
+                    Shape::Capsule(pb::Capsule {
+                        radius: 0.1,
+                        length: f64::NAN,
+                    }),
+                    None,
+                ),
+                "scene.objects[1].capsule.length: must be finite, got NaN",
             ),
         ];
         for (bad, expected) in cases {
