@@ -504,3 +504,54 @@ fn echoed_names_are_clipped() {
     let err = builtin_chain(&long).unwrap_err().to_string();
     assert!(err.len() < 400 && err.contains('…'), "{}", err.len());
 }
+
+/// Signed distance (m) from `p` (in the shape's frame) to a URDF primitive:
+/// capsules and cylinders along z, centred.
+fn urdf_shape_distance(shape: &urdf_rs::Geometry, p: &Vector3<f64>) -> f64 {
+    match shape {
+        urdf_rs::Geometry::Sphere { radius } => p.norm() - radius,
+        urdf_rs::Geometry::Capsule { radius, length } => {
+            let z = p.z.clamp(-length / 2.0, length / 2.0);
+            (p - Vector3::new(0.0, 0.0, z)).norm() - radius
+        }
+        urdf_rs::Geometry::Box { size } => {
+            let q = p.abs() - Vector3::new(size[0], size[1], size[2]) / 2.0;
+            q.map(|v| v.max(0.0)).norm() + q.max().min(0.0)
+        }
+        other => panic!("unexpected shape {other:?}"),
+    }
+}
+
+/// The built-in Panda's collision shapes hold the real arm: every vertex of
+/// the collision meshes MoveIt plans with (example-robot-data, placed in the
+/// built-in link frames by `fit_panda_covers.py`, which checks the frames
+/// against pinocchio's) lies inside the one convex shape of its link, so the
+/// shape holds the mesh, and a state the built-in model finds free is free for
+/// the real Panda. Read straight from the URDF text, not through our parser.
+#[test]
+fn builtin_panda_shapes_hold_the_real_meshes() {
+    let points = include_str!("builtin/panda_mesh_points.txt");
+    for name in ["franka_panda", "franka_panda_hand"] {
+        let robot = urdf_rs::read_from_string(builtin_urdf(name).unwrap()).unwrap();
+        let mut checked = 0;
+        for line in points.lines().filter(|l| !l.starts_with('#')) {
+            let mut it = line.split_whitespace();
+            let link_name = it.next().unwrap();
+            let v: Vec<f64> = it.map(|x| x.parse().unwrap()).collect();
+            let Some(link) = robot.links.iter().find(|l| l.name == link_name) else {
+                assert!(name == "franka_panda", "{name} has no link {link_name}");
+                continue;
+            };
+            assert_eq!(link.collision.len(), 1, "{name} {link_name}: one convex shape");
+            let c = &link.collision[0];
+            let (xyz, rpy) = (c.origin.xyz, c.origin.rpy);
+            let pose = Isometry3::new(Vector3::new(xyz[0], xyz[1], xyz[2]), Vector3::zeros())
+                * nalgebra::UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
+            let local = pose.inverse_transform_point(&nalgebra::Point3::new(v[0], v[1], v[2]));
+            let d = urdf_shape_distance(&c.geometry, &local.coords);
+            assert!(d <= -1e-4, "{name} {link_name}: mesh vertex {v:?} at {d} m from its shape (must be 0.1 mm inside)");
+            checked += 1;
+        }
+        assert!(checked >= 1000, "{name}: {checked} vertices checked");
+    }
+}

