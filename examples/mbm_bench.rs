@@ -25,7 +25,8 @@
 //! of planning, the minimum of five passes over all states and over the
 //! ones it finds free and in groups of eight that stop at their first
 //! collision (as VAMP's blocks do), and counts the states whose verdict differs from
-//! `FILE.vamp` (one byte per state, 1 = free), then prints one JSON line
+//! `FILE.vamp` (one byte per state, 1 = free), writes its own verdicts to
+//! `FILE.ours` (the same form), then prints one JSON line
 //! and stops (`benches/mbm/state_cost_vamp.py` runs it beside VAMP).
 //!
 //! `--batched` checks the states of motions four at a time through the
@@ -704,7 +705,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// `--states-from`: our state check timed on the states of `path`, beside
-/// the verdicts VAMP's harness wrote to `path.vamp`.
+/// the verdicts VAMP's harness wrote to `path.vamp`; our verdicts are written
+/// to `path.ours` (one byte per state, 1 = free) for the coal comparison.
 fn states_from(
     checker: &SceneChecker,
     path: &Path,
@@ -721,6 +723,10 @@ fn states_from(
         return Err(format!("{}: {} verdicts for {n} states", path.display(), vamp.len()).into());
     }
     let ours: Vec<bool> = states.chunks_exact(dof).map(|q| checker.is_valid(q)).collect();
+    std::fs::write(
+        path.with_extension("bin.ours"),
+        ours.iter().map(|&v| u8::from(v)).collect::<Vec<u8>>(),
+    )?;
     let free: Vec<f64> = states
         .chunks_exact(dof)
         .zip(&ours)
