@@ -522,16 +522,22 @@ fn urdf_shape_distance(shape: &urdf_rs::Geometry, p: &Vector3<f64>) -> f64 {
     }
 }
 
-/// The built-in Panda's collision shapes hold the real arm: every vertex of
-/// the collision meshes MoveIt plans with (example-robot-data, placed in the
-/// built-in link frames by `fit_panda_covers.py`, which checks the frames
-/// against pinocchio's) lies inside the one convex shape of its link, so the
-/// shape holds the mesh, and a state the built-in model finds free is free for
-/// the real Panda. Read straight from the URDF text, not through our parser.
+/// The built-in Panda's and UR5's collision shapes hold the real arms: every
+/// vertex of the collision meshes MoveIt plans with (example-robot-data,
+/// placed in the built-in link frames by `fit_covers.py`, which checks the
+/// kinematics against pinocchio's) lies inside the one convex shape of its
+/// link, so the shape holds the mesh, and a state the built-in model finds
+/// free is free for the real arm. Read straight from the URDF text, not
+/// through our parser.
 #[test]
-fn builtin_panda_shapes_hold_the_real_meshes() {
-    let points = include_str!("builtin/panda_mesh_points.txt");
-    for name in ["franka_panda", "franka_panda_hand"] {
+fn builtin_shapes_hold_the_real_meshes() {
+    let panda = include_str!("builtin/panda_mesh_points.txt");
+    let ur5 = include_str!("builtin/ur5_mesh_points.txt");
+    for (name, points) in [
+        ("franka_panda", panda),
+        ("franka_panda_hand", panda),
+        ("ur5", ur5),
+    ] {
         let robot = urdf_rs::read_from_string(builtin_urdf(name).unwrap()).unwrap();
         let mut checked = 0;
         for line in points.lines().filter(|l| !l.starts_with('#')) {
@@ -549,9 +555,12 @@ fn builtin_panda_shapes_hold_the_real_meshes() {
                 * nalgebra::UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
             let local = pose.inverse_transform_point(&nalgebra::Point3::new(v[0], v[1], v[2]));
             let d = urdf_shape_distance(&c.geometry, &local.coords);
-            assert!(d <= -1e-4, "{name} {link_name}: mesh vertex {v:?} at {d} m from its shape (must be 0.1 mm inside)");
+            assert!(
+                d <= -1e-4,
+                "{name} {link_name}: mesh vertex {v:?} at {d} m from its shape (must be 0.1 mm inside)"
+            );
             checked += 1;
         }
-        assert!(checked >= 1000, "{name}: {checked} vertices checked");
+        assert!(checked >= 500, "{name}: {checked} vertices checked");
     }
 }

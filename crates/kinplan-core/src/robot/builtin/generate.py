@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the built-in robots' URDF files (src/robot/builtin/*.urdf) from their
 published kinematic data (mm, degrees), with one capsule per link as collision
-geometry (the Panda's: shapes fitted around its real meshes, fit_panda_covers.py). Run: python3 src/robot/builtin/generate.py
+geometry (the Panda's and the UR5's: shapes fitted around their real meshes, fit_covers.py). Run: python3 src/robot/builtin/generate.py
 
 The URDFs are committed; this script documents where every number comes from.
 """
@@ -152,12 +152,12 @@ def cover_link_xml(name, cover):
     )
 
 
-def panda_covers():
-    """The shapes fit_panda_covers.py fitted around the real Panda's collision
+def covers_of(robot):
+    """The shapes fit_covers.py fitted around the real robot's collision
     meshes (example-robot-data, the meshes MoveIt plans with): one convex
     shape per link holding every vertex of the link's mesh, so a state the
     built-in model finds free is free for the real arm."""
-    with open(os.path.join(OUT, "panda_covers.json")) as f:
+    with open(os.path.join(OUT, f"{robot}_covers.json")) as f:
         return json.load(f)["covers"]
 
 
@@ -173,13 +173,13 @@ def with_covers(text, covers, links):
 PANDA_ARM_LINKS = ["base_link"] + [f"link_{i}" for i in range(1, 8)]
 
 
-def panda_arm():
-    """franka_panda's links get the shapes fitted around the real meshes."""
-    path = os.path.join(OUT, "franka_panda.urdf")
+def fitted(name, robot, links):
+    """The built-in `name`'s links get the shapes fitted around the real meshes."""
+    path = os.path.join(OUT, f"{name}.urdf")
     with open(path) as f:
         text = f.read()
-    text = with_covers(text, panda_covers(), PANDA_ARM_LINKS)
-    text = text.replace(" flange 107 mm -->", " flange 107 mm; collision shapes hold the real meshes (panda_covers.json) -->", 1)
+    text = with_covers(text, covers_of(robot), links)
+    text = text.replace(" -->", f"; collision shapes hold the real meshes ({robot}_covers.json) -->", 1)
     with open(path, "w") as f:
         f.write(text)
 
@@ -193,7 +193,7 @@ def panda_hand():
     A tool-centre frame `panda_hand_tcp` sits 0.1034 m along the hand's z."""
     with open(os.path.join(OUT, "franka_panda.urdf")) as f:
         text = f.read()
-    covers = panda_covers()
+    covers = covers_of("panda")
     extra = cover_link_xml("panda_hand", covers["panda_hand"])
     extra += cover_link_xml("panda_leftfinger", covers["panda_leftfinger"])
     extra += cover_link_xml("panda_rightfinger", covers["panda_rightfinger"])
@@ -249,6 +249,7 @@ def main():
         [(-360, 360)] * 6, [180] * 6,
         [0.075, 0.06, 0.05, 0.045, 0.045, 0.04],
     )
+    fitted("ur5", "ur5", ["base_link"] + [f"link_{i}" for i in range(1, 7)])
     r2d = math.degrees
     craig_dh(
         "franka_panda",
@@ -263,7 +264,7 @@ def main():
         [r2d(2.175)] * 4 + [r2d(2.61)] * 3,
         [0.09, 0.09, 0.08, 0.08, 0.07, 0.06, 0.05],
     )
-    panda_arm()
+    fitted("franka_panda", "panda", PANDA_ARM_LINKS)
     panda_hand()
     standard_dh(
         "kuka_lbr_iiwa14_r820",

@@ -1,13 +1,16 @@
 #!/usr/bin/env python3
-"""Fits the built-in Panda's collision shapes around the real Panda's collision
+"""Fits a built-in robot's collision shapes around the real robot's collision
 meshes, so that a state the built-in model finds free is free for the real arm.
 
-Reads the Franka Panda of `example-robot-data` (its collision meshes, the ones
-MoveIt plans with; pip install example-robot-data pin), places every mesh
-vertex in the link frames of `franka_panda_hand.urdf` (the same frames: the
-forward kinematics agree to rounding, checked here), and writes
+Reads the robot of `example-robot-data` (its collision meshes, the ones MoveIt
+plans with; pip install example-robot-data pin): the Franka Panda with its hand
+(`franka_panda_hand.urdf`) and the UR5 (`ur5.urdf`). Every mesh vertex is placed
+in the built-in model's link frames: both models are posed at the same joint
+values, and the one rigid transform between their bases (the UR5's ROS base is
+turned half a turn from the DH base) is found at one state and checked at
+others against the tool frame, so the kinematics agree. Then it writes
 
-- `panda_covers.json`: per link one convex shape holding every vertex of the
+- `<robot>_covers.json`: per link one convex shape holding every vertex of the
   link's mesh, so it holds the mesh (a convex set holding a mesh's vertices
   holds their hull): a capsule for the arm links (for each axis direction of
   a search, the smallest circle around the vertices projected across the
@@ -15,12 +18,12 @@ forward kinematics agree to rounding, checked here), and writes
   shrinks the volume), a box for the base, the hand and the fingers (the
   vertices' bounds in the link frame); every size grown by `MARGIN` and
   rounded outwards to 0.1 mm;
-- `panda_mesh_points.txt`: the vertices, `link x y z` per line in metres,
+- `<robot>_mesh_points.txt`: the vertices, `link x y z` per line in metres,
   which the Rust tests hold the committed URDFs against.
 
-generate.py reads `panda_covers.json`. Run by hand:
+generate.py reads the covers. Run by hand:
 
-    /work/py-venv-coal/bin/python src/robot/builtin/fit_panda_covers.py
+    /work/py-venv-coal/bin/python src/robot/builtin/fit_covers.py
 """
 import json
 import math
@@ -33,18 +36,32 @@ import pinocchio as pin
 OUT = os.path.dirname(os.path.abspath(__file__))
 MARGIN = 0.0005
 STEP = 1e-4
-# example-robot-data link -> built-in link
-NAMES = {f'panda_link{i}': f'link_{i}' for i in range(1, 8)}
-NAMES.update(panda_link0='base_link', panda_hand='panda_hand', panda_leftfinger='panda_leftfinger',
-             panda_rightfinger='panda_rightfinger')
-BOXES = {'base_link', 'panda_hand', 'panda_leftfinger', 'panda_rightfinger'}
+ROBOTS = {
+    'panda': dict(
+        urdf=('panda_description', 'panda.urdf'), builtin='franka_panda_hand.urdf',
+        joints=[f'panda_joint{i}' for i in range(1, 8)], held={'panda_finger_joint1': 0.0, 'panda_finger_joint2': 0.0},
+        tool=('panda_hand', 'panda_hand'),
+        names={**{f'panda_link{i}': f'link_{i}' for i in range(1, 8)}, 'panda_link0': 'base_link',
+               'panda_hand': 'panda_hand', 'panda_leftfinger': 'panda_leftfinger',
+               'panda_rightfinger': 'panda_rightfinger'},
+        boxes={'base_link', 'panda_hand', 'panda_leftfinger', 'panda_rightfinger'}),
+    'ur5': dict(
+        urdf=('ur_description', 'ur5_robot.urdf'), builtin='ur5.urdf',
+        joints=['shoulder_pan_joint', 'shoulder_lift_joint', 'elbow_joint', 'wrist_1_joint', 'wrist_2_joint',
+                'wrist_3_joint'], held={},
+        tool=('tool0', 'tool0'),
+        names={'base_link': 'base_link', 'shoulder_link': 'link_1', 'upper_arm_link': 'link_2',
+               'forearm_link': 'link_3', 'wrist_1_link': 'link_4', 'wrist_2_link': 'link_5',
+               'wrist_3_link': 'link_6', 'ee_link': 'link_6'},
+        boxes=set()),
+}
 
 
-def robot_dir():
+def robot_urdf(package, file):
     share = os.path.normpath(os.path.join(os.path.dirname(pin.__file__), '..', '..', '..', '..', 'share'))
-    path = os.path.join(share, 'example-robot-data', 'robots', 'panda_description')
-    if not os.path.isdir(path):
-        sys.exit(f'example-robot-data not found under {share}: pip install example-robot-data')
+    path = os.path.join(share, 'example-robot-data', 'robots', package, 'urdf', file)
+    if not os.path.isfile(path):
+        sys.exit(f'{path} not found: pip install example-robot-data')
     return share, path
 
 
@@ -54,11 +71,12 @@ def rpy(r, p, y):
             @ np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]]))
 
 
-def builtin_frames(q):
-    """Pose (4x4) of every link of franka_panda_hand.urdf at arm state q,
-    fingers at 0 (the finger frames' own coordinates do not depend on it)."""
+def builtin_frames(builtin, q):
+    """Pose (4x4) of every link of the built-in URDF at state q (joints
+    `joint_1`, `joint_2`, ...), other moving joints at 0 (a finger frame's own
+    coordinates do not depend on its opening)."""
     import xml.etree.ElementTree as ET
-    root = ET.parse(os.path.join(OUT, 'franka_panda_hand.urdf')).getroot()
+    root = ET.parse(os.path.join(OUT, builtin)).getroot()
     joints = {j.find('child').get('link'): j for j in root.findall('joint')}
     poses = {'base_link': np.eye(4)}
 
@@ -71,7 +89,7 @@ def builtin_frames(q):
         t[:3, 3] = [float(v) for v in o.get('xyz').split()]
         t[:3, :3] = rpy(*[float(v) for v in o.get('rpy').split()])
         t = pose(j.find('parent').get('link')) @ t
-        if j.get('type') == 'revolute':
+        if j.get('type') in ('revolute', 'continuous') and j.get('name').startswith('joint_'):
             k = int(j.get('name').split('_')[1]) - 1
             c, s = math.cos(q[k]), math.sin(q[k])
             t = t @ np.array([[c, -s, 0, 0], [s, c, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
@@ -82,24 +100,33 @@ def builtin_frames(q):
     return poses
 
 
-def mesh_points():
-    share, root = robot_dir()
-    urdf = os.path.join(root, 'urdf', 'panda.urdf')
+def pinocchio_pose(model, robot, q_arm):
+    q = pin.neutral(model)
+    for name, v in list(zip(robot['joints'], q_arm)) + list(robot['held'].items()):
+        q[model.joints[model.getJointId(name)].idx_q] = v
+    return q
+
+
+def mesh_points(robot):
+    share, urdf = robot_urdf(*robot['urdf'])
     model = pin.buildModelFromUrdf(urdf)
     geom = pin.buildGeomFromUrdf(model, urdf, pin.COLLISION, package_dirs=[share])
     data, gdata = model.createData(), geom.createData()
-    q_arm = np.array([0.3, -0.4, 0.5, -1.9, 0.6, 1.7, -0.7])
-    q = pin.neutral(model)
-    for i, v in enumerate(q_arm):
-        q[model.joints[model.getJointId(f'panda_joint{i + 1}')].idx_q] = v
+    rng = np.random.default_rng(3)
+    ours_tool, theirs_tool = robot['tool']
+    base = None  # built-in base in the example's world: ours = base @ theirs
+    for trial in range(4):
+        q_arm = rng.uniform(-2.5, 2.5, len(robot['joints']))
+        pin.framesForwardKinematics(model, data, pinocchio_pose(model, robot, q_arm))
+        theirs = data.oMf[model.getFrameId(theirs_tool)].homogeneous
+        ours = builtin_frames(robot['builtin'], q_arm)[ours_tool]
+        if base is None:
+            base = ours @ np.linalg.inv(theirs)
+        assert np.abs(base @ theirs - ours).max() < 1e-9, f'{robot["builtin"]}: the kinematics differ'
+    q = pinocchio_pose(model, robot, q_arm)
     pin.forwardKinematics(model, data, q)
     pin.updateGeometryPlacements(model, data, geom, gdata)
-    pin.updateFramePlacements(model, data)
-    frames = builtin_frames(q_arm)
-    for name in ['panda_link4', 'panda_link7', 'panda_hand']:
-        ours = frames[NAMES[name]]
-        theirs = data.oMf[model.getFrameId(name)].homogeneous
-        assert np.abs(ours - theirs).max() < 1e-12, f'{name}: the frames differ'
+    frames = builtin_frames(robot['builtin'], q_arm)
     points = {}
     for i, g in enumerate(geom.geometryObjects):
         shape = g.geometry
@@ -108,8 +135,8 @@ def mesh_points():
         else:  # a box
             e = shape.halfSide
             v = np.array([[sx * e[0], sy * e[1], sz * e[2]] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-        world = gdata.oMg[i].homogeneous @ np.c_[v, np.ones(len(v))].T
-        link = NAMES[model.frames[g.parentFrame].name]
+        world = base @ gdata.oMg[i].homogeneous @ np.c_[v, np.ones(len(v))].T
+        link = robot['names'][model.frames[g.parentFrame].name]
         points.setdefault(link, []).append((np.linalg.inv(frames[link]) @ world).T[:, :3])
     return {k: np.vstack(v) for k, v in points.items()}
 
@@ -203,21 +230,24 @@ def fit_box(p):
 
 
 def main():
-    points = mesh_points()
-    covers = {link: (fit_box(p) if link in BOXES else fit_capsule(p)) for link, p in sorted(points.items())}
-    covers = json.loads(json.dumps(covers, default=float), parse_float=lambda s: round(float(s), 4))
-    with open(os.path.join(OUT, 'panda_covers.json'), 'w') as f:
-        json.dump({'source': 'example-robot-data panda_description/urdf/panda.urdf collision meshes',
-                   'margin_m': MARGIN, 'covers': covers}, f, indent=1)
-        f.write('\n')
-    with open(os.path.join(OUT, 'panda_mesh_points.txt'), 'w') as f:
-        f.write('# Vertices of the Franka Panda collision meshes of example-robot-data (Apache-2.0 meshes by\n'
-                '# Franka Emika), in the link frames of franka_panda_hand.urdf, metres; fit_panda_covers.py.\n')
-        for link, p in sorted(points.items()):
-            for x in p:
-                f.write(f'{link} {x[0]:.6f} {x[1]:.6f} {x[2]:.6f}\n')
-    for link, c in covers.items():
-        print(link, c)
+    for name, robot in ROBOTS.items():
+        points = mesh_points(robot)
+        covers = {link: (fit_box(p) if link in robot['boxes'] else fit_capsule(p))
+                  for link, p in sorted(points.items())}
+        covers = json.loads(json.dumps(covers, default=float), parse_float=lambda s: round(float(s), 4))
+        package, file = robot['urdf']
+        with open(os.path.join(OUT, f'{name}_covers.json'), 'w') as f:
+            json.dump({'source': f'example-robot-data {package}/urdf/{file} collision meshes',
+                       'margin_m': MARGIN, 'covers': covers}, f, indent=1)
+            f.write('\n')
+        with open(os.path.join(OUT, f'{name}_mesh_points.txt'), 'w') as f:
+            f.write(f'# Vertices of the collision meshes of example-robot-data {package}/urdf/{file}, in the link\n'
+                    f'# frames of {robot["builtin"]}, metres; written by fit_covers.py.\n')
+            for link, p in sorted(points.items()):
+                for x in p:
+                    f.write(f'{link} {x[0]:.6f} {x[1]:.6f} {x[2]:.6f}\n')
+        for link, c in covers.items():
+            print(name, link, c)
 
 
 if __name__ == '__main__':
