@@ -98,7 +98,7 @@ fn geometry_json(g: &Geometry) -> Value {
 fn setup() -> (SceneChecker, SceneChecker, Vec<Vec<f64>>) {
     let chain = builtin_chain("franka_panda").unwrap();
     let model = Arc::new(RobotModel::new(chain.clone()).unwrap());
-    let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
+    let acm = AllowedCollisions::builtin(&model, "franka_panda", &AcmParams::default()).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let obstacles = scene(&mut rng);
     let scene = Scene::new(obstacles.clone(), &SceneLimits::default()).unwrap();

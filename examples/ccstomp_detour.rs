@@ -34,7 +34,7 @@ const T_R: f64 = 0.2;
 
 fn model(chain: &Arc<Chain>) -> (Arc<RobotModel>, AllowedCollisions) {
     let model = Arc::new(RobotModel::new(chain.clone()).expect("robot model"));
-    let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).expect("acm");
+    let acm = AllowedCollisions::builtin(&model, chain.name(), &AcmParams::default()).expect("acm");
     (model, acm)
 }
 

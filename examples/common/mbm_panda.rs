@@ -31,7 +31,7 @@ pub fn model(chain: &Arc<Chain>, opening: f64, cache: &mut BTreeMap<u64, Model>)
             let fingers = [("panda_finger_joint1", opening), ("panda_finger_joint2", opening)];
             let attached = attached_bodies(urdf, chain, &fingers).unwrap();
             let model = Arc::new(RobotModel::with_parts(chain.clone(), &attached, &[]).unwrap());
-            let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
+            let acm = AllowedCollisions::builtin(&model, "franka_panda_hand", &AcmParams::default()).unwrap();
             (model, acm)
         })
         .clone()

@@ -38,7 +38,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use kinplan_core::collision::{Geometry, Obstacle, SceneLimits, parse_joint_request, parse_planning_scene};
-use kinplan_core::robot::builtin_urdf;
+use kinplan_core::robot::{builtin_srdf, builtin_urdf};
 use kinplan_loadtest::pose_msg;
 use kinplan_proto as pb;
 use pb::planning_service_client::PlanningServiceClient;
@@ -152,6 +152,12 @@ fn robot_ref(as_urdf: bool) -> pb::RobotRef {
             .iter()
             .map(|f| (f.to_string(), FINGER_OPENING))
             .collect::<HashMap<_, _>>(),
+        // as a MoveIt user sends the robot: with its SRDF (designed contacts)
+        srdf: if as_urdf {
+            builtin_srdf(ROBOT).expect("built-in SRDF").to_string()
+        } else {
+            String::new()
+        },
         ..Default::default()
     }
 }

@@ -1,18 +1,26 @@
 //! The allowed-collision matrix: body pairs the checker never tests.
 //!
-//! Built as MoveIt's setup assistant does, once per robot model:
+//! Built as MoveIt's setup assistant does, once per robot model, with one
+//! rule left out:
 //! 1. **adjacent** pairs (parent and child in the kinematic tree, links
 //!    without geometry skipped) are always allowed;
-//! 2. **default**: pairs in collision at the default state (every joint at
-//!    0, clamped into its limits);
-//! 3. **always**: pairs in collision in at least `always_fraction` of
+//! 2. **always**: pairs in collision in at least `always_fraction` of
 //!    `samples` uniformly random states;
-//! 4. **never**: pairs in collision in none of the samples.
+//! 3. **never**: pairs in collision in none of the samples.
 //!
-//! Steps 2–4 are a sampling heuristic: a pair that collides in fewer than
+//! Steps 2–3 are a sampling heuristic: a pair that collides in fewer than
 //! about 1/`samples` of the joint space is allowed as "never" (MoveIt's
 //! default density of 10 000 samples has the same blind spot). The result
 //! depends only on the model and the parameters (seeded ChaCha8).
+//!
+//! The setup assistant also allows every pair in collision at the default
+//! state. Not here: collision shapes that hold the real parts (covers,
+//! convex hulls) are larger than them, so a pair can touch at the default
+//! state in the model while the real links are apart and collide elsewhere
+//! in the joint space — allowing it would call real collisions free.
+//! Designed contacts come from the robot's MoveIt configuration instead: an
+//! SRDF's `disable_collisions` pairs ([`AllowedCollisions::allow_named`]),
+//! which the built-in Panda carries (`robot::builtin_srdf`).
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -28,10 +36,9 @@ use nalgebra::Isometry3;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum AllowReason {
     Adjacent,
-    Default,
     Always,
     Never,
-    /// Allowed by the caller.
+    /// Allowed by the caller (an SRDF's `disable_collisions`, a built-in's).
     User,
 }
 
@@ -164,10 +171,6 @@ impl AllowedCollisions {
                 out[k] += hit as u32;
             }
         };
-        // Default state.
-        let q0: Vec<f64> = bounds.iter().map(|&(lo, hi)| 0.0_f64.clamp(lo, hi)).collect();
-        let mut at_default = vec![0u32; pairs.len()];
-        colliding(&q0, &mut at_default);
         // Random states, drawn sequentially so the set does not depend on
         // the thread count.
         let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
@@ -203,9 +206,7 @@ impl AllowedCollisions {
             })?;
         let always = (params.always_fraction * params.samples as f64).ceil() as u32;
         for (k, &(a, b)) in pairs.iter().enumerate() {
-            if at_default[k] > 0 {
-                acm.allow(a, b, AllowReason::Default);
-            } else if counts[k] >= always {
+            if counts[k] >= always {
                 acm.allow(a, b, AllowReason::Always);
             } else if counts[k] == 0 {
                 acm.allow(a, b, AllowReason::Never);
@@ -236,6 +237,43 @@ impl AllowedCollisions {
         if a < self.n && b < self.n {
             self.reasons[a * self.n + b] = Some(reason);
             self.reasons[b * self.n + a] = Some(reason);
+        }
+    }
+
+    /// The matrix of a built-in robot's model: [`Self::sampled`], and the
+    /// designed contacts of its MoveIt configuration
+    /// ([`crate::robot::builtin_srdf`]) allowed.
+    pub fn builtin(model: &RobotModel, builtin: &str, params: &AcmParams) -> Result<Self, CollisionError> {
+        let mut acm = Self::sampled(model, params)?;
+        if let Some(text) = crate::robot::builtin_srdf(builtin) {
+            let srdf = crate::robot::parse_srdf(text, &crate::robot::UrdfLimits::default())
+                .expect("the built-in SRDFs parse");
+            acm.allow_named(
+                model,
+                srdf.disabled_collisions
+                    .iter()
+                    .map(|(a, b)| (a.as_str(), b.as_str())),
+                AllowReason::User,
+            );
+        }
+        Ok(acm)
+    }
+
+    /// Allows every pair of `pairs` named by body (an SRDF's
+    /// `disable_collisions`), for `reason`; names the model does not hold
+    /// are left out (an SRDF may name links beyond the modelled chain).
+    pub fn allow_named<'a>(
+        &mut self,
+        model: &RobotModel,
+        pairs: impl IntoIterator<Item = (&'a str, &'a str)>,
+        reason: AllowReason,
+    ) {
+        let index: std::collections::HashMap<&str, usize> =
+            model.body_names().enumerate().map(|(i, n)| (n, i)).collect();
+        for (a, b) in pairs {
+            if let (Some(&i), Some(&j)) = (index.get(a), index.get(b)) {
+                self.allow(i, j, reason);
+            }
         }
     }
 

@@ -59,6 +59,18 @@ pub fn builtin_urdf(name: &str) -> Result<&'static str, RobotError> {
         })
 }
 
+/// The MoveIt SRDF of a built-in robot, when it has designed contacts: pairs
+/// of links in contact at the default pose of the real robot, which the
+/// collision checks allow (`collision::AllowedCollisions::allow_named`). The
+/// Panda's come from MoveIt's Panda configuration; `generate.py` writes them.
+pub fn builtin_srdf(name: &str) -> Option<&'static str> {
+    match name {
+        "franka_panda" => Some(include_str!("builtin/franka_panda.srdf")),
+        "franka_panda_hand" => Some(include_str!("builtin/franka_panda_hand.srdf")),
+        _ => None,
+    }
+}
+
 /// The default chain (base_link → tool tip) of a built-in robot, parsed once.
 pub fn builtin_chain(name: &str) -> Result<Arc<Chain>, RobotError> {
     static CHAINS: OnceLock<Vec<OnceLock<Arc<Chain>>>> = OnceLock::new();

@@ -81,13 +81,11 @@ impl CollisionSetup {
             },
             deadline,
         )?;
-        let index: std::collections::HashMap<&str, usize> =
-            model.body_names().enumerate().map(|(i, n)| (n, i)).collect();
-        for (a, b) in disabled {
-            if let (Some(&i), Some(&j)) = (index.get(a.as_str()), index.get(b.as_str())) {
-                acm.allow(i, j, AllowReason::User);
-            }
-        }
+        acm.allow_named(
+            &model,
+            disabled.iter().map(|(a, b)| (a.as_str(), b.as_str())),
+            AllowReason::User,
+        );
         Ok(Self { model, acm })
     }
 }

@@ -59,14 +59,6 @@ pub struct SrdfSource {
 pub type MeshFiles = Arc<[(String, Vec<u8>)]>;
 
 impl ModelSource {
-    fn of_urdf(urdf: Arc<str>) -> Self {
-        Self {
-            urdf,
-            meshes: Arc::from(Vec::new()),
-            srdf: None,
-        }
-    }
-
     /// Bytes held (the cache's accounting).
     fn bytes(&self) -> usize {
         self.urdf.len()
@@ -157,20 +149,36 @@ fn group_chain(source: &ModelSource, group: &str) -> Result<ChainSpec, Status> {
 /// A parsed chain and what it came from.
 type ParsedChain = (Arc<Chain>, ModelSource);
 
-/// The URDF text of a built-in robot, shared (not copied per request).
-fn builtin_text(name: &str) -> Result<Arc<str>, Status> {
-    static TEXTS: std::sync::OnceLock<HashMap<&'static str, Arc<str>>> = std::sync::OnceLock::new();
+/// The source of a built-in robot: its URDF text and, when it has one, its
+/// SRDF (designed contacts), read once and shared (not copied per request).
+fn builtin_source(name: &str) -> Result<ModelSource, Status> {
+    type Texts = HashMap<&'static str, (Arc<str>, Option<Arc<SrdfSource>>)>;
+    static TEXTS: std::sync::OnceLock<Texts> = std::sync::OnceLock::new();
     let texts = TEXTS.get_or_init(|| {
         kinplan_core::robot::BUILTIN_NAMES
             .iter()
-            .filter_map(|n| Some((*n, Arc::<str>::from(kinplan_core::robot::builtin_urdf(n).ok()?))))
+            .filter_map(|n| {
+                let urdf = Arc::<str>::from(kinplan_core::robot::builtin_urdf(n).ok()?);
+                let srdf = kinplan_core::robot::builtin_srdf(n).map(|text| {
+                    Arc::new(SrdfSource {
+                        text: text.to_string(),
+                        parsed: parse_srdf(text, &UrdfLimits::default()).expect("the built-in SRDFs parse"),
+                    })
+                });
+                Some((*n, (urdf, srdf)))
+            })
             .collect()
     });
     kinplan_core::robot::builtin_urdf(name).map_err(|e| robot_error(e, ""))?;
-    texts
+    let (urdf, srdf) = texts
         .get(name)
         .cloned()
-        .ok_or_else(|| invalid("robot.name", "a built-in robot without its URDF"))
+        .ok_or_else(|| invalid("robot.name", "a built-in robot without its URDF"))?;
+    Ok(ModelSource {
+        urdf,
+        meshes: Arc::from(Vec::new()),
+        srdf,
+    })
 }
 
 /// A small least-recently-used map, bounded in entries and in bytes (each
@@ -309,12 +317,12 @@ impl ModelStore {
                     return Ok(Resolved {
                         chain,
                         model_id: Vec::new(),
-                        source: ModelSource::of_urdf(builtin_text(name)?),
+                        source: builtin_source(name)?,
                         held: held_in(robot),
                     });
                 }
                 // Another chain of a built-in: parsed once, then cached like any URDF.
-                let source = ModelSource::of_urdf(builtin_text(name)?);
+                let source = builtin_source(name)?;
                 (source.id(), Some(source))
             }
             Some(Source::Urdf(text)) => {

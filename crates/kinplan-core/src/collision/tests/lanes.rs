@@ -23,7 +23,7 @@ fn panda_with_hand() -> (Arc<Chain>, Arc<RobotModel>, AllowedCollisions) {
     let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
     let attached = attached_bodies(urdf, &chain, &fingers).unwrap();
     let model = Arc::new(RobotModel::with_parts(chain.clone(), &attached, &[]).unwrap());
-    let acm = AllowedCollisions::sampled(&model, &AcmParams::default()).unwrap();
+    let acm = AllowedCollisions::builtin(&model, "franka_panda_hand", &AcmParams::default()).unwrap();
     (chain, model, acm)
 }
 

@@ -691,3 +691,47 @@ fn a_robot_of_max_bodies_collides_with_its_last_body_and_one_more_is_refused() {
         "{err}"
     );
 }
+
+/// The default-state rule of MoveIt's setup assistant is not applied: the
+/// built-in Panda's wrist (link_5) touches link_7, the hand and the right
+/// finger at the default state in its shapes, which are larger than the real
+/// links; only the pairs MoveIt's Panda configuration names as designed
+/// contacts (its SRDF) are allowed, so the wrist stays checked against the
+/// fingers, as MoveIt checks the real meshes.
+#[test]
+fn builtin_panda_allows_only_its_designed_contacts() {
+    let chain = builtin_chain("franka_panda_hand").unwrap();
+    let urdf = crate::robot::builtin_urdf("franka_panda_hand").unwrap();
+    let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
+    let attached = attached_bodies(urdf, &chain, &fingers).unwrap();
+    let model = RobotModel::with_parts(chain, &attached, &[]).unwrap();
+    let params = AcmParams {
+        samples: 2000,
+        ..AcmParams::default()
+    };
+    let index = |name: &str| model.body_names().position(|n| n == name).unwrap();
+    let (wrist, link_7, hand) = (index("link_5"), index("link_7"), index("panda_hand"));
+    let (left, right) = (index("panda_leftfinger"), index("panda_rightfinger"));
+    // the wrist overlaps link_7 and the right finger at the default state (every joint at 0
+    // clamped into its limits), and neither pair is adjacent nor always in contact
+    let mut poses = [Isometry3::identity(); super::super::model::MAX_BODIES];
+    let q0: Vec<f64> = model
+        .chain()
+        .limits()
+        .map(|(lo, hi)| 0.0_f64.clamp(lo, hi))
+        .collect();
+    model.body_poses(&q0, &mut poses);
+    let touch = |a: usize, b: usize| {
+        super::super::narrow::body_body_intersect(&model.bodies[a], &poses[a], &model.bodies[b], &poses[b])
+    };
+    assert!(touch(wrist, link_7) && touch(wrist, right));
+    let sampled = AllowedCollisions::sampled(&model, &params).unwrap();
+    assert_eq!(sampled.reason(wrist, link_7), None);
+    assert_eq!(sampled.reason(wrist, right), None);
+    let builtin = AllowedCollisions::builtin(&model, "franka_panda_hand", &params).unwrap();
+    assert_eq!(builtin.reason(wrist, link_7), Some(AllowReason::User));
+    assert_eq!(builtin.reason(wrist, hand), Some(AllowReason::User));
+    assert_eq!(builtin.reason(left, right), Some(AllowReason::User));
+    assert_eq!(builtin.reason(wrist, right), None);
+    assert_eq!(builtin.reason(wrist, left), None);
+}

@@ -172,6 +172,24 @@ def with_covers(text, covers, links):
 
 PANDA_ARM_LINKS = ["base_link"] + [f"link_{i}" for i in range(1, 8)]
 
+# The pairs MoveIt's Panda configuration (panda_moveit_config, and the SRDF of
+# example-robot-data) disables as in contact at the default pose on the real
+# meshes: designed contacts, which the built-in model inherits (its own
+# shapes are larger than the meshes, so its own default pose says nothing).
+PANDA_DEFAULT_PAIRS = [("link_5", "link_7"), ("link_5", "panda_hand"), ("panda_leftfinger", "panda_rightfinger")]
+
+
+def panda_srdf(name, links):
+    """A MoveIt SRDF holding the built-in's designed contacts."""
+    out = f'<?xml version="1.0"?>\n<!-- {name}: the pairs MoveIt\'s Panda configuration disables as in contact at the default pose (generate.py) -->\n'
+    out += f'<robot name="{name}">\n'
+    for a, b in PANDA_DEFAULT_PAIRS:
+        if a in links and b in links:
+            out += f'  <disable_collisions link1="{a}" link2="{b}" reason="Default"/>\n'
+    out += "</robot>\n"
+    with open(os.path.join(OUT, f"{name}.srdf"), "w") as f:
+        f.write(out)
+
 
 def fitted(name, robot, links):
     """The built-in `name`'s links get the shapes fitted around the real meshes."""
@@ -266,6 +284,8 @@ def main():
     )
     fitted("franka_panda", "panda", PANDA_ARM_LINKS)
     panda_hand()
+    panda_srdf("franka_panda", PANDA_ARM_LINKS)
+    panda_srdf("franka_panda_hand", PANDA_ARM_LINKS + ["panda_hand", "panda_leftfinger", "panda_rightfinger"])
     standard_dh(
         "kuka_lbr_iiwa14_r820",
         "KUKA LBR iiwa 14 R820, standard DH: d1 360, d3 420, d5 400, d7 81 mm, "
