@@ -166,6 +166,32 @@ class Panda:
         return True
 
 
+def scene_primitives(doc, path):
+    """(name, 4x4 pose, coal geometry) of every primitive of a MoveIt
+    PlanningScene document (`path` names it in errors)."""
+    out = []
+    for o in doc.get('world', {}).get('collision_objects', []):
+        base = np.eye(4)
+        if 'pose' in o:
+            base[:3, 3] = o['pose']['position']
+            base[:3, :3] = quat_matrix(*o['pose']['orientation'])
+        for i, (prim, pose) in enumerate(zip(o.get('primitives', []), o.get('primitive_poses', []))):
+            d, kind = prim['dimensions'], prim['type']
+            if kind in ('box', 1):
+                g = coal.Box(*d)
+            elif kind in ('sphere', 2):
+                g = coal.Sphere(d[0])
+            elif kind in ('cylinder', 3):
+                g = coal.Cylinder(d[1], d[0])
+            else:
+                raise ValueError(f'{path}: unsupported primitive {kind}')
+            m = np.eye(4)
+            m[:3, 3] = pose['position']
+            m[:3, :3] = quat_matrix(*pose['orientation'])
+            out.append((f"{o['id']}_{i}", base @ m, g))
+    return out
+
+
 class Scene:
     """A MoveIt PlanningScene's world primitives as coal objects."""
 
@@ -173,29 +199,10 @@ class Scene:
         with open(path) as f:
             doc = yaml.safe_load(f)
         self.objects = []
-        for o in doc.get('world', {}).get('collision_objects', []):
-            base = np.eye(4)
-            if 'pose' in o:
-                p = o['pose']
-                base[:3, 3] = p['position']
-                base[:3, :3] = quat_matrix(*p['orientation'])
-            for prim, pose in zip(o.get('primitives', []), o.get('primitive_poses', [])):
-                d = prim['dimensions']
-                kind = prim['type']
-                if kind in ('box', 1):
-                    g = coal.Box(*d)
-                elif kind in ('sphere', 2):
-                    g = coal.Sphere(d[0])
-                elif kind in ('cylinder', 3):
-                    g = coal.Cylinder(d[1], d[0])
-                else:
-                    raise ValueError(f'{path}: unsupported primitive {kind}')
-                m = np.eye(4)
-                m[:3, 3] = pose['position']
-                m[:3, :3] = quat_matrix(*pose['orientation'])
-                obj = coal.CollisionObject(g, transform(base @ m))
-                obj.computeAABB()
-                self.objects.append(obj)
+        for _, m, g in scene_primitives(doc, path):
+            obj = coal.CollisionObject(g, transform(m))
+            obj.computeAABB()
+            self.objects.append(obj)
         self.manager = coal.DynamicAABBTreeCollisionManager()
         for obj in self.objects:
             self.manager.registerObject(obj)

@@ -28,13 +28,12 @@ import statistics
 import sys
 import time
 
-import coal
 import numpy as np
 import pinocchio as pin
 import yaml
 
 sys.path.insert(0, os.path.dirname(__file__))
-from panda_coal import quat_matrix  # noqa: E402
+from panda_coal import scene_primitives  # noqa: E402
 
 SETS = ['table_pick', 'table_under_pick', 'box', 'bookshelf_small', 'bookshelf_tall', 'bookshelf_thin', 'cage']
 FINGER = 0.04
@@ -53,28 +52,7 @@ def scene_objects(path):
     """(name, SE3, coal geometry) of a MoveIt PlanningScene's primitives."""
     with open(path) as f:
         doc = yaml.safe_load(f)
-    out = []
-    for o in doc.get('world', {}).get('collision_objects', []):
-        base = np.eye(4)
-        if 'pose' in o:
-            base[:3, 3] = o['pose']['position']
-            base[:3, :3] = quat_matrix(*o['pose']['orientation'])
-        for i, (prim, pose) in enumerate(zip(o.get('primitives', []), o.get('primitive_poses', []))):
-            d, kind = prim['dimensions'], prim['type']
-            if kind in ('box', 1):
-                g = coal.Box(*d)
-            elif kind in ('sphere', 2):
-                g = coal.Sphere(d[0])
-            elif kind in ('cylinder', 3):
-                g = coal.Cylinder(d[1], d[0])
-            else:
-                raise ValueError(f'{path}: unsupported primitive {kind}')
-            m = np.eye(4)
-            m[:3, 3] = pose['position']
-            m[:3, :3] = quat_matrix(*pose['orientation'])
-            t = base @ m
-            out.append((f"{o['id']}_{i}", pin.SE3(t[:3, :3], t[:3, 3]), g))
-    return out
+    return [(name, pin.SE3(m[:3, :3], m[:3, 3]), g) for name, m, g in scene_primitives(doc, path)]
 
 
 class MeshPanda:

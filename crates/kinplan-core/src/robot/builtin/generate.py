@@ -28,6 +28,18 @@ def capsule_origin(p0, p1):
     return mid, [0.0, pitch, yaw], length
 
 
+def shape_link_xml(name, xyz, rpy, geom):
+    """A link with one collision shape `geom` (URDF geometry element) at (xyz, rpy)."""
+    return (
+        f'  <link name="{name}">\n'
+        f"    <collision>\n"
+        f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
+        f"      <geometry>{geom}</geometry>\n"
+        f"    </collision>\n"
+        f"  </link>\n"
+    )
+
+
 def link_xml(name, segment, radius):
     if segment is None:
         return f'  <link name="{name}"/>\n'
@@ -37,14 +49,7 @@ def link_xml(name, segment, radius):
         geom = f'<sphere radius="{float(radius)!r}"/>'
     else:
         geom = f'<capsule radius="{float(radius)!r}" length="{float(length)!r}"/>'
-    return (
-        f'  <link name="{name}">\n'
-        f"    <collision>\n"
-        f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-        f"      <geometry>{geom}</geometry>\n"
-        f"    </collision>\n"
-        f"  </link>\n"
-    )
+    return shape_link_xml(name, xyz, rpy, geom)
 
 
 def joint_xml(name, kind, parent, child, xyz, rpy, axis=None, limit=None):
@@ -132,7 +137,7 @@ def craig_dh(name, comment, d, a, alpha, flange, limits, speeds, radii):
 
 
 def cover_link_xml(name, cover):
-    """A link whose one collision shape is `cover` (panda_covers.json): a
+    """A link whose one collision shape is `cover` (<robot>_covers.json): a
     capsule between two points or a box between two corners, link frame."""
     if "capsule" in cover:
         c = cover["capsule"]
@@ -142,14 +147,7 @@ def cover_link_xml(name, cover):
         lo, hi = cover["box"]["min"], cover["box"]["max"]
         xyz, rpy = [(a + b) / 2 for a, b in zip(lo, hi)], [0.0, 0.0, 0.0]
         geom = f'<box size="{fmt([b - a for a, b in zip(lo, hi)])}"/>'
-    return (
-        f'  <link name="{name}">\n'
-        f"    <collision>\n"
-        f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-        f"      <geometry>{geom}</geometry>\n"
-        f"    </collision>\n"
-        f"  </link>\n"
-    )
+    return shape_link_xml(name, xyz, rpy, geom)
 
 
 def covers_of(robot):
