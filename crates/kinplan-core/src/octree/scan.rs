@@ -167,10 +167,13 @@ struct ScanCells {
 }
 
 impl CellSets {
-    /// Hands every cell with `true` for free, `false` for occupied to `each` in
-    /// ascending Morton order inside each 32³ block (dense) or in ascending Morton
-    /// order (sorted), until `each` breaks.
-    fn for_each<B>(&self, mut each: impl FnMut(&OcKey, bool) -> ControlFlow<B>) -> ControlFlow<B> {
+    /// Hands the cells to `each` grouped by their depth-15 parent, as the key of the
+    /// parent's child 0 and two disjoint masks of its children (bit `x + 2y + 4z`),
+    /// free and occupied: in ascending Morton order inside each 32³ block (dense) or
+    /// in ascending Morton order (sorted), until `each` breaks. In both layouts a
+    /// parent's eight children are eight consecutive bits, so a dense group is one
+    /// byte of each bitset.
+    fn for_each_group<B>(&self, mut each: impl FnMut(&OcKey, u8, u8) -> ControlFlow<B>) -> ControlFlow<B> {
         match self {
             CellSets::Dense { grid, free, occupied } => {
                 let blocks = free
@@ -184,23 +187,44 @@ impl CellSets {
                     for (w, (&f, &o)) in f.iter().zip(o).enumerate() {
                         let mut bits = f | o;
                         while bits != 0 {
-                            let i = bits.trailing_zeros() as usize;
-                            bits &= bits - 1;
-                            each(&grid.key_in_block(&base, w * 64 + i), o >> i & 1 == 0)?;
+                            let shift = bits.trailing_zeros() & !7;
+                            bits &= !(0xff << shift);
+                            let first = grid.key_in_block(&base, w * 64 + shift as usize);
+                            each(&first, (f >> shift) as u8, (o >> shift) as u8)?;
                         }
                     }
                 }
             }
             CellSets::Sorted { free, occupied } => {
                 let (mut i, mut j) = (0, 0);
+                let mut group: Option<(u64, u8, u8)> = None;
                 while i < free.len() || j < occupied.len() {
-                    if j == occupied.len() || (i < free.len() && free[i] < occupied[j]) {
-                        each(&unmorton(free[i]), true)?;
+                    let (m, is_free) = if j == occupied.len() || (i < free.len() && free[i] < occupied[j]) {
                         i += 1;
+                        (free[i - 1], true)
                     } else {
-                        each(&unmorton(occupied[j]), false)?;
                         j += 1;
+                        (occupied[j - 1], false)
+                    };
+                    let bit = 1u8 << (m & 7);
+                    match &mut group {
+                        Some((parent, f, o)) if *parent == m >> 3 => {
+                            *(if is_free { f } else { o }) |= bit;
+                        }
+                        _ => {
+                            if let Some((parent, f, o)) = group {
+                                each(&unmorton(parent << 3), f, o)?;
+                            }
+                            group = Some(if is_free {
+                                (m >> 3, bit, 0)
+                            } else {
+                                (m >> 3, 0, bit)
+                            });
+                        }
                     }
+                }
+                if let Some((parent, f, o)) = group {
+                    each(&unmorton(parent << 3), f, o)?;
                 }
             }
         }
@@ -357,24 +381,23 @@ impl Octree {
         stats.traced_cells = cells.traced;
         let t1 = Instant::now();
         let (hit, miss) = (self.model.hit, self.model.miss);
-        let mut updates = 0usize;
+        let (mut updates, mut next_check) = (0usize, 0usize);
         let mut batch = BatchUpdate::new();
-        let stopped = cells.sets.for_each(|key, is_free| {
-            if updates.is_multiple_of(UPDATES_PER_CHECK) {
+        let stopped = cells.sets.for_each_group(|first, free, occupied| {
+            if updates >= next_check {
                 if self.num_nodes > params.max_nodes {
                     return ControlFlow::Break(true);
                 }
                 if deadline.expired() {
                     return ControlFlow::Break(false);
                 }
+                next_check = updates + UPDATES_PER_CHECK;
             }
-            batch.update(self, key, if is_free { miss } else { hit });
-            if is_free {
-                stats.free_cells += 1;
-            } else {
-                stats.occupied_cells += 1;
-            }
-            updates += 1;
+            batch.update_siblings(self, first, free, occupied, hit, miss);
+            let (f, o) = (free.count_ones() as usize, occupied.count_ones() as usize);
+            stats.free_cells += f;
+            stats.occupied_cells += o;
+            updates += f + o;
             ControlFlow::Continue(())
         });
         batch.finish(self);
