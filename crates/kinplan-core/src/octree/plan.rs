@@ -116,6 +116,14 @@ impl<'a> PlanBuilder<'a> {
         let sumsq = diff[0] * diff[0] + diff[1] * diff[1] + diff[2] * diff[2];
         let finite = p.iter().all(|v| v.is_finite());
         let key = if finite { self.tree.key_of_f32(p) } else { None };
+        self.push_parts(diff, (sumsq as f64).sqrt(), key, finite)
+    }
+
+    /// Adds the beam to a point given as its difference from the origin, the
+    /// beam's length `‖diff‖` (squares summed in f32, root in f64), its key (`None`
+    /// outside the tree's cube or not finite) and whether it is finite; returns it.
+    #[inline]
+    pub(crate) fn push_parts(&mut self, diff: [f32; 3], norm: f64, key: Option<OcKey>, finite: bool) -> Beam {
         let (kind, end, cost) = match key {
             Some(k) => {
                 let l1: u64 = (0..3)
@@ -140,7 +148,7 @@ impl<'a> PlanBuilder<'a> {
         self.chunk_cells += cost;
         let beam = Beam {
             diff,
-            norm: (sumsq as f64).sqrt(),
+            norm,
             end,
             kind,
         };

@@ -14,6 +14,7 @@ use super::frame::{PixelBeam, near_field_starts};
 use super::grid::{BLOCK_WORDS, BlockGrid};
 use super::key::{OcKey, morton, unmorton};
 use super::plan::{Beam, EndPoint, PlanBuilder, ScanPlan};
+use super::project::RowProjector;
 use super::ray::{CellAddress, NoAddress, Walk, WalkStart};
 use super::{Octree, OctreeError, OctreeLimits};
 use crate::Deadline;
@@ -678,14 +679,8 @@ impl Octree {
             return self.insert_scan(&pts, &origin, params, deadline);
         }
         let t0 = Instant::now();
-        let mut builder = match PlanBuilder::new(self, &origin, params, depth.len()) {
-            Ok(b) => b,
-            Err(e) => {
-                // the image's own errors first
-                back_project(depth, width, height, intrinsics, camera_pose, |_, _| {})?;
-                return Err(e);
-            }
-        };
+        check_image(depth, width, height, intrinsics)?;
+        let mut builder = PlanBuilder::new(self, &origin, params, depth.len())?;
         let mut pixels = vec![
             PixelBeam {
                 covered: 0.0,
@@ -694,22 +689,36 @@ impl Octree {
             depth.len()
         ];
         let mut points = 0u32;
-        back_project(depth, width, height, intrinsics, camera_pose, |i, p| {
-            let beam = builder.push(&p);
-            let range = beam.norm();
-            let covered = if params.max_range > 0.0 && range > params.max_range {
-                params.max_range
-            } else if beam.kind == EndPoint::InTree {
-                range
-            } else {
-                0.0
-            };
-            pixels[i] = PixelBeam {
-                covered: covered as f32,
-                point: points,
-            };
-            points += 1;
-        })?;
+        let k = intrinsics;
+        let mut rows = RowProjector::new(width, k.fx, k.cx, camera_pose, &origin, self.resolution_factor);
+        for v in 0..height {
+            let row = v * width..(v + 1) * width;
+            rows.beams(&depth[row.clone()], (v as f64 - k.cy) / k.fy);
+            let r = &rows;
+            for (u, pixel) in pixels[row].iter_mut().enumerate() {
+                if !r.valid[u] {
+                    continue;
+                }
+                let diff = [r.diff[0][u], r.diff[1][u], r.diff[2][u]];
+                let key = [r.key[0][u], r.key[1][u], r.key[2][u]];
+                let finite = r.finite[u];
+                let beam =
+                    builder.push_parts(diff, r.norm[u], (finite && r.in_tree[u]).then_some(key), finite);
+                let range = beam.norm();
+                let covered = if params.max_range > 0.0 && range > params.max_range {
+                    params.max_range
+                } else if beam.kind == EndPoint::InTree {
+                    range
+                } else {
+                    0.0
+                };
+                *pixel = PixelBeam {
+                    covered: covered as f32,
+                    point: points,
+                };
+                points += 1;
+            }
+        }
         let starts = near_field_starts(
             &pixels,
             width,
@@ -766,7 +775,8 @@ pub fn depth_image_points(
 /// Checks the image and hands each pixel with a return to `each` as
 /// `(row-major pixel index, map-frame point)`, in pixel order: `z > 0` finite,
 /// `p_c = (a_u·z, b_v·z, z)` with `a_u = (u − cx)/fx`, `b_v = (v − cy)/fy`, and
-/// `p = R·p_c + t` for the pose's rotation matrix `R` and translation `t`.
+/// `p = R·p_c + t` for the pose's rotation matrix `R` and translation `t`
+/// ([`RowProjector`]).
 pub(crate) fn back_project(
     depth: &[f32],
     width: usize,
@@ -775,6 +785,21 @@ pub(crate) fn back_project(
     camera_pose: &Isometry3<f64>,
     mut each: impl FnMut(usize, [f32; 3]),
 ) -> Result<(), OctreeError> {
+    check_image(depth, width, height, k)?;
+    let mut rows = RowProjector::new(width, k.fx, k.cx, camera_pose, &[0.0; 3], 1.0);
+    for v in 0..height {
+        rows.points(&depth[v * width..(v + 1) * width], (v as f64 - k.cy) / k.fy);
+        let [px, py, pz] = &rows.p;
+        for u in (0..width).filter(|&u| rows.valid[u]) {
+            each(v * width + u, [px[u], py[u], pz[u]]);
+        }
+    }
+    Ok(())
+}
+
+/// Checks a depth image's size (`depth` holds `width · height` pixels) and
+/// intrinsics (finite focal lengths > 0, finite principal point).
+fn check_image(depth: &[f32], width: usize, height: usize, k: &PinholeIntrinsics) -> Result<(), OctreeError> {
     let expected = width.checked_mul(height).ok_or(OctreeError::InvalidParam {
         field: "width",
         value: width as f64,
@@ -800,22 +825,6 @@ pub(crate) fn back_project(
         return Err(OctreeError::NonFinite {
             field: "principal point",
         });
-    }
-    let r = *camera_pose.rotation.to_rotation_matrix().matrix();
-    let t = camera_pose.translation.vector;
-    let a: Vec<f64> = (0..width).map(|u| (u as f64 - k.cx) / k.fx).collect();
-    for v in 0..height {
-        let b = (v as f64 - k.cy) / k.fy;
-        let row = &depth[v * width..(v + 1) * width];
-        for (u, (&z, &a)) in row.iter().zip(&a).enumerate() {
-            let z = z as f64;
-            if !(z.is_finite() && z > 0.0) {
-                continue;
-            }
-            let (x, y) = (a * z, b * z);
-            let p = [0, 1, 2].map(|i| (r[(i, 0)] * x + r[(i, 1)] * y + r[(i, 2)] * z + t[i]) as f32);
-            each(v * width + u, p);
-        }
     }
     Ok(())
 }
