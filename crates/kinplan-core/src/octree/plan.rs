@@ -108,22 +108,22 @@ impl<'a> PlanBuilder<'a> {
         })
     }
 
-    /// Adds the beam to point `p` and returns it.
+    /// Adds the beam to point `p`.
     #[inline]
-    pub(crate) fn push(&mut self, p: &[f32; 3]) -> Beam {
+    pub(crate) fn push(&mut self, p: &[f32; 3]) {
         let o = &self.origin;
         let diff = [p[0] - o[0], p[1] - o[1], p[2] - o[2]];
         let sumsq = diff[0] * diff[0] + diff[1] * diff[1] + diff[2] * diff[2];
         let finite = p.iter().all(|v| v.is_finite());
         let key = if finite { self.tree.key_of_f32(p) } else { None };
-        self.push_parts(diff, (sumsq as f64).sqrt(), key, finite)
+        self.push_parts(diff, (sumsq as f64).sqrt(), key, finite);
     }
 
     /// Adds the beam to a point given as its difference from the origin, the
     /// beam's length `‖diff‖` (squares summed in f32, root in f64), its key (`None`
-    /// outside the tree's cube or not finite) and whether it is finite; returns it.
-    #[inline]
-    pub(crate) fn push_parts(&mut self, diff: [f32; 3], norm: f64, key: Option<OcKey>, finite: bool) -> Beam {
+    /// outside the tree's cube or not finite) and whether it is finite.
+    #[inline(always)]
+    pub(crate) fn push_parts(&mut self, diff: [f32; 3], norm: f64, key: Option<OcKey>, finite: bool) {
         let (kind, end, cost) = match key {
             Some(k) => {
                 let l1: u64 = (0..3)
@@ -146,14 +146,12 @@ impl<'a> PlanBuilder<'a> {
             (self.chunk_start, self.chunk_cells) = (i, 0);
         }
         self.chunk_cells += cost;
-        let beam = Beam {
+        self.plan.beams.push(Beam {
             diff,
             norm,
             end,
             kind,
-        };
-        self.plan.beams.push(beam);
-        beam
+        });
     }
 
     /// The plan; refuses it when its cells pass `params.max_traced_cells`.

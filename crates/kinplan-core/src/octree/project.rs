@@ -39,11 +39,17 @@ pub(crate) struct RowProjector {
     pub in_tree: Vec<bool>,
     /// The point is finite.
     pub finite: Vec<bool>,
+    /// Length the beam covers (m): its length, the range limit when it is longer,
+    /// 0 when the point is outside the tree's cube or not finite.
+    pub covered: Vec<f32>,
+    /// The range limit (m), ≤ 0 for none.
+    max_range: f64,
 }
 
 impl RowProjector {
     /// Buffers for rows of `width` pixels with intrinsics `fx, cx` (pixels), the
-    /// camera pose, the scan's origin and the tree's `1/res`.
+    /// camera pose, the scan's origin, the tree's `1/res` and the range limit (m,
+    /// ≤ 0 for none).
     pub(crate) fn new(
         width: usize,
         fx: f64,
@@ -51,6 +57,7 @@ impl RowProjector {
         camera_pose: &Isometry3<f64>,
         origin: &[f32; 3],
         factor: f64,
+        max_range: f64,
     ) -> Self {
         let m = camera_pose.rotation.to_rotation_matrix();
         let r = [0, 1, 2].map(|i| [0, 1, 2].map(|j| m[(i, j)]));
@@ -69,6 +76,8 @@ impl RowProjector {
             key: [vec![0; width], vec![0; width], vec![0; width]],
             in_tree: vec![false; width],
             finite: vec![false; width],
+            covered: vec![0.0; width],
+            max_range,
         }
     }
 
@@ -108,15 +117,21 @@ impl RowProjector {
         let [kx, ky, kz] = &mut self.key;
         let (kx, ky, kz) = (&mut kx[..n], &mut ky[..n], &mut kz[..n]);
         let (in_tree, finite) = (&mut self.in_tree[..n], &mut self.finite[..n]);
+        let (covered, norm, max_range) = (&mut self.covered[..n], &self.norm[..n], self.max_range);
         let limit = TREE_MAX_VAL as f64;
         for u in 0..n {
             let s = [px[u] as f64 * f, py[u] as f64 * f, pz[u] as f64 * f];
             // ⌊s⌋ ∈ [−32768, 32768) ⇔ s ∈ [−32768, 32768); NaN fails
             let inside = s.iter().fold(true, |acc, &s| acc & (s >= -limit) & (s < limit));
             finite[u] = px[u].is_finite() & py[u].is_finite() & pz[u].is_finite();
-            in_tree[u] = inside;
+            in_tree[u] = inside & finite[u];
             let k = s.map(|s| floor_to_i32(s).wrapping_add(TREE_MAX_VAL) as u16);
             (kx[u], ky[u], kz[u]) = (k[0], k[1], k[2]);
+        }
+        let cut_at = if max_range > 0.0 { max_range } else { f64::INFINITY };
+        for u in 0..n {
+            let kept = if in_tree[u] { norm[u] as f32 } else { 0.0 };
+            covered[u] = if norm[u] > cut_at { max_range as f32 } else { kept };
         }
     }
 }
@@ -142,7 +157,9 @@ mod tests {
         let origin = [1.3f32, -0.7, 1.1];
         let res = 0.05;
         let f = 1.0 / res;
-        let mut rows = RowProjector::new(w, fx, cx, &pose, &origin, f);
+        let mut rows = RowProjector::new(w, fx, cx, &pose, &origin, f, -1.0);
+        // and with a range limit of 3 m
+        let mut cut = RowProjector::new(w, fx, cx, &pose, &origin, f, 3.0);
         let m = pose.rotation.to_rotation_matrix();
         let mut checked = [0usize; 3];
         for v in 0..9 {
@@ -159,6 +176,7 @@ mod tests {
                 .collect();
             let b = (v as f64 - cy) / fy;
             rows.beams(&depth, b);
+            cut.beams(&depth, b);
             for u in 0..w {
                 let z = depth[u] as f64;
                 let valid = z.is_finite() && z > 0.0;
@@ -181,7 +199,11 @@ mod tests {
                 assert!(rows.norm[u] == norm || (rows.norm[u].is_nan() && norm.is_nan()));
                 let s = p.map(|c| (c as f64 * f).floor());
                 let inside = s.iter().all(|&s| (-32768.0..32768.0).contains(&s));
-                assert_eq!(rows.in_tree[u], inside, "pixel {u}, {v}: {p:?}");
+                assert_eq!(rows.in_tree[u], inside && finite, "pixel {u}, {v}: {p:?}");
+                let want = if inside && finite { norm as f32 } else { 0.0 };
+                assert_eq!(rows.covered[u].to_bits(), want.to_bits());
+                let want = if norm > 3.0 { 3.0 } else { want };
+                assert_eq!(cut.covered[u].to_bits(), want.to_bits());
                 if inside {
                     for i in 0..3 {
                         assert_eq!(rows.key[i][u], (s[i] as i32 + 32768) as u16);

@@ -690,30 +690,33 @@ impl Octree {
         ];
         let mut points = 0u32;
         let k = intrinsics;
-        let mut rows = RowProjector::new(width, k.fx, k.cx, camera_pose, &origin, self.resolution_factor);
+        let mut rows = RowProjector::new(
+            width,
+            k.fx,
+            k.cx,
+            camera_pose,
+            &origin,
+            self.resolution_factor,
+            params.max_range,
+        );
         for v in 0..height {
             let row = v * width..(v + 1) * width;
             rows.beams(&depth[row.clone()], (v as f64 - k.cy) / k.fy);
+            let n = width;
             let r = &rows;
-            for (u, pixel) in pixels[row].iter_mut().enumerate() {
-                if !r.valid[u] {
+            let (dx, dy, dz) = (&r.diff[0][..n], &r.diff[1][..n], &r.diff[2][..n]);
+            let (kx, ky, kz) = (&r.key[0][..n], &r.key[1][..n], &r.key[2][..n]);
+            let (valid, finite, in_tree) = (&r.valid[..n], &r.finite[..n], &r.in_tree[..n]);
+            let (norm, covered) = (&r.norm[..n], &r.covered[..n]);
+            let row_pixels = &mut pixels[row];
+            for u in 0..n {
+                if !valid[u] {
                     continue;
                 }
-                let diff = [r.diff[0][u], r.diff[1][u], r.diff[2][u]];
-                let key = [r.key[0][u], r.key[1][u], r.key[2][u]];
-                let finite = r.finite[u];
-                let beam =
-                    builder.push_parts(diff, r.norm[u], (finite && r.in_tree[u]).then_some(key), finite);
-                let range = beam.norm();
-                let covered = if params.max_range > 0.0 && range > params.max_range {
-                    params.max_range
-                } else if beam.kind == EndPoint::InTree {
-                    range
-                } else {
-                    0.0
-                };
-                *pixel = PixelBeam {
-                    covered: covered as f32,
+                let key = in_tree[u].then_some([kx[u], ky[u], kz[u]]);
+                builder.push_parts([dx[u], dy[u], dz[u]], norm[u], key, finite[u]);
+                row_pixels[u] = PixelBeam {
+                    covered: covered[u],
                     point: points,
                 };
                 points += 1;
@@ -786,7 +789,7 @@ pub(crate) fn back_project(
     mut each: impl FnMut(usize, [f32; 3]),
 ) -> Result<(), OctreeError> {
     check_image(depth, width, height, k)?;
-    let mut rows = RowProjector::new(width, k.fx, k.cx, camera_pose, &[0.0; 3], 1.0);
+    let mut rows = RowProjector::new(width, k.fx, k.cx, camera_pose, &[0.0; 3], 1.0, -1.0);
     for v in 0..height {
         rows.points(&depth[v * width..(v + 1) * width], (v as f64 - k.cy) / k.fy);
         let [px, py, pz] = &rows.p;
