@@ -31,7 +31,7 @@ pub struct ScanParams {
     /// Largest key box (cells, once widened to whole blocks of 32³ cells aligned to
     /// multiples of 32 keys) traced into dense bitsets (one bit per cell and set, per
     /// worker); larger scans collect sorted key vectors. Default 2^27 (16 MiB per
-    /// bitset).
+    /// bitset); values above 2^32 act as 2^32.
     pub dense_limit_cells: usize,
     /// Most cells the beams may cross in all, counted before any is traced as
     /// `Σ_beams min(‖key(p) − key(o)‖₁ + 1, 3·max_range/resolution + 4)` — the
@@ -267,6 +267,9 @@ const BATCH_CELLS: u64 = 1 << 22;
 /// Beams whose walks are started in a row before they are walked (dense path).
 const WALK_GROUP: usize = 64;
 
+/// Most cells of a dense key box (its bit addresses are u32).
+const MAX_DENSE_CELLS: usize = 1 << 32;
+
 /// Cell updates between two looks at the stop flag and the node count.
 const UPDATES_PER_CHECK: usize = 4096;
 
@@ -368,7 +371,8 @@ impl Octree {
             trace_us: 0,
             update_us: 0,
         };
-        let dense = BlockGrid::cells_for(&plan.lo, &plan.hi).is_some_and(|c| c <= params.dense_limit_cells);
+        let dense_limit = params.dense_limit_cells.min(MAX_DENSE_CELLS);
+        let dense = BlockGrid::cells_for(&plan.lo, &plan.hi).is_some_and(|c| c <= dense_limit);
         let traced = if dense {
             self.trace_dense(origin, starts, params.max_range, plan, deadline)
         } else {
