@@ -5,7 +5,7 @@
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
-use super::key::{OcKey, TREE_DEPTH, coord_to_key_axis, key_to_coord_axis};
+use super::key::{OcKey, TREE_DEPTH, TREE_MAX_VAL, coord_to_key_axis, floor_to_i32, key_to_coord_axis};
 use super::{Octree, OctreeError, SearchCache};
 
 /// Options of [`Octree::cast_ray`].
@@ -282,11 +282,17 @@ impl Octree {
         let length = length as f64;
         let (ks, dda) = if t_start > 0.0 {
             let f = self.resolution_factor;
-            let at = |i: usize| coord_to_key_axis(origin[i] as f64 + t_start * dir[i] as f64, f);
-            let (Some(x), Some(y), Some(z)) = (at(0), at(1), at(2)) else {
-                return WalkStart::Empty;
+            // `coord_to_key_axis` with the range test on the key: the point lies
+            // between two points of the cube, so |c·f| < 2^51 and the floor is exact
+            let at = |i: usize| {
+                let s = (origin[i] as f64 + t_start * dir[i] as f64) * f;
+                floor_to_i32(s).wrapping_add(TREE_MAX_VAL) as u32
             };
-            let ks = [x, y, z];
+            let k = [at(0), at(1), at(2)];
+            if (k[0] | k[1] | k[2]) > u16::MAX as u32 {
+                return WalkStart::Empty;
+            }
+            let ks = k.map(|k| k as u16);
             if ks == ke {
                 return WalkStart::Empty;
             }
