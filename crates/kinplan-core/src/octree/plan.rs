@@ -155,17 +155,7 @@ impl<'a> PlanBuilder<'a> {
     }
 
     /// The plan; refuses it when its cells pass `params.max_traced_cells`.
-    pub(crate) fn finish(mut self, params: &ScanParams) -> Result<ScanPlan, OctreeError> {
-        let n = self.plan.beams.len();
-        if self.chunk_start < n {
-            self.plan.chunks.push((self.chunk_start..n, self.chunk_cells));
-        }
-        if self.total > params.max_traced_cells {
-            return Err(OctreeError::ScanTooLarge {
-                cells: self.total,
-                limit: params.max_traced_cells,
-            });
-        }
+    pub(crate) fn finish(self, params: &ScanParams) -> Result<ScanPlan, OctreeError> {
         // the key box of the origin and the end points, in one pass over the beams
         // (kept in registers, where per point it was a load and store of the box
         // each point's update had to wait for)
@@ -181,6 +171,30 @@ impl<'a> PlanBuilder<'a> {
                 hi[a] = hi[a].max(k[a]);
             }
         }
+        self.finish_in_box(params, &lo, &hi)
+    }
+
+    /// [`finish`](Self::finish) given the key box `[lo, hi]` (inclusive; `lo > hi`
+    /// for none) of the end points in the tree, worked out by the caller; the
+    /// origin's key is added here.
+    pub(crate) fn finish_in_box(
+        mut self,
+        params: &ScanParams,
+        lo: &OcKey,
+        hi: &OcKey,
+    ) -> Result<ScanPlan, OctreeError> {
+        let n = self.plan.beams.len();
+        if self.chunk_start < n {
+            self.plan.chunks.push((self.chunk_start..n, self.chunk_cells));
+        }
+        if self.total > params.max_traced_cells {
+            return Err(OctreeError::ScanTooLarge {
+                cells: self.total,
+                limit: params.max_traced_cells,
+            });
+        }
+        let lo = [0, 1, 2].map(|a| lo[a].min(self.ko[a]));
+        let hi = [0, 1, 2].map(|a| hi[a].max(self.ko[a]));
         (self.plan.lo, self.plan.hi) = (lo, hi);
         // a cut beam of a far point can leave the end points' box: widen it by the cut
         if self.max_range > 0.0 && self.any_outside {

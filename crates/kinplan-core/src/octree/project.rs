@@ -44,6 +44,12 @@ pub(crate) struct RowProjector {
     pub covered: Vec<f32>,
     /// The range limit (m), ≤ 0 for none.
     max_range: f64,
+    /// Key box (inclusive) of the returns' points in the tree, of every row so far
+    /// (`lo > hi` on every axis while there is none).
+    pub lo: [u16; 3],
+    pub hi: [u16; 3],
+    /// Never take the AVX2 build (tests).
+    pub portable: bool,
 }
 
 impl RowProjector {
@@ -78,12 +84,31 @@ impl RowProjector {
             finite: vec![false; width],
             covered: vec![0.0; width],
             max_range,
+            lo: [u16::MAX; 3],
+            hi: [0; 3],
+            portable: false,
         }
     }
 
     /// The points of one row (`depth`, `width` long) whose optical-frame `y` factor
-    /// is `b = b_v`: fills `valid` and `p`.
+    /// is `b = b_v`: fills `valid` and `p`. Built for AVX2 too, taken when the CPU
+    /// has it (the same operations, so the same values), unless `portable`.
     pub(crate) fn points(&mut self, depth: &[f32], b: f64) {
+        #[cfg(target_arch = "x86_64")]
+        if !self.portable && std::is_x86_feature_detected!("avx2") {
+            #[target_feature(enable = "avx2")]
+            unsafe fn points_avx2(rows: &mut RowProjector, depth: &[f32], b: f64) {
+                rows.points_in(depth, b)
+            }
+            // SAFETY: the CPU has the features the function is built for.
+            return unsafe { points_avx2(self, depth, b) };
+        }
+        self.points_in(depth, b)
+    }
+
+    /// [`beams`](Self::beams)'s and [`points`](Self::points)' work.
+    #[inline(always)]
+    fn points_in(&mut self, depth: &[f32], b: f64) {
         let (r, t) = (&self.r, &self.t);
         let [px, py, pz] = &mut self.p;
         let n = depth.len();
@@ -100,9 +125,24 @@ impl RowProjector {
     }
 
     /// [`points`](Self::points) and each point's difference from the origin, beam
-    /// length and key: fills every buffer.
+    /// length, key and covered length, and the key box: fills every buffer (AVX2
+    /// as `points`).
     pub(crate) fn beams(&mut self, depth: &[f32], b: f64) {
-        self.points(depth, b);
+        #[cfg(target_arch = "x86_64")]
+        if !self.portable && std::is_x86_feature_detected!("avx2") {
+            #[target_feature(enable = "avx2")]
+            unsafe fn beams_avx2(rows: &mut RowProjector, depth: &[f32], b: f64) {
+                rows.beams_in(depth, b)
+            }
+            // SAFETY: the CPU has the features the function is built for.
+            return unsafe { beams_avx2(self, depth, b) };
+        }
+        self.beams_in(depth, b)
+    }
+
+    #[inline(always)]
+    fn beams_in(&mut self, depth: &[f32], b: f64) {
+        self.points_in(depth, b);
         let n = depth.len();
         let (o, f) = (self.origin, self.factor);
         let [px, py, pz] = &self.p;
@@ -133,6 +173,19 @@ impl RowProjector {
             let kept = if in_tree[u] { norm[u] as f32 } else { 0.0 };
             covered[u] = if norm[u] > cut_at { max_range as f32 } else { kept };
         }
+        // the key box of the returns in the tree, each key masked to the box's
+        // neutral value where it does not count
+        let (valid, in_tree) = (&self.valid[..n], &self.in_tree[..n]);
+        for a in 0..3 {
+            let k = &self.key[a][..n];
+            let (mut lo, mut hi) = (self.lo[a], self.hi[a]);
+            for ((&k, &v), &t) in k.iter().zip(valid).zip(in_tree) {
+                let mask = 0u16.wrapping_sub(u16::from(v & t));
+                lo = lo.min(k | !mask);
+                hi = hi.max(k & mask);
+            }
+            (self.lo[a], self.hi[a]) = (lo, hi);
+        }
     }
 }
 
@@ -158,8 +211,11 @@ mod tests {
         let res = 0.05;
         let f = 1.0 / res;
         let mut rows = RowProjector::new(w, fx, cx, &pose, &origin, f, -1.0);
-        // and with a range limit of 3 m
+        // and with a range limit of 3 m, built without AVX2 (where the CPU has it,
+        // `rows` takes the AVX2 build)
         let mut cut = RowProjector::new(w, fx, cx, &pose, &origin, f, 3.0);
+        cut.portable = true;
+        let (mut lo, mut hi) = ([u16::MAX; 3], [0u16; 3]);
         let m = pose.rotation.to_rotation_matrix();
         let mut checked = [0usize; 3];
         for v in 0..9 {
@@ -204,14 +260,25 @@ mod tests {
                 assert_eq!(rows.covered[u].to_bits(), want.to_bits());
                 let want = if norm > 3.0 { 3.0 } else { want };
                 assert_eq!(cut.covered[u].to_bits(), want.to_bits());
-                if inside {
+                for i in 0..3 {
+                    assert_eq!(cut.p[i][u].to_bits(), p[i].to_bits());
+                    assert_eq!(cut.diff[i][u].to_bits(), d[i].to_bits());
+                    assert_eq!(cut.key[i][u], rows.key[i][u]);
+                }
+                assert_eq!(cut.norm[u].to_bits(), rows.norm[u].to_bits());
+                assert_eq!((cut.finite[u], cut.in_tree[u]), (rows.finite[u], rows.in_tree[u]));
+                if inside && finite {
                     for i in 0..3 {
-                        assert_eq!(rows.key[i][u], (s[i] as i32 + 32768) as u16);
+                        let k = (s[i] as i32 + 32768) as u16;
+                        assert_eq!(rows.key[i][u], k);
+                        (lo[i], hi[i]) = (lo[i].min(k), hi[i].max(k));
                     }
                 }
                 checked[usize::from(finite) + usize::from(inside)] += 1;
             }
         }
+        assert_eq!((rows.lo, rows.hi), (lo, hi));
+        assert_eq!((cut.lo, cut.hi), (lo, hi));
         // finite points outside the cube and inside it both met (a depth's point
         // cannot overflow f32: ‖p − t‖ ≤ ‖p_c‖ < 1.01·z for these intrinsics)
         assert!(checked[1] > 0 && checked[2] > 0, "{checked:?}");

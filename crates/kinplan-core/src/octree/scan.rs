@@ -735,7 +735,7 @@ impl Octree {
             params.near_ray_spacing * self.resolution,
             self.near_field_margin(),
         );
-        let plan = builder.finish(params)?;
+        let plan = builder.finish_in_box(params, &rows.lo, &rows.hi)?;
         self.insert_planned(
             &plan,
             &origin,
