@@ -233,8 +233,8 @@ mod tests {
             let b = (v as f64 - cy) / fy;
             rows.beams(&depth, b);
             cut.beams(&depth, b);
-            for u in 0..w {
-                let z = depth[u] as f64;
+            for (u, &z) in depth.iter().enumerate() {
+                let z = z as f64;
                 let valid = z.is_finite() && z > 0.0;
                 assert_eq!(rows.valid[u], valid, "pixel {u}, {v}");
                 if !valid {
