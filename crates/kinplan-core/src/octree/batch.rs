@@ -51,12 +51,148 @@ impl BatchUpdate {
         self.leave(tree, 0);
     }
 
+    /// Updates the cells below one depth-15 node, its children `i` (`x + 2y + 4z`)
+    /// with bit `i` of `free` (by `miss`) or of `occupied` (by `hit`; the two masks
+    /// disjoint), in ascending child order: the tree of one [`update`](Self::update)
+    /// per cell in that order. `first` is the key of child 0 (lowest key bit clear on
+    /// every axis). The descent to the depth-15 node is shared by the siblings; a
+    /// pruned leaf above depth 15 (whose expansion depends on each cell's update)
+    /// hands the cells to `update` one by one.
+    pub(crate) fn update_siblings(
+        &mut self,
+        tree: &mut Octree,
+        first: &OcKey,
+        free: u8,
+        occupied: u8,
+        hit: f32,
+        miss: f32,
+    ) {
+        const PARENT: u8 = TREE_DEPTH - 1;
+        let child = |pos: u32| {
+            [
+                first[0] | (pos & 1) as u16,
+                first[1] | (pos >> 1 & 1) as u16,
+                first[2] | (pos >> 2) as u16,
+            ]
+        };
+        let delta = |pos: u32| if occupied >> pos & 1 != 0 { hit } else { miss };
+        let shared = self.shared_depth(first);
+        self.leave(tree, shared + 1);
+        self.key = *first;
+        let mut just_created = self.enter_root(tree);
+        for depth in shared..PARENT {
+            let loc = self.path[depth as usize];
+            let node = *tree.node(loc);
+            if !node.has_children() && !just_created {
+                // a pruned leaf: whether it expands depends on each cell's update
+                let mut cells = free | occupied;
+                while cells != 0 {
+                    let pos = cells.trailing_zeros();
+                    cells &= cells - 1;
+                    self.update(tree, &child(pos), delta(pos));
+                }
+                return;
+            }
+            just_created = self.step_down(tree, loc, node, child_index(first, depth), depth, just_created);
+        }
+        let (lo, hi) = (tree.model.clamp_min, tree.model.clamp_max);
+        let loc = self.path[PARENT as usize];
+        let cells = free | occupied;
+        let last = 7 - cells.leading_zeros();
+        let node = *tree.node(loc);
+        if node.has_children() || just_created {
+            // the children exist or are all created here (at 0): each one's rule in
+            // turn without a change of path, which ends at the last child
+            let block = if node.has_children() {
+                node.block
+            } else {
+                tree.num_nodes += cells.count_ones() as usize;
+                let block = tree.alloc_block(Block {
+                    nodes: [Node::leaf(0.0); 8],
+                    mask: 0,
+                });
+                tree.node_mut(loc).block = block;
+                block
+            };
+            let blk = &mut tree.blocks[block as usize];
+            let mut left = cells;
+            while left != 0 {
+                let pos = left.trailing_zeros() as usize;
+                left &= left - 1;
+                let d = delta(pos as u32);
+                let leaf = &mut blk.nodes[pos];
+                if blk.mask & (1 << pos) == 0 {
+                    blk.mask |= 1 << pos;
+                    *leaf = Node::leaf(0.0);
+                    tree.num_nodes += usize::from(node.has_children());
+                } else if (d >= 0.0 && leaf.value >= hi) || (d <= 0.0 && leaf.value <= lo) {
+                    continue;
+                }
+                leaf.value = (leaf.value + d).clamp(lo, hi);
+                tree.max_likelihood_pruned = false;
+            }
+            self.path[TREE_DEPTH as usize] = block * 8 + last;
+            self.depth = Some(TREE_DEPTH);
+            self.key = child(last);
+            return;
+        }
+        // a pruned depth-15 leaf: it expands for the first cell not at the clamp
+        let mut left = cells;
+        while left != 0 {
+            let pos = left.trailing_zeros();
+            left &= left - 1;
+            let d = delta(pos);
+            let at_clamp = |v: f32| (d >= 0.0 && v >= hi) || (d <= 0.0 && v <= lo);
+            self.key = child(pos);
+            let node = *tree.node(loc);
+            if !node.has_children() && at_clamp(node.value) {
+                self.depth = Some(PARENT);
+                continue;
+            }
+            self.step_down(tree, loc, node, pos as usize, PARENT, false);
+            let leaf = tree.node_mut(self.path[TREE_DEPTH as usize]);
+            if at_clamp(leaf.value) {
+                continue;
+            }
+            leaf.value = (leaf.value + d).clamp(lo, hi);
+            tree.max_likelihood_pruned = false;
+        }
+    }
+
     /// Adds `delta` (log-odds) to the depth-16 cell `key` with the rule of
     /// [`Octree::update_key`]; returns false when the cell was already at the clamp
     /// in the update's direction (nothing changed).
     pub(crate) fn update(&mut self, tree: &mut Octree, key: &OcKey, delta: f32) -> bool {
-        // the nodes both keys share: depths 0..=shared
-        let shared = match self.depth {
+        let shared = self.shared_depth(key);
+        self.leave(tree, shared + 1);
+        self.key = *key;
+        let (lo, hi) = (tree.model.clamp_min, tree.model.clamp_max);
+        let at_clamp = |v: f32| (delta >= 0.0 && v >= hi) || (delta <= 0.0 && v <= lo);
+        let mut just_created = self.enter_root(tree);
+        for depth in shared..TREE_DEPTH {
+            let loc = self.path[depth as usize];
+            let node = *tree.node(loc);
+            // a pruned leaf above depth 16: its value is the cell's
+            if !node.has_children() && !just_created && at_clamp(node.value) {
+                return false;
+            }
+            just_created = self.step_down(tree, loc, node, child_index(key, depth), depth, just_created);
+        }
+        let leaf = tree.node_mut(self.path[TREE_DEPTH as usize]);
+        if !just_created && at_clamp(leaf.value) {
+            return false;
+        }
+        leaf.value = (leaf.value + delta).clamp(lo, hi);
+        tree.max_likelihood_pruned = false;
+        true
+    }
+
+    /// The depth down to which the last path is also `key`'s (the nodes both share:
+    /// depths 0..=shared, at most the path's deepest valid entry); 0 before the first
+    /// update.
+    #[inline]
+    fn shared_depth(&self, key: &OcKey) -> u8 {
+        match self.depth {
             Some(d) => {
                 let common = self
                     .key
@@ -67,11 +203,13 @@ impl BatchUpdate {
                 common.min(d)
             }
             None => 0,
-        };
-        self.leave(tree, shared + 1);
-        self.key = *key;
-        let (lo, hi) = (tree.model.clamp_min, tree.model.clamp_max);
-        let at_clamp = |v: f32| (delta >= 0.0 && v >= hi) || (delta <= 0.0 && v <= lo);
+        }
+    }
+
+    /// Starts the path at the root when none is held, creating the root (value 0) in
+    /// an empty tree; true when it was just created.
+    #[inline]
+    fn enter_root(&mut self, tree: &mut Octree) -> bool {
         let mut just_created = false;
         if self.depth.is_none() {
             if tree.root.is_none() {
@@ -82,56 +220,54 @@ impl BatchUpdate {
             self.path[0] = ROOT;
             self.depth = Some(0);
         }
-        for depth in shared..TREE_DEPTH {
-            let loc = self.path[depth as usize];
-            let node = *tree.node(loc);
-            let pos = child_index(key, depth);
-            let mut created = false;
-            let block = if !node.has_children() {
-                if just_created {
-                    created = true;
-                    tree.num_nodes += 1;
-                    let mut blk = Block {
-                        nodes: [Node::leaf(0.0); 8],
-                        mask: 1 << pos,
-                    };
-                    blk.nodes[pos] = Node::leaf(0.0);
-                    tree.alloc_block(blk)
-                } else {
-                    // a pruned leaf above depth 16: its value is the cell's
-                    if at_clamp(node.value) {
-                        return false;
-                    }
-                    tree.num_nodes += 8;
-                    tree.alloc_block(Block {
-                        nodes: [Node::leaf(node.value); 8],
-                        mask: 0xff,
-                    })
-                }
+        just_created
+    }
+
+    /// Moves the path from `node` (at `loc`, depth `depth`) to its child `pos`: a
+    /// missing child is created at value 0, a childless node gets a block of
+    /// children (only `pos` when the node was `just_created`, otherwise all eight
+    /// at the node's value: a pruned leaf expanded). True when the child was created.
+    #[inline]
+    fn step_down(
+        &mut self,
+        tree: &mut Octree,
+        loc: Loc,
+        node: Node,
+        pos: usize,
+        depth: u8,
+        just_created: bool,
+    ) -> bool {
+        let mut created = false;
+        let block = if !node.has_children() {
+            let block = if just_created {
+                created = true;
+                tree.num_nodes += 1;
+                tree.alloc_block(Block {
+                    nodes: [Node::leaf(0.0); 8],
+                    mask: 1 << pos,
+                })
             } else {
-                let b = node.block;
-                let blk = &mut tree.blocks[b as usize];
-                if blk.mask & (1 << pos) == 0 {
-                    blk.mask |= 1 << pos;
-                    blk.nodes[pos] = Node::leaf(0.0);
-                    tree.num_nodes += 1;
-                    created = true;
-                }
-                b
+                tree.num_nodes += 8;
+                tree.alloc_block(Block {
+                    nodes: [Node::leaf(node.value); 8],
+                    mask: 0xff,
+                })
             };
-            if !node.has_children() {
-                tree.node_mut(loc).block = block;
+            tree.node_mut(loc).block = block;
+            block
+        } else {
+            let b = node.block;
+            let blk = &mut tree.blocks[b as usize];
+            if blk.mask & (1 << pos) == 0 {
+                blk.mask |= 1 << pos;
+                blk.nodes[pos] = Node::leaf(0.0);
+                tree.num_nodes += 1;
+                created = true;
             }
-            self.path[depth as usize + 1] = block * 8 + pos as u32;
-            self.depth = Some(depth + 1);
-            just_created = created;
-        }
-        let leaf = tree.node_mut(self.path[TREE_DEPTH as usize]);
-        if !just_created && at_clamp(leaf.value) {
-            return false;
-        }
-        leaf.value = (leaf.value + delta).clamp(lo, hi);
-        tree.max_likelihood_pruned = false;
-        true
+            b
+        };
+        self.path[depth as usize + 1] = block * 8 + pos as u32;
+        self.depth = Some(depth + 1);
+        created
     }
 }

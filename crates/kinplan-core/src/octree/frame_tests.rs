@@ -201,3 +201,107 @@ fn a_batched_update_builds_the_tree_of_one_update_per_key() {
         base = one;
     }
 }
+
+#[test]
+fn sibling_groups_build_the_tree_of_one_update_per_key() {
+    // the base tree of the test above (pruned free space, a clamped cell, gaps); the
+    // groups come in ascending Morton order of their parents, as a scan hands them,
+    // each with random disjoint free and occupied masks, some under pruned leaves at
+    // depth 15 and above, some at the clamp
+    let mut rng = ChaCha8Rng::seed_from_u64(2027);
+    let mut base = Octree::new(0.1).unwrap();
+    let miss0 = base.sensor_model().log_odds().miss;
+    for _ in 0..6 {
+        for x in 32760..32776u16 {
+            for y in 32760..32768u16 {
+                // 4 × 4 × 4 blocks pruned at depth 14, and a layer that is not
+                for z in 32764..32769u16 {
+                    base.update_key(&[x, y, z], miss0);
+                }
+            }
+        }
+        // one 2 × 2 × 2 cube pruned at depth 15
+        for pos in 0..8u16 {
+            base.update_key(
+                &[32770 | (pos & 1), 32764 | (pos >> 1 & 1), 32770 | (pos >> 2)],
+                miss0,
+            );
+        }
+    }
+    base.update_key(&[32770, 32770, 32770], 5.0);
+    base.to_max_likelihood_pruned();
+    // the 640 cells updated: 512 of them in pruned leaves (without, > 640 nodes)
+    assert!(base.num_nodes() < 400, "{} nodes", base.num_nodes());
+    let (hit, miss) = (0.85f32, -0.4f32);
+    for round in 0..6 {
+        let mut parents: Vec<u64> = (0..400)
+            .map(|_| {
+                let k = [
+                    rng.random_range(32756u16..32780) & !1,
+                    rng.random_range(32756u16..32772) & !1,
+                    rng.random_range(32764u16..32772) & !1,
+                ];
+                morton(&k)
+            })
+            .collect();
+        parents.sort_unstable();
+        parents.dedup();
+        let groups: Vec<(OcKey, u8, u8)> = parents
+            .iter()
+            .map(|&m| {
+                let cells: u8 = rng.random_range(1..=255);
+                let occupied = cells & rng.random::<u8>();
+                (crate::octree::key::unmorton(m), cells & !occupied, occupied)
+            })
+            .collect();
+        let mut one = base.clone();
+        for (first, free, occupied) in &groups {
+            for pos in 0..8u16 {
+                let k = [
+                    first[0] | (pos & 1),
+                    first[1] | (pos >> 1 & 1),
+                    first[2] | (pos >> 2),
+                ];
+                if occupied >> pos & 1 != 0 {
+                    one.update_key(&k, hit);
+                } else if free >> pos & 1 != 0 {
+                    one.update_key(&k, miss);
+                }
+            }
+        }
+        let mut grouped = base.clone();
+        let mut b = BatchUpdate::new();
+        for (first, free, occupied) in &groups {
+            b.update_siblings(&mut grouped, first, *free, *occupied, hit, miss);
+        }
+        b.finish(&mut grouped);
+        assert_eq!(one.num_nodes(), grouped.num_nodes(), "round {round}");
+        assert_eq!(one.write_ot(), grouped.write_ot(), "round {round}");
+        base = one;
+    }
+    // into an empty tree
+    let mut one = Octree::new(0.1).unwrap();
+    let mut grouped = one.clone();
+    let mut b = BatchUpdate::new();
+    for (first, free, occupied) in [
+        ([32768u16, 32768, 32768], 0b1010_0101u8, 0b0100_0000u8),
+        ([32770, 32768, 32768], 0, 1),
+    ] {
+        b.update_siblings(&mut grouped, &first, free, occupied, hit, miss);
+        for pos in 0..8u16 {
+            let k = [
+                first[0] | (pos & 1),
+                first[1] | (pos >> 1 & 1),
+                first[2] | (pos >> 2),
+            ];
+            if occupied >> pos & 1 != 0 {
+                one.update_key(&k, hit);
+            } else if free >> pos & 1 != 0 {
+                one.update_key(&k, miss);
+            }
+        }
+    }
+    b.finish(&mut grouped);
+    assert_eq!(one.num_nodes(), 1 + 15 + 5 + 1 + 1);
+    assert_eq!(one.write_ot(), grouped.write_ot());
+}

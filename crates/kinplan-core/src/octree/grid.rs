@@ -20,6 +20,8 @@ use super::ray::CellAddress;
 const BLOCK_BITS: u32 = 5;
 /// Cells of a block: bits of one block of the bitset.
 const BLOCK_CELLS: usize = 1 << (3 * BLOCK_BITS);
+/// Keys per axis.
+const KEYS: usize = 1 << 16;
 /// Words (u64) of one block.
 pub(crate) const BLOCK_WORDS: usize = BLOCK_CELLS / 64;
 
@@ -35,8 +37,11 @@ pub(crate) struct BlockGrid {
     lo: OcKey,
     /// Blocks per axis.
     blocks: [usize; 3],
-    /// Per axis, the address term `A_a` of every key from `lo_a` on.
-    terms: [Vec<usize>; 3],
+    /// Per axis, the address term `A_a` of every key (indexed by the key itself, so
+    /// a lookup needs no range check; 0 outside the box). Addresses fit in u32: a
+    /// dense grid has at most `ScanParams::dense_limit_cells` bits, and `new`
+    /// refuses more than 2^32.
+    terms: [Box<[u32; KEYS]>; 3],
 }
 
 impl BlockGrid {
@@ -54,10 +59,20 @@ impl BlockGrid {
         let lo = lo.map(|k| k & !31);
         let blocks = [0, 1, 2].map(|a| ((hi[a] | 31) as usize - lo[a] as usize + 1) >> BLOCK_BITS);
         let strides = [1, blocks[0], blocks[0] * blocks[1]];
+        assert!(
+            blocks.iter().product::<usize>() * BLOCK_CELLS <= 1 << 32,
+            "a dense grid holds at most 2^32 cells"
+        );
         let terms = [0, 1, 2].map(|a| {
-            (0..blocks[a] << BLOCK_BITS)
-                .map(|i| (i >> BLOCK_BITS) * strides[a] * BLOCK_CELLS + (spread5(i & 31) << a))
-                .collect()
+            let mut t: Box<[u32; KEYS]> = vec![0u32; KEYS]
+                .into_boxed_slice()
+                .try_into()
+                .expect("KEYS entries");
+            for i in 0..blocks[a] << BLOCK_BITS {
+                t[lo[a] as usize + i] =
+                    ((i >> BLOCK_BITS) * strides[a] * BLOCK_CELLS + (spread5(i & 31) << a)) as u32;
+            }
+            t
         });
         BlockGrid { lo, blocks, terms }
     }
@@ -94,8 +109,7 @@ impl CellAddress for BlockGrid {
     /// key past its end before it stops, and visits no such cell).
     #[inline]
     fn term(&self, axis: usize, k: u16) -> usize {
-        let i = k.wrapping_sub(self.lo[axis]) as usize;
-        self.terms[axis].get(i).copied().unwrap_or(0)
+        self.terms[axis][k as usize] as usize
     }
 }
 

@@ -26,16 +26,21 @@ pub fn coord_to_key_axis(c: f64, resolution_factor: f64) -> Option<u16> {
     if !(s >= -(TREE_MAX_VAL as f64) && s < TREE_MAX_VAL as f64) {
         return None;
     }
-    // ⌊s⌋ without a libm call: adding 1.5·2^52 rounds s to the nearest integer n
-    // (exact for |s| < 2^51) and leaves n in the low bits of the sum's mantissa, in
-    // two's complement (the mantissa is 2^51 + n); removing it again gives n as a
-    // float, and ⌊s⌋ is one less where n > s. Reading n from the bits spares the
-    // saturating float-to-int conversion.
+    Some((floor_to_i32(s) + TREE_MAX_VAL) as u16)
+}
+
+/// `⌊s⌋` for `|s| < 2^51` without a libm call (any other `s`, NaN included, gives
+/// some value and no panic): adding 1.5·2^52 rounds s to the nearest integer n (exact
+/// for |s| < 2^51) and leaves n in the low bits of the sum's mantissa, in two's
+/// complement (the mantissa is 2^51 + n); removing it again gives n as a float, and
+/// ⌊s⌋ is one less where n > s. Reading n from the bits spares the saturating
+/// float-to-int conversion.
+#[inline(always)]
+pub(crate) fn floor_to_i32(s: f64) -> i32 {
     const ROUND: f64 = 6_755_399_441_055_744.0;
     let y = s + ROUND;
     let n = y.to_bits() as u32 as i32;
-    let floor = n - ((y - ROUND > s) as i32);
-    Some((floor + TREE_MAX_VAL) as u16)
+    n.wrapping_sub((y - ROUND > s) as i32)
 }
 
 /// Centre of a depth-16 key along one axis (m): `(k − 32768 + ½) · res`.

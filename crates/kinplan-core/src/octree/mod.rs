@@ -11,6 +11,7 @@ mod io;
 mod key;
 mod params;
 mod plan;
+mod project;
 mod query;
 mod ray;
 mod scan;

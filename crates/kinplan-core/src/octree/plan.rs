@@ -108,14 +108,22 @@ impl<'a> PlanBuilder<'a> {
         })
     }
 
-    /// Adds the beam to point `p` and returns it.
+    /// Adds the beam to point `p`.
     #[inline]
-    pub(crate) fn push(&mut self, p: &[f32; 3]) -> Beam {
+    pub(crate) fn push(&mut self, p: &[f32; 3]) {
         let o = &self.origin;
         let diff = [p[0] - o[0], p[1] - o[1], p[2] - o[2]];
         let sumsq = diff[0] * diff[0] + diff[1] * diff[1] + diff[2] * diff[2];
         let finite = p.iter().all(|v| v.is_finite());
         let key = if finite { self.tree.key_of_f32(p) } else { None };
+        self.push_parts(diff, (sumsq as f64).sqrt(), key, finite);
+    }
+
+    /// Adds the beam to a point given as its difference from the origin, the
+    /// beam's length `‖diff‖` (squares summed in f32, root in f64), its key (`None`
+    /// outside the tree's cube or not finite) and whether it is finite.
+    #[inline(always)]
+    pub(crate) fn push_parts(&mut self, diff: [f32; 3], norm: f64, key: Option<OcKey>, finite: bool) {
         let (kind, end, cost) = match key {
             Some(k) => {
                 let l1: u64 = (0..3)
@@ -138,28 +146,16 @@ impl<'a> PlanBuilder<'a> {
             (self.chunk_start, self.chunk_cells) = (i, 0);
         }
         self.chunk_cells += cost;
-        let beam = Beam {
+        self.plan.beams.push(Beam {
             diff,
-            norm: (sumsq as f64).sqrt(),
+            norm,
             end,
             kind,
-        };
-        self.plan.beams.push(beam);
-        beam
+        });
     }
 
     /// The plan; refuses it when its cells pass `params.max_traced_cells`.
-    pub(crate) fn finish(mut self, params: &ScanParams) -> Result<ScanPlan, OctreeError> {
-        let n = self.plan.beams.len();
-        if self.chunk_start < n {
-            self.plan.chunks.push((self.chunk_start..n, self.chunk_cells));
-        }
-        if self.total > params.max_traced_cells {
-            return Err(OctreeError::ScanTooLarge {
-                cells: self.total,
-                limit: params.max_traced_cells,
-            });
-        }
+    pub(crate) fn finish(self, params: &ScanParams) -> Result<ScanPlan, OctreeError> {
         // the key box of the origin and the end points, in one pass over the beams
         // (kept in registers, where per point it was a load and store of the box
         // each point's update had to wait for)
@@ -175,6 +171,30 @@ impl<'a> PlanBuilder<'a> {
                 hi[a] = hi[a].max(k[a]);
             }
         }
+        self.finish_in_box(params, &lo, &hi)
+    }
+
+    /// [`finish`](Self::finish) given the key box `[lo, hi]` (inclusive; `lo > hi`
+    /// for none) of the end points in the tree, worked out by the caller; the
+    /// origin's key is added here.
+    pub(crate) fn finish_in_box(
+        mut self,
+        params: &ScanParams,
+        lo: &OcKey,
+        hi: &OcKey,
+    ) -> Result<ScanPlan, OctreeError> {
+        let n = self.plan.beams.len();
+        if self.chunk_start < n {
+            self.plan.chunks.push((self.chunk_start..n, self.chunk_cells));
+        }
+        if self.total > params.max_traced_cells {
+            return Err(OctreeError::ScanTooLarge {
+                cells: self.total,
+                limit: params.max_traced_cells,
+            });
+        }
+        let lo = [0, 1, 2].map(|a| lo[a].min(self.ko[a]));
+        let hi = [0, 1, 2].map(|a| hi[a].max(self.ko[a]));
         (self.plan.lo, self.plan.hi) = (lo, hi);
         // a cut beam of a far point can leave the end points' box: widen it by the cut
         if self.max_range > 0.0 && self.any_outside {

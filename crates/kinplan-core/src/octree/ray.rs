@@ -5,7 +5,7 @@
 use nalgebra::{Point3, Vector3};
 use rayon::prelude::*;
 
-use super::key::{OcKey, TREE_DEPTH, coord_to_key_axis, key_to_coord_axis};
+use super::key::{OcKey, TREE_DEPTH, TREE_MAX_VAL, coord_to_key_axis, floor_to_i32, key_to_coord_axis};
 use super::{Octree, OctreeError, SearchCache};
 
 /// Options of [`Octree::cast_ray`].
@@ -282,11 +282,17 @@ impl Octree {
         let length = length as f64;
         let (ks, dda) = if t_start > 0.0 {
             let f = self.resolution_factor;
-            let at = |i: usize| coord_to_key_axis(origin[i] as f64 + t_start * dir[i] as f64, f);
-            let (Some(x), Some(y), Some(z)) = (at(0), at(1), at(2)) else {
-                return WalkStart::Empty;
+            // `coord_to_key_axis` with the range test on the key: the point lies
+            // between two points of the cube, so |c·f| < 2^51 and the floor is exact
+            let at = |i: usize| {
+                let s = (origin[i] as f64 + t_start * dir[i] as f64) * f;
+                floor_to_i32(s).wrapping_add(TREE_MAX_VAL) as u32
             };
-            let ks = [x, y, z];
+            let k = [at(0), at(1), at(2)];
+            if (k[0] | k[1] | k[2]) > u16::MAX as u32 {
+                return WalkStart::Empty;
+            }
+            let ks = k.map(|k| k as u16);
             if ks == ke {
                 return WalkStart::Empty;
             }
@@ -328,7 +334,7 @@ impl Octree {
         // sign only, so it meets `ke` exactly after Σ_a (ke_a − ks_a)·step_a steps if
         // every term is ≥ 0 (and 0 on a still axis), or never (−1: the count only
         // falls and never meets 0).
-        let mut to_end = (0..3)
+        let to_end = (0..3)
             .try_fold(0i64, |n, a| {
                 let r = (ke[a] as i64 - ks[a] as i64) * dda.step[a] as i64;
                 (r >= 0 && (dda.step[a] != 0 || r == 0)).then_some(n + r)
@@ -347,10 +353,10 @@ impl Octree {
         // branch first checks its own `t_max` (not for the first step, out of the
         // start cell, visited above), then visits the cell, then steps.
         macro_rules! step {
-            ($t:ident, $d:ident, $k:ident, $s:ident, $a:ident, $axis:expr, $first:expr) => {{
+            ($walk:lifetime, $t:ident, $d:ident, $k:ident, $s:ident, $a:ident, $axis:expr, $first:expr) => {{
                 if !$first {
                     if $t > length {
-                        break;
+                        break $walk;
                     }
                     visit(&[kx, ky, kz], ax + ay + az);
                 }
@@ -361,30 +367,35 @@ impl Octree {
         }
         // axis of the smallest t_max, ties as in `Dda::axis`
         macro_rules! choose_and_step {
-            ($first:expr) => {{
+            ($walk:lifetime, $first:expr) => {{
                 if tx < ty {
                     if tx < tz {
-                        step!(tx, dx, kx, sx, ax, 0, $first)
+                        step!($walk, tx, dx, kx, sx, ax, 0, $first)
                     } else {
-                        step!(tz, dz, kz, sz, az, 2, $first)
+                        step!($walk, tz, dz, kz, sz, az, 2, $first)
                     }
                 } else if ty < tz {
-                    step!(ty, dy, ky, sy, ay, 1, $first)
+                    step!($walk, ty, dy, ky, sy, ay, 1, $first)
                 } else {
-                    step!(tz, dz, kz, sz, az, 2, $first)
-                }
-                to_end -= 1;
-                if to_end == 0 && kx == ke[0] && ky == ke[1] && kz == ke[2] {
-                    break;
+                    step!($walk, tz, dz, kz, sz, az, 2, $first)
                 }
             }};
         }
-        // a beam between two keys in the cube crosses at most 3 · 65536 borders
-        #[allow(clippy::never_loop)]
-        for _ in 0..1 {
-            choose_and_step!(true);
+        // The key can equal the end key only after exactly `to_end` steps, so the
+        // first `to_end` steps run without looking at it, then it is compared once;
+        // a walk that missed it (or never meets it, `to_end` = −1) goes on until
+        // the length stops it. A beam between two keys in the cube crosses at most
+        // 3 · 65536 borders.
+        'walk: {
+            choose_and_step!('walk, true);
+            for _ in 1..to_end {
+                choose_and_step!('walk, false);
+            }
+            if to_end >= 1 && kx == ke[0] && ky == ke[1] && kz == ke[2] {
+                break 'walk;
+            }
             for _ in 0..3 * 65536 {
-                choose_and_step!(false);
+                choose_and_step!('walk, false);
             }
         }
     }

@@ -14,6 +14,7 @@ use super::frame::{PixelBeam, near_field_starts};
 use super::grid::{BLOCK_WORDS, BlockGrid};
 use super::key::{OcKey, morton, unmorton};
 use super::plan::{Beam, EndPoint, PlanBuilder, ScanPlan};
+use super::project::RowProjector;
 use super::ray::{CellAddress, NoAddress, Walk, WalkStart};
 use super::{Octree, OctreeError, OctreeLimits};
 use crate::Deadline;
@@ -30,7 +31,7 @@ pub struct ScanParams {
     /// Largest key box (cells, once widened to whole blocks of 32³ cells aligned to
     /// multiples of 32 keys) traced into dense bitsets (one bit per cell and set, per
     /// worker); larger scans collect sorted key vectors. Default 2^27 (16 MiB per
-    /// bitset).
+    /// bitset); values above 2^32 act as 2^32.
     pub dense_limit_cells: usize,
     /// Most cells the beams may cross in all, counted before any is traced as
     /// `Σ_beams min(‖key(p) − key(o)‖₁ + 1, 3·max_range/resolution + 4)` — the
@@ -167,10 +168,13 @@ struct ScanCells {
 }
 
 impl CellSets {
-    /// Hands every cell with `true` for free, `false` for occupied to `each` in
-    /// ascending Morton order inside each 32³ block (dense) or in ascending Morton
-    /// order (sorted), until `each` breaks.
-    fn for_each<B>(&self, mut each: impl FnMut(&OcKey, bool) -> ControlFlow<B>) -> ControlFlow<B> {
+    /// Hands the cells to `each` grouped by their depth-15 parent, as the key of the
+    /// parent's child 0 and two disjoint masks of its children (bit `x + 2y + 4z`),
+    /// free and occupied: in ascending Morton order inside each 32³ block (dense) or
+    /// in ascending Morton order (sorted), until `each` breaks. In both layouts a
+    /// parent's eight children are eight consecutive bits, so a dense group is one
+    /// byte of each bitset.
+    fn for_each_group<B>(&self, mut each: impl FnMut(&OcKey, u8, u8) -> ControlFlow<B>) -> ControlFlow<B> {
         match self {
             CellSets::Dense { grid, free, occupied } => {
                 let blocks = free
@@ -184,23 +188,44 @@ impl CellSets {
                     for (w, (&f, &o)) in f.iter().zip(o).enumerate() {
                         let mut bits = f | o;
                         while bits != 0 {
-                            let i = bits.trailing_zeros() as usize;
-                            bits &= bits - 1;
-                            each(&grid.key_in_block(&base, w * 64 + i), o >> i & 1 == 0)?;
+                            let shift = bits.trailing_zeros() & !7;
+                            bits &= !(0xff << shift);
+                            let first = grid.key_in_block(&base, w * 64 + shift as usize);
+                            each(&first, (f >> shift) as u8, (o >> shift) as u8)?;
                         }
                     }
                 }
             }
             CellSets::Sorted { free, occupied } => {
                 let (mut i, mut j) = (0, 0);
+                let mut group: Option<(u64, u8, u8)> = None;
                 while i < free.len() || j < occupied.len() {
-                    if j == occupied.len() || (i < free.len() && free[i] < occupied[j]) {
-                        each(&unmorton(free[i]), true)?;
+                    let (m, is_free) = if j == occupied.len() || (i < free.len() && free[i] < occupied[j]) {
                         i += 1;
+                        (free[i - 1], true)
                     } else {
-                        each(&unmorton(occupied[j]), false)?;
                         j += 1;
+                        (occupied[j - 1], false)
+                    };
+                    let bit = 1u8 << (m & 7);
+                    match &mut group {
+                        Some((parent, f, o)) if *parent == m >> 3 => {
+                            *(if is_free { f } else { o }) |= bit;
+                        }
+                        _ => {
+                            if let Some((parent, f, o)) = group {
+                                each(&unmorton(parent << 3), f, o)?;
+                            }
+                            group = Some(if is_free {
+                                (m >> 3, bit, 0)
+                            } else {
+                                (m >> 3, 0, bit)
+                            });
+                        }
                     }
+                }
+                if let Some((parent, f, o)) = group {
+                    each(&unmorton(parent << 3), f, o)?;
                 }
             }
         }
@@ -241,6 +266,9 @@ const BATCH_CELLS: u64 = 1 << 22;
 
 /// Beams whose walks are started in a row before they are walked (dense path).
 const WALK_GROUP: usize = 64;
+
+/// Most cells of a dense key box (its bit addresses are u32).
+const MAX_DENSE_CELLS: usize = 1 << 32;
 
 /// Cell updates between two looks at the stop flag and the node count.
 const UPDATES_PER_CHECK: usize = 4096;
@@ -343,7 +371,8 @@ impl Octree {
             trace_us: 0,
             update_us: 0,
         };
-        let dense = BlockGrid::cells_for(&plan.lo, &plan.hi).is_some_and(|c| c <= params.dense_limit_cells);
+        let dense_limit = params.dense_limit_cells.min(MAX_DENSE_CELLS);
+        let dense = BlockGrid::cells_for(&plan.lo, &plan.hi).is_some_and(|c| c <= dense_limit);
         let traced = if dense {
             self.trace_dense(origin, starts, params.max_range, plan, deadline)
         } else {
@@ -357,24 +386,23 @@ impl Octree {
         stats.traced_cells = cells.traced;
         let t1 = Instant::now();
         let (hit, miss) = (self.model.hit, self.model.miss);
-        let mut updates = 0usize;
+        let (mut updates, mut next_check) = (0usize, 0usize);
         let mut batch = BatchUpdate::new();
-        let stopped = cells.sets.for_each(|key, is_free| {
-            if updates.is_multiple_of(UPDATES_PER_CHECK) {
+        let stopped = cells.sets.for_each_group(|first, free, occupied| {
+            if updates >= next_check {
                 if self.num_nodes > params.max_nodes {
                     return ControlFlow::Break(true);
                 }
                 if deadline.expired() {
                     return ControlFlow::Break(false);
                 }
+                next_check = updates + UPDATES_PER_CHECK;
             }
-            batch.update(self, key, if is_free { miss } else { hit });
-            if is_free {
-                stats.free_cells += 1;
-            } else {
-                stats.occupied_cells += 1;
-            }
-            updates += 1;
+            batch.update_siblings(self, first, free, occupied, hit, miss);
+            let (f, o) = (free.count_ones() as usize, occupied.count_ones() as usize);
+            stats.free_cells += f;
+            stats.occupied_cells += o;
+            updates += f + o;
             ControlFlow::Continue(())
         });
         batch.finish(self);
@@ -655,14 +683,8 @@ impl Octree {
             return self.insert_scan(&pts, &origin, params, deadline);
         }
         let t0 = Instant::now();
-        let mut builder = match PlanBuilder::new(self, &origin, params, depth.len()) {
-            Ok(b) => b,
-            Err(e) => {
-                // the image's own errors first
-                back_project(depth, width, height, intrinsics, camera_pose, |_, _| {})?;
-                return Err(e);
-            }
-        };
+        check_image(depth, width, height, intrinsics)?;
+        let mut builder = PlanBuilder::new(self, &origin, params, depth.len())?;
         let mut pixels = vec![
             PixelBeam {
                 covered: 0.0,
@@ -671,22 +693,39 @@ impl Octree {
             depth.len()
         ];
         let mut points = 0u32;
-        back_project(depth, width, height, intrinsics, camera_pose, |i, p| {
-            let beam = builder.push(&p);
-            let range = beam.norm();
-            let covered = if params.max_range > 0.0 && range > params.max_range {
-                params.max_range
-            } else if beam.kind == EndPoint::InTree {
-                range
-            } else {
-                0.0
-            };
-            pixels[i] = PixelBeam {
-                covered: covered as f32,
-                point: points,
-            };
-            points += 1;
-        })?;
+        let k = intrinsics;
+        let mut rows = RowProjector::new(
+            width,
+            k.fx,
+            k.cx,
+            camera_pose,
+            &origin,
+            self.resolution_factor,
+            params.max_range,
+        );
+        for v in 0..height {
+            let row = v * width..(v + 1) * width;
+            rows.beams(&depth[row.clone()], (v as f64 - k.cy) / k.fy);
+            let n = width;
+            let r = &rows;
+            let (dx, dy, dz) = (&r.diff[0][..n], &r.diff[1][..n], &r.diff[2][..n]);
+            let (kx, ky, kz) = (&r.key[0][..n], &r.key[1][..n], &r.key[2][..n]);
+            let (valid, finite, in_tree) = (&r.valid[..n], &r.finite[..n], &r.in_tree[..n]);
+            let (norm, covered) = (&r.norm[..n], &r.covered[..n]);
+            let row_pixels = &mut pixels[row];
+            for u in 0..n {
+                if !valid[u] {
+                    continue;
+                }
+                let key = in_tree[u].then_some([kx[u], ky[u], kz[u]]);
+                builder.push_parts([dx[u], dy[u], dz[u]], norm[u], key, finite[u]);
+                row_pixels[u] = PixelBeam {
+                    covered: covered[u],
+                    point: points,
+                };
+                points += 1;
+            }
+        }
         let starts = near_field_starts(
             &pixels,
             width,
@@ -696,7 +735,7 @@ impl Octree {
             params.near_ray_spacing * self.resolution,
             self.near_field_margin(),
         );
-        let plan = builder.finish(params)?;
+        let plan = builder.finish_in_box(params, &rows.lo, &rows.hi)?;
         self.insert_planned(
             &plan,
             &origin,
@@ -743,7 +782,8 @@ pub fn depth_image_points(
 /// Checks the image and hands each pixel with a return to `each` as
 /// `(row-major pixel index, map-frame point)`, in pixel order: `z > 0` finite,
 /// `p_c = (a_u·z, b_v·z, z)` with `a_u = (u − cx)/fx`, `b_v = (v − cy)/fy`, and
-/// `p = R·p_c + t` for the pose's rotation matrix `R` and translation `t`.
+/// `p = R·p_c + t` for the pose's rotation matrix `R` and translation `t`
+/// ([`RowProjector`]).
 pub(crate) fn back_project(
     depth: &[f32],
     width: usize,
@@ -752,6 +792,21 @@ pub(crate) fn back_project(
     camera_pose: &Isometry3<f64>,
     mut each: impl FnMut(usize, [f32; 3]),
 ) -> Result<(), OctreeError> {
+    check_image(depth, width, height, k)?;
+    let mut rows = RowProjector::new(width, k.fx, k.cx, camera_pose, &[0.0; 3], 1.0, -1.0);
+    for v in 0..height {
+        rows.points(&depth[v * width..(v + 1) * width], (v as f64 - k.cy) / k.fy);
+        let [px, py, pz] = &rows.p;
+        for u in (0..width).filter(|&u| rows.valid[u]) {
+            each(v * width + u, [px[u], py[u], pz[u]]);
+        }
+    }
+    Ok(())
+}
+
+/// Checks a depth image's size (`depth` holds `width · height` pixels) and
+/// intrinsics (finite focal lengths > 0, finite principal point).
+fn check_image(depth: &[f32], width: usize, height: usize, k: &PinholeIntrinsics) -> Result<(), OctreeError> {
     let expected = width.checked_mul(height).ok_or(OctreeError::InvalidParam {
         field: "width",
         value: width as f64,
@@ -777,22 +832,6 @@ pub(crate) fn back_project(
         return Err(OctreeError::NonFinite {
             field: "principal point",
         });
-    }
-    let r = *camera_pose.rotation.to_rotation_matrix().matrix();
-    let t = camera_pose.translation.vector;
-    let a: Vec<f64> = (0..width).map(|u| (u as f64 - k.cx) / k.fx).collect();
-    for v in 0..height {
-        let b = (v as f64 - k.cy) / k.fy;
-        let row = &depth[v * width..(v + 1) * width];
-        for (u, (&z, &a)) in row.iter().zip(&a).enumerate() {
-            let z = z as f64;
-            if !(z.is_finite() && z > 0.0) {
-                continue;
-            }
-            let (x, y) = (a * z, b * z);
-            let p = [0, 1, 2].map(|i| (r[(i, 0)] * x + r[(i, 1)] * y + r[(i, 2)] * z + t[i]) as f32);
-            each(v * width + u, p);
-        }
     }
     Ok(())
 }
