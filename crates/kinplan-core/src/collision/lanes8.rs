@@ -440,7 +440,7 @@ impl Lanes8 {
             return unsafe { self.unsure_avx2(q, scene_bodies, self_pairs, frames, flags) };
         }
         let _ = portable;
-        self.unsure_in(q, scene_bodies, self_pairs, frames, flags)
+        self.unsure_in::<false>(q, scene_bodies, self_pairs, frames, flags)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -453,11 +453,13 @@ impl Lanes8 {
         frames: &mut [Frame8],
         flags: &mut Flags,
     ) -> u32 {
-        self.unsure_in(q, scene_bodies, self_pairs, frames, flags)
+        self.unsure_in::<true>(q, scene_bodies, self_pairs, frames, flags)
     }
 
+    /// The batch check; `AVX`: built inside [`Lanes8::unsure_avx2`] (the
+    /// masks then come from `vmovmskps`).
     #[inline(always)]
-    fn unsure_in(
+    fn unsure_in<const AVX: bool>(
         &self,
         q: &[Lane8],
         scene_bodies: &[u16],
@@ -488,7 +490,7 @@ impl Lanes8 {
                         d2[l] += e * e;
                     }
                 }
-                let m = mask(&d2, t);
+                let m = mask::<AVX>(&d2, t);
                 if m != 0 {
                     near[count] = (i as u16, m);
                     count += 1;
@@ -502,7 +504,7 @@ impl Lanes8 {
             for s in &self.fine[self.start[b]..self.start[b + 1]] {
                 let x = place(f, &s.c);
                 for &(i, m) in &near[..count] {
-                    hit |= sphere_prim(&x, s, &self.prims[i as usize]) & m;
+                    hit |= sphere_prim::<AVX>(&x, s, &self.prims[i as usize]) & m;
                 }
             }
             if hit != 0 {
@@ -513,11 +515,11 @@ impl Lanes8 {
         for (i, &(a, b)) in self_pairs.iter().enumerate() {
             let (a, b) = (a as usize, b as usize);
             let reach = self.coarse[a].r + self.coarse[b].r;
-            let m = mask(&dist2(&centres[a], &centres[b]), reach * reach * GROW);
+            let m = mask::<AVX>(&dist2(&centres[a], &centres[b]), reach * reach * GROW);
             if m == 0 {
                 continue;
             }
-            let hit = self.fine_pairs_meet(&frames[a], a, &frames[b], b, &centres[a], &centres[b]) & m;
+            let hit = self.fine_pairs_meet::<AVX>(&frames[a], a, &frames[b], b, &centres[a], &centres[b]) & m;
             if hit != 0 {
                 unsure |= hit;
                 let bit = 1u64 << i.min(PAIR_BITS);
@@ -532,7 +534,7 @@ impl Lanes8 {
     /// that every lane counts as meeting — unsure, never wrong).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn fine_pairs_meet(
+    fn fine_pairs_meet<const AVX: bool>(
         &self,
         fa: &Frame8,
         a: usize,
@@ -548,7 +550,7 @@ impl Lanes8 {
         for t in &self.fine[self.start[b]..self.start[b + 1]] {
             let y = place(fb, &t.c);
             let reach = t.r + sa.r;
-            let close = mask(&dist2(&y, ca), reach * reach * GROW);
+            let close = mask::<AVX>(&dist2(&y, ca), reach * reach * GROW);
             if close != 0 {
                 if count == CLOSE {
                     return (1 << WIDTH) - 1;
@@ -564,13 +566,13 @@ impl Lanes8 {
             }
             let x = place(fa, &s.c);
             let reach = s.r + sb.r;
-            let close = mask(&dist2(&x, cb), reach * reach * GROW);
+            let close = mask::<AVX>(&dist2(&x, cb), reach * reach * GROW);
             if close == 0 {
                 continue;
             }
             for (y, r, near) in &kept[..count] {
                 let reach = s.r + r;
-                meet |= mask(&dist2(&x, y), reach * reach * GROW) & close & near;
+                meet |= mask::<AVX>(&dist2(&x, y), reach * reach * GROW) & close & near;
             }
         }
         meet
@@ -688,14 +690,31 @@ fn min(a: f32, b: f32) -> f32 {
     if a < b { a } else { b }
 }
 
-/// Lanes whose `d2` is at most `t`.
+/// Lanes whose `d2` is at most `t`: one compare and `vmovmskps` in the
+/// AVX2 build (`AVX`), a loop elsewhere; the same bits.
 #[inline(always)]
-fn mask(d2: &Lane8, t: f32) -> u32 {
+fn mask<const AVX: bool>(d2: &Lane8, t: f32) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if AVX {
+        // SAFETY: `AVX` is set only in the AVX2 build, which runs after the
+        // CPU was found to have AVX2.
+        return unsafe { mask_avx(d2, t) };
+    }
     let mut bits = 0u32;
     for l in 0..WIDTH {
         bits |= u32::from(d2[l] <= t) << l;
     }
     bits
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn mask_avx(d2: &Lane8, t: f32) -> u32 {
+    use std::arch::x86_64::{_CMP_LE_OQ, _mm256_cmp_ps, _mm256_loadu_ps, _mm256_movemask_ps, _mm256_set1_ps};
+    // SAFETY: `d2` is eight readable floats.
+    let v = unsafe { _mm256_loadu_ps(d2.as_ptr()) };
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(v, _mm256_set1_ps(t))) as u32
 }
 
 /// Calls `f` with every set bit's index.
@@ -772,7 +791,7 @@ fn dist2(x: &[Lane8; 3], y: &[Lane8; 3]) -> Lane8 {
 
 /// Lanes whose sphere `s` at `x` meets the leaf.
 #[inline(always)]
-fn sphere_prim(x: &[Lane8; 3], s: &Ball, prim: &Prim) -> u32 {
+fn sphere_prim<const AVX: bool>(x: &[Lane8; 3], s: &Ball, prim: &Prim) -> u32 {
     let mut d2 = [0.0f32; WIDTH];
     match prim {
         Prim::Aabb { lo, hi } => {
@@ -782,28 +801,46 @@ fn sphere_prim(x: &[Lane8; 3], s: &Ball, prim: &Prim) -> u32 {
                     d2[l] += e * e;
                 }
             }
-            mask(&d2, s.r2)
+            mask::<AVX>(&d2, s.r2)
         }
         Prim::Box { c, m, half } => {
-            for l in 0..WIDTH {
-                let v = [x[0][l] - c[0], x[1][l] - c[1], x[2][l] - c[2]];
-                for k in 0..3 {
-                    let local = m[0][k] * v[0] + m[1][k] * v[1] + m[2][k] * v[2];
+            let mut v = [[0.0f32; WIDTH]; 3];
+            for k in 0..3 {
+                for l in 0..WIDTH {
+                    v[k][l] = x[k][l] - c[k];
+                }
+            }
+            for k in 0..3 {
+                for l in 0..WIDTH {
+                    let local = m[0][k] * v[0][l] + m[1][k] * v[1][l] + m[2][k] * v[2][l];
                     let e = max(local.abs() - half[k], 0.0);
                     d2[l] += e * e;
                 }
             }
-            mask(&d2, s.r2)
+            mask::<AVX>(&d2, s.r2)
         }
         Prim::Capsule { a, d, inv, r } => {
+            let mut v = [[0.0f32; WIDTH]; 3];
+            for k in 0..3 {
+                for l in 0..WIDTH {
+                    v[k][l] = x[k][l] - a[k];
+                }
+            }
+            let mut t = [0.0f32; WIDTH];
             for l in 0..WIDTH {
-                let v = [x[0][l] - a[0], x[1][l] - a[1], x[2][l] - a[2]];
-                let t = min(max((v[0] * d[0] + v[1] * d[1] + v[2] * d[2]) * inv, 0.0), 1.0);
-                let w = [v[0] - t * d[0], v[1] - t * d[1], v[2] - t * d[2]];
-                d2[l] = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+                t[l] = min(
+                    max((v[0][l] * d[0] + v[1][l] * d[1] + v[2][l] * d[2]) * inv, 0.0),
+                    1.0,
+                );
+            }
+            for k in 0..3 {
+                for l in 0..WIDTH {
+                    let w = v[k][l] - t[l] * d[k];
+                    d2[l] += w * w;
+                }
             }
             let reach = s.r + r;
-            mask(&d2, reach * reach * GROW)
+            mask::<AVX>(&d2, reach * reach * GROW)
         }
     }
 }

@@ -145,8 +145,9 @@ fn motion_valid_as<C: StateChecker + ?Sized>(
 }
 
 /// States handed to [`StateChecker::states_valid`] at once: the lanes of
-/// the batched check.
-const BATCH: usize = 4;
+/// the batched check (a state-by-state check stops at the first collision
+/// of a batch all the same).
+const BATCH: usize = 8;
 /// Most joints batched here (stack buffer); longer chains go state by state.
 const BATCH_DOF: usize = 32;
 
