@@ -57,6 +57,8 @@
 // index loops, which the vectoriser takes.
 #![allow(clippy::needless_range_loop)]
 
+use std::mem::MaybeUninit;
+
 use nalgebra::{Matrix3, Point3, Rotation3, Vector3};
 
 use super::fast::LeafFast;
@@ -182,9 +184,9 @@ pub(crate) struct Lanes8 {
     /// already in the radii, kept for the tests).
     #[cfg_attr(not(test), allow(dead_code))]
     margin: Vec<f64>,
-    /// Leaf boxes, structure of arrays.
-    lo: [Vec<f32>; 3],
-    hi: [Vec<f32>; 3],
+    /// Leaf boxes `[lo, hi]` (each leaf's bounds are broadcast to the lanes,
+    /// so one record per leaf).
+    boxes: Vec<[[f32; 3]; 2]>,
     prims: Vec<Prim>,
 }
 
@@ -327,6 +329,16 @@ impl Lanes8 {
                 }
             }
         }
+        // every body posed exactly once: the batch reads every body's frame
+        let mut posed = vec![0; body_count];
+        for op in &ops {
+            if let Op::Body { body } = op {
+                posed[*body] += 1;
+            }
+        }
+        if posed.iter().any(|&n| n != 1) {
+            return None;
+        }
         let ball = |(c, r): &(Vector3<f64>, f64), grow: f64| {
             let r = r + grow;
             Ball {
@@ -349,8 +361,7 @@ impl Lanes8 {
         if !(x.is_finite() && x <= MAX_COORD) {
             return None;
         }
-        let mut lo: [Vec<f32>; 3] = Default::default();
-        let mut hi: [Vec<f32>; 3] = Default::default();
+        let mut boxes = Vec::with_capacity(world.leaves.len());
         let mut prims = Vec::with_capacity(world.leaves.len());
         for leaf in &world.leaves {
             let (a, b) = (leaf.aabb.min, leaf.aabb.max);
@@ -361,10 +372,10 @@ impl Lanes8 {
             {
                 return None;
             }
-            for k in 0..3 {
-                lo[k].push(down(a[k] - SLACK));
-                hi[k].push(up(b[k] + SLACK));
-            }
+            boxes.push([
+                [0, 1, 2].map(|k| down(a[k] - SLACK)),
+                [0, 1, 2].map(|k| up(b[k] + SLACK)),
+            ]);
             prims.push(prim_of(leaf, x));
         }
         Some(Lanes8 {
@@ -375,8 +386,7 @@ impl Lanes8 {
             fine,
             start,
             margin,
-            lo,
-            hi,
+            boxes,
             prims,
         })
     }
@@ -402,13 +412,13 @@ impl Lanes8 {
         if !portable && std::is_x86_feature_detected!("avx2") {
             #[target_feature(enable = "avx2")]
             fn fk_avx2(lanes: &Lanes8, q: &[Lane8], frames: &mut [Frame8]) {
-                lanes.fk(q, frames)
+                frames[..lanes.body_count].copy_from_slice(lanes.fk(q, &mut uninit_frames()));
             }
             // SAFETY: the CPU has the features the function is built for.
             return unsafe { fk_avx2(self, q, frames) };
         }
         let _ = portable;
-        self.fk(q, frames);
+        frames[..self.body_count].copy_from_slice(self.fk(q, &mut uninit_frames()));
     }
 
     /// Body `b`'s sphere centres (coarse first, then fine) placed at the
@@ -423,24 +433,23 @@ impl Lanes8 {
 
     /// Unsure lanes (bit `l` for lane `l`) of the batch `q` (module doc), for
     /// the scene around `scene_bodies` and the `self_pairs`; `flags` gets
-    /// what was not cleared per lane. `frames`: scratch of at least the body
-    /// count. The AVX2 build when the CPU has it, unless `portable`.
+    /// what was not cleared per lane. The AVX2 build when the CPU has it,
+    /// unless `portable`.
     pub(crate) fn unsure(
         &self,
         q: &[Lane8],
         scene_bodies: &[u16],
         self_pairs: &[(u16, u16)],
-        frames: &mut [Frame8],
         flags: &mut Flags,
         portable: bool,
     ) -> u32 {
         #[cfg(target_arch = "x86_64")]
         if !portable && std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has the features the function is built for.
-            return unsafe { self.unsure_avx2(q, scene_bodies, self_pairs, frames, flags) };
+            return unsafe { self.unsure_avx2(q, scene_bodies, self_pairs, flags) };
         }
         let _ = portable;
-        self.unsure_in::<false>(q, scene_bodies, self_pairs, frames, flags)
+        self.unsure_in::<false>(q, scene_bodies, self_pairs, flags)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -450,10 +459,9 @@ impl Lanes8 {
         q: &[Lane8],
         scene_bodies: &[u16],
         self_pairs: &[(u16, u16)],
-        frames: &mut [Frame8],
         flags: &mut Flags,
     ) -> u32 {
-        self.unsure_in::<true>(q, scene_bodies, self_pairs, frames, flags)
+        self.unsure_in::<true>(q, scene_bodies, self_pairs, flags)
     }
 
     /// The batch check; `AVX`: built inside [`Lanes8::unsure_avx2`] (the
@@ -464,27 +472,30 @@ impl Lanes8 {
         q: &[Lane8],
         scene_bodies: &[u16],
         self_pairs: &[(u16, u16)],
-        frames: &mut [Frame8],
         flags: &mut Flags,
     ) -> u32 {
-        self.fk(q, frames);
+        // scratch left uninitialised (zeroing it cost more than the checks):
+        // every entry is written before it is read
+        let mut frames = uninit_frames();
+        let frames = self.fk(q, &mut frames);
         *flags = Flags::default();
         let mut unsure = 0u32;
-        let mut centres = [[[0.0f32; WIDTH]; 3]; MAX_BODIES8];
+        let mut centres = [const { MaybeUninit::<[Lane8; 3]>::uninit() }; MAX_BODIES8];
         for b in 0..self.body_count {
-            centres[b] = place(&frames[b], &self.coarse[b].c);
+            centres[b].write(place(&frames[b], &self.coarse[b].c));
         }
-        let leaves = self.prims.len();
-        let mut near = [(0u16, 0u32); MAX_LEAVES8];
+        // SAFETY: the first `body_count` entries were just written.
+        let centres: &[[Lane8; 3]] = unsafe { assume_init(&centres[..self.body_count]) };
+        let mut near = [const { MaybeUninit::<(u16, u32)>::uninit() }; MAX_LEAVES8];
         for &b in scene_bodies {
             let b = b as usize;
             let c = &centres[b];
             let t = self.coarse[b].r2;
             let mut count = 0;
-            for i in 0..leaves {
+            for (i, [lo, hi]) in self.boxes.iter().enumerate() {
                 let mut d2 = [0.0f32; WIDTH];
                 for k in 0..3 {
-                    let (lo, hi) = (self.lo[k][i], self.hi[k][i]);
+                    let (lo, hi) = (lo[k], hi[k]);
                     for l in 0..WIDTH {
                         let e = max(max(lo - c[k][l], c[k][l] - hi), 0.0);
                         d2[l] += e * e;
@@ -492,7 +503,7 @@ impl Lanes8 {
                 }
                 let m = mask::<AVX>(&d2, t);
                 if m != 0 {
-                    near[count] = (i as u16, m);
+                    near[count].write((i as u16, m));
                     count += 1;
                 }
             }
@@ -500,10 +511,12 @@ impl Lanes8 {
                 continue;
             }
             let f = &frames[b];
+            // SAFETY: the first `count` entries were just written.
+            let near: &[(u16, u32)] = unsafe { assume_init(&near[..count]) };
             let mut hit = 0u32;
             for s in &self.fine[self.start[b]..self.start[b + 1]] {
                 let x = place(f, &s.c);
-                for &(i, m) in &near[..count] {
+                for &(i, m) in near {
                     hit |= sphere_prim::<AVX>(&x, s, &self.prims[i as usize]) & m;
                 }
             }
@@ -545,7 +558,7 @@ impl Lanes8 {
     ) -> u32 {
         const CLOSE: usize = 24;
         let (sa, sb) = (self.coarse[a], self.coarse[b]);
-        let mut kept = [([[0.0f32; WIDTH]; 3], 0.0f32, 0u32); CLOSE];
+        let mut kept = [const { MaybeUninit::<([Lane8; 3], f32, u32)>::uninit() }; CLOSE];
         let mut count = 0;
         for t in &self.fine[self.start[b]..self.start[b + 1]] {
             let y = place(fb, &t.c);
@@ -555,22 +568,24 @@ impl Lanes8 {
                 if count == CLOSE {
                     return (1 << WIDTH) - 1;
                 }
-                kept[count] = (y, t.r, close);
+                kept[count].write((y, t.r, close));
                 count += 1;
             }
         }
+        if count == 0 {
+            return 0;
+        }
+        // SAFETY: the first `count` entries were just written.
+        let kept: &[([Lane8; 3], f32, u32)] = unsafe { assume_init(&kept[..count]) };
         let mut meet = 0u32;
         for s in &self.fine[self.start[a]..self.start[a + 1]] {
-            if count == 0 {
-                break;
-            }
             let x = place(fa, &s.c);
             let reach = s.r + sb.r;
             let close = mask::<AVX>(&dist2(&x, cb), reach * reach * GROW);
             if close == 0 {
                 continue;
             }
-            for (y, r, near) in &kept[..count] {
+            for (y, r, near) in kept {
                 let reach = s.r + r;
                 meet |= mask::<AVX>(&dist2(&x, y), reach * reach * GROW) & close & near;
             }
@@ -578,8 +593,10 @@ impl Lanes8 {
         meet
     }
 
+    /// The body frames of the batch, written into `frames` (at least the
+    /// body count) and returned initialised.
     #[inline(always)]
-    fn fk(&self, q: &[Lane8], frames: &mut [Frame8]) {
+    fn fk<'a>(&self, q: &[Lane8], frames: &'a mut [MaybeUninit<Frame8>]) -> &'a [Frame8] {
         let mut t = Frame8::IDENTITY;
         let mut joint = 0;
         for op in &self.ops {
@@ -609,10 +626,32 @@ impl Lanes8 {
                         }
                     }
                 }
-                Op::Body { body } => frames[*body] = t,
+                Op::Body { body } => {
+                    frames[*body].write(t);
+                }
             }
         }
+        // SAFETY: the program poses every body below the body count (checked
+        // when the layout was built).
+        unsafe { assume_init(&frames[..self.body_count]) }
     }
+}
+
+/// Scratch for the body frames of a batch.
+#[inline(always)]
+fn uninit_frames() -> [MaybeUninit<Frame8>; MAX_BODIES8] {
+    [const { MaybeUninit::uninit() }; MAX_BODIES8]
+}
+
+/// `items` as initialised values.
+///
+/// # Safety
+/// Every entry of `items` must have been written.
+#[inline(always)]
+unsafe fn assume_init<T>(items: &[MaybeUninit<T>]) -> &[T] {
+    // SAFETY: `MaybeUninit<T>` has the layout of `T`, and the caller vouches
+    // that every entry is initialised.
+    unsafe { &*(items as *const [MaybeUninit<T>] as *const [T]) }
 }
 
 /// Per joint, the largest `|q|` its limits allow; `None` beyond what the

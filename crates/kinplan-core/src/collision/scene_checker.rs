@@ -18,7 +18,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 use super::acm::AllowedCollisions;
 use super::bvh::Aabb;
 use super::lanes::{LANES, LaneFrame, Lanes, MAX_LANE_BODIES, MAX_LANE_DOF};
-use super::lanes8::{Flags, Frame8, Lanes8, MAX_BODIES8, MAX_DOF8, WIDTH};
+use super::lanes8::{Flags, Lanes8, MAX_BODIES8, MAX_DOF8, WIDTH};
 use super::model::{JointAxis, MAX_BODIES, MAX_LINKS, RobotModel};
 use super::narrow::{
     Witness, body_body_contact, body_body_intersect, body_body_within, body_leaf_contact,
@@ -288,7 +288,6 @@ impl SceneChecker {
         if dof == 0 || !rows.len().is_multiple_of(dof) {
             return None;
         }
-        let mut frames = [Frame8::IDENTITY; MAX_BODIES8];
         let mut flags = Flags::default();
         for batch in rows.chunks(WIDTH * dof) {
             let n = batch.len() / dof;
@@ -311,7 +310,6 @@ impl SceneChecker {
                 &q[..dof],
                 &self.scene_bodies,
                 &self.self_pairs,
-                &mut frames,
                 &mut flags,
                 portable,
             );

@@ -125,16 +125,8 @@ fn unsure(checker: &SceneChecker, batch: &[Vec<f64>], portable: bool) -> (u32, F
     let lanes = checker.lanes8().expect("a batched checker");
     let (scene_bodies, self_pairs) = checker.checked_parts();
     let q = lanes_of(batch, lanes.dof());
-    let mut frames = [Frame8::IDENTITY; MAX_BODIES8];
     let mut flags = Flags::default();
-    let m = lanes.unsure(
-        &q[..lanes.dof()],
-        scene_bodies,
-        self_pairs,
-        &mut frames,
-        &mut flags,
-        portable,
-    );
+    let m = lanes.unsure(&q[..lanes.dof()], scene_bodies, self_pairs, &mut flags, portable);
     (m, flags)
 }
 
