@@ -42,9 +42,11 @@
 //! Rounding of the leaf tests (`X` bounds every placed coordinate, `u` the
 //! unit roundoff): an axis-aligned box is tested by `max(lo − x, x − hi,
 //! 0)` per axis, each a single rounded difference (relative error `u`);
-//! an oriented box by `max(|M̂ᵀ(x − ĉ)| − ĥ, 0)`, whose local coordinates
-//! are within `β = 32u·(X + |c| + |h|)` of the exact ones, so its half
-//! extents are grown by `β`; a capsule by the distance to `a + t̂·d`, `t̂`
+//! an oriented box by `max(|M̂ᵀx − d̂| − ĥ, 0)`, `d = Mᵀc` (`M̂` rounded and
+//! snapped within 1e-12, `d̂` rounded: at most `3u·√3X + u|c|` besides the
+//! `γ₄(|c| + √3X)` of the sums), whose local coordinates are within
+//! `β = 32u·(X + |c| + |h|)` of the exact ones, so its half extents are
+//! grown by `β`; a capsule by the distance to `a + t̂·d`, `t̂`
 //! the clamped projection, within `γ₅|v|` of the optimum along the axis
 //! and `γ₃(|v| + |d|)` per coordinate, so its radius is grown by
 //! `32u·(X + |a| + |d|)`.
@@ -124,10 +126,12 @@ struct Ball {
 enum Prim {
     /// Axis-aligned box.
     Aabb { lo: [f32; 3], hi: [f32; 3] },
-    /// Oriented box: centre, axes (columns of `m`), grown half extents.
+    /// Oriented box: axes (columns of `m`, entries within 1e-12 of 0 or ±1
+    /// snapped to them), `d = mᵀ·centre`, grown half extents; a point's
+    /// box coordinates are `mᵀx − d`.
     Box {
-        c: [f32; 3],
         m: [[f32; 3]; 3],
+        d: [f32; 3],
         half: [f32; 3],
     },
     /// Segment `[a, a + d]` swept by the grown radius `r`; `inv` = 1/|d|²
@@ -218,18 +222,20 @@ fn z_to(axis: &Vector3<f64>) -> Matrix3<f64> {
     }
 }
 
+/// `x` with values within 1e-12 of 0 or ±1 snapped to them.
+fn snap(x: f64) -> f64 {
+    if x.abs() <= 1e-12 {
+        0.0
+    } else if (x.abs() - 1.0).abs() <= 1e-12 {
+        x.signum()
+    } else {
+        x
+    }
+}
+
 /// The lanes' form of the fixed rotation `m` (entries within 1e-12 of 0
 /// or ±1 snapped to them).
 fn rot_of(m: &Matrix3<f64>) -> Rot {
-    let snap = |x: f64| {
-        if x.abs() <= 1e-12 {
-            0.0
-        } else if (x.abs() - 1.0).abs() <= 1e-12 {
-            x.signum()
-        } else {
-            x
-        }
-    };
     let s = m.map(snap);
     if s == Matrix3::identity() {
         return Rot::Identity;
@@ -700,8 +706,8 @@ fn prim_of(leaf: &super::world::Leaf, x: f64) -> Prim {
             let c = pose.translation.vector;
             let grow = 32.0 * U * (x + c.norm() + half.norm()) + SLACK;
             Prim::Box {
-                c: f32s(&c),
-                m: [0, 1, 2].map(|j| [0, 1, 2].map(|k| m[(j, k)] as f32)),
+                m: [0, 1, 2].map(|j| [0, 1, 2].map(|k| snap(m[(j, k)]) as f32)),
+                d: f32s(&(m.transpose() * c)),
                 half: [0, 1, 2].map(|k| up(half[k] + grow)),
             }
         }
@@ -842,17 +848,20 @@ fn sphere_prim<const AVX: bool>(x: &[Lane8; 3], s: &Ball, prim: &Prim) -> u32 {
             }
             mask::<AVX>(&d2, s.r2)
         }
-        Prim::Box { c, m, half } => {
-            let mut v = [[0.0f32; WIDTH]; 3];
+        Prim::Box { m, d, half } => {
             for k in 0..3 {
-                for l in 0..WIDTH {
-                    v[k][l] = x[k][l] - c[k];
+                // box coordinate k; the zero entries of a box turned about
+                // one axis skipped
+                let mut local = [-d[k]; WIDTH];
+                for j in 0..3 {
+                    if m[j][k] != 0.0 {
+                        for l in 0..WIDTH {
+                            local[l] += m[j][k] * x[j][l];
+                        }
+                    }
                 }
-            }
-            for k in 0..3 {
                 for l in 0..WIDTH {
-                    let local = m[0][k] * v[0][l] + m[1][k] * v[1][l] + m[2][k] * v[2][l];
-                    let e = max(local.abs() - half[k], 0.0);
+                    let e = max(local[l].abs() - half[k], 0.0);
                     d2[l] += e * e;
                 }
             }

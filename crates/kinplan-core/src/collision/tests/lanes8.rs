@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -170,11 +170,45 @@ fn check_states(name: &str, checker: &SceneChecker, states: &[Vec<f64>]) -> (usi
     (free, cleared)
 }
 
+/// Boxes and capsules turned about every axis around the arm (the generated
+/// scenes turn theirs about `z` only).
+fn tilted(rng: &mut ChaCha8Rng) -> Vec<Obstacle> {
+    (0..12)
+        .map(|i| {
+            let pose = Isometry3::from_parts(
+                Translation3::new(
+                    rng.random_range(-0.7..0.7),
+                    rng.random_range(-0.7..0.7),
+                    rng.random_range(0.0..1.0),
+                ),
+                UnitQuaternion::from_euler_angles(
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-3.0..3.0),
+                    rng.random_range(-3.0..3.0),
+                ),
+            );
+            let geometry = if i % 2 == 0 {
+                Geometry::Box {
+                    half_extents: Vector3::new(0.12, 0.04, 0.08),
+                }
+            } else {
+                Geometry::Capsule {
+                    radius: 0.03,
+                    length: 0.25,
+                }
+            };
+            Obstacle::new(format!("tilted{i}"), pose, geometry)
+        })
+        .collect()
+}
+
 #[test]
 fn eight_lanes_never_clear_a_colliding_state_near_contact() {
     let (chain, model, acm) = panda_with_hand();
     let mut rng = ChaCha8Rng::seed_from_u64(88);
-    for (name, obstacles) in scenes(&mut rng) {
+    let mut all = scenes(&mut rng);
+    all.push(("tilted", tilted(&mut rng)));
+    for (name, obstacles) in all {
         let world =
             Arc::new(SceneGeometry::build(&Scene::new(obstacles, &SceneLimits::default()).unwrap()).unwrap());
         let checker = SceneChecker::new(model.clone(), &acm, world, batched()).unwrap();
