@@ -196,8 +196,9 @@ pub struct SceneChecker {
     params: CheckerParams,
     /// How far bodies move per joint step (`None`: unbounded, cannot pad).
     sweep: Option<SweepBound>,
-    /// The sphere model and scene laid out for batches of states
-    /// ([`SceneChecker::states_valid`]); `None` beyond the batch limits.
+    /// The sphere model and scene laid out for batches of four padded
+    /// pieces in `f64` ([`StateChecker::padded_free_batch`]); `None` beyond
+    /// the batch limits.
     lanes: Option<Lanes>,
     /// The same in eight `f32` lanes ([`StateChecker::states_valid`]).
     lanes8: Option<Lanes8>,
