@@ -16,7 +16,7 @@
 //! number), `is_valid` on each (limits, forward kinematics, scene and self
 //! pairs), the whole loop timed once; reported as ns per state, median over
 //! the scenes of a set, with the fraction of valid states; and the same
-//! states through `states_valid` four at a time (the batched check the
+//! states through `states_valid` eight at a time (the batched check the
 //! motion checks use; a batch stops at its first colliding state), per
 //! state.
 //!
@@ -24,13 +24,16 @@
 //! seven little-endian f64) in the first selected problem's scene instead
 //! of planning, the minimum of five passes over all states and over the
 //! ones it finds free and in groups of eight that stop at their first
-//! collision (as VAMP's blocks do), and counts the states whose verdict differs from
+//! collision (as VAMP's blocks do), the same groups and the free states in
+//! blocks of eight through the eight-lane check (`CheckerParams::batched`),
+//! and counts the states whose verdict differs from
 //! `FILE.vamp` (one byte per state, 1 = free), writes its own verdicts to
 //! `FILE.ours` (the same form), then prints one JSON line
 //! and stops (`benches/mbm/state_cost_vamp.py` runs it beside VAMP).
 //!
-//! `--batched` checks the states of motions four at a time through the
-//! sphere model in vector lanes (`CheckerParams::batched`; same verdicts).
+//! `--batched` checks the states of motions eight at a time through the
+//! sphere model in `f32` vector lanes (`CheckerParams::batched`; same
+//! verdicts).
 //!
 //! `--problems` keeps only the listed problem numbers (say the band around a
 //! set's median, to profile what the median measures).
@@ -415,7 +418,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..Row::default()
             };
             if let Some(path) = &a.states_from {
-                println!("{}", states_from(&checker, path, dof)?);
+                // the same scene with the eight-lane check, for its columns
+                let lanes = SceneChecker::new(
+                    checker.model().clone(),
+                    &acm,
+                    checker.world().clone(),
+                    CheckerParams {
+                        batched: true,
+                        ..CheckerParams::default()
+                    },
+                )?;
+                println!("{}", states_from(&checker, &lanes, path, dof)?);
                 return Ok(());
             }
             if a.state_cost > 0 {
@@ -433,10 +446,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let valid = states.chunks_exact(dof).filter(|q| checker.is_valid(q)).count();
                 row.state_ns = t.elapsed().as_secs_f64() * 1e9 / a.state_cost as f64;
                 row.state_valid = valid as f64 / a.state_cost as f64;
-                // the same states handed over four at a time, as the motion
+                // the same states handed over eight at a time, as the motion
                 // checks do (a batch stops at its first colliding state)
                 let t = Instant::now();
-                let batches = states.chunks(4 * dof).filter(|g| checker.states_valid(g)).count();
+                let batches = states.chunks(8 * dof).filter(|g| checker.states_valid(g)).count();
                 row.state_batch_ns = t.elapsed().as_secs_f64() * 1e9 / a.state_cost as f64;
                 std::hint::black_box(batches);
             }
@@ -709,6 +722,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// to `path.ours` (one byte per state, 1 = free) for the coal comparison.
 fn states_from(
     checker: &SceneChecker,
+    lanes: &SceneChecker,
     path: &Path,
     dof: usize,
 ) -> Result<serde_json::Value, Box<dyn std::error::Error>> {
@@ -744,17 +758,25 @@ fn states_from(
             .fold(f64::INFINITY, f64::min)
     };
     // groups of eight stopping at their first collision, as VAMP's blocks
-    let groups = (0..5)
-        .map(|_| {
-            let t = Instant::now();
-            let valid = states.chunks(8 * dof).filter(|g| checker.states_valid(g)).count();
-            std::hint::black_box(valid);
-            t.elapsed().as_secs_f64() * 1e9 / n.max(1) as f64
-        })
-        .fold(f64::INFINITY, f64::min);
+    let groups = |checker: &SceneChecker, rows: &[f64]| -> f64 {
+        (0..5)
+            .map(|_| {
+                let t = Instant::now();
+                let valid = rows.chunks(8 * dof).filter(|g| checker.states_valid(g)).count();
+                std::hint::black_box(valid);
+                t.elapsed().as_secs_f64() * 1e9 / (rows.len() / dof).max(1) as f64
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let lanes_ok = free.chunks(8 * dof).all(|g| lanes.states_valid(g));
+    if !lanes_ok {
+        return Err("the eight-lane check refused a free state".into());
+    }
     Ok(json!({
         "ours_ns": time(&states),
-        "ours_groups_ns": groups,
+        "ours_groups_ns": groups(checker, &states),
+        "ours_lanes_groups_ns": groups(lanes, &states),
+        "ours_lanes_free_ns": groups(lanes, &free),
         "ours_free_ns": time(&free),
         "ours_free": free.len() / dof,
         "differ": ours.iter().zip(&vamp).filter(|(o, v)| **o != (**v == 1)).count(),

@@ -269,6 +269,7 @@ impl Lanes {
     /// for `scene_bodies`, the bounding spheres of
     /// `self_pairs`. `frames` is scratch of at least the body count.
     /// Dispatches to the AVX2 build when the CPU has it, unless `portable`.
+    #[cfg(test)]
     pub(crate) fn unsure(
         &self,
         q: &[Lane],

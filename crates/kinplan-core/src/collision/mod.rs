@@ -37,6 +37,8 @@ mod fast;
 mod fast_box;
 mod fixed_frame;
 mod lanes;
+mod lanes8;
+mod lanes8_bound;
 mod mesh_dae;
 mod mesh_file;
 mod model;
@@ -49,6 +51,7 @@ mod scene_checker;
 mod spheres;
 mod sweep;
 mod trig;
+mod trig32;
 mod world;
 
 pub use acm::{AcmParams, AllowReason, AllowedCollisions, MAX_ACM_PAIR_TESTS};

@@ -17,7 +17,8 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::acm::AllowedCollisions;
 use super::bvh::Aabb;
-use super::lanes::{LANES, Lane, LaneFrame, Lanes, MAX_LANE_BODIES, MAX_LANE_DOF};
+use super::lanes::{LANES, LaneFrame, Lanes, MAX_LANE_BODIES, MAX_LANE_DOF};
+use super::lanes8::{Flags, Lanes8, MAX_BODIES8, MAX_DOF8, WIDTH};
 use super::model::{JointAxis, MAX_BODIES, MAX_LINKS, RobotModel};
 use super::narrow::{
     Witness, body_body_contact, body_body_intersect, body_body_within, body_leaf_contact,
@@ -56,11 +57,11 @@ pub struct CheckerParams {
     /// `false` checks interpolated states as they are
     /// ([`MotionCheck::Interpolated`]).
     pub padded_motion: bool,
-    /// Check the states of a motion four at a time through the sphere model
-    /// in vector lanes, the states it leaves unsure exactly
-    /// ([`StateChecker::states_valid`]; the same verdicts). Default `false`:
-    /// on the MotionBenchMaker Panda problems it is not yet faster than the
-    /// state-by-state check (`benches/RESULTS.md`).
+    /// Check the states of a motion eight at a time through the sphere model
+    /// in `f32` vector lanes, the states it leaves unsure exactly, only for
+    /// the bodies and pairs the spheres did not clear
+    /// ([`StateChecker::states_valid`]; the same verdicts). Default `false`
+    /// (see `benches/RESULTS.md` for where it pays).
     pub batched: bool,
 }
 
@@ -195,9 +196,12 @@ pub struct SceneChecker {
     params: CheckerParams,
     /// How far bodies move per joint step (`None`: unbounded, cannot pad).
     sweep: Option<SweepBound>,
-    /// The sphere model and scene laid out for batches of states
-    /// ([`SceneChecker::states_valid`]); `None` beyond the batch limits.
+    /// The sphere model and scene laid out for batches of four padded
+    /// pieces in `f64` ([`StateChecker::padded_free_batch`]); `None` beyond
+    /// the batch limits.
     lanes: Option<Lanes>,
+    /// The same in eight `f32` lanes ([`StateChecker::states_valid`]).
+    lanes8: Option<Lanes8>,
 }
 
 impl SceneChecker {
@@ -223,11 +227,12 @@ impl SceneChecker {
             return Err(CollisionError::CannotPad);
         }
         let scene_bodies = scene_bodies(&model, &world, sweep.as_ref());
-        let lanes = params
+        let spheres = params
             .batched
             .then(|| SphereModel::build(&model, &LANE_SPHERES).ok())
-            .flatten()
-            .and_then(|spheres| Lanes::new(&model, &spheres, &world));
+            .flatten();
+        let lanes = spheres.as_ref().and_then(|s| Lanes::new(&model, s, &world));
+        let lanes8 = spheres.as_ref().and_then(|s| Lanes8::new(&model, s, &world));
         Ok(SceneChecker {
             model,
             world,
@@ -236,6 +241,7 @@ impl SceneChecker {
             params,
             sweep,
             lanes,
+            lanes8,
         })
     }
 
@@ -270,38 +276,30 @@ impl SceneChecker {
         }
     }
 
-    /// [`StateChecker::states_valid`] in batches of [`LANES`] states: the
+    /// [`StateChecker::states_valid`] in batches of [`WIDTH`] states: the
     /// limits, then forward kinematics and the sphere model against the
-    /// scene for the whole batch (`Lanes::unsure`); a state the spheres
-    /// leave unsure is checked exactly ([`SceneChecker::in_collision`]), so
-    /// the answer is the exact check's. `portable` forces the baseline
-    /// build of the batch code. `None` when the checker has no batched form
-    /// or a value is outside what it takes.
+    /// scene for the whole batch in `f32` lanes (`Lanes8::unsure`); a state
+    /// the spheres leave unsure is checked exactly for the bodies and pairs
+    /// they did not clear ([`SceneChecker::hits_flagged`]), so the answer is
+    /// the exact check's. `portable` forces the baseline build of the batch
+    /// code. `None` when the checker has no batched form.
     pub(crate) fn states_valid_in_lanes(&self, rows: &[f64], portable: bool) -> Option<bool> {
-        let lanes = self.lanes.as_ref()?;
+        let lanes = self.lanes8.as_ref()?;
         let dof = lanes.dof();
-        if dof == 0 || !rows.len().is_multiple_of(dof) || !rows.iter().all(|&v| in_reduced_range(v)) {
+        if dof == 0 || !rows.len().is_multiple_of(dof) {
             return None;
         }
-        // the first state alone and exactly: a motion that collides mostly
-        // does so at the first state asked (its new end, or its middle), which
-        // a batch would only find after testing all its lanes
-        let Some((first, rows)) = rows.split_at_checked(dof) else {
-            return Some(true);
-        };
-        if !StateChecker::is_valid(self, first) {
-            return Some(false);
-        }
-        let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
-        for batch in rows.chunks(LANES * dof) {
+        let mut flags = Flags::default();
+        for batch in rows.chunks(WIDTH * dof) {
             let n = batch.len() / dof;
-            let mut q = [[0.0; LANES]; MAX_LANE_DOF];
+            let mut q = [[0.0f32; WIDTH]; MAX_DOF8];
             for (l, row) in batch.chunks_exact(dof).enumerate() {
+                // the limits also keep every value within what the lanes take
                 if !self.within_limits(row) {
                     return Some(false);
                 }
                 for (j, &v) in row.iter().enumerate() {
-                    q[j][l] = v;
+                    q[j][l] = v as f32;
                 }
             }
             // unused lanes repeat the last state
@@ -309,22 +307,55 @@ impl SceneChecker {
                 let last = qj[n - 1];
                 qj[n..].fill(last);
             }
-            let q: &[Lane] = &q[..dof];
             let unsure = lanes.unsure(
-                q,
-                &self.world.bvh,
+                &q[..dof],
                 &self.scene_bodies,
                 &self.self_pairs,
-                &mut frames,
+                &mut flags,
                 portable,
             );
             for (l, row) in batch.chunks_exact(dof).enumerate() {
-                if unsure & (1 << l) != 0 && self.in_collision(row) {
+                if unsure & (1 << l) != 0 && self.hits_flagged(row, flags.bodies[l], flags.pairs[l]) {
                     return Some(false);
                 }
             }
         }
         Some(true)
+    }
+
+    /// True when `q` collides, testing only the scene around the bodies of
+    /// `bodies` (bit `b`: body `b`) and the checked self pairs of `pairs`
+    /// (bit `i`: pair `i`; bit 63: every pair from the 63rd on). `q` must
+    /// hold `dof` finite values.
+    pub(crate) fn hits_flagged(&self, q: &[f64], bodies: u32, pairs: u64) -> bool {
+        let mut poses = [Isometry3::identity(); MAX_BODIES8];
+        if self.model.body_count() > MAX_BODIES8 {
+            return self.in_collision(q);
+        }
+        self.model.body_poses(q, &mut poses);
+        let all = &self.model.bodies;
+        let mut bits = bodies;
+        while bits != 0 {
+            let b = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let c = sphere_center(&all[b], &poses[b]);
+            let free = self.world.bvh.for_each_near(&c, all[b].radius, |leaf| {
+                !shapes_intersect_leaf(&all[b], &poses[b], &self.world.leaves[leaf as usize])
+            });
+            if !free {
+                return true;
+            }
+        }
+        self.self_pairs.iter().enumerate().any(|(i, &(a, b))| {
+            let (a, b) = (a as usize, b as usize);
+            pairs & (1 << i.min(63)) != 0 && body_body_intersect(&all[a], &poses[a], &all[b], &poses[b])
+        })
+    }
+
+    /// The eight-lane form (tests).
+    #[cfg(test)]
+    pub(crate) fn lanes8(&self) -> Option<&Lanes8> {
+        self.lanes8.as_ref()
     }
 
     /// The batched form (tests).
@@ -700,8 +731,8 @@ impl StateChecker for SceneChecker {
         self.within_limits(q) && !self.in_collision(q)
     }
 
-    /// Batches of [`LANES`] states through the sphere model, the unsure
-    /// ones checked exactly (`SceneChecker::states_valid_in_lanes`).
+    /// Batches of [`WIDTH`] states through the sphere model in `f32` lanes,
+    /// the unsure ones checked exactly (`SceneChecker::states_valid_in_lanes`).
     fn states_valid(&self, rows: &[f64]) -> bool {
         match self.states_valid_in_lanes(rows, false) {
             Some(valid) => valid,

@@ -13,6 +13,7 @@ use super::*;
 use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
 mod lanes;
+mod lanes8;
 mod robot;
 mod spheres;
 mod sweep;

@@ -42,8 +42,26 @@ impl ColumnScan {
     }
 
     /// Index of the row nearest to `target` (Euclidean; the first of
-    /// equals), `None` when empty.
+    /// equals), `None` when empty. The same code built for AVX2 when the CPU
+    /// has it (four rows per instruction instead of two; no multiply and add
+    /// are fused, so the answers are the same).
     pub fn nearest(&self, target: &[f64]) -> Option<usize> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has the features the function is built for.
+            return unsafe { self.nearest_avx2(target) };
+        }
+        self.nearest_in(target)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn nearest_avx2(&self, target: &[f64]) -> Option<usize> {
+        self.nearest_in(target)
+    }
+
+    #[inline(always)]
+    fn nearest_in(&self, target: &[f64]) -> Option<usize> {
         let (mut best, mut best_d) = (None, f64::INFINITY);
         let mut sums = [0.0_f64; BLOCK];
         for start in (0..self.len).step_by(BLOCK) {

@@ -145,8 +145,9 @@ fn motion_valid_as<C: StateChecker + ?Sized>(
 }
 
 /// States handed to [`StateChecker::states_valid`] at once: the lanes of
-/// the batched check.
-const BATCH: usize = 4;
+/// the batched check (a state-by-state check stops at the first collision
+/// of a batch all the same).
+const BATCH: usize = 8;
 /// Most joints batched here (stack buffer); longer chains go state by state.
 const BATCH_DOF: usize = 32;
 
@@ -177,10 +178,13 @@ fn states_between_valid<C: StateChecker + ?Sized>(
     }
     let steps = (steps.max(1.0) as usize).next_power_of_two();
     let dof = a.len();
-    // the interior states: every index but 0, in bisection order; the end
-    // (index `steps`) first when asked
-    let end = with_end.then_some(steps);
-    let mut order = end.into_iter().chain(bisection_order(steps).skip(1));
+    // the end first and alone when asked: an extension that collides mostly
+    // does so at its new end, which one state check settles; then the
+    // interior states, every index but 0, in bisection order
+    if with_end && !checker.is_valid(b) {
+        return Some(false);
+    }
+    let mut order = bisection_order(steps).skip(1);
     if dof > BATCH_DOF || dof == 0 {
         for (visited, i) in order.enumerate() {
             if (visited + 1).is_multiple_of(32) && clock.interrupted().is_some() {
@@ -202,13 +206,9 @@ fn states_between_valid<C: StateChecker + ?Sized>(
         let mut n = 0;
         for i in order.by_ref().take(BATCH) {
             let row = &mut rows[n * dof..(n + 1) * dof];
-            if i == steps {
-                row.copy_from_slice(b);
-            } else {
-                let s = i as f64 / steps as f64;
-                for ((v, x), y) in row.iter_mut().zip(a).zip(b) {
-                    *v = x + s * (y - x);
-                }
+            let s = i as f64 / steps as f64;
+            for ((v, x), y) in row.iter_mut().zip(a).zip(b) {
+                *v = x + s * (y - x);
             }
             n += 1;
         }

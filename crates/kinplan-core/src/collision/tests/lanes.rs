@@ -17,7 +17,7 @@ use super::probe_urdf;
 use crate::robot::{Chain, ChainSpec, UrdfLimits, builtin_chain, builtin_urdf, parse_chain};
 
 /// The Panda with its hand, fingers 4 cm open (as the benchmark runs it).
-fn panda_with_hand() -> (Arc<Chain>, Arc<RobotModel>, AllowedCollisions) {
+pub(super) fn panda_with_hand() -> (Arc<Chain>, Arc<RobotModel>, AllowedCollisions) {
     let chain = builtin_chain("franka_panda").unwrap();
     let urdf = builtin_urdf("franka_panda_hand").unwrap();
     let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
@@ -29,7 +29,7 @@ fn panda_with_hand() -> (Arc<Chain>, Arc<RobotModel>, AllowedCollisions) {
 
 /// A chain turning about x, y and a slanted axis from turned origins, then
 /// sliding: every kind of joint motion the lanes apply.
-fn mixed_chain_urdf() -> String {
+pub(super) fn mixed_chain_urdf() -> String {
     let link = |name: &str| {
         format!(
             r#"<link name="{name}"><collision><origin xyz="0 0 0.1" rpy="0.2 0 0"/>
@@ -64,14 +64,14 @@ fn mixed_chain_urdf() -> String {
     )
 }
 
-fn batched() -> CheckerParams {
+pub(super) fn batched() -> CheckerParams {
     CheckerParams {
         batched: true,
         ..CheckerParams::default()
     }
 }
 
-fn random_state(chain: &Chain, rng: &mut ChaCha8Rng) -> Vec<f64> {
+pub(super) fn random_state(chain: &Chain, rng: &mut ChaCha8Rng) -> Vec<f64> {
     chain
         .joints()
         .iter()
@@ -156,7 +156,7 @@ fn batched_forward_kinematics_equals_the_scalar_poses_in_both_builds() {
 /// MotionBenchMaker-like scenes around the Panda, from a seed: a table with
 /// clutter on it, a shelf of boards, a cage of bars, a table of cylinders
 /// and spheres, turned about z.
-fn scenes(rng: &mut ChaCha8Rng) -> Vec<(&'static str, Vec<Obstacle>)> {
+pub(super) fn scenes(rng: &mut ChaCha8Rng) -> Vec<(&'static str, Vec<Obstacle>)> {
     let turned = |x: f64, y: f64, z: f64, yaw: f64| {
         Isometry3::from_parts(
             Translation3::new(x, y, z),
