@@ -14,7 +14,7 @@ use super::count::FrustumCounter;
 use super::frontier::{candidate_pose, frontier_cells, potential_field, unknown_needed};
 use super::gain::{GainMethod, GainWorkspace, ray_gain};
 use super::grid::{Ball, MAX_CELLS, StateGrid};
-use super::visibility::{PredictWorkspace, ViewPrediction, predict_view_in};
+use super::visibility::{PredictWorkspace, ViewGrid, ViewPrediction, predict_on_grid, predict_view_in};
 use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
 use crate::octree::{CellState, Octree};
@@ -427,6 +427,11 @@ pub fn next_best_view(
             Some((a, b)) => Some((tree.key_of(a)?, tree.key_of(b)?)),
             None => None,
         };
+        // the state grid recoded for the walks once, shared by every view
+        let view_grid = match (&grid, region_keys) {
+            (Some(g), Some(keys)) => ViewGrid::new(g, keys),
+            _ => None,
+        };
         let mut kept: Vec<NbvCandidate> = Vec::with_capacity(params.max_results);
         let mut rest = scored.into_iter();
         // one workspace per candidate of a batch, kept from batch to batch
@@ -450,16 +455,19 @@ pub fn next_best_view(
                     if clock.interrupted().is_some() {
                         return None;
                     }
-                    Some(predict_view_in(
-                        tree,
-                        grid.as_ref(),
-                        camera,
-                        &c.pose,
-                        vp,
-                        region_keys,
-                        ws,
-                        clock.deadline,
-                    ))
+                    Some(match &view_grid {
+                        Some(vg) => predict_on_grid(tree, vg, camera, &c.pose, vp, ws, clock.deadline),
+                        None => predict_view_in(
+                            tree,
+                            grid.as_ref(),
+                            camera,
+                            &c.pose,
+                            vp,
+                            region_keys,
+                            ws,
+                            clock.deadline,
+                        ),
+                    })
                 })
                 .collect();
             for (mut c, p) in batch.into_iter().zip(preds) {

@@ -23,6 +23,8 @@
 //! Autonomous Robots 42 (2018), with the visibility product cut to a fixed number of
 //! unknown cells.
 
+use std::hint::select_unpredictable;
+
 use nalgebra::{Isometry3, Point3};
 
 use super::NbvError;
@@ -161,9 +163,9 @@ pub(crate) fn predict_view_in(
     deadline: Deadline<'_>,
 ) -> ViewPrediction {
     if let (Some(g), Some(keys)) = (grid, region_keys)
-        && let Some(prediction) = predict_on_grid(tree, g, camera, pose, params, keys, ws, deadline)
+        && let Some(vg) = ViewGrid::new(g, keys)
     {
-        return prediction;
+        return predict_on_grid(tree, &vg, camera, pose, params, ws, deadline);
     }
     let mut cache = SearchCache::default();
     let mut lookup = |k: &OcKey| match grid.and_then(|g| g.index_of(k).map(|i| g.cells[i])) {
@@ -233,45 +235,116 @@ pub(crate) fn predict_view_in(
     out
 }
 
-/// The prediction of [`predict_view_in`] when the state grid covers the region: the
-/// same rays and the same DDA (Amanatides & Woo, as [`walk_with`]), with the cell
-/// states read from the grid by index and the distinct region cells marked in bit
-/// sets instead of sorted key lists. A ray that has been inside the grid and leaves it
-/// is stopped there: the grid's box is convex and holds the region, so the straight
-/// ray cannot meet a region cell again and nothing further can be counted (only the
-/// reported DDA steps are fewer). Before a ray enters the grid, cells are read from the
-/// tree. `None` when the region is not inside the grid or has more than
-/// [`MAX_BITSET_CELLS`] cells (the caller then takes the key lists).
+/// The state grid recoded for the visibility walk over one region: unknown cells
+/// outside the region read as free (the walk passes them as open), so that the walk's
+/// inner loop meets only three kinds of cell: free (go on), unknown region cells
+/// (count) and anything else (occupied, or past the key space: stop). Built once per
+/// request and shared by every predicted view.
+#[derive(Debug, Clone)]
+pub(crate) struct ViewGrid {
+    lo: [i64; 3],
+    dims: [usize; 3],
+    cells: Vec<u8>,
+    /// The region's lowest key (its box lies inside the grid).
+    rlo: OcKey,
+    /// Cells of the region box per axis.
+    rdims: [usize; 3],
+}
+
+impl ViewGrid {
+    /// `None` when the region `[rlo, rhi]` is empty, not inside `grid`, or has more
+    /// than [`MAX_BITSET_CELLS`] cells (the caller then takes the key lists).
+    pub fn new(grid: &StateGrid, (rlo, rhi): (OcKey, OcKey)) -> Option<Self> {
+        let glo = grid.lo;
+        let mut rdims = [0usize; 3];
+        for i in 0..3 {
+            if rlo[i] > rhi[i] || (rlo[i] as i64) < glo[i] || rhi[i] as i64 >= glo[i] + grid.dims[i] as i64 {
+                return None;
+            }
+            rdims[i] = (rhi[i] - rlo[i]) as usize + 1;
+        }
+        if rdims[0] * rdims[1] * rdims[2] > MAX_BITSET_CELLS {
+            return None;
+        }
+        let [nx, ny, _] = grid.dims;
+        // region offsets in the grid, per axis
+        let o = [0, 1, 2].map(|i| (rlo[i] as i64 - glo[i]) as usize);
+        let e = [0, 1, 2].map(|i| (rhi[i] as i64 - glo[i]) as usize);
+        // unknown (0) outside the region becomes free (1); the other states keep
+        // their codes
+        let open = |row: &mut [u8]| {
+            for c in row {
+                *c += (*c == UNKNOWN) as u8;
+            }
+        };
+        let mut cells = grid.cells.clone();
+        for (z, plane) in cells.chunks_mut(nx * ny).enumerate() {
+            for (y, row) in plane.chunks_mut(nx).enumerate() {
+                if (o[1]..=e[1]).contains(&y) && (o[2]..=e[2]).contains(&z) {
+                    let (head, rest) = row.split_at_mut(o[0]);
+                    open(head);
+                    open(&mut rest[e[0] - o[0] + 1..]);
+                } else {
+                    open(row);
+                }
+            }
+        }
+        Some(Self {
+            lo: glo,
+            dims: grid.dims,
+            cells,
+            rlo,
+            rdims,
+        })
+    }
+
+    /// Whether `k` lies inside the grid.
+    #[inline]
+    fn contains(&self, k: &OcKey) -> bool {
+        (0..3).all(|i| k[i] as i64 >= self.lo[i] && (k[i] as i64) < self.lo[i] + self.dims[i] as i64)
+    }
+
+    /// Index in the region box of the cell at grid index `idx`, which must lie in it.
+    #[inline]
+    fn region_index(&self, idx: usize) -> usize {
+        // grids hold at most 2^24 cells: 32-bit divisions
+        let (nx, plane) = (self.dims[0] as u32, (self.dims[0] * self.dims[1]) as u32);
+        let i = idx as u32;
+        let (z, rest) = (i / plane, i % plane);
+        let g = [rest % nx, rest / nx, z].map(|v| v as usize);
+        let r = [0, 1, 2].map(|i| (g[i] as i64 + self.lo[i] - self.rlo[i] as i64) as usize);
+        debug_assert!((0..3).all(|i| r[i] < self.rdims[i]));
+        r[0] + self.rdims[0] * (r[1] + self.rdims[1] * r[2])
+    }
+}
+
+/// The prediction of [`predict_view_in`] on a [`ViewGrid`] of the region: the same
+/// rays and the same DDA (Amanatides & Woo, as [`walk_with`]: the same floating-point
+/// operations in the same order, so the same cells), with the cell states read from
+/// the grid by index and the distinct region cells marked in bit sets instead of
+/// sorted key lists. A ray that has been inside the grid and leaves it is stopped
+/// there: the grid's box is convex and holds the region, so the straight ray cannot
+/// meet a region cell again and nothing further can be counted (only the reported DDA
+/// steps are fewer). Before a ray enters the grid, cells are read from the tree.
 #[allow(clippy::too_many_arguments)]
-fn predict_on_grid(
+pub(crate) fn predict_on_grid(
     tree: &Octree,
-    grid: &StateGrid,
+    grid: &ViewGrid,
     camera: &CameraModel,
     pose: &Isometry3<f64>,
     params: &VisibilityParams,
-    (rlo, rhi): (OcKey, OcKey),
     ws: &mut PredictWorkspace,
     deadline: Deadline<'_>,
-) -> Option<ViewPrediction> {
+) -> ViewPrediction {
     let glo = grid.lo;
     let gdims = grid.dims.map(|d| d as i64);
-    let mut rdims = [0usize; 3];
-    for i in 0..3 {
-        if rlo[i] > rhi[i] || (rlo[i] as i64) < glo[i] || rhi[i] as i64 >= glo[i] + gdims[i] {
-            return None;
-        }
-        rdims[i] = (rhi[i] - rlo[i]) as usize + 1;
-    }
-    let rcells = rdims[0] * rdims[1] * rdims[2];
-    if rcells > MAX_BITSET_CELLS {
-        return None;
-    }
-    let words = rcells.div_ceil(64);
+    let words = (grid.rdims[0] * grid.rdims[1] * grid.rdims[2]).div_ceil(64);
     for bits in [&mut ws.first_bits, &mut ws.reached_bits] {
         bits.clear();
         bits.resize(words, 0);
     }
     let (first_bits, reached_bits) = (&mut ws.first_bits[..], &mut ws.reached_bits[..]);
+    let cells = &grid.cells[..];
     let mut cache = SearchCache::default();
     let res = tree.resolution();
     let stride = params.pixel_stride.max(1);
@@ -282,8 +355,9 @@ fn predict_on_grid(
     let Ok(k0) = tree.key_of(&origin) else {
         // every ray starts outside the key space: the DDA takes no step
         out.rays = camera.height.div_ceil(stride) as u32 * camera.width.div_ceil(stride) as u32;
-        return Some(out);
+        return out;
     };
+    let lookahead = params.lookahead;
     'rows: for v in (0..camera.height).step_by(stride) {
         'ray: for u in (0..camera.width).step_by(stride) {
             if out.rays % 64 == 63 && deadline.expired() {
@@ -296,12 +370,8 @@ fn predict_on_grid(
             // the DDA set-up of `walk_with` from t0 = 0
             let mut k = k0;
             let (step, mut t_max, t_delta) = dda_start(&k, &origin, &dir, 0.0, res);
-            let mut unknown = 0usize;
             // phase 1: outside the grid, states from the tree, until the ray enters it
-            let in_grid =
-                |k: &OcKey| (0..3).all(|i| k[i] as i64 >= glo[i] && (k[i] as i64) < glo[i] + gdims[i]);
-            let mut inside = in_grid(&k);
-            while !inside {
+            while !grid.contains(&k) {
                 out.steps += 1;
                 if tree_state(tree, &k, &mut cache).0 == CellState::Occupied {
                     continue 'ray;
@@ -316,98 +386,131 @@ fn predict_on_grid(
                 }
                 k[a] = nk as u16;
                 t_max[a] += t_delta[a];
-                inside = in_grid(&k);
             }
-            // phase 2: inside the grid. The DDA state sits in scalars and each step is
-            // branch-free; per axis, `rem` counts the steps left before the key leaves the
-            // grid or the key space (either ends the ray: no region cell lies ahead)
+            // phase 2: inside the grid. Per axis, `rem` counts the steps left before
+            // the key leaves the grid or the key space (either ends the ray: no region
+            // cell lies ahead). Each step is branch-free but for the cell's state and
+            // the ends of the ray: the axis of `next_axis` from two comparisons
+            // (x < y, then the smaller against z), applied by selects
             let g = [0, 1, 2].map(|i| k[i] as i64 - glo[i]);
-            let mut idx = grid.index(g) as i64;
-            let rem_on = |i: usize| {
-                let (last_key, last_g) = if step[i] > 0 {
-                    (65535 - k[i] as i64, gdims[i] - 1 - g[i])
-                } else {
-                    (k[i] as i64, g[i])
-                };
-                if step[i] == 0 {
-                    i64::MAX
-                } else {
-                    last_key.min(last_g)
-                }
+            let rem_on = |i: usize| match step[i] {
+                0 => i64::MAX,
+                1 => (65535 - k[i] as i64).min(gdims[i] - 1 - g[i]),
+                _ => (k[i] as i64).min(g[i]),
             };
             let (mut rx, mut ry, mut rz) = (rem_on(0), rem_on(1), rem_on(2));
-            let (sx, sy, sz) = (step[0] as i64, step[1] as i64, step[2] as i64);
-            let (gx, gy, gz) = (sx, sy * gdims[0], sz * gdims[0] * gdims[1]);
-            let (mut kx, mut ky, mut kz) = (k[0] as i64, k[1] as i64, k[2] as i64);
+            let (gx, gy, gz) = (
+                step[0] as i64,
+                step[1] as i64 * gdims[0],
+                step[2] as i64 * gdims[0] * gdims[1],
+            );
+            let mut idx = (g[0] + gdims[0] * (g[1] + gdims[1] * g[2])) as usize;
             let [mut tx, mut ty, mut tz] = t_max;
             let [dx, dy, dz] = t_delta;
+            let mut unknown = 0usize;
+            let mut steps = 0u64;
             loop {
-                out.steps += 1;
-                let state = grid.cells[idx as usize];
+                steps += 1;
+                let state = cells[idx];
                 if state != FREE {
-                    let key = [kx as u16, ky as u16, kz as u16];
-                    let go_on = match state {
-                        OCCUPIED => false,
-                        UNKNOWN if (0..3).all(|i| key[i] >= rlo[i] && key[i] <= rhi[i]) => {
-                            unknown += 1;
-                            let r = (key[0] - rlo[0]) as usize
-                                + rdims[0]
-                                    * ((key[1] - rlo[1]) as usize + rdims[1] * (key[2] - rlo[2]) as usize);
-                            let (w, bit) = (r / 64, 1u64 << (r % 64));
-                            if unknown == 1 && first_bits[w] & bit == 0 {
-                                first_bits[w] |= bit;
-                                first += 1;
-                            }
-                            if reached_bits[w] & bit == 0 {
-                                reached_bits[w] |= bit;
-                                reached += 1;
-                            }
-                            unknown < params.lookahead
-                        }
-                        // unknown outside the region: passed as open
-                        UNKNOWN => true,
-                        // a grid cell past the key space cannot hold a key; read the tree
-                        _ => tree_state(tree, &key, &mut cache).0 != CellState::Occupied,
-                    };
-                    if !go_on {
+                    if state != UNKNOWN {
+                        break; // occupied (or past the key space)
+                    }
+                    // an unknown region cell
+                    unknown += 1;
+                    let r = grid.region_index(idx);
+                    let (w, bit) = (r / 64, 1u64 << (r % 64));
+                    if unknown == 1 && first_bits[w] & bit == 0 {
+                        first_bits[w] |= bit;
+                        first += 1;
+                    }
+                    if reached_bits[w] & bit == 0 {
+                        reached_bits[w] |= bit;
+                        reached += 1;
+                    }
+                    if unknown >= lookahead {
                         break;
                     }
                 }
-                // the axis of `next_axis`, as three flags
-                let x_lt_y = tx < ty;
-                let ax = x_lt_y & (tx < tz);
-                let ay = !x_lt_y & (ty < tz);
-                let az = !(ax | ay);
-                let t = if ax {
-                    tx
-                } else if ay {
-                    ty
-                } else {
-                    tz
-                };
-                if t > t1 {
+                // the axis of `next_axis` (x when tx < ty and tx < tz, y when ty ≤ tx
+                // and ty < tz, else z), each flag one comparison against a bound
+                // picked by another, so that the updates below compile to masks
+                let m = select_unpredictable(tx < ty, tx, ty);
+                if select_unpredictable(m < tz, m, tz) > t1 {
                     break;
                 }
-                let (fx, fy, fz) = (ax as i64, ay as i64, az as i64);
-                rx -= fx;
-                ry -= fy;
-                rz -= fz;
+                let x_bound = select_unpredictable(ty < tz, ty, tz);
+                let y_bound = select_unpredictable(tx < ty, f64::NEG_INFINITY, tz);
+                let (ax, ay, az) = (tx < x_bound, ty < y_bound, !(m < tz));
+                rx -= ax as i64;
+                ry -= ay as i64;
+                rz -= az as i64;
                 if (rx | ry | rz) < 0 {
                     break;
                 }
-                tx += if ax { dx } else { 0.0 };
-                ty += if ay { dy } else { 0.0 };
-                tz += if az { dz } else { 0.0 };
-                kx += fx * sx;
-                ky += fy * sy;
-                kz += fz * sz;
-                idx += fx * gx + fy * gy + fz * gz;
+                idx = idx.wrapping_add_signed(
+                    (select_unpredictable(ax, gx, 0)
+                        + select_unpredictable(ay, gy, 0)
+                        + select_unpredictable(az, gz, 0)) as isize,
+                );
+                tx = add_if_less(tx, x_bound, tx, dx);
+                ty = add_if_less(ty, y_bound, ty, dy);
+                tz = add_unless_less(m, tz, tz, dz);
             }
+            out.steps += steps;
         }
     }
     out.first = first;
     out.reached = reached;
-    Some(out)
+    out
+}
+
+/// `t + d` when `a < b`, else `t`, without a branch: the DDA's axis is as good as
+/// random from step to step, and a mispredicted branch costs more than the step.
+#[inline(always)]
+fn add_if_less(a: f64, b: f64, t: f64, d: f64) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{
+            _mm_add_sd, _mm_and_pd, _mm_andnot_pd, _mm_cmplt_sd, _mm_cvtsd_f64, _mm_or_pd, _mm_set_sd,
+        };
+        // SAFETY: SSE2 is part of every x86_64 CPU. The comparison's mask picks the
+        // sum or `t`.
+        unsafe {
+            let (t, m) = (_mm_set_sd(t), _mm_cmplt_sd(_mm_set_sd(a), _mm_set_sd(b)));
+            _mm_cvtsd_f64(_mm_or_pd(
+                _mm_and_pd(m, _mm_add_sd(t, _mm_set_sd(d))),
+                _mm_andnot_pd(m, t),
+            ))
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        select_unpredictable(a < b, t + d, t)
+    }
+}
+
+/// `t + d` unless `a < b`, else `t`, as [`add_if_less`].
+#[inline(always)]
+fn add_unless_less(a: f64, b: f64, t: f64, d: f64) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{
+            _mm_add_sd, _mm_and_pd, _mm_andnot_pd, _mm_cmpnlt_sd, _mm_cvtsd_f64, _mm_or_pd, _mm_set_sd,
+        };
+        // SAFETY: as in `add_if_less`
+        unsafe {
+            let (t, m) = (_mm_set_sd(t), _mm_cmpnlt_sd(_mm_set_sd(a), _mm_set_sd(b)));
+            _mm_cvtsd_f64(_mm_or_pd(
+                _mm_and_pd(m, _mm_add_sd(t, _mm_set_sd(d))),
+                _mm_andnot_pd(m, t),
+            ))
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        select_unpredictable(!(a < b), t + d, t)
+    }
 }
 
 /// The axis whose cell border the DDA crosses next (the smallest `t_max`; ties to the
