@@ -226,6 +226,54 @@ impl StateGrid {
     }
 }
 
+/// Cells whose potential fields [`StateGrid::fields`] sums in one pass.
+pub(crate) const FIELD_LANES: usize = 4;
+
+impl StateGrid {
+    /// The potential fields of [`field`](Self::field) for `FIELD_LANES` cells at once
+    /// (each inside the grid with the ball's margin), bit for bit the same: per cell
+    /// the same terms are added in the same order, but the cells' sums are independent
+    /// chains of additions, which the processor overlaps (one cell's sum waits on each
+    /// addition's latency). `lin` holds the ball's offsets as index steps of this grid
+    /// ([`Ball::index_steps`]).
+    pub fn fields(
+        &self,
+        keys: &[OcKey; FIELD_LANES],
+        ball: &Ball,
+        lin: &[isize],
+    ) -> [Vector3<f64>; FIELD_LANES] {
+        const SIGN: [f64; 4] = [1.0, -1.0, -1.0, 0.0];
+        let [c0, c1, c2, c3] = keys.map(|k| self.index_of(&k).expect("field cell inside the grid") as isize);
+        let sign = |i: isize| SIGN[self.cells[i as usize] as usize & 3];
+        // twelve accumulators in registers: (cell, axis)
+        let (mut x0, mut y0, mut z0) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut x1, mut y1, mut z1) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut x2, mut y2, mut z2) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut x3, mut y3, mut z3) = (0.0f64, 0.0f64, 0.0f64);
+        for (&o, &[vx, vy, vz]) in lin.iter().zip(&ball.terms) {
+            let (s0, s1, s2, s3) = (sign(c0 + o), sign(c1 + o), sign(c2 + o), sign(c3 + o));
+            x0 += s0 * vx;
+            y0 += s0 * vy;
+            z0 += s0 * vz;
+            x1 += s1 * vx;
+            y1 += s1 * vy;
+            z1 += s1 * vz;
+            x2 += s2 * vx;
+            y2 += s2 * vy;
+            z2 += s2 * vz;
+            x3 += s3 * vx;
+            y3 += s3 * vy;
+            z3 += s3 * vz;
+        }
+        [
+            Vector3::new(x0, y0, z0),
+            Vector3::new(x1, y1, z1),
+            Vector3::new(x2, y2, z2),
+            Vector3::new(x3, y3, z3),
+        ]
+    }
+}
+
 /// The key offsets `o ≠ 0` of the cells within `radius` of a cell centre —
 /// `‖o·res‖ ≤ radius`, with `o·res` computed per axis as `o_i · res` in f64 — and each
 /// one's term `o·res / ‖o·res‖²` (unit direction over distance).
@@ -266,6 +314,17 @@ impl Ball {
             offsets,
             terms,
         })
+    }
+}
+
+impl Ball {
+    /// The offsets as steps of the linear index of `grid` (x fastest).
+    pub fn index_steps(&self, grid: &StateGrid) -> Vec<isize> {
+        let (sy, sz) = (grid.dims[0] as isize, (grid.dims[0] * grid.dims[1]) as isize);
+        self.offsets
+            .iter()
+            .map(|o| o[0] as isize + sy * o[1] as isize + sz * o[2] as isize)
+            .collect()
     }
 }
 

@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use kiddo::{KdTree, SquaredEuclidean};
-use nalgebra::{Isometry3, Point3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -13,7 +13,7 @@ use super::camera::{CameraModel, Frustum};
 use super::count::FrustumCounter;
 use super::frontier::{candidate_pose, frontier_cells, potential_field, unknown_needed};
 use super::gain::{GainMethod, GainWorkspace, ray_gain};
-use super::grid::{Ball, MAX_CELLS, StateGrid};
+use super::grid::{Ball, FIELD_LANES, MAX_CELLS, StateGrid};
 use super::visibility::{PredictWorkspace, ViewGrid, ViewPrediction, predict_on_grid, predict_view_in};
 use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
@@ -244,25 +244,44 @@ pub fn next_best_view(
     }
     st.frontier_us = us(t);
     let t = Instant::now();
-    // potential fields in parallel; the clock is polled per frontier cell
+    // potential fields in parallel, FIELD_LANES cells per pass on the grid (the last
+    // group padded with its last cell); the clock is polled per group
+    let steps = match (&grid, &ball) {
+        (Some(g), Some(b)) => b.index_steps(g),
+        _ => Vec::new(),
+    };
     let fields: Vec<Option<Option<Isometry3<f64>>>> = frontier
-        .par_iter()
-        .map(|f| {
+        .par_chunks(FIELD_LANES)
+        .map(|group| {
+            let mut out = [None; FIELD_LANES];
             if clock.interrupted().is_some() {
-                return Ok(None);
+                return Ok(out);
             }
-            let field = match (&grid, &ball) {
-                (Some(g), Some(b)) => g.field(&f.key, b),
-                _ => potential_field(tree, &f.key, params.field_radius)?,
+            let poses = |fs: &[Vector3<f64>], out: &mut [Option<Option<Isometry3<f64>>>; FIELD_LANES]| {
+                for ((o, f), field) in out.iter_mut().zip(group).zip(fs) {
+                    *o = Some(candidate_pose(&f.center, field, params.standoff, camera.near));
+                }
             };
-            Ok(Some(candidate_pose(
-                &f.center,
-                &field,
-                params.standoff,
-                camera.near,
-            )))
+            match (&grid, &ball) {
+                (Some(g), Some(b)) => {
+                    let keys = std::array::from_fn(|l| group[l.min(group.len() - 1)].key);
+                    poses(&g.fields(&keys, b, &steps), &mut out);
+                }
+                _ => {
+                    let mut fs = [Vector3::zeros(); FIELD_LANES];
+                    for (v, f) in fs.iter_mut().zip(group) {
+                        *v = potential_field(tree, &f.key, params.field_radius)?;
+                    }
+                    poses(&fs, &mut out);
+                }
+            }
+            Ok(out)
         })
-        .collect::<Result<_, crate::octree::OctreeError>>()?;
+        .collect::<Result<Vec<_>, crate::octree::OctreeError>>()?
+        .into_iter()
+        .flatten()
+        .take(frontier.len())
+        .collect();
     if fields.iter().any(Option::is_none)
         && let Some(s) = clock.interrupted()
     {

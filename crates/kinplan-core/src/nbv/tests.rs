@@ -4,7 +4,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::*;
 use crate::Deadline;
-use crate::octree::{CellState, OcKey, Octree};
+use crate::octree::{CellState, OcKey, Octree, TREE_DEPTH};
 
 fn hm(t: &Octree) -> (f32, f32) {
     let m = t.sensor_model().log_odds();
@@ -545,4 +545,58 @@ fn the_grid_prediction_counts_what_the_tree_walk_counts() {
         counted += (on_tree.reached > 0) as usize;
     }
     assert!(counted >= 10, "too few views see unknown cells: {counted}");
+}
+
+#[test]
+fn four_field_lanes_are_the_per_cell_sums_bit_for_bit() {
+    use rand::{Rng, SeedableRng};
+    // random free and occupied boxes; the ball of 0.25 m at 0.05 m (reach 6 cells)
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(91);
+    let mut t = Octree::new(0.05).unwrap();
+    let (hit, miss) = hm(&t);
+    for _ in 0..40 {
+        let c: [u16; 3] = [0, 1, 2].map(|_| rng.random_range(32750..32786));
+        let h: [u16; 3] = [0, 1, 2].map(|_| rng.random_range(0..4));
+        let v = if rng.random_bool(0.3) { hit } else { miss };
+        for x in c[0]..=c[0] + h[0] {
+            for y in c[1]..=c[1] + h[1] {
+                for z in c[2]..=c[2] + h[2] {
+                    t.update_key(&[x, y, z], v);
+                }
+            }
+        }
+    }
+    let ball = grid::Ball::new(0.05, 0.25).unwrap();
+    let g = grid::StateGrid::new(&t, [32740; 3], [32795; 3], 1 << 20).unwrap();
+    let steps = ball.index_steps(&g);
+    let mut checked = 0;
+    for _ in 0..10 {
+        let keys: [OcKey; grid::FIELD_LANES] =
+            std::array::from_fn(|_| [0, 1, 2].map(|_| rng.random_range(32746..32790)));
+        let got = g.fields(&keys, &ball, &steps);
+        for (k, f) in keys.iter().zip(&got) {
+            // the same terms in the ball's order, each cell's state from the tree:
+            // unknown attracts (+), free and occupied repel (−)
+            let mut want = [0.0f64; 3];
+            for (o, v) in ball.offsets.iter().zip(&ball.terms) {
+                let key = [0, 1, 2].map(|i| (k[i] as i32 + o[i]) as u16);
+                let s = match t.search_key(&key, TREE_DEPTH) {
+                    None => 1.0,
+                    Some(_) => -1.0,
+                };
+                for i in 0..3 {
+                    want[i] += s * v[i];
+                }
+            }
+            assert_eq!(
+                [f.x, f.y, f.z].map(f64::to_bits),
+                want.map(f64::to_bits),
+                "cell {k:?}"
+            );
+            assert_eq!(*f, g.field(k, &ball));
+            checked += (f.norm() > 1.0) as usize;
+        }
+    }
+    // most cells see a mix of known and unknown space: the fields are not trivial
+    assert!(checked >= 8, "{checked}");
 }
