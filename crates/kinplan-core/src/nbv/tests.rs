@@ -600,3 +600,56 @@ fn four_field_lanes_are_the_per_cell_sums_bit_for_bit() {
     // most cells see a mix of known and unknown space: the fields are not trivial
     assert!(checked >= 8, "{checked}");
 }
+
+#[test]
+fn grid_walks_ending_at_the_key_space_edge_count_like_the_tree_walk() {
+    use rand::{Rng, SeedableRng};
+    // free cells next to key 0 on every axis, the two layers of keys 0 and 1
+    // unknown; the grid reaches two cells past the key space (outside cells), so rays
+    // looking towards the corner end there, inside the grid, some after unknown region
+    // cells: the grid walk and the tree walk take the very same steps
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let mut t = Octree::new(0.1).unwrap();
+    let (hit, miss) = hm(&t);
+    free_box(&mut t, [2, 2, 2], [9, 9, 9]);
+    for _ in 0..25 {
+        let k: OcKey = [0, 1, 2].map(|_| rng.random_range(0..12));
+        t.update_key(&k, if rng.random_bool(0.4) { hit } else { miss });
+    }
+    let vp = VisibilityParams {
+        pixel_stride: 1,
+        ..VisibilityParams::default()
+    };
+    let cam = small_camera();
+    let region: (OcKey, OcKey) = ([0, 0, 0], [15, 15, 15]);
+    let g = grid::StateGrid::new(&t, [-2, -2, -2], [18, 18, 18], 1 << 20).unwrap();
+    let mut ws = PredictWorkspace::default();
+    let centre = |k: [f64; 3]| Point3::from(k.map(|v| (v - 32768.0 + 0.5) * 0.1));
+    let (mut edge_rays, mut seeing) = (0, 0);
+    for i in 0..12 {
+        let at = centre([0, 1, 2].map(|_| rng.random_range(3..8) as f64));
+        // towards the corner (key 0), along axes and diagonals
+        let aim = match i % 3 {
+            0 => Vector3::new(-1.0, -1.0, -1.0),
+            1 => Vector3::new(-1.0, rng.random_range(-0.3..0.3), rng.random_range(-0.3..0.3)),
+            _ => Vector3::new(rng.random_range(-1.0..0.0), -1.0, rng.random_range(-1.0..0.0)),
+        };
+        let pose = look_along(&at, &aim).unwrap();
+        let on_tree = predict_view(&t, &cam, &pose, &vp, Some(region), &mut ws, Deadline::none());
+        let on_grid = visibility::predict_view_in(
+            &t,
+            Some(&g),
+            &cam,
+            &pose,
+            &vp,
+            Some(region),
+            &mut ws,
+            Deadline::none(),
+        );
+        assert_eq!(on_grid, on_tree, "view {i}");
+        edge_rays += (on_tree.steps > 0) as usize;
+        seeing += (on_tree.reached > 0) as usize;
+    }
+    assert_eq!(edge_rays, 12);
+    assert!(seeing >= 6, "{seeing}");
+}

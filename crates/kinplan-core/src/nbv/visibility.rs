@@ -30,7 +30,7 @@ use nalgebra::{Isometry3, Point3};
 use super::NbvError;
 use super::camera::CameraModel;
 use super::gain::{dda_start, tree_state, walk_with};
-use super::grid::{FREE, OCCUPIED, StateGrid, UNKNOWN};
+use super::grid::{FREE, OCCUPIED, OUTSIDE, StateGrid, UNKNOWN};
 use crate::Deadline;
 use crate::octree::{CellState, OcKey, Octree, SearchCache, morton};
 
@@ -236,13 +236,18 @@ pub(crate) fn predict_view_in(
 }
 
 /// The state grid recoded for the visibility walk over one region: unknown cells
-/// outside the region read as free (the walk passes them as open), so that the walk's
-/// inner loop meets only three kinds of cell: free (go on), unknown region cells
-/// (count) and anything else (occupied, or past the key space: stop). Built once per
-/// request and shared by every predicted view.
+/// outside the region read as free (the walk passes them as open), and one layer of
+/// [`OUTSIDE`] cells around the grid, so that the walk's inner loop meets only four
+/// kinds of cell: free (go on), unknown region cells (count), occupied (stop) and
+/// outside, past the grid or the key space (stop before it). Built once per request
+/// and shared by every predicted view.
 #[derive(Debug, Clone)]
 pub(crate) struct ViewGrid {
+    /// Lowest key of the state grid (the layer around it starts one cell lower).
     lo: [i64; 3],
+    /// Cells of the state grid per axis (the padded grid has two more).
+    inner: [usize; 3],
+    /// Padded cells per axis.
     dims: [usize; 3],
     cells: Vec<u8>,
     /// The region's lowest key (its box lies inside the grid).
@@ -266,7 +271,8 @@ impl ViewGrid {
         if rdims[0] * rdims[1] * rdims[2] > MAX_BITSET_CELLS {
             return None;
         }
-        let [nx, ny, _] = grid.dims;
+        let [nx, ny, nz] = grid.dims;
+        let dims = grid.dims.map(|d| d + 2);
         // region offsets in the grid, per axis
         let o = [0, 1, 2].map(|i| (rlo[i] as i64 - glo[i]) as usize);
         let e = [0, 1, 2].map(|i| (rhi[i] as i64 - glo[i]) as usize);
@@ -277,9 +283,13 @@ impl ViewGrid {
                 *c += (*c == UNKNOWN) as u8;
             }
         };
-        let mut cells = grid.cells.clone();
-        for (z, plane) in cells.chunks_mut(nx * ny).enumerate() {
-            for (y, row) in plane.chunks_mut(nx).enumerate() {
+        let mut cells = vec![OUTSIDE; dims[0] * dims[1] * dims[2]];
+        for z in 0..nz {
+            for y in 0..ny {
+                let from = (z * ny + y) * nx;
+                let at = ((z + 1) * dims[1] + y + 1) * dims[0] + 1;
+                let row = &mut cells[at..at + nx];
+                row.copy_from_slice(&grid.cells[from..from + nx]);
                 if (o[1]..=e[1]).contains(&y) && (o[2]..=e[2]).contains(&z) {
                     let (head, rest) = row.split_at_mut(o[0]);
                     open(head);
@@ -291,17 +301,18 @@ impl ViewGrid {
         }
         Some(Self {
             lo: glo,
-            dims: grid.dims,
+            inner: grid.dims,
+            dims,
             cells,
             rlo,
             rdims,
         })
     }
 
-    /// Whether `k` lies inside the grid.
+    /// Whether `k` lies inside the state grid.
     #[inline]
     fn contains(&self, k: &OcKey) -> bool {
-        (0..3).all(|i| k[i] as i64 >= self.lo[i] && (k[i] as i64) < self.lo[i] + self.dims[i] as i64)
+        (0..3).all(|i| k[i] as i64 >= self.lo[i] && (k[i] as i64) < self.lo[i] + self.inner[i] as i64)
     }
 
     /// Index in the region box of the cell at grid index `idx`, which must lie in it.
@@ -312,7 +323,8 @@ impl ViewGrid {
         let i = idx as u32;
         let (z, rest) = (i / plane, i % plane);
         let g = [rest % nx, rest / nx, z].map(|v| v as usize);
-        let r = [0, 1, 2].map(|i| (g[i] as i64 + self.lo[i] - self.rlo[i] as i64) as usize);
+        // padded offsets are one more than the state grid's
+        let r = [0, 1, 2].map(|i| (g[i] as i64 - 1 + self.lo[i] - self.rlo[i] as i64) as usize);
         debug_assert!((0..3).all(|i| r[i] < self.rdims[i]));
         r[0] + self.rdims[0] * (r[1] + self.rdims[1] * r[2])
     }
@@ -336,8 +348,7 @@ pub(crate) fn predict_on_grid(
     ws: &mut PredictWorkspace,
     deadline: Deadline<'_>,
 ) -> ViewPrediction {
-    let glo = grid.lo;
-    let gdims = grid.dims.map(|d| d as i64);
+    let (glo, pdims) = (grid.lo, grid.dims);
     let words = (grid.rdims[0] * grid.rdims[1] * grid.rdims[2]).div_ceil(64);
     for bits in [&mut ws.first_bits, &mut ws.reached_bits] {
         bits.clear();
@@ -387,24 +398,19 @@ pub(crate) fn predict_on_grid(
                 k[a] = nk as u16;
                 t_max[a] += t_delta[a];
             }
-            // phase 2: inside the grid. Per axis, `rem` counts the steps left before
-            // the key leaves the grid or the key space (either ends the ray: no region
-            // cell lies ahead). Each step is branch-free but for the cell's state and
-            // the ends of the ray: the axis of `next_axis` from two comparisons
-            // (x < y, then the smaller against z), applied by selects
-            let g = [0, 1, 2].map(|i| k[i] as i64 - glo[i]);
-            let rem_on = |i: usize| match step[i] {
-                0 => i64::MAX,
-                1 => (65535 - k[i] as i64).min(gdims[i] - 1 - g[i]),
-                _ => (k[i] as i64).min(g[i]),
-            };
-            let (mut rx, mut ry, mut rz) = (rem_on(0), rem_on(1), rem_on(2));
+            // phase 2: inside the grid, each step branch-free but for the cell's state
+            // and the far end: the axis of `next_axis` from the comparisons x < y and
+            // min(x, y) < z, applied by masks. The walk ends on an occupied cell, after
+            // `lookahead` unknown region cells, past `t1`, or before an outside cell (the
+            // layer around the grid, or past the key space): no region cell lies beyond
+            // the grid, and the step onto the outside cell is not counted
+            let g = [0, 1, 2].map(|i| k[i] as i64 - glo[i] + 1);
             let (gx, gy, gz) = (
-                step[0] as i64,
-                step[1] as i64 * gdims[0],
-                step[2] as i64 * gdims[0] * gdims[1],
+                step[0] as isize,
+                step[1] as isize * pdims[0] as isize,
+                step[2] as isize * (pdims[0] * pdims[1]) as isize,
             );
-            let mut idx = (g[0] + gdims[0] * (g[1] + gdims[1] * g[2])) as usize;
+            let mut idx = (g[0] + pdims[0] as i64 * (g[1] + pdims[1] as i64 * g[2])) as usize;
             let [mut tx, mut ty, mut tz] = t_max;
             let [dx, dy, dz] = t_delta;
             let mut unknown = 0usize;
@@ -414,7 +420,8 @@ pub(crate) fn predict_on_grid(
                 let state = cells[idx];
                 if state != FREE {
                     if state != UNKNOWN {
-                        break; // occupied (or past the key space)
+                        steps -= (state == OUTSIDE) as u64;
+                        break;
                     }
                     // an unknown region cell
                     unknown += 1;
@@ -432,27 +439,20 @@ pub(crate) fn predict_on_grid(
                         break;
                     }
                 }
-                // the axis of `next_axis` (x when tx < ty and tx < tz, y when ty ≤ tx
-                // and ty < tz, else z), each flag one comparison against a bound
-                // picked by another, so that the updates below compile to masks
-                let m = select_unpredictable(tx < ty, tx, ty);
-                if select_unpredictable(m < tz, m, tz) > t1 {
+                // x when tx < ty and tx < tz, y when ty ≤ tx and ty < tz, else z
+                let x_lt_y = tx < ty;
+                let m = select_unpredictable(x_lt_y, tx, ty);
+                let m_lt_z = m < tz;
+                if select_unpredictable(m_lt_z, m, tz) > t1 {
                     break;
                 }
+                idx = idx.wrapping_add_signed(select_unpredictable(
+                    m_lt_z,
+                    select_unpredictable(x_lt_y, gx, gy),
+                    gz,
+                ));
                 let x_bound = select_unpredictable(ty < tz, ty, tz);
-                let y_bound = select_unpredictable(tx < ty, f64::NEG_INFINITY, tz);
-                let (ax, ay, az) = (tx < x_bound, ty < y_bound, !(m < tz));
-                rx -= ax as i64;
-                ry -= ay as i64;
-                rz -= az as i64;
-                if (rx | ry | rz) < 0 {
-                    break;
-                }
-                idx = idx.wrapping_add_signed(
-                    (select_unpredictable(ax, gx, 0)
-                        + select_unpredictable(ay, gy, 0)
-                        + select_unpredictable(az, gz, 0)) as isize,
-                );
+                let y_bound = select_unpredictable(x_lt_y, f64::NEG_INFINITY, tz);
                 tx = add_if_less(tx, x_bound, tx, dx);
                 ty = add_if_less(ty, y_bound, ty, dy);
                 tz = add_unless_less(m, tz, tz, dz);
