@@ -23,6 +23,7 @@
 //! Autonomous Robots 42 (2018), with the visibility product cut to a fixed number of
 //! unknown cells.
 
+#[cfg(not(target_arch = "x86_64"))]
 use std::hint::select_unpredictable;
 
 use nalgebra::{Isometry3, Point3};
@@ -411,8 +412,7 @@ pub(crate) fn predict_on_grid(
                 step[2] as isize * (pdims[0] * pdims[1]) as isize,
             );
             let mut idx = (g[0] + pdims[0] as i64 * (g[1] + pdims[1] as i64 * g[2])) as usize;
-            let [mut tx, mut ty, mut tz] = t_max;
-            let [dx, dy, dz] = t_delta;
+            let mut dda = GridDda::new(t_max, t_delta, t1, [gx, gy, gz]);
             let mut unknown = 0usize;
             let mut steps = 0u64;
             loop {
@@ -439,23 +439,10 @@ pub(crate) fn predict_on_grid(
                         break;
                     }
                 }
-                // x when tx < ty and tx < tz, y when ty ≤ tx and ty < tz, else z
-                let x_lt_y = tx < ty;
-                let m = select_unpredictable(x_lt_y, tx, ty);
-                let m_lt_z = m < tz;
-                if select_unpredictable(m_lt_z, m, tz) > t1 {
+                let Some(d) = dda.advance() else {
                     break;
-                }
-                idx = idx.wrapping_add_signed(select_unpredictable(
-                    m_lt_z,
-                    select_unpredictable(x_lt_y, gx, gy),
-                    gz,
-                ));
-                let x_bound = select_unpredictable(ty < tz, ty, tz);
-                let y_bound = select_unpredictable(x_lt_y, f64::NEG_INFINITY, tz);
-                tx = add_if_less(tx, x_bound, tx, dx);
-                ty = add_if_less(ty, y_bound, ty, dy);
-                tz = add_unless_less(m, tz, tz, dz);
+                };
+                idx = idx.wrapping_add_signed(d);
             }
             out.steps += steps;
         }
@@ -465,51 +452,93 @@ pub(crate) fn predict_on_grid(
     out
 }
 
-/// `t + d` when `a < b`, else `t`, without a branch: the DDA's axis is as good as
-/// random from step to step, and a mispredicted branch costs more than the step.
-#[inline(always)]
-fn add_if_less(a: f64, b: f64, t: f64, d: f64) -> f64 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{
-            _mm_add_sd, _mm_and_pd, _mm_andnot_pd, _mm_cmplt_sd, _mm_cvtsd_f64, _mm_or_pd, _mm_set_sd,
-        };
-        // SAFETY: SSE2 is part of every x86_64 CPU. The comparison's mask picks the
-        // sum or `t`.
-        unsafe {
-            let (t, m) = (_mm_set_sd(t), _mm_cmplt_sd(_mm_set_sd(a), _mm_set_sd(b)));
-            _mm_cvtsd_f64(_mm_or_pd(
-                _mm_and_pd(m, _mm_add_sd(t, _mm_set_sd(d))),
-                _mm_andnot_pd(m, t),
-            ))
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        select_unpredictable(a < b, t + d, t)
-    }
+/// The floating-point state of the grid walk's DDA (Amanatides & Woo, as
+/// [`walk_with`]): per axis the ray parameter of the next cell border and the
+/// parameter between borders, the far end `t1`, and the grid index step per axis.
+/// [`advance`](Self::advance) picks the axis of [`next_axis`] (x when tx < ty and
+/// tx < tz, y when ty ≤ tx and ty < tz, else z) without a branch: the axis is as
+/// good as random from step to step, and a mispredicted branch costs more than the
+/// step. The chosen t gains its delta, the other two `+0.0` (every t ≥ +0: unchanged),
+/// so the sums are those of the walk, bit for bit.
+#[cfg(target_arch = "x86_64")]
+struct GridDda {
+    t: [std::arch::x86_64::__m128d; 3],
+    d: [std::arch::x86_64::__m128d; 3],
+    t1: std::arch::x86_64::__m128d,
+    /// Index step by the axis masks' sign bits: 0 = y, 1 = x, 2 = z.
+    steps: [isize; 4],
 }
 
-/// `t + d` unless `a < b`, else `t`, as [`add_if_less`].
-#[inline(always)]
-fn add_unless_less(a: f64, b: f64, t: f64, d: f64) -> f64 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{
-            _mm_add_sd, _mm_and_pd, _mm_andnot_pd, _mm_cmpnlt_sd, _mm_cvtsd_f64, _mm_or_pd, _mm_set_sd,
-        };
-        // SAFETY: as in `add_if_less`
+#[cfg(target_arch = "x86_64")]
+impl GridDda {
+    #[inline(always)]
+    fn new(t: [f64; 3], d: [f64; 3], t1: f64, [gx, gy, gz]: [isize; 3]) -> Self {
+        use std::arch::x86_64::_mm_set_sd;
+        // SAFETY: SSE2 is part of every x86_64 CPU.
         unsafe {
-            let (t, m) = (_mm_set_sd(t), _mm_cmpnlt_sd(_mm_set_sd(a), _mm_set_sd(b)));
-            _mm_cvtsd_f64(_mm_or_pd(
-                _mm_and_pd(m, _mm_add_sd(t, _mm_set_sd(d))),
-                _mm_andnot_pd(m, t),
-            ))
+            Self {
+                t: t.map(|v| _mm_set_sd(v)),
+                d: d.map(|v| _mm_set_sd(v)),
+                t1: _mm_set_sd(t1),
+                steps: [gy, gx, gz, gz],
+            }
         }
     }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        select_unpredictable(!(a < b), t + d, t)
+
+    /// The index step to the next cell, `None` when its border lies past `t1`.
+    #[inline(always)]
+    fn advance(&mut self) -> Option<isize> {
+        use std::arch::x86_64::{
+            _mm_add_sd, _mm_and_pd, _mm_andnot_pd, _mm_cmplt_sd, _mm_cmpnlt_sd, _mm_comigt_sd, _mm_min_sd,
+            _mm_movemask_pd, _mm_or_pd,
+        };
+        let [x, y, z] = self.t;
+        // SAFETY: SSE2 is part of every x86_64 CPU. `minsd(a, b)` is `a < b ? a : b`.
+        unsafe {
+            let m = _mm_min_sd(x, y);
+            if _mm_comigt_sd(_mm_min_sd(m, z), self.t1) != 0 {
+                return None;
+            }
+            let mx = _mm_cmplt_sd(x, _mm_min_sd(y, z));
+            let mz = _mm_cmpnlt_sd(m, z);
+            // the high lanes are zero: bit 0 of each mask is its low lane's sign
+            let pick = ((_mm_movemask_pd(mx) & 1) | ((_mm_movemask_pd(mz) & 1) << 1)) as usize;
+            // t + (d & mask); y's mask is neither x's nor z's
+            self.t[0] = _mm_add_sd(x, _mm_and_pd(mx, self.d[0]));
+            self.t[1] = _mm_add_sd(y, _mm_andnot_pd(_mm_or_pd(mx, mz), self.d[1]));
+            self.t[2] = _mm_add_sd(z, _mm_and_pd(mz, self.d[2]));
+            Some(self.steps[pick])
+        }
+    }
+}
+/// [`GridDda`] without SSE2: the same choice by selects.
+#[cfg(not(target_arch = "x86_64"))]
+struct GridDda {
+    t: [f64; 3],
+    d: [f64; 3],
+    t1: f64,
+    steps: [isize; 3],
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+impl GridDda {
+    #[inline(always)]
+    fn new(t: [f64; 3], d: [f64; 3], t1: f64, steps: [isize; 3]) -> Self {
+        Self { t, d, t1, steps }
+    }
+
+    #[inline(always)]
+    fn advance(&mut self) -> Option<isize> {
+        let [x, y, z] = self.t;
+        let x_lt_y = x < y;
+        let m = select_unpredictable(x_lt_y, x, y);
+        let m_lt_z = m < z;
+        if select_unpredictable(m_lt_z, m, z) > self.t1 {
+            return None;
+        }
+        let a = select_unpredictable(m_lt_z, select_unpredictable(x_lt_y, 0, 1), 2);
+        self.t[a] += self.d[a];
+        Some(self.steps[a])
     }
 }
 
