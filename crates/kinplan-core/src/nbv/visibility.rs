@@ -23,7 +23,6 @@
 //! Autonomous Robots 42 (2018), with the visibility product cut to a fixed number of
 //! unknown cells.
 
-#[cfg(not(target_arch = "x86_64"))]
 use std::hint::select_unpredictable;
 
 use nalgebra::{Isometry3, Point3};
@@ -452,7 +451,7 @@ pub(crate) fn predict_on_grid(
     out
 }
 
-/// The floating-point state of the grid walk's DDA (Amanatides & Woo, as
+/// The floating-point state of the grid walk's DDA on x86_64 (Amanatides & Woo, as
 /// [`walk_with`]): per axis the ray parameter of the next cell border and the
 /// parameter between borders, the far end `t1`, and the grid index step per axis.
 /// [`advance`](Self::advance) picks the axis of [`next_axis`] (x when tx < ty and
@@ -461,7 +460,7 @@ pub(crate) fn predict_on_grid(
 /// step. The chosen t gains its delta, the other two `+0.0` (every t ≥ +0: unchanged),
 /// so the sums are those of the walk, bit for bit.
 #[cfg(target_arch = "x86_64")]
-struct GridDda {
+struct SseDda {
     t: [std::arch::x86_64::__m128d; 3],
     d: [std::arch::x86_64::__m128d; 3],
     t1: std::arch::x86_64::__m128d,
@@ -470,7 +469,7 @@ struct GridDda {
 }
 
 #[cfg(target_arch = "x86_64")]
-impl GridDda {
+impl SseDda {
     #[inline(always)]
     fn new(t: [f64; 3], d: [f64; 3], t1: f64, [gx, gy, gz]: [isize; 3]) -> Self {
         use std::arch::x86_64::_mm_set_sd;
@@ -511,17 +510,23 @@ impl GridDda {
         }
     }
 }
-/// [`GridDda`] without SSE2: the same choice by selects.
+/// The DDA state of the grid walk on this target.
+#[cfg(target_arch = "x86_64")]
+type GridDda = SseDda;
 #[cfg(not(target_arch = "x86_64"))]
-struct GridDda {
+type GridDda = SelectDda;
+
+/// [`SseDda`] without SSE2: the same choice by selects, the chosen t alone updated.
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+struct SelectDda {
     t: [f64; 3],
     d: [f64; 3],
     t1: f64,
     steps: [isize; 3],
 }
 
-#[cfg(not(target_arch = "x86_64"))]
-impl GridDda {
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+impl SelectDda {
     #[inline(always)]
     fn new(t: [f64; 3], d: [f64; 3], t1: f64, steps: [isize; 3]) -> Self {
         Self { t, d, t1, steps }
@@ -552,5 +557,55 @@ fn next_axis(t_max: &[f64; 3]) -> usize {
         1
     } else {
         2
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use rand::{Rng, SeedableRng};
+
+    use super::{SelectDda, SseDda};
+
+    #[test]
+    fn the_sse_and_the_select_dda_step_alike_bit_for_bit() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
+        for ray in 0..300 {
+            // t_max and deltas on a lattice of 1/8 for many ties, or random
+            let tie = ray % 2 == 0;
+            let v = |rng: &mut rand_chacha::ChaCha8Rng| {
+                if tie {
+                    rng.random_range(0..16) as f64 / 8.0
+                } else {
+                    rng.random_range(0.0..2.0)
+                }
+            };
+            let t = [v(&mut rng), v(&mut rng), v(&mut rng)];
+            let d = [0, 1, 2].map(|_| {
+                if rng.random_bool(0.1) {
+                    f64::INFINITY
+                } else {
+                    0.125 + v(&mut rng)
+                }
+            });
+            let t1 = rng.random_range(1.0..6.0);
+            let (mut a, mut b) = (
+                SseDda::new(t, d, t1, [1, 10, 100]),
+                SelectDda::new(t, d, t1, [1, 10, 100]),
+            );
+            let mut n = 0;
+            loop {
+                let (sa, sb) = (a.advance(), b.advance());
+                assert_eq!(sa, sb, "ray {ray} step {n}");
+                // SAFETY: SSE2 is part of every x86_64 CPU.
+                let ta =
+                    a.t.map(|x| unsafe { std::arch::x86_64::_mm_cvtsd_f64(x) }.to_bits());
+                assert_eq!(ta, b.t.map(f64::to_bits), "ray {ray} step {n}");
+                if sa.is_none() {
+                    break;
+                }
+                n += 1;
+            }
+            assert!(n < 200);
+        }
     }
 }
