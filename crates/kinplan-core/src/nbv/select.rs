@@ -250,38 +250,45 @@ pub fn next_best_view(
         (Some(g), Some(b)) => b.index_steps(g),
         _ => Vec::new(),
     };
-    let fields: Vec<Option<Option<Isometry3<f64>>>> = frontier
-        .par_chunks(FIELD_LANES)
-        .map(|group| {
-            let mut out = [None; FIELD_LANES];
-            if clock.interrupted().is_some() {
-                return Ok(out);
-            }
-            let poses = |fs: &[Vector3<f64>], out: &mut [Option<Option<Isometry3<f64>>>; FIELD_LANES]| {
-                for ((o, f), field) in out.iter_mut().zip(group).zip(fs) {
-                    *o = Some(candidate_pose(&f.center, field, params.standoff, camera.near));
+    let fields_stage = || {
+        frontier
+            .par_chunks(FIELD_LANES)
+            .map(|group| {
+                let mut out = [None; FIELD_LANES];
+                if clock.interrupted().is_some() {
+                    return Ok(out);
                 }
-            };
-            match (&grid, &ball) {
-                (Some(g), Some(b)) => {
-                    let keys = std::array::from_fn(|l| group[l.min(group.len() - 1)].key);
-                    poses(&g.fields(&keys, b, &steps), &mut out);
-                }
-                _ => {
-                    let mut fs = [Vector3::zeros(); FIELD_LANES];
-                    for (v, f) in fs.iter_mut().zip(group) {
-                        *v = potential_field(tree, &f.key, params.field_radius)?;
+                let poses = |fs: &[Vector3<f64>], out: &mut [Option<Option<Isometry3<f64>>>; FIELD_LANES]| {
+                    for ((o, f), field) in out.iter_mut().zip(group).zip(fs) {
+                        *o = Some(candidate_pose(&f.center, field, params.standoff, camera.near));
                     }
-                    poses(&fs, &mut out);
+                };
+                match (&grid, &ball) {
+                    (Some(g), Some(b)) => {
+                        let keys = std::array::from_fn(|l| group[l.min(group.len() - 1)].key);
+                        poses(&g.fields(&keys, b, &steps), &mut out);
+                    }
+                    _ => {
+                        let mut fs = [Vector3::zeros(); FIELD_LANES];
+                        for (v, f) in fs.iter_mut().zip(group) {
+                            *v = potential_field(tree, &f.key, params.field_radius)?;
+                        }
+                        poses(&fs, &mut out);
+                    }
                 }
-            }
-            Ok(out)
-        })
-        .collect::<Result<Vec<_>, crate::octree::OctreeError>>()?
-        .into_iter()
-        .flatten()
-        .take(frontier.len())
-        .collect();
+                Ok(out)
+            })
+            .collect::<Result<Vec<_>, crate::octree::OctreeError>>()
+    };
+    // beside the fields, on whichever thread is free: the tree's known-cell counts for
+    // the intersection gain and the robot's reach for ORF (neither reads the fields)
+    let side_work = || {
+        let counter = matches!(params.gain, GainMethod::Intersection).then(|| FrustumCounter::new(tree));
+        (counter, params.reach.or_else(|| robot.map(estimate_reach)))
+    };
+    let (fields, (counter, reach)) = rayon::join(fields_stage, side_work);
+    let fields: Vec<Option<Option<Isometry3<f64>>>> =
+        fields?.into_iter().flatten().take(frontier.len()).collect();
     if fields.iter().any(Option::is_none)
         && let Some(s) = clock.interrupted()
     {
@@ -299,7 +306,6 @@ pub fn next_best_view(
 
     // 2a. ORF
     let t = Instant::now();
-    let reach = params.reach.or_else(|| robot.map(estimate_reach));
     if let Some(r) = reach {
         let base = params.robot_base.translation.vector;
         cands.retain(|(p, _)| (p.translation.vector - base).norm() <= r);
@@ -349,27 +355,37 @@ pub fn next_best_view(
         _ => None,
     };
     let c_max = camera.frustum_volume() / tree.resolution().powi(3);
-    // the tree's known-cell counts, built once and shared by every candidate's count
-    let counter = matches!(params.gain, GainMethod::Intersection).then(|| FrustumCounter::new(tree));
-    let gains: Vec<Option<(f64, f64, u64)>> = kept
-        .par_iter()
-        .map_init(GainWorkspace::default, |ws, (pose, _)| {
-            if clock.interrupted().is_some() {
-                return None;
-            }
-            Some(match params.gain {
-                GainMethod::Intersection => {
-                    let counter = counter.as_ref().expect("built for the intersection gain");
-                    let c = counter.count_in(&Frustum::new(camera, pose), gain_keys) as f64;
-                    (c, c / c_max, 0)
+    // the state grid recoded for the visibility walks, built beside the gains (the
+    // visibility stage checks the region's keys again)
+    let view_grid_work = || match (&params.visibility, &grid, &region) {
+        (Some(_), Some(g), Some((a, b))) => match (tree.key_of(a), tree.key_of(b)) {
+            (Ok(ka), Ok(kb)) => ViewGrid::new(g, (ka, kb)),
+            _ => None,
+        },
+        _ => None,
+    };
+    // the counter (the tree's known-cell counts) is shared by every candidate's count
+    let gains_stage = || {
+        kept.par_iter()
+            .map_init(GainWorkspace::default, |ws, (pose, _)| {
+                if clock.interrupted().is_some() {
+                    return None;
                 }
-                m => {
-                    let g = ray_gain(tree, camera, pose, m, ws, clock.deadline);
-                    (g.cells, g.ig, g.ray_steps)
-                }
+                Some(match params.gain {
+                    GainMethod::Intersection => {
+                        let counter = counter.as_ref().expect("built for the intersection gain");
+                        let c = counter.count_in(&Frustum::new(camera, pose), gain_keys) as f64;
+                        (c, c / c_max, 0)
+                    }
+                    m => {
+                        let g = ray_gain(tree, camera, pose, m, ws, clock.deadline);
+                        (g.cells, g.ig, g.ray_steps)
+                    }
+                })
             })
-        })
-        .collect();
+            .collect::<Vec<Option<(f64, f64, u64)>>>()
+    };
+    let (gains, view_grid) = rayon::join(gains_stage, view_grid_work);
     if gains.iter().any(Option::is_none)
         && let Some(s) = clock.interrupted()
     {
@@ -445,11 +461,6 @@ pub fn next_best_view(
         let region_keys = match &region {
             Some((a, b)) => Some((tree.key_of(a)?, tree.key_of(b)?)),
             None => None,
-        };
-        // the state grid recoded for the walks once, shared by every view
-        let view_grid = match (&grid, region_keys) {
-            (Some(g), Some(keys)) => ViewGrid::new(g, keys),
-            _ => None,
         };
         let mut kept: Vec<NbvCandidate> = Vec::with_capacity(params.max_results);
         let mut rest = scored.into_iter();
