@@ -358,8 +358,8 @@ pub fn next_best_view(
     // the state grid recoded for the visibility walks, built beside the gains (the
     // visibility stage checks the region's keys again)
     let view_grid_work = || match (&params.visibility, &grid, &region) {
-        (Some(_), Some(g), Some((a, b))) => match (tree.key_of(a), tree.key_of(b)) {
-            (Ok(ka), Ok(kb)) => ViewGrid::new(g, (ka, kb)),
+        (Some(vp), Some(g), Some((a, b))) => match (tree.key_of(a), tree.key_of(b)) {
+            (Ok(ka), Ok(kb)) => ViewGrid::new(g, (ka, kb), camera, vp.pixel_stride),
             _ => None,
         },
         _ => None,

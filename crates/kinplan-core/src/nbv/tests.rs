@@ -647,6 +647,10 @@ fn grid_walks_ending_at_the_key_space_edge_count_like_the_tree_walk() {
             Deadline::none(),
         );
         assert_eq!(on_grid, on_tree, "view {i}");
+        // a recoded grid whose rays were built for another stride casts this one's
+        let vg = visibility::ViewGrid::new(&g, region, &cam, 3).unwrap();
+        let other = visibility::predict_on_grid(&t, &vg, &cam, &pose, &vp, &mut ws, Deadline::none());
+        assert_eq!(other, on_tree, "view {i}");
         edge_rays += (on_tree.steps > 0) as usize;
         seeing += (on_tree.reached > 0) as usize;
     }

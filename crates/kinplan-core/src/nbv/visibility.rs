@@ -25,7 +25,7 @@
 
 use std::hint::select_unpredictable;
 
-use nalgebra::{Isometry3, Point3};
+use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::NbvError;
 use super::camera::CameraModel;
@@ -163,7 +163,7 @@ pub(crate) fn predict_view_in(
     deadline: Deadline<'_>,
 ) -> ViewPrediction {
     if let (Some(g), Some(keys)) = (grid, region_keys)
-        && let Some(vg) = ViewGrid::new(g, keys)
+        && let Some(vg) = ViewGrid::new(g, keys, camera, params.pixel_stride)
     {
         return predict_on_grid(tree, &vg, camera, pose, params, ws, deadline);
     }
@@ -254,12 +254,22 @@ pub(crate) struct ViewGrid {
     rlo: OcKey,
     /// Cells of the region box per axis.
     rdims: [usize; 3],
+    /// Per ray of the camera's strided pixel grid (rows, then columns): its unit
+    /// direction in the optical frame and its parameter at depth `far`.
+    rays: Vec<(Vector3<f64>, f64)>,
+    /// The camera and stride the rays were built for.
+    rays_for: (CameraModel, usize),
 }
 
 impl ViewGrid {
     /// `None` when the region `[rlo, rhi]` is empty, not inside `grid`, or has more
     /// than [`MAX_BITSET_CELLS`] cells (the caller then takes the key lists).
-    pub fn new(grid: &StateGrid, (rlo, rhi): (OcKey, OcKey)) -> Option<Self> {
+    pub fn new(
+        grid: &StateGrid,
+        (rlo, rhi): (OcKey, OcKey),
+        camera: &CameraModel,
+        stride: usize,
+    ) -> Option<Self> {
         let glo = grid.lo;
         let mut rdims = [0usize; 3];
         for i in 0..3 {
@@ -299,6 +309,7 @@ impl ViewGrid {
                 }
             }
         }
+        let stride = stride.max(1);
         Some(Self {
             lo: glo,
             inner: grid.dims,
@@ -306,7 +317,25 @@ impl ViewGrid {
             cells,
             rlo,
             rdims,
+            rays: camera_rays(camera, stride),
+            rays_for: (*camera, stride),
         })
+    }
+
+    /// The rays of `camera` at `stride` ([`camera_rays`]): the grid's own when it was
+    /// built for them, else computed into `local`.
+    fn rays<'a>(
+        &'a self,
+        camera: &CameraModel,
+        stride: usize,
+        local: &'a mut Vec<(Vector3<f64>, f64)>,
+    ) -> &'a [(Vector3<f64>, f64)] {
+        if self.rays_for == (*camera, stride) {
+            &self.rays
+        } else {
+            *local = camera_rays(camera, stride);
+            local
+        }
     }
 
     /// Whether `k` lies inside the state grid.
@@ -328,6 +357,21 @@ impl ViewGrid {
         debug_assert!((0..3).all(|i| r[i] < self.rdims[i]));
         r[0] + self.rdims[0] * (r[1] + self.rdims[1] * r[2])
     }
+}
+
+/// The rays through every `stride`-th pixel of every `stride`-th row (rows, then
+/// columns), each as its unit direction in the optical frame and its parameter at
+/// depth `far`, computed as [`predict_view_in`] computes them per ray.
+fn camera_rays(camera: &CameraModel, stride: usize) -> Vec<(Vector3<f64>, f64)> {
+    let tangents = camera.half_tangents();
+    let mut rays = Vec::with_capacity(camera.height.div_ceil(stride) * camera.width.div_ceil(stride));
+    for v in (0..camera.height).step_by(stride) {
+        for u in (0..camera.width).step_by(stride) {
+            let local = camera.ray_direction_with(tangents, u, v);
+            rays.push((local, camera.far / local.z));
+        }
+    }
+    rays
 }
 
 /// The prediction of [`predict_view_in`] on a [`ViewGrid`] of the region: the same
@@ -359,7 +403,6 @@ pub(crate) fn predict_on_grid(
     let mut cache = SearchCache::default();
     let res = tree.resolution();
     let stride = params.pixel_stride.max(1);
-    let tangents = camera.half_tangents();
     let origin = Point3::from(pose.translation.vector);
     let mut out = ViewPrediction::default();
     let (mut first, mut reached) = (0u32, 0u32);
@@ -369,82 +412,79 @@ pub(crate) fn predict_on_grid(
         return out;
     };
     let lookahead = params.lookahead;
-    'rows: for v in (0..camera.height).step_by(stride) {
-        'ray: for u in (0..camera.width).step_by(stride) {
-            if out.rays % 64 == 63 && deadline.expired() {
-                break 'rows;
-            }
-            out.rays += 1;
-            let local = camera.ray_direction_with(tangents, u, v);
-            let dir = pose.rotation * local;
-            let t1 = camera.far / local.z;
-            // the DDA set-up of `walk_with` from t0 = 0
-            let mut k = k0;
-            let (step, mut t_max, t_delta) = dda_start(&k, &origin, &dir, 0.0, res);
-            // phase 1: outside the grid, states from the tree, until the ray enters it
-            while !grid.contains(&k) {
-                out.steps += 1;
-                if tree_state(tree, &k, &mut cache).0 == CellState::Occupied {
-                    continue 'ray;
-                }
-                let a = next_axis(&t_max);
-                if t_max[a] > t1 {
-                    continue 'ray;
-                }
-                let nk = k[a] as i32 + step[a];
-                if !(0..65536).contains(&nk) {
-                    continue 'ray;
-                }
-                k[a] = nk as u16;
-                t_max[a] += t_delta[a];
-            }
-            // phase 2: inside the grid, each step branch-free but for the cell's state
-            // and the far end: the axis of `next_axis` from the comparisons x < y and
-            // min(x, y) < z, applied by masks. The walk ends on an occupied cell, after
-            // `lookahead` unknown region cells, past `t1`, or before an outside cell (the
-            // layer around the grid, or past the key space): no region cell lies beyond
-            // the grid, and the step onto the outside cell is not counted
-            let g = [0, 1, 2].map(|i| k[i] as i64 - glo[i] + 1);
-            let (gx, gy, gz) = (
-                step[0] as isize,
-                step[1] as isize * pdims[0] as isize,
-                step[2] as isize * (pdims[0] * pdims[1]) as isize,
-            );
-            let mut idx = (g[0] + pdims[0] as i64 * (g[1] + pdims[1] as i64 * g[2])) as usize;
-            let mut dda = GridDda::new(t_max, t_delta, t1, [gx, gy, gz]);
-            let mut unknown = 0usize;
-            let mut steps = 0u64;
-            loop {
-                steps += 1;
-                let state = cells[idx];
-                if state != FREE {
-                    if state != UNKNOWN {
-                        steps -= (state == OUTSIDE) as u64;
-                        break;
-                    }
-                    // an unknown region cell
-                    unknown += 1;
-                    let r = grid.region_index(idx);
-                    let (w, bit) = (r / 64, 1u64 << (r % 64));
-                    if unknown == 1 && first_bits[w] & bit == 0 {
-                        first_bits[w] |= bit;
-                        first += 1;
-                    }
-                    if reached_bits[w] & bit == 0 {
-                        reached_bits[w] |= bit;
-                        reached += 1;
-                    }
-                    if unknown >= lookahead {
-                        break;
-                    }
-                }
-                let Some(d) = dda.advance() else {
-                    break;
-                };
-                idx = idx.wrapping_add_signed(d);
-            }
-            out.steps += steps;
+    let mut own_rays = Vec::new();
+    'ray: for &(local, t1) in grid.rays(camera, stride, &mut own_rays) {
+        if out.rays % 64 == 63 && deadline.expired() {
+            break 'ray;
         }
+        out.rays += 1;
+        let dir = pose.rotation * local;
+        // the DDA set-up of `walk_with` from t0 = 0
+        let mut k = k0;
+        let (step, mut t_max, t_delta) = dda_start(&k, &origin, &dir, 0.0, res);
+        // phase 1: outside the grid, states from the tree, until the ray enters it
+        while !grid.contains(&k) {
+            out.steps += 1;
+            if tree_state(tree, &k, &mut cache).0 == CellState::Occupied {
+                continue 'ray;
+            }
+            let a = next_axis(&t_max);
+            if t_max[a] > t1 {
+                continue 'ray;
+            }
+            let nk = k[a] as i32 + step[a];
+            if !(0..65536).contains(&nk) {
+                continue 'ray;
+            }
+            k[a] = nk as u16;
+            t_max[a] += t_delta[a];
+        }
+        // phase 2: inside the grid, each step branch-free but for the cell's state
+        // and the far end: the axis of `next_axis` from the comparisons x < y and
+        // min(x, y) < z, applied by masks. The walk ends on an occupied cell, after
+        // `lookahead` unknown region cells, past `t1`, or before an outside cell (the
+        // layer around the grid, or past the key space): no region cell lies beyond
+        // the grid, and the step onto the outside cell is not counted
+        let g = [0, 1, 2].map(|i| k[i] as i64 - glo[i] + 1);
+        let (gx, gy, gz) = (
+            step[0] as isize,
+            step[1] as isize * pdims[0] as isize,
+            step[2] as isize * (pdims[0] * pdims[1]) as isize,
+        );
+        let mut idx = (g[0] + pdims[0] as i64 * (g[1] + pdims[1] as i64 * g[2])) as usize;
+        let mut dda = GridDda::new(t_max, t_delta, t1, [gx, gy, gz]);
+        let mut unknown = 0usize;
+        let mut steps = 0u64;
+        loop {
+            steps += 1;
+            let state = cells[idx];
+            if state != FREE {
+                if state != UNKNOWN {
+                    steps -= (state == OUTSIDE) as u64;
+                    break;
+                }
+                // an unknown region cell
+                unknown += 1;
+                let r = grid.region_index(idx);
+                let (w, bit) = (r / 64, 1u64 << (r % 64));
+                if unknown == 1 && first_bits[w] & bit == 0 {
+                    first_bits[w] |= bit;
+                    first += 1;
+                }
+                if reached_bits[w] & bit == 0 {
+                    reached_bits[w] |= bit;
+                    reached += 1;
+                }
+                if unknown >= lookahead {
+                    break;
+                }
+            }
+            let Some(d) = dda.advance() else {
+                break;
+            };
+            idx = idx.wrapping_add_signed(d);
+        }
+        out.steps += steps;
     }
     out.first = first;
     out.reached = reached;
