@@ -464,8 +464,6 @@ pub fn next_best_view(
         };
         let mut kept: Vec<NbvCandidate> = Vec::with_capacity(params.max_results);
         let mut rest = scored.into_iter();
-        // one workspace per candidate of a batch, kept from batch to batch
-        let mut workspaces: Vec<PredictWorkspace> = Vec::new();
         loop {
             let batch: Vec<NbvCandidate> = rest.by_ref().take(vp.batch).collect();
             if batch.is_empty() {
@@ -475,13 +473,10 @@ pub fn next_best_view(
                 status = s;
                 break;
             }
-            if workspaces.len() < batch.len() {
-                workspaces.resize_with(batch.len(), PredictWorkspace::default);
-            }
+            // a workspace per thread's share of the batch (its bit sets span the region)
             let preds: Vec<Option<ViewPrediction>> = batch
                 .par_iter()
-                .zip(workspaces.par_iter_mut())
-                .map(|(c, ws)| {
+                .map_init(PredictWorkspace::default, |ws, c| {
                     if clock.interrupted().is_some() {
                         return None;
                     }
