@@ -211,7 +211,9 @@ pub fn next_best_view(
     let mut frontier = match &region {
         Some((a, b)) if params.max_frontier_candidates > 0 => {
             let (ka, kb) = (tree.key_of(a)?, tree.key_of(b)?);
-            let pad = ball.as_ref().map_or(1, |b| b.reach.max(1));
+            // the field's reach, and one more layer that the visibility walk recodes
+            // as the grid's end (`ViewGrid::from_padded`)
+            let pad = ball.as_ref().map_or(1, |b| b.reach.max(1)) + 1;
             if (0..3).all(|i| ka[i] <= kb[i]) {
                 grid = StateGrid::new(
                     tree,
@@ -357,12 +359,22 @@ pub fn next_best_view(
     let c_max = camera.frustum_volume() / tree.resolution().powi(3);
     // the state grid recoded for the visibility walks, built beside the gains (the
     // visibility stage checks the region's keys again)
-    let view_grid_work = || match (&params.visibility, &grid, &region) {
+    // visibility stage checks the region's keys again); it takes the state grid over
+    // and gives it back when it cannot
+    let state_grid = if params.visibility.is_some() {
+        grid.take()
+    } else {
+        None
+    };
+    let view_grid_work = move || match (&params.visibility, state_grid, &region) {
         (Some(vp), Some(g), Some((a, b))) => match (tree.key_of(a), tree.key_of(b)) {
-            (Ok(ka), Ok(kb)) => ViewGrid::new(g, (ka, kb), camera, vp.pixel_stride),
-            _ => None,
+            (Ok(ka), Ok(kb)) => match ViewGrid::from_padded(g, (ka, kb), camera, vp.pixel_stride) {
+                Ok(vg) => (Some(vg), None),
+                Err(g) => (None, Some(g)),
+            },
+            _ => (None, Some(g)),
         },
-        _ => None,
+        (_, g, _) => (None, g),
     };
     // the counter (the tree's known-cell counts) is shared by every candidate's count
     let gains_stage = || {
@@ -385,7 +397,10 @@ pub fn next_best_view(
             })
             .collect::<Vec<Option<(f64, f64, u64)>>>()
     };
-    let (gains, view_grid) = rayon::join(gains_stage, view_grid_work);
+    let (gains, (view_grid, back)) = rayon::join(gains_stage, view_grid_work);
+    if back.is_some() {
+        grid = back;
+    }
     if gains.iter().any(Option::is_none)
         && let Some(s) = clock.interrupted()
     {

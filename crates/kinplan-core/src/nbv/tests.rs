@@ -651,9 +651,17 @@ fn grid_walks_ending_at_the_key_space_edge_count_like_the_tree_walk() {
         let vg = visibility::ViewGrid::new(&g, region, &cam, 3).unwrap();
         let other = visibility::predict_on_grid(&t, &vg, &cam, &pose, &vp, &mut ws, Deadline::none());
         assert_eq!(other, on_tree, "view {i}");
+        // the same walks on a state grid one layer wider, recoded in place
+        let wide = grid::StateGrid::new(&t, [-3, -3, -3], [19, 19, 19], 1 << 20).unwrap();
+        let vg = visibility::ViewGrid::from_padded(wide, region, &cam, 1).unwrap();
+        let in_place = visibility::predict_on_grid(&t, &vg, &cam, &pose, &vp, &mut ws, Deadline::none());
+        assert_eq!(in_place, on_tree, "view {i}");
         edge_rays += (on_tree.steps > 0) as usize;
         seeing += (on_tree.reached > 0) as usize;
     }
     assert_eq!(edge_rays, 12);
     assert!(seeing >= 6, "{seeing}");
+    // a state grid whose inner box does not hold the region is given back
+    let small = grid::StateGrid::new(&t, [-1, -1, -1], [10, 10, 10], 1 << 20).unwrap();
+    assert!(visibility::ViewGrid::from_padded(small, region, &cam, 1).is_err());
 }

@@ -286,13 +286,6 @@ impl ViewGrid {
         // region offsets in the grid, per axis
         let o = [0, 1, 2].map(|i| (rlo[i] as i64 - glo[i]) as usize);
         let e = [0, 1, 2].map(|i| (rhi[i] as i64 - glo[i]) as usize);
-        // unknown (0) outside the region becomes free (1); the other states keep
-        // their codes
-        let open = |row: &mut [u8]| {
-            for c in row {
-                *c += (*c == UNKNOWN) as u8;
-            }
-        };
         let mut cells = vec![OUTSIDE; dims[0] * dims[1] * dims[2]];
         for z in 0..nz {
             for y in 0..ny {
@@ -315,6 +308,65 @@ impl ViewGrid {
             inner: grid.dims,
             dims,
             cells,
+            rlo,
+            rdims,
+            rays: camera_rays(camera, stride),
+            rays_for: (*camera, stride),
+        })
+    }
+
+    /// [`new`](Self::new) recoding `grid` in place: its outermost layer becomes the
+    /// outside layer, the rest (at least one cell of `grid` on every axis) the grid the
+    /// walks read. The state grid is given back when the region does not fit.
+    pub fn from_padded(
+        mut grid: StateGrid,
+        (rlo, rhi): (OcKey, OcKey),
+        camera: &CameraModel,
+        stride: usize,
+    ) -> Result<Self, StateGrid> {
+        let dims = grid.dims;
+        let lo = grid.lo.map(|v| v + 1);
+        let mut rdims = [0usize; 3];
+        for i in 0..3 {
+            if dims[i] < 3
+                || rlo[i] > rhi[i]
+                || (rlo[i] as i64) < lo[i]
+                || rhi[i] as i64 >= lo[i] + dims[i] as i64 - 2
+            {
+                return Err(grid);
+            }
+            rdims[i] = (rhi[i] - rlo[i]) as usize + 1;
+        }
+        if rdims[0] * rdims[1] * rdims[2] > MAX_BITSET_CELLS {
+            return Err(grid);
+        }
+        let [nx, ny, nz] = dims;
+        // region offsets in the padded grid, per axis
+        let o = [0, 1, 2].map(|i| (rlo[i] as i64 - grid.lo[i]) as usize);
+        let e = [0, 1, 2].map(|i| (rhi[i] as i64 - grid.lo[i]) as usize);
+        for (z, plane) in grid.cells.chunks_mut(nx * ny).enumerate() {
+            for (y, row) in plane.chunks_mut(nx).enumerate() {
+                if z == 0 || z == nz - 1 || y == 0 || y == ny - 1 {
+                    row.fill(OUTSIDE);
+                    continue;
+                }
+                if (o[1]..=e[1]).contains(&y) && (o[2]..=e[2]).contains(&z) {
+                    let (head, rest) = row.split_at_mut(o[0]);
+                    open(head);
+                    open(&mut rest[e[0] - o[0] + 1..]);
+                } else {
+                    open(row);
+                }
+                row[0] = OUTSIDE;
+                row[nx - 1] = OUTSIDE;
+            }
+        }
+        let stride = stride.max(1);
+        Ok(Self {
+            lo,
+            inner: dims.map(|d| d - 2),
+            dims,
+            cells: grid.cells,
             rlo,
             rdims,
             rays: camera_rays(camera, stride),
@@ -356,6 +408,13 @@ impl ViewGrid {
         let r = [0, 1, 2].map(|i| (g[i] as i64 - 1 + self.lo[i] - self.rlo[i] as i64) as usize);
         debug_assert!((0..3).all(|i| r[i] < self.rdims[i]));
         r[0] + self.rdims[0] * (r[1] + self.rdims[1] * r[2])
+    }
+}
+
+/// Unknown cells (0) become free (1); the other states keep their codes.
+fn open(row: &mut [u8]) {
+    for c in row {
+        *c += (*c == UNKNOWN) as u8;
     }
 }
 
