@@ -68,33 +68,19 @@ impl StateGrid {
                 }
             }
         }
-        let Some(root) = tree.root_ref() else {
-            return Some(g);
-        };
-        let thr = tree.threshold_log_odds();
-        let mut stack: Vec<(NodeRef, OcKey, u8)> = Vec::with_capacity(8 * (TREE_DEPTH as usize + 1));
-        stack.push((root, [0; 3], 0));
-        while let Some((node, key, depth)) = stack.pop() {
-            let side = 1i64 << (TREE_DEPTH - depth);
-            let a = [0, 1, 2].map(|i| (key[i] as i64).max(lo[i]));
-            let b = [0, 1, 2].map(|i| (key[i] as i64 + side - 1).min(hi[i]));
-            if (0..3).any(|i| a[i] > b[i]) {
-                continue;
-            }
-            if !tree.has_children(node) {
-                let s = if tree.log_odds_of(node) > thr {
-                    OCCUPIED
-                } else {
-                    FREE
-                };
-                g.fill(a, b, s);
-                continue;
-            }
-            for i in 0..8 {
-                if let Some(c) = tree.child_ref(node, i) {
-                    stack.push((c, child_key(&key, depth, i), depth + 1));
-                }
-            }
+        // two slabs along z, filled side by side (each cell lies in one leaf at most,
+        // so the slabs' walks write disjoint cells)
+        let plane = dims[0] * dims[1];
+        let mid = dims[2] / 2;
+        if mid == 0 || n < 1 << 16 {
+            fill_from_tree(tree, &mut g.cells, lo, hi, dims[0], dims[1]);
+        } else {
+            let (near, far) = g.cells.split_at_mut(mid * plane);
+            let z_mid = lo[2] + mid as i64;
+            rayon::join(
+                || fill_from_tree(tree, near, lo, [hi[0], hi[1], z_mid - 1], dims[0], dims[1]),
+                || fill_from_tree(tree, far, [lo[0], lo[1], z_mid], hi, dims[0], dims[1]),
+            );
         }
         Some(g)
     }
@@ -112,16 +98,6 @@ impl StateGrid {
         (0..3)
             .all(|i| k[i] >= 0 && (k[i] as usize) < self.dims[i])
             .then(|| self.index(k))
-    }
-
-    fn fill(&mut self, a: [i64; 3], b: [i64; 3], s: u8) {
-        let (x0, x1) = ((a[0] - self.lo[0]) as usize, (b[0] - self.lo[0]) as usize);
-        for z in a[2]..=b[2] {
-            for y in a[1]..=b[1] {
-                let row = self.index([0, y - self.lo[1], z - self.lo[2]]);
-                self.cells[row + x0..=row + x1].fill(s);
-            }
-        }
     }
 
     /// Frontier cells of the key box `[kmin, kmax]`, which must lie inside the grid with
@@ -223,6 +199,45 @@ impl StateGrid {
             f[2] += s * v[2];
         }
         Vector3::from(f)
+    }
+}
+
+/// Writes every leaf of `tree` overlapping the key box `[lo, hi]` into `cells`, the
+/// box's cells (x fastest, rows of `nx`, planes of `nx · ny`), clipped to the box.
+fn fill_from_tree(tree: &Octree, cells: &mut [u8], lo: [i64; 3], hi: [i64; 3], nx: usize, ny: usize) {
+    let Some(root) = tree.root_ref() else {
+        return;
+    };
+    let thr = tree.threshold_log_odds();
+    let mut stack: Vec<(NodeRef, OcKey, u8)> = Vec::with_capacity(8 * (TREE_DEPTH as usize + 1));
+    stack.push((root, [0; 3], 0));
+    while let Some((node, key, depth)) = stack.pop() {
+        let side = 1i64 << (TREE_DEPTH - depth);
+        let a = [0, 1, 2].map(|i| (key[i] as i64).max(lo[i]));
+        let b = [0, 1, 2].map(|i| (key[i] as i64 + side - 1).min(hi[i]));
+        if (0..3).any(|i| a[i] > b[i]) {
+            continue;
+        }
+        if !tree.has_children(node) {
+            let s = if tree.log_odds_of(node) > thr {
+                OCCUPIED
+            } else {
+                FREE
+            };
+            let (x0, x1) = ((a[0] - lo[0]) as usize, (b[0] - lo[0]) as usize);
+            for z in a[2]..=b[2] {
+                for y in a[1]..=b[1] {
+                    let row = ((y - lo[1]) as usize + ny * (z - lo[2]) as usize) * nx;
+                    cells[row + x0..=row + x1].fill(s);
+                }
+            }
+            continue;
+        }
+        for i in 0..8 {
+            if let Some(c) = tree.child_ref(node, i) {
+                stack.push((c, child_key(&key, depth, i), depth + 1));
+            }
+        }
     }
 }
 

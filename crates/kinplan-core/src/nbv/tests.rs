@@ -665,3 +665,48 @@ fn grid_walks_ending_at_the_key_space_edge_count_like_the_tree_walk() {
     let small = grid::StateGrid::new(&t, [-1, -1, -1], [10, 10, 10], 1 << 20).unwrap();
     assert!(visibility::ViewGrid::from_padded(small, region, &cam, 1).is_err());
 }
+
+#[test]
+fn a_state_grid_filled_in_two_slabs_holds_every_cell_state() {
+    use rand::{Rng, SeedableRng};
+    // over 2^16 cells: filled by two walks side by side (a z slab each); every cell
+    // against a lookup of its own, including cells past the key space
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(44);
+    let mut t = Octree::new(0.1).unwrap();
+    let (hit, miss) = hm(&t);
+    free_box(&mut t, [0, 0, 0], [7, 7, 7]);
+    free_box(&mut t, [32760, 32760, 32760], [32775, 32775, 32775]);
+    for _ in 0..400 {
+        let k: OcKey = [0, 1, 2].map(|_| rng.random_range(32744..32792));
+        t.update_key(&k, if rng.random_bool(0.5) { hit } else { miss });
+    }
+    for (lo, hi) in [
+        ([32740, 32742, 32738], [32795, 32790, 32779]),
+        ([-3, -2, -4], [40, 40, 37]),
+    ] {
+        let g = grid::StateGrid::new(&t, lo, hi, 1 << 20).unwrap();
+        assert!(g.cells.len() > 1 << 16);
+        let mut seen = [0usize; 4];
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    let k = [x, y, z];
+                    let want = if k.iter().any(|v| !(0..65536).contains(v)) {
+                        grid::OUTSIDE
+                    } else {
+                        match t.state_of_key(&k.map(|v| v as u16)) {
+                            CellState::Unknown => grid::UNKNOWN,
+                            CellState::Free => grid::FREE,
+                            CellState::Occupied => grid::OCCUPIED,
+                        }
+                    };
+                    let got = g.cells[g.index([x - lo[0], y - lo[1], z - lo[2]])];
+                    assert_eq!(got, want, "{k:?}");
+                    seen[got as usize] += 1;
+                }
+            }
+        }
+        // known cells in the grid (the first grid has them in both slabs)
+        assert!(seen[grid::FREE as usize] > 0, "{seen:?}");
+    }
+}
