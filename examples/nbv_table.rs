@@ -3,7 +3,10 @@
 //! 0.05–0.15 m and on geb079.bt; then NBV end to end with 1,000 frontier candidates at
 //! 5 cm. Seeded; prints Markdown.
 //!
-//! cargo run --release -p kinplan-core --example nbv_table [-- --no-rays | --nbv-only] [--config I] [--write-bt PATH]
+//! cargo run --release -p kinplan-core --example nbv_table [-- --no-rays | --nbv-only] [--config I] [--repeat N] [--write-bt PATH]
+//!
+//! `--repeat N` runs each NBV config N times on the same tree (one row per run), so that a
+//! profiler's samples are those of the request rather than of the scene's construction.
 
 use std::time::Instant;
 
@@ -226,7 +229,17 @@ fn main() {
         .position(|a| a == "--config")
         .and_then(|i| args.get(i + 1))
         .and_then(|v| v.parse().ok());
-    for (i, (name, p)) in cfgs.into_iter().enumerate() {
+    let repeat: usize = args
+        .iter()
+        .position(|a| a == "--repeat")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1);
+    let runs = cfgs
+        .into_iter()
+        .enumerate()
+        .flat_map(|(i, c)| std::iter::repeat_n((i, c), repeat));
+    for (i, (name, p)) in runs {
         if no_rays && !matches!(p.gain, GainMethod::Intersection) || only.is_some_and(|o| o != i) {
             continue;
         }
@@ -288,6 +301,10 @@ fn main() {
                 }
             }
         }
-        eprintln!("{name}: {} ranked, ranking digest {h:016x}", r.candidates.len());
+        eprintln!(
+            "{name}: {} ranked, ranking digest {h:016x}, ray steps {}",
+            r.candidates.len(),
+            st.ray_steps
+        );
     }
 }

@@ -89,7 +89,10 @@ impl Entry {
 ///   `n·c + d ≥ 0` bounds the cells to one interval, found from the crossing
 ///   `x* = −(n_b·c_b + n_c·c_c + d)/n_a` and confirmed with the per-cell test itself
 ///   wherever the crossing lies within rounding of a cell centre (the test is monotone
-///   along a row), so the count equals the count of every cell centre;
+///   along a row), so the count equals the count of every cell centre. A cutting plane
+///   that another on the same side of the rows bounds at least two keys more tightly
+///   over the whole tile (the near plane in the tiles the side planes bound) is left
+///   out of its rows;
 /// - `known`: a depth-first walk over the known nodes only: a node inside every plane
 ///   (planes already cleared by an ancestor are not tested again) and inside the key
 ///   box adds `known(node)`, one outside a plane or the key box nothing, a known leaf
@@ -509,20 +512,36 @@ impl<'f> RowCounter<'f> {
                 }
             }
         }
+        // planes another one of the same side dominates over the whole box bound no
+        // row (see `dominated`); the rest ordered lower bounds first
+        let mut kept: [Lin; 6] = [(0, 0.0, 0.0, 0.0, 0.0, false); 6];
+        let mut n = 0;
+        for up in [true, false] {
+            for p in 0..nl {
+                if lin[p].5 == up && !(0..nl).any(|q| q != p && dominated(&lin[p], &lin[q], r, b, c)) {
+                    kept[n] = lin[p];
+                    n += 1;
+                }
+            }
+        }
+        let (lin, nl) = (kept, n);
+        let nu = lin[..nl].iter().filter(|p| p.5).count();
         // the crossings of the cutting planes in 32.32 fixed point when every plane's
         // |cb| ≤ 2^20 and fewer than 32 rows are stepped along b (cubes of at most
         // 2^ROW_LOG cells a side, tiles of TILE)
         let max_cb = lin[..nl].iter().fold(0.0f64, |m, p| m.max(p.2.abs()));
         if ne == 0 && max_cb <= 1_048_576.0 && r[b].1 - r[b].0 < 32 {
-            match nl {
-                1 => return self.fixed_rows::<1>(&lin, r, [a, b, c], max_cb),
-                2 => return self.fixed_rows::<2>(&lin, r, [a, b, c], max_cb),
-                3 => return self.fixed_rows::<3>(&lin, r, [a, b, c], max_cb),
-                4 => return self.fixed_rows::<4>(&lin, r, [a, b, c], max_cb),
-                5 => return self.fixed_rows::<5>(&lin, r, [a, b, c], max_cb),
-                6 => return self.fixed_rows::<6>(&lin, r, [a, b, c], max_cb),
-                _ => {}
+            let axes = [a, b, c];
+            macro_rules! rows {
+                ($($u:literal $d:literal),*) => {
+                    match (nu, nl - nu) {
+                        $(($u, $d) => return self.fixed_rows::<$u, $d>(&lin, r, axes, max_cb),)*
+                        _ => {}
+                    }
+                };
             }
+            rows!(1 0, 0 1, 2 0, 1 1, 0 2, 3 0, 2 1, 1 2, 0 3, 4 0, 3 1, 2 2, 1 3, 0 4,
+                5 0, 4 1, 3 2, 2 3, 1 4, 0 5, 6 0, 5 1, 4 2, 3 3, 2 4, 1 5, 0 6);
         }
         let mut total = 0u64;
         let mut k = [0i64; 3];
@@ -588,17 +607,18 @@ impl<'f> RowCounter<'f> {
         total
     }
 
-    /// The rows of [`count`](Self::count) for `N` (1–6) cutting planes, all with a
-    /// crossing (`lin`), in 32.32 fixed point relative to `alo`: per c-row each
-    /// crossing is evaluated once in f64 at the first b, then stepped by `cb` as an
-    /// integer (at most 31 steps; truncating `cb` and the start to 2^−32 adds under
-    /// 2^−26 keys of error, covered by the 2^−20 added to each `tol`). Starting
-    /// crossings are clamped to `[−m, len + m]` with `m = 4 + 32·⌈max|cb|⌉`: 31 steps
-    /// cannot bring a clamped one back into `[−1, len + 1]`, so its rows count the same
-    /// (all or none of the row). A row with a crossing within `tol` of an integer is
-    /// decided by the per-cell tests, as in the f64 path.
+    /// The rows of [`count`](Self::count) for `U` lower-bound planes (`lin[..U]`, `n_a >
+    /// 0`) and `D` upper-bound ones after them (1–6 together), all with a crossing, in
+    /// 32.32 fixed point relative to `alo`: per c-row each crossing is evaluated once in
+    /// f64 at the first b, then stepped by `cb` as an integer (at most 31 steps;
+    /// truncating `cb` and the start to 2^−32 adds under 2^−26 keys of error, covered by
+    /// the 2^−20 added to each `tol`). Starting crossings are clamped to `[−m, len + m]`
+    /// with `m = 4 + 32·⌈max|cb|⌉`: 31 steps cannot bring a clamped one back into
+    /// `[−1, len + 1]`, so its rows count the same (all or none of the row). A row with a
+    /// crossing within `tol` of an integer is decided by the per-cell tests, as in the
+    /// f64 path.
     #[inline(always)]
-    fn fixed_rows<const N: usize>(
+    fn fixed_rows<const U: usize, const D: usize>(
         &self,
         lin: &[Lin; 6],
         r: &[(i64, i64); 3],
@@ -609,58 +629,74 @@ impl<'f> RowCounter<'f> {
         let (alo, ahi) = r[a];
         let len = ahi - alo + 1;
         let margin = 4.0 + 32.0 * max_cb.ceil();
-        let (mut steps, mut tols, mut ups) = ([0i64; N], [0i64; N], [false; N]);
-        for p in 0..N {
-            steps[p] = (lin[p].2 * ONE as f64) as i64;
-            tols[p] = ((lin[p].4 + 1.0 / 1_048_576.0) * ONE as f64) as i64;
-            ups[p] = lin[p].5;
+        // per plane (lower bounds first): step per b-row and tolerance, fixed point
+        let (mut us, mut ut) = ([0i64; U], [0i64; U]);
+        let (mut ds, mut dt) = ([0i64; D], [0i64; D]);
+        let fixed = |p: usize| {
+            (
+                (lin[p].2 * ONE as f64) as i64,
+                ((lin[p].4 + 1.0 / 1_048_576.0) * ONE as f64) as i64,
+            )
+        };
+        for p in 0..U {
+            (us[p], ut[p]) = fixed(p);
+        }
+        for p in 0..D {
+            (ds[p], dt[p]) = fixed(U + p);
         }
         // `v ∈ (−1, len)` (keys, fixed point) as one unsigned compare
         let span = ((len + 1) * ONE - 1) as u64;
+        // within tol of an integer: `frac(v) ≤ tol` or `frac(v) ≥ 1 − tol`, i.e.
+        // `(v + tol) mod 1 ≤ 2·tol` (tol < ¼), and inside the row; no branches
+        let near = |v: i64, tol: i64| (((v + ONE - 1) as u64) < span) & (((v + tol) & (ONE - 1)) <= 2 * tol);
+        let start = |p: usize, kc: i64| {
+            let (_, k0, cb, cc, _, _) = lin[p];
+            let rel =
+                (k0 + cb * r[b].0 as f64 + cc * kc as f64 - alo as f64).clamp(-margin, len as f64 + margin);
+            (rel * ONE as f64) as i64
+        };
         let mut total = 0u64;
         let mut k = [0i64; 3];
         for kc in r[c].0..=r[c].1 {
             k[c] = kc;
-            let mut vs = [0i64; N];
-            for p in 0..N {
-                let (_, k0, cb, cc, _, _) = lin[p];
-                let rel = (k0 + cb * r[b].0 as f64 + cc * kc as f64 - alo as f64)
-                    .clamp(-margin, len as f64 + margin);
-                vs[p] = (rel * ONE as f64) as i64;
-            }
+            let mut uv: [i64; U] = std::array::from_fn(|p| start(p, kc));
+            let mut dv: [i64; D] = std::array::from_fn(|p| start(U + p, kc));
             for kb in r[b].0..=r[b].1 {
                 // relative first and last keys inside every plane
                 let (mut first, mut last) = (0i64, len - 1);
-                let mut near = false;
-                let mut fls = [0i64; N];
-                for p in 0..N {
-                    let v = vs[p];
-                    vs[p] += steps[p];
-                    let fl = v >> 32;
-                    fls[p] = fl;
-                    let frac = v & (ONE - 1);
-                    // within tol of an integer: `frac ≤ tol` or `frac ≥ 1 − tol`, i.e.
-                    // `(frac + tol) mod 1 ≤ 2·tol` (tol < ¼); no branches
-                    let inside = ((v + ONE - 1) as u64) < span;
-                    near |= inside & (((frac + tols[p]) & (ONE - 1)) <= 2 * tols[p]);
-                    first = first.max(if ups[p] { fl + 1 } else { i64::MIN });
-                    last = last.min(if ups[p] { i64::MAX } else { fl });
+                let mut any_near = false;
+                for p in 0..U {
+                    let v = uv[p];
+                    uv[p] += us[p];
+                    any_near |= near(v, ut[p]);
+                    first = first.max((v >> 32) + 1);
                 }
-                if near {
-                    // the per-cell tests, searched from the floors
+                for p in 0..D {
+                    let v = dv[p];
+                    dv[p] += ds[p];
+                    any_near |= near(v, dt[p]);
+                    last = last.min(v >> 32);
+                }
+                if any_near {
+                    // the per-cell tests, searched from the floors (of the crossings
+                    // just stepped past)
                     k[b] = kb;
                     let (mut f, mut l) = (alo, ahi);
-                    for p in 0..N {
+                    for p in 0..U {
                         if f > l {
                             break;
                         }
-                        if ups[p] {
-                            let guess = (alo + fls[p] + 1).clamp(alo, ahi + 1);
-                            f = f.max(self.first_inside(lin[p].0, k, a, guess, alo, ahi));
-                        } else {
-                            let guess = (alo + fls[p]).clamp(alo - 1, ahi);
-                            l = l.min(self.last_inside(lin[p].0, k, a, guess, alo, ahi));
+                        let fl = (uv[p] - us[p]) >> 32;
+                        let guess = (alo + fl + 1).clamp(alo, ahi + 1);
+                        f = f.max(self.first_inside(lin[p].0, k, a, guess, alo, ahi));
+                    }
+                    for p in 0..D {
+                        if f > l {
+                            break;
                         }
+                        let fl = (dv[p] - ds[p]) >> 32;
+                        let guess = (alo + fl).clamp(alo - 1, ahi);
+                        l = l.min(self.last_inside(lin[U + p].0, k, a, guess, alo, ahi));
                     }
                     total += (l - f + 1).max(0) as u64;
                 } else {
@@ -710,9 +746,58 @@ impl<'f> RowCounter<'f> {
     }
 }
 
+/// Whether the cutting plane `p` bounds no row of the box `r` that plane `q`, on the
+/// same side (both lower or both upper bounds along the rows), does not bound more
+/// tightly: the crossings `κ_p`, `κ_q` (keys) differ by at least 2 in `q`'s favour
+/// over the whole box — checked at its four (b, c) corners, the difference being
+/// linear in b and c. Then every cell that `p`'s per-cell test refuses, `q`'s refuses
+/// too (each crossing is within `tol` < ¼ key of its test's switch), and the row
+/// counts without `p` are the same.
+#[inline]
+fn dominated(p: &Lin, q: &Lin, r: &[(i64, i64); 3], b: usize, c: usize) -> bool {
+    if p.5 != q.5 {
+        return false;
+    }
+    // κ_q − κ_p for lower bounds (q's crossing later), κ_p − κ_q for upper ones
+    let s = if p.5 { 1.0 } else { -1.0 };
+    let (d0, db, dc) = (s * (q.1 - p.1), s * (q.2 - p.2), s * (q.3 - p.3));
+    let lowest =
+        d0 + (db * r[b].0 as f64).min(db * r[b].1 as f64) + (dc * r[c].0 as f64).min(dc * r[c].1 as f64);
+    lowest >= 2.0
+}
+
 /// `⌊x⌋` for |x| well inside the i64 range, without a libm call.
 #[inline]
 fn floor_i64(x: f64) -> i64 {
     let t = x as i64;
     if (t as f64) > x { t - 1 } else { t }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::dominated;
+
+    #[test]
+    fn a_plane_is_dominated_only_by_one_on_its_side_two_keys_tighter_over_the_box() {
+        // rows along x (a = 0), the box b = y ∈ [0, 15], c = z ∈ [0, 15]
+        let r = [(0, 40), (0, 15), (0, 15)];
+        // lower bounds: κ = 10 everywhere, and κ = 12 + 0.01·y (≥ 2 keys later)
+        let p = (0, 10.0, 0.0, 0.0, 1e-4, true);
+        let q = (1, 12.0, 0.01, 0.0, 1e-4, true);
+        assert!(dominated(&p, &q, &r, 1, 2));
+        assert!(!dominated(&q, &p, &r, 1, 2));
+        // 1.9 keys apart at y = 0: not enough
+        let q2 = (1, 11.9, 0.01, 0.0, 1e-4, true);
+        assert!(!dominated(&p, &q2, &r, 1, 2));
+        // κ_q = 13 − 0.1·z: 11.5 at z = 15, 1.5 keys later only
+        let q3 = (1, 13.0, 0.0, -0.1, 1e-4, true);
+        assert!(!dominated(&p, &q3, &r, 1, 2));
+        // upper bounds: the smaller crossing binds
+        let (pu, qu) = ((2, 14.0, 0.0, 0.0, 1e-4, false), (3, 12.0, 0.0, 0.0, 1e-4, false));
+        assert!(dominated(&pu, &qu, &r, 1, 2));
+        assert!(!dominated(&qu, &pu, &r, 1, 2));
+        // a lower and an upper bound never dominate each other
+        assert!(!dominated(&p, &qu, &r, 1, 2));
+        assert!(!dominated(&qu, &p, &r, 1, 2));
+    }
 }

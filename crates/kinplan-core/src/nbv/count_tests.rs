@@ -386,3 +386,26 @@ fn a_view_leaving_the_key_space_counts_like_every_cell() {
     assert!(n > 30 && n < all, "{n} {all}");
     assert_eq!(FrustumCounter::new(&t).count(&f), n);
 }
+
+#[test]
+fn deep_wide_frusta_count_like_every_cell() {
+    // the sensor's frustum (70.6° × 60°, 0.5–4.5 m) at 0.1 m: tiles of columns far
+    // from the view axis, where the side planes bound the rows and the near plane
+    // bounds none, are counted with fewer planes; the count still equals the count
+    // of every cell
+    let cam = CameraModel::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(2711);
+    for seed in 0..4u64 {
+        let t = random_tree(seed);
+        let counter = FrustumCounter::new(&t);
+        let at = Point3::new(
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-3.0..3.0),
+            rng.random_range(-1.0..1.0),
+        );
+        let aim = Point3::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), 0.0) - at;
+        let f = Frustum::new(&cam, &look_along(&at, &aim).unwrap());
+        let (lo, hi) = corner_box(&t, &f);
+        assert_eq!(counter.count(&f), brute(&t, &f, lo, hi), "view {seed}");
+    }
+}

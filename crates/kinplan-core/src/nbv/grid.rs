@@ -68,33 +68,19 @@ impl StateGrid {
                 }
             }
         }
-        let Some(root) = tree.root_ref() else {
-            return Some(g);
-        };
-        let thr = tree.threshold_log_odds();
-        let mut stack: Vec<(NodeRef, OcKey, u8)> = Vec::with_capacity(8 * (TREE_DEPTH as usize + 1));
-        stack.push((root, [0; 3], 0));
-        while let Some((node, key, depth)) = stack.pop() {
-            let side = 1i64 << (TREE_DEPTH - depth);
-            let a = [0, 1, 2].map(|i| (key[i] as i64).max(lo[i]));
-            let b = [0, 1, 2].map(|i| (key[i] as i64 + side - 1).min(hi[i]));
-            if (0..3).any(|i| a[i] > b[i]) {
-                continue;
-            }
-            if !tree.has_children(node) {
-                let s = if tree.log_odds_of(node) > thr {
-                    OCCUPIED
-                } else {
-                    FREE
-                };
-                g.fill(a, b, s);
-                continue;
-            }
-            for i in 0..8 {
-                if let Some(c) = tree.child_ref(node, i) {
-                    stack.push((c, child_key(&key, depth, i), depth + 1));
-                }
-            }
+        // two slabs along z, filled side by side (each cell lies in one leaf at most,
+        // so the slabs' walks write disjoint cells)
+        let plane = dims[0] * dims[1];
+        let mid = dims[2] / 2;
+        if mid == 0 || n < 1 << 16 {
+            fill_from_tree(tree, &mut g.cells, lo, hi, dims[0], dims[1]);
+        } else {
+            let (near, far) = g.cells.split_at_mut(mid * plane);
+            let z_mid = lo[2] + mid as i64;
+            rayon::join(
+                || fill_from_tree(tree, near, lo, [hi[0], hi[1], z_mid - 1], dims[0], dims[1]),
+                || fill_from_tree(tree, far, [lo[0], lo[1], z_mid], hi, dims[0], dims[1]),
+            );
         }
         Some(g)
     }
@@ -112,16 +98,6 @@ impl StateGrid {
         (0..3)
             .all(|i| k[i] >= 0 && (k[i] as usize) < self.dims[i])
             .then(|| self.index(k))
-    }
-
-    fn fill(&mut self, a: [i64; 3], b: [i64; 3], s: u8) {
-        let (x0, x1) = ((a[0] - self.lo[0]) as usize, (b[0] - self.lo[0]) as usize);
-        for z in a[2]..=b[2] {
-            for y in a[1]..=b[1] {
-                let row = self.index([0, y - self.lo[1], z - self.lo[2]]);
-                self.cells[row + x0..=row + x1].fill(s);
-            }
-        }
     }
 
     /// Frontier cells of the key box `[kmin, kmax]`, which must lie inside the grid with
@@ -226,6 +202,93 @@ impl StateGrid {
     }
 }
 
+/// Writes every leaf of `tree` overlapping the key box `[lo, hi]` into `cells`, the
+/// box's cells (x fastest, rows of `nx`, planes of `nx · ny`), clipped to the box.
+fn fill_from_tree(tree: &Octree, cells: &mut [u8], lo: [i64; 3], hi: [i64; 3], nx: usize, ny: usize) {
+    let Some(root) = tree.root_ref() else {
+        return;
+    };
+    let thr = tree.threshold_log_odds();
+    let mut stack: Vec<(NodeRef, OcKey, u8)> = Vec::with_capacity(8 * (TREE_DEPTH as usize + 1));
+    stack.push((root, [0; 3], 0));
+    while let Some((node, key, depth)) = stack.pop() {
+        let side = 1i64 << (TREE_DEPTH - depth);
+        let a = [0, 1, 2].map(|i| (key[i] as i64).max(lo[i]));
+        let b = [0, 1, 2].map(|i| (key[i] as i64 + side - 1).min(hi[i]));
+        if (0..3).any(|i| a[i] > b[i]) {
+            continue;
+        }
+        if !tree.has_children(node) {
+            let s = if tree.log_odds_of(node) > thr {
+                OCCUPIED
+            } else {
+                FREE
+            };
+            let (x0, x1) = ((a[0] - lo[0]) as usize, (b[0] - lo[0]) as usize);
+            for z in a[2]..=b[2] {
+                for y in a[1]..=b[1] {
+                    let row = ((y - lo[1]) as usize + ny * (z - lo[2]) as usize) * nx;
+                    cells[row + x0..=row + x1].fill(s);
+                }
+            }
+            continue;
+        }
+        for i in 0..8 {
+            if let Some(c) = tree.child_ref(node, i) {
+                stack.push((c, child_key(&key, depth, i), depth + 1));
+            }
+        }
+    }
+}
+
+/// Cells whose potential fields [`StateGrid::fields`] sums in one pass.
+pub(crate) const FIELD_LANES: usize = 4;
+
+impl StateGrid {
+    /// The potential fields of [`field`](Self::field) for `FIELD_LANES` cells at once
+    /// (each inside the grid with the ball's margin), bit for bit the same: per cell
+    /// the same terms are added in the same order, but the cells' sums are independent
+    /// chains of additions, which the processor overlaps (one cell's sum waits on each
+    /// addition's latency). `lin` holds the ball's offsets as index steps of this grid
+    /// ([`Ball::index_steps`]).
+    pub fn fields(
+        &self,
+        keys: &[OcKey; FIELD_LANES],
+        ball: &Ball,
+        lin: &[isize],
+    ) -> [Vector3<f64>; FIELD_LANES] {
+        const SIGN: [f64; 4] = [1.0, -1.0, -1.0, 0.0];
+        let [c0, c1, c2, c3] = keys.map(|k| self.index_of(&k).expect("field cell inside the grid") as isize);
+        let sign = |i: isize| SIGN[self.cells[i as usize] as usize & 3];
+        // twelve accumulators in registers: (cell, axis)
+        let (mut x0, mut y0, mut z0) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut x1, mut y1, mut z1) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut x2, mut y2, mut z2) = (0.0f64, 0.0f64, 0.0f64);
+        let (mut x3, mut y3, mut z3) = (0.0f64, 0.0f64, 0.0f64);
+        for (&o, &[vx, vy, vz]) in lin.iter().zip(&ball.terms) {
+            let (s0, s1, s2, s3) = (sign(c0 + o), sign(c1 + o), sign(c2 + o), sign(c3 + o));
+            x0 += s0 * vx;
+            y0 += s0 * vy;
+            z0 += s0 * vz;
+            x1 += s1 * vx;
+            y1 += s1 * vy;
+            z1 += s1 * vz;
+            x2 += s2 * vx;
+            y2 += s2 * vy;
+            z2 += s2 * vz;
+            x3 += s3 * vx;
+            y3 += s3 * vy;
+            z3 += s3 * vz;
+        }
+        [
+            Vector3::new(x0, y0, z0),
+            Vector3::new(x1, y1, z1),
+            Vector3::new(x2, y2, z2),
+            Vector3::new(x3, y3, z3),
+        ]
+    }
+}
+
 /// The key offsets `o ≠ 0` of the cells within `radius` of a cell centre —
 /// `‖o·res‖ ≤ radius`, with `o·res` computed per axis as `o_i · res` in f64 — and each
 /// one's term `o·res / ‖o·res‖²` (unit direction over distance).
@@ -266,6 +329,17 @@ impl Ball {
             offsets,
             terms,
         })
+    }
+}
+
+impl Ball {
+    /// The offsets as steps of the linear index of `grid` (x fastest).
+    pub fn index_steps(&self, grid: &StateGrid) -> Vec<isize> {
+        let (sy, sz) = (grid.dims[0] as isize, (grid.dims[0] * grid.dims[1]) as isize);
+        self.offsets
+            .iter()
+            .map(|o| o[0] as isize + sy * o[1] as isize + sz * o[2] as isize)
+            .collect()
     }
 }
 

@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use kiddo::{KdTree, SquaredEuclidean};
-use nalgebra::{Isometry3, Point3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -13,8 +13,8 @@ use super::camera::{CameraModel, Frustum};
 use super::count::FrustumCounter;
 use super::frontier::{candidate_pose, frontier_cells, potential_field, unknown_needed};
 use super::gain::{GainMethod, GainWorkspace, ray_gain};
-use super::grid::{Ball, MAX_CELLS, StateGrid};
-use super::visibility::{PredictWorkspace, ViewPrediction, predict_view_in};
+use super::grid::{Ball, FIELD_LANES, MAX_CELLS, StateGrid};
+use super::visibility::{PredictWorkspace, ViewGrid, ViewPrediction, predict_on_grid, predict_view_in};
 use super::{NbvError, NbvParams, Weights};
 use crate::ik::{IkTarget, solve_ik};
 use crate::octree::{CellState, Octree};
@@ -211,7 +211,9 @@ pub fn next_best_view(
     let mut frontier = match &region {
         Some((a, b)) if params.max_frontier_candidates > 0 => {
             let (ka, kb) = (tree.key_of(a)?, tree.key_of(b)?);
-            let pad = ball.as_ref().map_or(1, |b| b.reach.max(1));
+            // the field's reach, and one more layer that the visibility walk recodes
+            // as the grid's end (`ViewGrid::from_padded`)
+            let pad = ball.as_ref().map_or(1, |b| b.reach.max(1)) + 1;
             if (0..3).all(|i| ka[i] <= kb[i]) {
                 grid = StateGrid::new(
                     tree,
@@ -244,25 +246,51 @@ pub fn next_best_view(
     }
     st.frontier_us = us(t);
     let t = Instant::now();
-    // potential fields in parallel; the clock is polled per frontier cell
-    let fields: Vec<Option<Option<Isometry3<f64>>>> = frontier
-        .par_iter()
-        .map(|f| {
-            if clock.interrupted().is_some() {
-                return Ok(None);
-            }
-            let field = match (&grid, &ball) {
-                (Some(g), Some(b)) => g.field(&f.key, b),
-                _ => potential_field(tree, &f.key, params.field_radius)?,
-            };
-            Ok(Some(candidate_pose(
-                &f.center,
-                &field,
-                params.standoff,
-                camera.near,
-            )))
-        })
-        .collect::<Result<_, crate::octree::OctreeError>>()?;
+    // potential fields in parallel, FIELD_LANES cells per pass on the grid (the last
+    // group padded with its last cell); the clock is polled per group
+    let steps = match (&grid, &ball) {
+        (Some(g), Some(b)) => b.index_steps(g),
+        _ => Vec::new(),
+    };
+    let fields_stage = || {
+        frontier
+            .par_chunks(FIELD_LANES)
+            .map(|group| {
+                let mut out = [None; FIELD_LANES];
+                if clock.interrupted().is_some() {
+                    return Ok(out);
+                }
+                let poses = |fs: &[Vector3<f64>], out: &mut [Option<Option<Isometry3<f64>>>; FIELD_LANES]| {
+                    for ((o, f), field) in out.iter_mut().zip(group).zip(fs) {
+                        *o = Some(candidate_pose(&f.center, field, params.standoff, camera.near));
+                    }
+                };
+                match (&grid, &ball) {
+                    (Some(g), Some(b)) => {
+                        let keys = std::array::from_fn(|l| group[l.min(group.len() - 1)].key);
+                        poses(&g.fields(&keys, b, &steps), &mut out);
+                    }
+                    _ => {
+                        let mut fs = [Vector3::zeros(); FIELD_LANES];
+                        for (v, f) in fs.iter_mut().zip(group) {
+                            *v = potential_field(tree, &f.key, params.field_radius)?;
+                        }
+                        poses(&fs, &mut out);
+                    }
+                }
+                Ok(out)
+            })
+            .collect::<Result<Vec<_>, crate::octree::OctreeError>>()
+    };
+    // beside the fields, on whichever thread is free: the tree's known-cell counts for
+    // the intersection gain and the robot's reach for ORF (neither reads the fields)
+    let side_work = || {
+        let counter = matches!(params.gain, GainMethod::Intersection).then(|| FrustumCounter::new(tree));
+        (counter, params.reach.or_else(|| robot.map(estimate_reach)))
+    };
+    let (fields, (counter, reach)) = rayon::join(fields_stage, side_work);
+    let fields: Vec<Option<Option<Isometry3<f64>>>> =
+        fields?.into_iter().flatten().take(frontier.len()).collect();
     if fields.iter().any(Option::is_none)
         && let Some(s) = clock.interrupted()
     {
@@ -280,7 +308,6 @@ pub fn next_best_view(
 
     // 2a. ORF
     let t = Instant::now();
-    let reach = params.reach.or_else(|| robot.map(estimate_reach));
     if let Some(r) = reach {
         let base = params.robot_base.translation.vector;
         cands.retain(|(p, _)| (p.translation.vector - base).norm() <= r);
@@ -330,27 +357,50 @@ pub fn next_best_view(
         _ => None,
     };
     let c_max = camera.frustum_volume() / tree.resolution().powi(3);
-    // the tree's known-cell counts, built once and shared by every candidate's count
-    let counter = matches!(params.gain, GainMethod::Intersection).then(|| FrustumCounter::new(tree));
-    let gains: Vec<Option<(f64, f64, u64)>> = kept
-        .par_iter()
-        .map_init(GainWorkspace::default, |ws, (pose, _)| {
-            if clock.interrupted().is_some() {
-                return None;
-            }
-            Some(match params.gain {
-                GainMethod::Intersection => {
-                    let counter = counter.as_ref().expect("built for the intersection gain");
-                    let c = counter.count_in(&Frustum::new(camera, pose), gain_keys) as f64;
-                    (c, c / c_max, 0)
+    // the state grid recoded for the visibility walks, built beside the gains (the
+    // visibility stage checks the region's keys again)
+    // visibility stage checks the region's keys again); it takes the state grid over
+    // and gives it back when it cannot
+    let state_grid = if params.visibility.is_some() {
+        grid.take()
+    } else {
+        None
+    };
+    let view_grid_work = move || match (&params.visibility, state_grid, &region) {
+        (Some(vp), Some(g), Some((a, b))) => match (tree.key_of(a), tree.key_of(b)) {
+            (Ok(ka), Ok(kb)) => match ViewGrid::from_padded(g, (ka, kb), camera, vp.pixel_stride) {
+                Ok(vg) => (Some(vg), None),
+                Err(g) => (None, Some(g)),
+            },
+            _ => (None, Some(g)),
+        },
+        (_, g, _) => (None, g),
+    };
+    // the counter (the tree's known-cell counts) is shared by every candidate's count
+    let gains_stage = || {
+        kept.par_iter()
+            .map_init(GainWorkspace::default, |ws, (pose, _)| {
+                if clock.interrupted().is_some() {
+                    return None;
                 }
-                m => {
-                    let g = ray_gain(tree, camera, pose, m, ws, clock.deadline);
-                    (g.cells, g.ig, g.ray_steps)
-                }
+                Some(match params.gain {
+                    GainMethod::Intersection => {
+                        let counter = counter.as_ref().expect("built for the intersection gain");
+                        let c = counter.count_in(&Frustum::new(camera, pose), gain_keys) as f64;
+                        (c, c / c_max, 0)
+                    }
+                    m => {
+                        let g = ray_gain(tree, camera, pose, m, ws, clock.deadline);
+                        (g.cells, g.ig, g.ray_steps)
+                    }
+                })
             })
-        })
-        .collect();
+            .collect::<Vec<Option<(f64, f64, u64)>>>()
+    };
+    let (gains, (view_grid, back)) = rayon::join(gains_stage, view_grid_work);
+    if back.is_some() {
+        grid = back;
+    }
     if gains.iter().any(Option::is_none)
         && let Some(s) = clock.interrupted()
     {
@@ -429,8 +479,6 @@ pub fn next_best_view(
         };
         let mut kept: Vec<NbvCandidate> = Vec::with_capacity(params.max_results);
         let mut rest = scored.into_iter();
-        // one workspace per candidate of a batch, kept from batch to batch
-        let mut workspaces: Vec<PredictWorkspace> = Vec::new();
         loop {
             let batch: Vec<NbvCandidate> = rest.by_ref().take(vp.batch).collect();
             if batch.is_empty() {
@@ -440,26 +488,26 @@ pub fn next_best_view(
                 status = s;
                 break;
             }
-            if workspaces.len() < batch.len() {
-                workspaces.resize_with(batch.len(), PredictWorkspace::default);
-            }
+            // a workspace per thread's share of the batch (its bit sets span the region)
             let preds: Vec<Option<ViewPrediction>> = batch
                 .par_iter()
-                .zip(workspaces.par_iter_mut())
-                .map(|(c, ws)| {
+                .map_init(PredictWorkspace::default, |ws, c| {
                     if clock.interrupted().is_some() {
                         return None;
                     }
-                    Some(predict_view_in(
-                        tree,
-                        grid.as_ref(),
-                        camera,
-                        &c.pose,
-                        vp,
-                        region_keys,
-                        ws,
-                        clock.deadline,
-                    ))
+                    Some(match &view_grid {
+                        Some(vg) => predict_on_grid(tree, vg, camera, &c.pose, vp, ws, clock.deadline),
+                        None => predict_view_in(
+                            tree,
+                            grid.as_ref(),
+                            camera,
+                            &c.pose,
+                            vp,
+                            region_keys,
+                            ws,
+                            clock.deadline,
+                        ),
+                    })
                 })
                 .collect();
             for (mut c, p) in batch.into_iter().zip(preds) {

@@ -4,7 +4,7 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::*;
 use crate::Deadline;
-use crate::octree::{CellState, OcKey, Octree};
+use crate::octree::{CellState, OcKey, Octree, TREE_DEPTH};
 
 fn hm(t: &Octree) -> (f32, f32) {
     let m = t.sensor_model().log_odds();
@@ -545,4 +545,168 @@ fn the_grid_prediction_counts_what_the_tree_walk_counts() {
         counted += (on_tree.reached > 0) as usize;
     }
     assert!(counted >= 10, "too few views see unknown cells: {counted}");
+}
+
+#[test]
+fn four_field_lanes_are_the_per_cell_sums_bit_for_bit() {
+    use rand::{Rng, SeedableRng};
+    // random free and occupied boxes; the ball of 0.25 m at 0.05 m (reach 6 cells)
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(91);
+    let mut t = Octree::new(0.05).unwrap();
+    let (hit, miss) = hm(&t);
+    for _ in 0..40 {
+        let c: [u16; 3] = [0, 1, 2].map(|_| rng.random_range(32750..32786));
+        let h: [u16; 3] = [0, 1, 2].map(|_| rng.random_range(0..4));
+        let v = if rng.random_bool(0.3) { hit } else { miss };
+        for x in c[0]..=c[0] + h[0] {
+            for y in c[1]..=c[1] + h[1] {
+                for z in c[2]..=c[2] + h[2] {
+                    t.update_key(&[x, y, z], v);
+                }
+            }
+        }
+    }
+    let ball = grid::Ball::new(0.05, 0.25).unwrap();
+    let g = grid::StateGrid::new(&t, [32740; 3], [32795; 3], 1 << 20).unwrap();
+    let steps = ball.index_steps(&g);
+    let mut checked = 0;
+    for _ in 0..10 {
+        let keys: [OcKey; grid::FIELD_LANES] =
+            std::array::from_fn(|_| [0, 1, 2].map(|_| rng.random_range(32746..32790)));
+        let got = g.fields(&keys, &ball, &steps);
+        for (k, f) in keys.iter().zip(&got) {
+            // the same terms in the ball's order, each cell's state from the tree:
+            // unknown attracts (+), free and occupied repel (−)
+            let mut want = [0.0f64; 3];
+            for (o, v) in ball.offsets.iter().zip(&ball.terms) {
+                let key = [0, 1, 2].map(|i| (k[i] as i32 + o[i]) as u16);
+                let s = match t.search_key(&key, TREE_DEPTH) {
+                    None => 1.0,
+                    Some(_) => -1.0,
+                };
+                for i in 0..3 {
+                    want[i] += s * v[i];
+                }
+            }
+            assert_eq!(
+                [f.x, f.y, f.z].map(f64::to_bits),
+                want.map(f64::to_bits),
+                "cell {k:?}"
+            );
+            assert_eq!(*f, g.field(k, &ball));
+            checked += (f.norm() > 1.0) as usize;
+        }
+    }
+    // most cells see a mix of known and unknown space: the fields are not trivial
+    assert!(checked >= 8, "{checked}");
+}
+
+#[test]
+fn grid_walks_ending_at_the_key_space_edge_count_like_the_tree_walk() {
+    use rand::{Rng, SeedableRng};
+    // free cells next to key 0 on every axis, the two layers of keys 0 and 1
+    // unknown; the grid reaches two cells past the key space (outside cells), so rays
+    // looking towards the corner end there, inside the grid, some after unknown region
+    // cells: the grid walk and the tree walk take the very same steps
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let mut t = Octree::new(0.1).unwrap();
+    let (hit, miss) = hm(&t);
+    free_box(&mut t, [2, 2, 2], [9, 9, 9]);
+    for _ in 0..25 {
+        let k: OcKey = [0, 1, 2].map(|_| rng.random_range(0..12));
+        t.update_key(&k, if rng.random_bool(0.4) { hit } else { miss });
+    }
+    let vp = VisibilityParams {
+        pixel_stride: 1,
+        ..VisibilityParams::default()
+    };
+    let cam = small_camera();
+    let region: (OcKey, OcKey) = ([0, 0, 0], [15, 15, 15]);
+    let g = grid::StateGrid::new(&t, [-2, -2, -2], [18, 18, 18], 1 << 20).unwrap();
+    let mut ws = PredictWorkspace::default();
+    let centre = |k: [f64; 3]| Point3::from(k.map(|v| (v - 32768.0 + 0.5) * 0.1));
+    let (mut edge_rays, mut seeing) = (0, 0);
+    for i in 0..12 {
+        let at = centre([0, 1, 2].map(|_| rng.random_range(3..8) as f64));
+        // towards the corner (key 0), along axes and diagonals
+        let aim = match i % 3 {
+            0 => Vector3::new(-1.0, -1.0, -1.0),
+            1 => Vector3::new(-1.0, rng.random_range(-0.3..0.3), rng.random_range(-0.3..0.3)),
+            _ => Vector3::new(rng.random_range(-1.0..0.0), -1.0, rng.random_range(-1.0..0.0)),
+        };
+        let pose = look_along(&at, &aim).unwrap();
+        let on_tree = predict_view(&t, &cam, &pose, &vp, Some(region), &mut ws, Deadline::none());
+        let on_grid = visibility::predict_view_in(
+            &t,
+            Some(&g),
+            &cam,
+            &pose,
+            &vp,
+            Some(region),
+            &mut ws,
+            Deadline::none(),
+        );
+        assert_eq!(on_grid, on_tree, "view {i}");
+        // a recoded grid whose rays were built for another stride casts this one's
+        let vg = visibility::ViewGrid::new(&g, region, &cam, 3).unwrap();
+        let other = visibility::predict_on_grid(&t, &vg, &cam, &pose, &vp, &mut ws, Deadline::none());
+        assert_eq!(other, on_tree, "view {i}");
+        // the same walks on a state grid one layer wider, recoded in place
+        let wide = grid::StateGrid::new(&t, [-3, -3, -3], [19, 19, 19], 1 << 20).unwrap();
+        let vg = visibility::ViewGrid::from_padded(wide, region, &cam, 1).unwrap();
+        let in_place = visibility::predict_on_grid(&t, &vg, &cam, &pose, &vp, &mut ws, Deadline::none());
+        assert_eq!(in_place, on_tree, "view {i}");
+        edge_rays += (on_tree.steps > 0) as usize;
+        seeing += (on_tree.reached > 0) as usize;
+    }
+    assert_eq!(edge_rays, 12);
+    assert!(seeing >= 6, "{seeing}");
+    // a state grid whose inner box does not hold the region is given back
+    let small = grid::StateGrid::new(&t, [-1, -1, -1], [10, 10, 10], 1 << 20).unwrap();
+    assert!(visibility::ViewGrid::from_padded(small, region, &cam, 1).is_err());
+}
+
+#[test]
+fn a_state_grid_filled_in_two_slabs_holds_every_cell_state() {
+    use rand::{Rng, SeedableRng};
+    // over 2^16 cells: filled by two walks side by side (a z slab each); every cell
+    // against a lookup of its own, including cells past the key space
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(44);
+    let mut t = Octree::new(0.1).unwrap();
+    let (hit, miss) = hm(&t);
+    free_box(&mut t, [0, 0, 0], [7, 7, 7]);
+    free_box(&mut t, [32760, 32760, 32760], [32775, 32775, 32775]);
+    for _ in 0..400 {
+        let k: OcKey = [0, 1, 2].map(|_| rng.random_range(32744..32792));
+        t.update_key(&k, if rng.random_bool(0.5) { hit } else { miss });
+    }
+    for (lo, hi) in [
+        ([32740, 32742, 32738], [32795, 32790, 32779]),
+        ([-3, -2, -4], [40, 40, 37]),
+    ] {
+        let g = grid::StateGrid::new(&t, lo, hi, 1 << 20).unwrap();
+        assert!(g.cells.len() > 1 << 16);
+        let mut seen = [0usize; 4];
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    let k = [x, y, z];
+                    let want = if k.iter().any(|v| !(0..65536).contains(v)) {
+                        grid::OUTSIDE
+                    } else {
+                        match t.state_of_key(&k.map(|v| v as u16)) {
+                            CellState::Unknown => grid::UNKNOWN,
+                            CellState::Free => grid::FREE,
+                            CellState::Occupied => grid::OCCUPIED,
+                        }
+                    };
+                    let got = g.cells[g.index([x - lo[0], y - lo[1], z - lo[2]])];
+                    assert_eq!(got, want, "{k:?}");
+                    seen[got as usize] += 1;
+                }
+            }
+        }
+        // known cells in the grid (the first grid has them in both slabs)
+        assert!(seen[grid::FREE as usize] > 0, "{seen:?}");
+    }
 }
