@@ -522,15 +522,13 @@ fn urdf_shape_distance(shape: &urdf_rs::Geometry, p: &Vector3<f64>) -> f64 {
     }
 }
 
-/// The built-in Panda's and UR5's collision shapes hold the real arms: each
-/// point of the fixture — a vertex of the collision meshes MoveIt plans with
-/// (example-robot-data), or where a mesh edge crosses the plane that cuts a
-/// link in two, placed in the built-in link frames by `fit_covers.py`, which
-/// checks the kinematics against pinocchio's — lies inside the convex shape
-/// its line names. A convex shape holding all the corners of one side of a
-/// link's solid holds that side, so the shapes hold the solid, and a state
-/// the built-in model finds free is free for the real arm. Read straight
-/// from the URDF text, not through our parser.
+/// The built-in Panda's and UR5's collision shapes hold the real arms: every
+/// vertex of the collision meshes MoveIt plans with (example-robot-data,
+/// placed in the built-in link frames by `fit_covers.py`, which checks the
+/// kinematics against pinocchio's) lies inside the one convex shape of its
+/// link, so the shape holds the mesh, and a state the built-in model finds
+/// free is free for the real arm. Read straight from the URDF text, not
+/// through our parser.
 #[test]
 fn builtin_shapes_hold_the_real_meshes() {
     let panda = include_str!("builtin/panda_mesh_points.txt");
@@ -545,13 +543,13 @@ fn builtin_shapes_hold_the_real_meshes() {
         for line in points.lines().filter(|l| !l.starts_with('#')) {
             let mut it = line.split_whitespace();
             let link_name = it.next().unwrap();
-            let part: usize = it.next().unwrap().parse().unwrap();
             let v: Vec<f64> = it.map(|x| x.parse().unwrap()).collect();
             let Some(link) = robot.links.iter().find(|l| l.name == link_name) else {
                 assert!(name == "franka_panda", "{name} has no link {link_name}");
                 continue;
             };
-            let c = &link.collision[part];
+            assert_eq!(link.collision.len(), 1, "{name} {link_name}: one convex shape");
+            let c = &link.collision[0];
             let (xyz, rpy) = (c.origin.xyz, c.origin.rpy);
             let pose = Isometry3::new(Vector3::new(xyz[0], xyz[1], xyz[2]), Vector3::zeros())
                 * nalgebra::UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
@@ -559,10 +557,10 @@ fn builtin_shapes_hold_the_real_meshes() {
             let d = urdf_shape_distance(&c.geometry, &local.coords);
             assert!(
                 d <= -1e-4,
-                "{name} {link_name}[{part}]: mesh point {v:?} at {d} m from its shape (must be 0.1 mm inside)"
+                "{name} {link_name}: mesh vertex {v:?} at {d} m from its shape (must be 0.1 mm inside)"
             );
             checked += 1;
         }
-        assert!(checked >= 500, "{name}: {checked} points checked");
+        assert!(checked >= 500, "{name}: {checked} vertices checked");
     }
 }

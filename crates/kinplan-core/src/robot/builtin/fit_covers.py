@@ -10,20 +10,16 @@ values, and the one rigid transform between their bases (the UR5's ROS base is
 turned half a turn from the DH base) is found at one state and checked at
 others against the tool frame, so the kinematics agree. Then it writes
 
-- `<robot>_covers.json`: per link convex shapes that together hold the
-  link's solid. A convex shape holding a set of points holds their hull, so
-  a shape around all of a mesh's vertices holds the mesh; the arm links,
-  L-shaped housings, get two capsules where that is smaller: the solid is
-  cut by a plane, and each capsule holds one side's points (its vertices and
-  the points where edges cross the plane: the corners of that side of the
-  solid). A capsule: for each axis direction of a search, the smallest
-  circle around the points projected across the axis, caps as short as the
-  points allow, the radius grown while that shrinks the volume. Boxes for
-  the base, the hand and the fingers (the vertices' bounds in the link
-  frame). Every size grown by `MARGIN` and rounded outwards to 0.1 mm;
-- `<robot>_mesh_points.txt`: those points, `link part x y z` per line in
-  metres (the part-th shape of the link holds the point), which the Rust
-  tests hold the committed URDFs against.
+- `<robot>_covers.json`: per link one convex shape holding every vertex of the
+  link's mesh, so it holds the mesh (a convex set holding a mesh's vertices
+  holds their hull): a capsule for the arm links (for each axis direction of
+  a search, the smallest circle around the vertices projected across the
+  axis, caps as short as the vertices allow, the radius grown while that
+  shrinks the volume), a box for the base, the hand and the fingers (the
+  vertices' bounds in the link frame); every size grown by `MARGIN` and
+  rounded outwards to 0.1 mm;
+- `<robot>_mesh_points.txt`: the vertices, `link x y z` per line in metres,
+  which the Rust tests hold the committed URDFs against.
 
 generate.py reads the covers. Run by hand:
 
@@ -131,45 +127,18 @@ def mesh_points(robot):
     pin.forwardKinematics(model, data, q)
     pin.updateGeometryPlacements(model, data, geom, gdata)
     frames = builtin_frames(robot['builtin'], q_arm)
-    pieces = {}
+    points = {}
     for i, g in enumerate(geom.geometryObjects):
         shape = g.geometry
         if hasattr(shape, 'vertices'):
             v = np.array(shape.vertices())
-            tris = [shape.tri_indices(k) for k in range(shape.num_tris)]
-            edges = {tuple(sorted((t[a], t[b]))) for t in tris for a, b in ((0, 1), (1, 2), (2, 0))}
-        else:  # a box: its corners and twelve edges
+        else:  # a box
             e = shape.halfSide
             v = np.array([[sx * e[0], sy * e[1], sz * e[2]] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-            edges = {(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count('1') == 1}
         world = base @ gdata.oMg[i].homogeneous @ np.c_[v, np.ones(len(v))].T
         link = robot['names'][model.frames[g.parentFrame].name]
-        pieces.setdefault(link, []).append(((np.linalg.inv(frames[link]) @ world).T[:, :3], sorted(edges)))
-    return pieces
-
-
-def split(pieces, n, c):
-    """The solid's points on each side of the plane n·x = c: the vertices on
-    that side and every point where an edge crosses the plane. A polyhedron
-    cut by a plane has no other corners, so the hull of each side's points
-    holds that side of the solid, and covers of the two sides cover it."""
-    low, high = [], []
-    for v, edges in pieces:
-        d = v @ n - c
-        low.append(v[d <= 0])
-        high.append(v[d >= 0])
-        for a, b in edges:
-            if d[a] * d[b] < 0:
-                x = v[a] + (v[b] - v[a]) * (d[a] / (d[a] - d[b]))
-                low.append(x[None])
-                high.append(x[None])
-    return np.vstack(low), np.vstack(high)
-
-
-def quick_volume(p):
-    """Volume of a capsule around p along the best of its principal and frame axes (a ranking)."""
-    axes = list(np.linalg.svd(p - p.mean(0), full_matrices=False)[2]) + list(np.eye(3))
-    return min(capsule_along(p, u)[0] for u in axes)
+        points.setdefault(link, []).append((np.linalg.inv(frames[link]) @ world).T[:, :3])
+    return {k: np.vstack(v) for k, v in points.items()}
 
 
 def min_circle(p):
@@ -254,24 +223,6 @@ def fit_capsule(p):
     return {'capsule': {'p0': e0.tolist(), 'p1': e1.tolist(), 'radius': math.ceil((need + MARGIN) / STEP) * STEP}}
 
 
-def fit_capsules(pieces):
-    """One capsule around the link's solid, or two around its two sides of
-    the best plane cut (normals: the principal and frame axes; offsets: the
-    vertex projections' deciles), whichever has the smaller volume."""
-    p = np.vstack([v for v, _ in pieces])
-    best = (quick_volume(p), None)
-    axes = list(np.linalg.svd(p - p.mean(0), full_matrices=False)[2]) + list(np.eye(3))
-    for n in axes:
-        for c in np.quantile(p @ n, np.linspace(0.1, 0.9, 9)):
-            low, high = split(pieces, n, c)
-            if len(low) >= 4 and len(high) >= 4:
-                volume = quick_volume(low) + quick_volume(high)
-                if volume < best[0]:
-                    best = (volume, (low, high))
-    parts = [p] if best[1] is None else list(best[1])
-    return {'capsules': [fit_capsule(part)['capsule'] for part in parts]}, parts
-
-
 def fit_box(p):
     lo = np.floor((p.min(0) - MARGIN) / STEP) * STEP
     hi = np.ceil((p.max(0) + MARGIN) / STEP) * STEP
@@ -280,14 +231,9 @@ def fit_box(p):
 
 def main():
     for name, robot in ROBOTS.items():
-        covers, points = {}, {}
-        for link, pieces in sorted(mesh_points(robot).items()):
-            if link in robot['boxes']:
-                p = np.vstack([v for v, _ in pieces])
-                covers[link], points[link] = fit_box(p), [p]
-            else:
-                covers[link], points[link] = fit_capsules(pieces)
-            print(name, link, [len(p) for p in points[link]], flush=True)
+        points = mesh_points(robot)
+        covers = {link: (fit_box(p) if link in robot['boxes'] else fit_capsule(p))
+                  for link, p in sorted(points.items())}
         covers = json.loads(json.dumps(covers, default=float), parse_float=lambda s: round(float(s), 4))
         package, file = robot['urdf']
         with open(os.path.join(OUT, f'{name}_covers.json'), 'w') as f:
@@ -295,14 +241,11 @@ def main():
                        'margin_m': MARGIN, 'covers': covers}, f, indent=1)
             f.write('\n')
         with open(os.path.join(OUT, f'{name}_mesh_points.txt'), 'w') as f:
-            f.write(f'# Points of the collision meshes of example-robot-data {package}/urdf/{file} in the link\n'
-                    f'# frames of {robot["builtin"]}, metres, as `link part x y z`: the part-th collision shape of\n'
-                    f'# the link must hold the point (the vertices on its side of the cut and the edges\' crossings).\n'
-                    f'# Written by fit_covers.py.\n')
-            for link, parts in sorted(points.items()):
-                for k, p in enumerate(parts):
-                    for x in p:
-                        f.write(f'{link} {k} {x[0]:.6f} {x[1]:.6f} {x[2]:.6f}\n')
+            f.write(f'# Vertices of the collision meshes of example-robot-data {package}/urdf/{file}, in the link\n'
+                    f'# frames of {robot["builtin"]}, metres; written by fit_covers.py.\n')
+            for link, p in sorted(points.items()):
+                for x in p:
+                    f.write(f'{link} {x[0]:.6f} {x[1]:.6f} {x[2]:.6f}\n')
         for link, c in covers.items():
             print(name, link, c)
 

@@ -28,17 +28,16 @@ def capsule_origin(p0, p1):
     return mid, [0.0, pitch, yaw], length
 
 
-def shape_link_xml(name, shapes):
-    """A link with collision shapes `shapes`: (xyz, rpy, URDF geometry element)."""
-    out = f'  <link name="{name}">\n'
-    for xyz, rpy, geom in shapes:
-        out += (
-            f"    <collision>\n"
-            f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
-            f"      <geometry>{geom}</geometry>\n"
-            f"    </collision>\n"
-        )
-    return out + "  </link>\n"
+def shape_link_xml(name, xyz, rpy, geom):
+    """A link with one collision shape `geom` (URDF geometry element) at (xyz, rpy)."""
+    return (
+        f'  <link name="{name}">\n'
+        f"    <collision>\n"
+        f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>\n'
+        f"      <geometry>{geom}</geometry>\n"
+        f"    </collision>\n"
+        f"  </link>\n"
+    )
 
 
 def link_xml(name, segment, radius):
@@ -50,7 +49,7 @@ def link_xml(name, segment, radius):
         geom = f'<sphere radius="{float(radius)!r}"/>'
     else:
         geom = f'<capsule radius="{float(radius)!r}" length="{float(length)!r}"/>'
-    return shape_link_xml(name, [(xyz, rpy, geom)])
+    return shape_link_xml(name, xyz, rpy, geom)
 
 
 def joint_xml(name, kind, parent, child, xyz, rpy, axis=None, limit=None):
@@ -138,24 +137,24 @@ def craig_dh(name, comment, d, a, alpha, flange, limits, speeds, radii):
 
 
 def cover_link_xml(name, cover):
-    """A link whose collision shapes are `cover` (<robot>_covers.json):
-    capsules between two points, or a box between two corners, link frame."""
-    shapes = []
-    for c in cover.get("capsules", []):
+    """A link whose one collision shape is `cover` (<robot>_covers.json): a
+    capsule between two points or a box between two corners, link frame."""
+    if "capsule" in cover:
+        c = cover["capsule"]
         xyz, rpy, length = capsule_origin(c["p0"], c["p1"])
-        shapes.append((xyz, rpy, f'<capsule radius="{float(c["radius"])!r}" length="{float(length)!r}"/>'))
-    if "box" in cover:
+        geom = f'<capsule radius="{float(c["radius"])!r}" length="{float(length)!r}"/>'
+    else:
         lo, hi = cover["box"]["min"], cover["box"]["max"]
-        xyz = [(a + b) / 2 for a, b in zip(lo, hi)]
-        shapes.append((xyz, [0.0, 0.0, 0.0], f'<box size="{fmt([b - a for a, b in zip(lo, hi)])}"/>'))
-    return shape_link_xml(name, shapes)
+        xyz, rpy = [(a + b) / 2 for a, b in zip(lo, hi)], [0.0, 0.0, 0.0]
+        geom = f'<box size="{fmt([b - a for a, b in zip(lo, hi)])}"/>'
+    return shape_link_xml(name, xyz, rpy, geom)
 
 
 def covers_of(robot):
     """The shapes fit_covers.py fitted around the real robot's collision
-    meshes (example-robot-data, the meshes MoveIt plans with): convex shapes
-    per link that together hold the link's solid, so a state the built-in
-    model finds free is free for the real arm."""
+    meshes (example-robot-data, the meshes MoveIt plans with): one convex
+    shape per link holding every vertex of the link's mesh, so a state the
+    built-in model finds free is free for the real arm."""
     with open(os.path.join(OUT, f"{robot}_covers.json")) as f:
         return json.load(f)["covers"]
 
