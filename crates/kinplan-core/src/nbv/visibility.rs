@@ -293,13 +293,7 @@ impl ViewGrid {
                 let at = ((z + 1) * dims[1] + y + 1) * dims[0] + 1;
                 let row = &mut cells[at..at + nx];
                 row.copy_from_slice(&grid.cells[from..from + nx]);
-                if (o[1]..=e[1]).contains(&y) && (o[2]..=e[2]).contains(&z) {
-                    let (head, rest) = row.split_at_mut(o[0]);
-                    open(head);
-                    open(&mut rest[e[0] - o[0] + 1..]);
-                } else {
-                    open(row);
-                }
+                open_outside_region(row, y, z, &o, &e);
             }
         }
         let stride = stride.max(1);
@@ -350,13 +344,7 @@ impl ViewGrid {
                     row.fill(OUTSIDE);
                     continue;
                 }
-                if (o[1]..=e[1]).contains(&y) && (o[2]..=e[2]).contains(&z) {
-                    let (head, rest) = row.split_at_mut(o[0]);
-                    open(head);
-                    open(&mut rest[e[0] - o[0] + 1..]);
-                } else {
-                    open(row);
-                }
+                open_outside_region(row, y, z, &o, &e);
                 row[0] = OUTSIDE;
                 row[nx - 1] = OUTSIDE;
             }
@@ -408,6 +396,19 @@ impl ViewGrid {
         let r = [0, 1, 2].map(|i| (g[i] as i64 - 1 + self.lo[i] - self.rlo[i] as i64) as usize);
         debug_assert!((0..3).all(|i| r[i] < self.rdims[i]));
         r[0] + self.rdims[0] * (r[1] + self.rdims[1] * r[2])
+    }
+}
+
+/// Opens the cells of grid row (`y`, `z`) that lie outside the region
+/// `o..=e` (grid offsets per axis): unknown space outside the region is read
+/// as free.
+fn open_outside_region(row: &mut [u8], y: usize, z: usize, o: &[usize; 3], e: &[usize; 3]) {
+    if (o[1]..=e[1]).contains(&y) && (o[2]..=e[2]).contains(&z) {
+        let (head, rest) = row.split_at_mut(o[0]);
+        open(head);
+        open(&mut rest[e[0] - o[0] + 1..]);
+    } else {
+        open(row);
     }
 }
 

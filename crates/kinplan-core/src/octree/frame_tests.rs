@@ -256,18 +256,7 @@ fn sibling_groups_build_the_tree_of_one_update_per_key() {
             .collect();
         let mut one = base.clone();
         for (first, free, occupied) in &groups {
-            for pos in 0..8u16 {
-                let k = [
-                    first[0] | (pos & 1),
-                    first[1] | (pos >> 1 & 1),
-                    first[2] | (pos >> 2),
-                ];
-                if occupied >> pos & 1 != 0 {
-                    one.update_key(&k, hit);
-                } else if free >> pos & 1 != 0 {
-                    one.update_key(&k, miss);
-                }
-            }
+            update_siblings_one_by_one(&mut one, first, *free, *occupied, hit, miss);
         }
         let mut grouped = base.clone();
         let mut b = BatchUpdate::new();
@@ -288,20 +277,35 @@ fn sibling_groups_build_the_tree_of_one_update_per_key() {
         ([32770, 32768, 32768], 0, 1),
     ] {
         b.update_siblings(&mut grouped, &first, free, occupied, hit, miss);
-        for pos in 0..8u16 {
-            let k = [
-                first[0] | (pos & 1),
-                first[1] | (pos >> 1 & 1),
-                first[2] | (pos >> 2),
-            ];
-            if occupied >> pos & 1 != 0 {
-                one.update_key(&k, hit);
-            } else if free >> pos & 1 != 0 {
-                one.update_key(&k, miss);
-            }
-        }
+        update_siblings_one_by_one(&mut one, &first, free, occupied, hit, miss);
     }
     b.finish(&mut grouped);
     assert_eq!(one.num_nodes(), 1 + 15 + 5 + 1 + 1);
     assert_eq!(one.write_ot(), grouped.write_ot());
+}
+
+/// The reference for `BatchUpdate::update_siblings`: each of the eight
+/// siblings from `first` (position bits x, y, z) updated by its own key —
+/// occupied where its bit of `occupied` is set, else free where its bit of
+/// `free` is.
+fn update_siblings_one_by_one(
+    tree: &mut Octree,
+    first: &[u16; 3],
+    free: u8,
+    occupied: u8,
+    hit: f32,
+    miss: f32,
+) {
+    for pos in 0..8u16 {
+        let k = [
+            first[0] | (pos & 1),
+            first[1] | (pos >> 1 & 1),
+            first[2] | (pos >> 2),
+        ];
+        if occupied >> pos & 1 != 0 {
+            tree.update_key(&k, hit);
+        } else if free >> pos & 1 != 0 {
+            tree.update_key(&k, miss);
+        }
+    }
 }
