@@ -9,15 +9,7 @@ use kinplan_core::collision::{AcmParams, AllowedCollisions, RobotModel, attached
 use kinplan_core::robot::{Chain, builtin_urdf};
 
 /// The problem sets of `../shared/bench/mbm/` in MotionBenchMaker's order.
-pub const SETS: [&str; 7] = [
-    "table_pick",
-    "table_under_pick",
-    "box",
-    "bookshelf_small",
-    "bookshelf_tall",
-    "bookshelf_thin",
-    "cage",
-];
+pub use kinplan_core::mbm_data::SETS;
 
 /// A collision model and its allowed-collision matrix.
 pub type Model = (Arc<RobotModel>, AllowedCollisions);

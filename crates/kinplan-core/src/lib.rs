@@ -15,8 +15,8 @@ pub mod deadline;
 pub mod explore;
 pub mod ik;
 pub mod linalg;
-#[cfg(test)]
-mod mbm_data;
+#[doc(hidden)]
+pub mod mbm_data;
 pub mod mobile;
 pub mod nbv;
 pub mod octree;

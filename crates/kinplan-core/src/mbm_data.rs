@@ -1,4 +1,4 @@
-//! The MotionBenchMaker Panda problems for tests (Chamzas et al., RA-L
+//! The MotionBenchMaker Panda problems for tests and the benchmark examples (Chamzas et al., RA-L
 //! 2022; the archive `../shared/bench/mbm/panda_problems.tar.bz2` beside the
 //! repository, which is read where it lies and never copied in).
 //!
@@ -14,7 +14,7 @@ use std::path::PathBuf;
 /// `requestNNNN.yaml`), or `None` (with a message) when the problems are
 /// not extracted. Panics when `KINPLAN_MBM_PROBLEMS` names a folder that is
 /// not there: a run that was promised the data must not skip.
-pub(crate) fn problems() -> Option<PathBuf> {
+pub fn problems() -> Option<PathBuf> {
     if let Some(dir) = std::env::var_os("KINPLAN_MBM_PROBLEMS") {
         let dir = PathBuf::from(dir);
         assert!(
@@ -36,7 +36,7 @@ pub(crate) fn problems() -> Option<PathBuf> {
 }
 
 /// Problem `number`'s scene and request YAML of `set` (e.g. `"box"`).
-pub(crate) fn problem(dir: &std::path::Path, set: &str, number: usize) -> (String, String) {
+pub fn problem(dir: &std::path::Path, set: &str, number: usize) -> (String, String) {
     let read = |kind: &str| {
         let path = dir.join(format!("{set}_panda/{kind}{number:04}.yaml"));
         std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -45,7 +45,7 @@ pub(crate) fn problem(dir: &std::path::Path, set: &str, number: usize) -> (Strin
 }
 
 /// The seven problem sets.
-pub(crate) const SETS: [&str; 7] = [
+pub const SETS: [&str; 7] = [
     "table_pick",
     "table_under_pick",
     "box",
