@@ -210,15 +210,16 @@ fn f32s(v: &Vector3<f64>) -> [f32; 3] {
     [v.x as f32, v.y as f32, v.z as f32]
 }
 
-/// A rotation taking `ẑ` to the unit `axis`.
-fn z_to(axis: &Vector3<f64>) -> Matrix3<f64> {
+/// A rotation taking `ẑ` to the unit `axis`; `None` when none is found (the
+/// model is then left to the exact check, never posed by a wrong frame).
+fn z_to(axis: &Vector3<f64>) -> Option<Matrix3<f64>> {
     let z = Vector3::z();
     if (axis - z).norm() <= 1e-15 {
-        Matrix3::identity()
+        Some(Matrix3::identity())
     } else if (axis + z).norm() <= 1e-15 {
-        Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0))
+        Some(Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, -1.0)))
     } else {
-        Rotation3::rotation_between(&z, axis).map_or(Matrix3::identity(), |r| r.into_inner())
+        Rotation3::rotation_between(&z, axis).map(|r| r.into_inner())
     }
 }
 
@@ -295,7 +296,7 @@ impl Lanes8 {
         for op in model.fk_program() {
             match op {
                 FkOp::Joint { origin, axis, kind } => {
-                    let q = z_to(&axis);
+                    let q = z_to(&axis)?;
                     let r = owed * origin.rotation.to_rotation_matrix().into_inner() * q;
                     let p = owed * origin.translation.vector;
                     owed = q.transpose();

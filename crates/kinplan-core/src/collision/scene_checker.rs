@@ -196,10 +196,12 @@ pub struct SceneChecker {
     params: CheckerParams,
     /// How far bodies move per joint step (`None`: unbounded, cannot pad).
     sweep: Option<SweepBound>,
+    /// The sphere model of the batched checks (`None` unbatched).
+    spheres: Option<SphereModel>,
     /// The sphere model and scene laid out for batches of four padded
-    /// pieces in `f64` ([`StateChecker::padded_free_batch`]); `None` beyond
-    /// the batch limits.
-    lanes: Option<Lanes>,
+    /// pieces in `f64` ([`StateChecker::padded_free_batch`]), built on first
+    /// use (the motion checks do not call it); `None` beyond the batch limits.
+    lanes: std::sync::OnceLock<Option<Lanes>>,
     /// The same in eight `f32` lanes ([`StateChecker::states_valid`]).
     lanes8: Option<Lanes8>,
 }
@@ -231,7 +233,6 @@ impl SceneChecker {
             .batched
             .then(|| SphereModel::build(&model, &LANE_SPHERES).ok())
             .flatten();
-        let lanes = spheres.as_ref().and_then(|s| Lanes::new(&model, s, &world));
         let lanes8 = spheres.as_ref().and_then(|s| Lanes8::new(&model, s, &world));
         Ok(SceneChecker {
             model,
@@ -240,7 +241,8 @@ impl SceneChecker {
             scene_bodies,
             params,
             sweep,
-            lanes,
+            spheres,
+            lanes: std::sync::OnceLock::new(),
             lanes8,
         })
     }
@@ -358,10 +360,11 @@ impl SceneChecker {
         self.lanes8.as_ref()
     }
 
-    /// The batched form (tests).
-    #[cfg(test)]
+    /// The four-lane `f64` form, built on first use.
     pub(crate) fn lanes(&self) -> Option<&Lanes> {
-        self.lanes.as_ref()
+        self.lanes
+            .get_or_init(|| self.spheres.as_ref().and_then(|s| Lanes::new(&self.model, s, &self.world)))
+            .as_ref()
     }
 
     /// The bodies tested against the scene and the checked self pairs
@@ -802,7 +805,7 @@ impl StateChecker for SceneChecker {
     /// free at every state. Pieces whose midpoint is outside the limits are
     /// left out.
     fn padded_free_batch(&self, rows: &[f64], half_step: &[f64]) -> Option<u32> {
-        let (lanes, sweep) = (self.lanes.as_ref()?, self.sweep.as_ref()?);
+        let (lanes, sweep) = (self.lanes()?, self.sweep.as_ref()?);
         let dof = lanes.dof();
         if dof == 0
             || half_step.len() != dof

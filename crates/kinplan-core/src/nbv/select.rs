@@ -358,7 +358,6 @@ pub fn next_best_view(
     };
     let c_max = camera.frustum_volume() / tree.resolution().powi(3);
     // the state grid recoded for the visibility walks, built beside the gains (the
-    // visibility stage checks the region's keys again)
     // visibility stage checks the region's keys again); it takes the state grid over
     // and gives it back when it cannot
     let state_grid = if params.visibility.is_some() {

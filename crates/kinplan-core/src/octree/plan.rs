@@ -34,14 +34,6 @@ pub(crate) struct Beam {
     pub kind: EndPoint,
 }
 
-impl Beam {
-    /// The beam's length (m): `√(diff · diff)` with the squares summed in f32.
-    #[inline]
-    pub(crate) fn norm(&self) -> f64 {
-        self.norm
-    }
-}
-
 /// A scan's beams, key box and chunks.
 pub(crate) struct ScanPlan {
     /// Key box of the origin and every usable end point (inclusive): all beams lie

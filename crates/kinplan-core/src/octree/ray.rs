@@ -217,7 +217,7 @@ impl Octree {
 
     /// Walks from `start`: false when the beam lies outside the tree's cube.
     #[inline]
-    fn walk_from(&self, start: WalkStart, addr: &impl CellAddress, visit: impl FnMut(&OcKey, usize)) -> bool {
+    pub(crate) fn walk_from(&self, start: WalkStart, addr: &impl CellAddress, visit: impl FnMut(&OcKey, usize)) -> bool {
         match start {
             WalkStart::Outside => false,
             WalkStart::Empty => true,
@@ -242,26 +242,9 @@ impl Octree {
         self.walk_start(origin, &diff, norm, &ke, t_start)
     }
 
-    /// The walk of [`visit_ray_cells_from`](Self::visit_ray_cells_from) given the
-    /// beam's difference `end − origin` (f32), its norm `f32_norm(diff)` and the end
-    /// point's key (in the tree).
-    #[inline]
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn walk_beam(
-        &self,
-        origin: &[f32; 3],
-        diff: &[f32; 3],
-        norm: f64,
-        ke: &OcKey,
-        t_start: f64,
-        addr: &impl CellAddress,
-        visit: impl FnMut(&OcKey, usize),
-    ) -> bool {
-        self.walk_from(self.walk_start(origin, diff, norm, ke, t_start), addr, visit)
-    }
-
-    /// The start of [`walk_beam`](Self::walk_beam): its first cell and DDA state, or
-    /// why it visits nothing. Apart from the walk itself, so that a scan can work out
+    /// The start of a beam's walk given its difference `end − origin` (f32), its
+    /// norm `f32_norm(diff)` and the end point's key (in the tree): its first cell
+    /// and DDA state, or why it visits nothing. Apart from the walk itself, so that a scan can work out
     /// the starts of many beams in a row (independent of each other) before it walks
     /// them.
     #[inline]
@@ -317,7 +300,7 @@ impl Octree {
         WalkStart::From(Walk { ks, ke, dda, length })
     }
 
-    /// Visits the cells of a started walk (see [`walk_beam`](Self::walk_beam)).
+    /// Visits the cells of a started walk (see [`walk_start`](Self::walk_start)).
     #[inline]
     pub(crate) fn walk(&self, w: &Walk, addr: &impl CellAddress, mut visit: impl FnMut(&OcKey, usize)) {
         let Walk {

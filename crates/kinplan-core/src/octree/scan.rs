@@ -436,27 +436,12 @@ impl Octree {
         t0: f64,
         max_range: f64,
         addr: &impl CellAddress,
-        mut free: impl FnMut(&OcKey, usize),
+        free: impl FnMut(&OcKey, usize),
         end: impl FnOnce(&OcKey),
     ) -> bool {
-        if beam.kind == EndPoint::NonFinite {
-            return false;
-        }
-        let norm = beam.norm();
-        if max_range <= 0.0 || norm <= max_range {
-            if beam.kind != EndPoint::InTree {
-                return false;
-            }
-            if t0 < norm {
-                self.walk_beam(origin, &beam.diff, norm, &beam.end, t0, addr, &mut free);
-            }
-            end(&beam.end);
-        } else if t0 < max_range {
-            let (n, m) = (norm as f32, max_range as f32);
-            let e = [0, 1, 2].map(|i| origin[i] + beam.diff[i] / n * m);
-            self.visit_ray_cells_from(origin, &e, t0, addr, free);
-        }
-        true
+        let (kept, start) = self.beam_start(beam, origin, t0, max_range, end);
+        self.walk_from(start, addr, free);
+        kept
     }
 
     /// [`trace_beam`](Self::trace_beam) up to the start of its walk: the end cell
@@ -474,7 +459,7 @@ impl Octree {
         if beam.kind == EndPoint::NonFinite {
             return (false, WalkStart::Empty);
         }
-        let norm = beam.norm();
+        let norm = beam.norm;
         if max_range <= 0.0 || norm <= max_range {
             if beam.kind != EndPoint::InTree {
                 return (false, WalkStart::Empty);
