@@ -185,6 +185,9 @@ pub fn next_best_view(
 ) -> Result<NbvResult, NbvError> {
     params.validate()?;
     camera.validate()?;
+    if let Some(v) = &params.visibility {
+        v.validate_for(camera)?;
+    }
     let start = Instant::now();
     let clock = Clock {
         deadline: deadline.min_with_budget(params.time_budget),

@@ -263,6 +263,23 @@ fn next_best_view_ranks_filters_and_checks_reach() {
         ..NbvParams::default()
     };
     assert!(next_best_view(&t, &bad, &cam, &current, None, Deadline::none()).is_err());
+    // a visibility check whose ray table would outgrow its bound is refused by name:
+    // 2048 × 1024 pixels at stride 1 are 2^21 rays, at stride 2 exactly 2^20
+    let wide = CameraModel {
+        width: 2048,
+        height: 1024,
+        ..CameraModel::default()
+    };
+    let with_stride = |pixel_stride| NbvParams {
+        visibility: Some(VisibilityParams {
+            pixel_stride,
+            ..VisibilityParams::default()
+        }),
+        ..NbvParams::default()
+    };
+    let err = next_best_view(&t, &with_stride(1), &wide, &current, None, Deadline::none()).unwrap_err();
+    assert!(err.to_string().contains("visibility.pixel_stride"), "{err}");
+    assert!(with_stride(2).visibility.unwrap().validate_for(&wide).is_ok());
 }
 
 /// The reachability IK runs under the request's deadline: an IK that can never

@@ -42,7 +42,8 @@ pub struct VisibilityParams {
     /// (count ≥ 1). Default 24.
     pub batch: usize,
     /// Every `pixel_stride`-th pixel of every `pixel_stride`-th row casts a ray
-    /// (pixels, in [1, 64]). Default 8 (64 × 53 rays of a Kinect v2 image).
+    /// (pixels, in [1, 64], and at most [`MAX_VIEW_RAYS`] rays per view for the
+    /// camera). Default 8 (64 × 53 rays of a Kinect v2 image).
     pub pixel_stride: usize,
     /// Unknown cells a ray enters before the prediction stops following it (count ≥ 1).
     /// Default 3.
@@ -91,7 +92,26 @@ impl VisibilityParams {
         }
         Ok(())
     }
+
+    /// [`Self::validate`], and the rays one view casts with `camera` at most
+    /// [`MAX_VIEW_RAYS`]: the check keeps a table of them for the request.
+    pub fn validate_for(&self, camera: &CameraModel) -> Result<(), NbvError> {
+        self.validate()?;
+        let stride = self.pixel_stride;
+        let rays = camera.width.div_ceil(stride).saturating_mul(camera.height.div_ceil(stride));
+        if rays > MAX_VIEW_RAYS {
+            return Err(NbvError::InvalidParam {
+                field: "visibility.pixel_stride",
+                value: stride as f64,
+                reason: "casts more than 2^20 rays per view with this camera (⌈width/stride⌉·⌈height/stride⌉); take a larger stride",
+            });
+        }
+        Ok(())
+    }
 }
+
+/// Most rays one view of the visibility check casts.
+pub const MAX_VIEW_RAYS: usize = 1 << 20;
 
 /// What one view is predicted to reveal.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
