@@ -208,7 +208,7 @@ struct Args {
     only_problems: Option<Vec<usize>>,
     /// Random states per scene for the state-check timing (0: none).
     state_cost: usize,
-    /// Check motion states four at a time through the sphere model.
+    /// Check motion states eight at a time through the sphere model (`f32` lanes).
     batched: bool,
     /// Time the state check on these states (and compare with VAMP's verdicts).
     states_from: Option<PathBuf>,

@@ -358,3 +358,7 @@ def test_analytic_ik_offset_wrist_is_searched(client):
     with pytest.raises(kinplan.InvalidArgument) as e:
         robot.ik(T, seed=q, method="analytic", search_samples=4)
     assert "search_samples" in str(e.value)
+    # the IkOptions path sends the field too: the same refusal
+    with pytest.raises(kinplan.InvalidArgument) as e:
+        robot.ik(T, seed=q, options=kinplan.IkOptions(method="analytic", search_samples=4))
+    assert "search_samples" in str(e.value)

@@ -245,9 +245,7 @@ impl AllowedCollisions {
     /// ([`crate::robot::builtin_srdf`]) allowed.
     pub fn builtin(model: &RobotModel, builtin: &str, params: &AcmParams) -> Result<Self, CollisionError> {
         let mut acm = Self::sampled(model, params)?;
-        if let Some(text) = crate::robot::builtin_srdf(builtin) {
-            let srdf = crate::robot::parse_srdf(text, &crate::robot::UrdfLimits::default())
-                .expect("the built-in SRDFs parse");
+        if let Some(srdf) = crate::robot::builtin_srdf_parsed(builtin) {
             acm.allow_named(
                 model,
                 srdf.disabled_collisions

@@ -363,7 +363,11 @@ impl SceneChecker {
     /// The four-lane `f64` form, built on first use.
     pub(crate) fn lanes(&self) -> Option<&Lanes> {
         self.lanes
-            .get_or_init(|| self.spheres.as_ref().and_then(|s| Lanes::new(&self.model, s, &self.world)))
+            .get_or_init(|| {
+                self.spheres
+                    .as_ref()
+                    .and_then(|s| Lanes::new(&self.model, s, &self.world))
+            })
             .as_ref()
     }
 

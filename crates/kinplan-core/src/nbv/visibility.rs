@@ -98,7 +98,10 @@ impl VisibilityParams {
     pub fn validate_for(&self, camera: &CameraModel) -> Result<(), NbvError> {
         self.validate()?;
         let stride = self.pixel_stride;
-        let rays = camera.width.div_ceil(stride).saturating_mul(camera.height.div_ceil(stride));
+        let rays = camera
+            .width
+            .div_ceil(stride)
+            .saturating_mul(camera.height.div_ceil(stride));
         if rays > MAX_VIEW_RAYS {
             return Err(NbvError::InvalidParam {
                 field: "visibility.pixel_stride",

@@ -217,7 +217,12 @@ impl Octree {
 
     /// Walks from `start`: false when the beam lies outside the tree's cube.
     #[inline]
-    pub(crate) fn walk_from(&self, start: WalkStart, addr: &impl CellAddress, visit: impl FnMut(&OcKey, usize)) -> bool {
+    pub(crate) fn walk_from(
+        &self,
+        start: WalkStart,
+        addr: &impl CellAddress,
+        visit: impl FnMut(&OcKey, usize),
+    ) -> bool {
         match start {
             WalkStart::Outside => false,
             WalkStart::Empty => true,

@@ -3,7 +3,7 @@
 
 use std::sync::{Arc, OnceLock};
 
-use super::{Chain, ChainSpec, RobotError, UrdfLimits, parse_chain};
+use super::{Chain, ChainSpec, RobotError, Srdf, UrdfLimits, parse_chain, parse_srdf};
 
 macro_rules! builtins {
     ($($name:literal),* $(,)?) => {
@@ -69,6 +69,24 @@ pub fn builtin_srdf(name: &str) -> Option<&'static str> {
         "franka_panda_hand" => Some(include_str!("builtin/franka_panda_hand.srdf")),
         _ => None,
     }
+}
+
+/// [`builtin_srdf`] as read, parsed once.
+pub fn builtin_srdf_parsed(name: &str) -> Option<&'static Srdf> {
+    static PARSED: OnceLock<Vec<(&'static str, Srdf)>> = OnceLock::new();
+    let parsed = PARSED.get_or_init(|| {
+        BUILTIN_NAMES
+            .iter()
+            .filter_map(|n| {
+                let text = builtin_srdf(n)?;
+                Some((
+                    *n,
+                    parse_srdf(text, &UrdfLimits::default()).expect("the built-in SRDFs parse"),
+                ))
+            })
+            .collect()
+    });
+    parsed.iter().find(|(n, _)| *n == name).map(|(_, s)| s)
 }
 
 /// The default chain (base_link → tool tip) of a built-in robot, parsed once.

@@ -9,7 +9,7 @@ mod srdf;
 mod urdf;
 mod urdf_export;
 
-pub use builtin::{ARM_NAMES, BUILTIN_NAMES, builtin_chain, builtin_srdf, builtin_urdf};
+pub use builtin::{ARM_NAMES, BUILTIN_NAMES, builtin_chain, builtin_srdf, builtin_srdf_parsed, builtin_urdf};
 pub use chain::{Chain, Joint, JointKind, LinkFrame};
 pub use error::RobotError;
 pub use geometry::{CollisionShape, LinkCollision, Shape, mesh_scale};

@@ -159,10 +159,12 @@ fn builtin_source(name: &str) -> Result<ModelSource, Status> {
             .iter()
             .filter_map(|n| {
                 let urdf = Arc::<str>::from(kinplan_core::robot::builtin_urdf(n).ok()?);
-                let srdf = kinplan_core::robot::builtin_srdf(n).map(|text| {
+                let srdf =
+                    kinplan_core::robot::builtin_srdf(n).zip(kinplan_core::robot::builtin_srdf_parsed(n));
+                let srdf = srdf.map(|(text, parsed)| {
                     Arc::new(SrdfSource {
                         text: text.to_string(),
-                        parsed: parse_srdf(text, &UrdfLimits::default()).expect("the built-in SRDFs parse"),
+                        parsed: parsed.clone(),
                     })
                 });
                 Some((*n, (urdf, srdf)))

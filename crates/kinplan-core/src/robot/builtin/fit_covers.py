@@ -21,9 +21,10 @@ others against the tool frame, so the kinematics agree. Then it writes
 - `<robot>_mesh_points.txt`: the vertices, `link x y z` per line in metres,
   which the Rust tests hold the committed URDFs against.
 
-generate.py reads the covers. Run by hand:
+generate.py reads the covers. Run by hand, with a Python that has
+`example-robot-data` and `pin` installed:
 
-    /work/py-venv-coal/bin/python src/robot/builtin/fit_covers.py
+    python src/robot/builtin/fit_covers.py
 """
 import json
 import math
