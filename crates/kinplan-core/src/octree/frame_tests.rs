@@ -309,3 +309,26 @@ fn update_siblings_one_by_one(
         }
     }
 }
+
+/// An image of more than 2^24 pixels is refused by the library itself (the
+/// scan's per-pixel indices are 32-bit), naming the width, before its length
+/// is looked at.
+#[test]
+fn depth_images_over_the_pixel_limit_are_refused() {
+    let pose = camera([0.0, 0.0, 1.0], Vector3::new(1.0, 0.0, 0.0));
+    let (_, k) = frame(8, 6, 365.0, &pose, 0);
+    let mut tree = Octree::new(0.05).unwrap();
+    let err = tree
+        .insert_depth_image(
+            &[],
+            4096,
+            4097,
+            &k,
+            &pose,
+            &ScanParams::default(),
+            Deadline::none(),
+        )
+        .unwrap_err();
+    assert!(err.to_string().contains("width"), "{err}");
+    assert!(err.to_string().contains("2^24"), "{err}");
+}

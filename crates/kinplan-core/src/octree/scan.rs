@@ -797,6 +797,13 @@ fn check_image(depth: &[f32], width: usize, height: usize, k: &PinholeIntrinsics
         value: width as f64,
         reason: "width · height overflows",
     })?;
+    if expected > MAX_DEPTH_PIXELS {
+        return Err(OctreeError::InvalidParam {
+            field: "width",
+            value: width as f64,
+            reason: "width · height must be at most 2^24",
+        });
+    }
     if depth.len() != expected {
         return Err(OctreeError::WrongLength {
             field: "depth",
