@@ -330,21 +330,16 @@ impl SceneChecker {
     /// (bit `i`: pair `i`; bit 63: every pair from the 63rd on). `q` must
     /// hold `dof` finite values.
     pub(crate) fn hits_flagged(&self, q: &[f64], bodies: u32, pairs: u64) -> bool {
+        // the eight lanes exist only for models of at most MAX_BODIES8 bodies
+        debug_assert!(self.model.body_count() <= MAX_BODIES8);
         let mut poses = [Isometry3::identity(); MAX_BODIES8];
-        if self.model.body_count() > MAX_BODIES8 {
-            return self.in_collision(q);
-        }
         self.model.body_poses(q, &mut poses);
         let all = &self.model.bodies;
         let mut bits = bodies;
         while bits != 0 {
             let b = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let c = sphere_center(&all[b], &poses[b]);
-            let free = self.world.bvh.for_each_near(&c, all[b].radius, |leaf| {
-                !shapes_intersect_leaf(&all[b], &poses[b], &self.world.leaves[leaf as usize])
-            });
-            if !free {
+            if self.body_hits_scene(b, &poses[b], &sphere_center(&all[b], &poses[b])) {
                 return true;
             }
         }
@@ -378,6 +373,17 @@ impl SceneChecker {
         (&self.scene_bodies, &self.self_pairs)
     }
 
+    /// True when body `b` at `pose` (bounding-sphere centre `center`) touches
+    /// the scene: the leaves near its sphere, each by its exact test.
+    #[inline]
+    fn body_hits_scene(&self, b: usize, pose: &Isometry3<f64>, center: &Vector3<f64>) -> bool {
+        let body = &self.model.bodies[b];
+        // the query's sphere is the body's: leaves arrive culled by it
+        !self.world.bvh.for_each_near(center, body.radius, |leaf| {
+            !shapes_intersect_leaf(body, pose, &self.world.leaves[leaf as usize])
+        })
+    }
+
     /// The bodies' bounding-sphere centres at `poses` (`N` ≥ the body count).
     fn centers<const N: usize>(&self, poses: &[Isometry3<f64>; N]) -> [Vector3<f64>; N] {
         let mut centers = [Vector3::zeros(); N];
@@ -393,12 +399,8 @@ impl SceneChecker {
         let bodies = &self.model.bodies;
         let centers = self.centers(poses);
         for &b in &self.scene_bodies {
-            let (b, c) = (b as usize, &centers[b as usize]);
-            // the query's sphere is the body's: leaves arrive culled by it
-            let free = self.world.bvh.for_each_near(c, bodies[b].radius, |leaf| {
-                !shapes_intersect_leaf(&bodies[b], &poses[b], &self.world.leaves[leaf as usize])
-            });
-            if !free {
+            let b = b as usize;
+            if self.body_hits_scene(b, &poses[b], &centers[b]) {
                 return true;
             }
         }
