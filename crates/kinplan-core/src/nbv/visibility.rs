@@ -687,8 +687,10 @@ fn next_axis(t_max: &[f64; 3]) -> usize {
 mod tests {
     use rand::{Rng, SeedableRng};
 
-    use super::{SelectDda, SseDda};
+    use super::{SelectDda, SseDda, next_axis};
 
+    /// Both branch-free steps against the reference step of [`walk_with`]: the
+    /// axis of [`next_axis`], stopping once the smallest `t_max` passes `t1`.
     #[test]
     fn the_sse_and_the_select_dda_step_alike_bit_for_bit() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
@@ -715,10 +717,22 @@ mod tests {
                 SseDda::new(t, d, t1, [1, 10, 100]),
                 SelectDda::new(t, d, t1, [1, 10, 100]),
             );
+            let mut reference = t;
             let mut n = 0;
             loop {
                 let (sa, sb) = (a.advance(), b.advance());
                 assert_eq!(sa, sb, "ray {ray} step {n}");
+                let axis = next_axis(&reference);
+                let expected = (reference[axis] <= t1).then(|| {
+                    reference[axis] += d[axis];
+                    [1, 10, 100][axis]
+                });
+                assert_eq!(sb, expected, "ray {ray} step {n}: the reference step");
+                assert_eq!(
+                    b.t.map(f64::to_bits),
+                    reference.map(f64::to_bits),
+                    "ray {ray} step {n}"
+                );
                 // SAFETY: SSE2 is part of every x86_64 CPU.
                 let ta =
                     a.t.map(|x| unsafe { std::arch::x86_64::_mm_cvtsd_f64(x) }.to_bits());
