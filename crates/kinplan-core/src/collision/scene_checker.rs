@@ -399,8 +399,12 @@ impl SceneChecker {
         let bodies = &self.model.bodies;
         let centers = self.centers(poses);
         for &b in &self.scene_bodies {
-            let b = b as usize;
-            if self.body_hits_scene(b, &poses[b], &centers[b]) {
+            let (b, c) = (b as usize, &centers[b as usize]);
+            // the query's sphere is the body's: leaves arrive culled by it
+            let free = self.world.bvh.for_each_near(c, bodies[b].radius, |leaf| {
+                !shapes_intersect_leaf(&bodies[b], &poses[b], &self.world.leaves[leaf as usize])
+            });
+            if !free {
                 return true;
             }
         }
