@@ -731,14 +731,15 @@ fn states_from(
         .chunks_exact(8)
         .map(|b| f64::from_le_bytes(b.try_into().expect("eight bytes")))
         .collect();
-    let vamp = std::fs::read(path.with_extension("bin.vamp"))?;
+    let beside = |ext: &str| PathBuf::from(format!("{}.{ext}", path.display()));
+    let vamp = std::fs::read(beside("vamp"))?;
     let n = states.len() / dof;
     if vamp.len() != n {
         return Err(format!("{}: {} verdicts for {n} states", path.display(), vamp.len()).into());
     }
     let ours: Vec<bool> = states.chunks_exact(dof).map(|q| checker.is_valid(q)).collect();
     std::fs::write(
-        path.with_extension("bin.ours"),
+        beside("ours"),
         ours.iter().map(|&v| u8::from(v)).collect::<Vec<u8>>(),
     )?;
     let free: Vec<f64> = states

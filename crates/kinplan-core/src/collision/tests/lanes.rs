@@ -427,9 +427,8 @@ fn pieces_proved_together_are_free_at_every_sampled_state() {
 /// batches of four. The AVX2 and portable builds give the same unsure
 /// masks; a state the spheres clear is free by the exact check (so the
 /// batched verdict, the spheres' "free" or else the exact check, equals the
-/// exact verdict state by state); and `states_valid` over the lanes answers
-/// as the exact check does for each group of five (one state alone, then a
-/// batch).
+/// exact verdict state by state); and the batched `states_valid` answers as
+/// the exact check does for each group of five states.
 #[test]
 fn batched_verdicts_equal_the_exact_ones_on_every_motionbenchmaker_set() {
     let Some(dir) = crate::mbm_data::problems() else {
