@@ -89,13 +89,13 @@ pub trait StateChecker: Sync {
     /// [`StateChecker::dof`] values per row, at most 32 rows) and the common
     /// signed half vector `half_step`, those proved free at once as
     /// [`StateChecker::padded_valid`] would (bit `i` for row `i`); a piece
-    /// left out is not proved either way and goes to the one-piece check.
-    /// `None` when the checker has no such batched proof (the default).
-    /// [`padded_motion`](super::padded_motion) does not use it: grown by
-    /// the global pads, the spheres proved too few of its pieces to pay on
-    /// the MotionBenchMaker problems (`benches/RESULTS.md`).
-    fn padded_free_batch(&self, rows: &[f64], half_step: &[f64]) -> Option<u32> {
-        let _ = (rows, half_step);
+    /// left out is not proved either way and goes to the one-piece check,
+    /// which may spare what `cleared[i]` says was proved clear over piece
+    /// `i` (as [`StateChecker::padded_verdict_sparing`]'s `proved`; 0 when
+    /// nothing). `None` when the checker has no such batched proof (the
+    /// default).
+    fn padded_free_batch(&self, rows: &[f64], half_step: &[f64], cleared: &mut [u64]) -> Option<u32> {
+        let _ = (rows, half_step, cleared);
         None
     }
 

@@ -71,6 +71,8 @@ use super::trig32::{MAX_TURN, eta, sin_cos32};
 use super::world::SceneGeometry;
 use crate::robot::{Chain, JointKind};
 
+mod padded;
+
 /// States per batch.
 pub(crate) const WIDTH: usize = 8;
 /// One value per state of a batch.
@@ -192,6 +194,15 @@ pub(crate) struct Lanes8 {
     /// so one record per leaf).
     boxes: Vec<[[f32; 3]; 2]>,
     prims: Vec<Prim>,
+    /// Per body, the last joint moving it (`None`: fixed to the base).
+    last: Vec<Option<usize>>,
+    /// Some joint slides (the padded batch takes turning joints only).
+    slides: bool,
+    /// The rotation rows' error bound at the end of the chain (the largest
+    /// along it; `lanes8_bound`).
+    rho: f64,
+    /// Every placed coordinate is within this of the base (m).
+    reach: f64,
 }
 
 /// `x` rounded to an `f32` not below it.
@@ -289,6 +300,8 @@ impl Lanes8 {
         let mut fine_of: Vec<Vec<(Vector3<f64>, f64)>> = vec![Vec::new(); body_count];
         let mut coarse_of = vec![(Vector3::zeros(), 0.0); body_count];
         let mut margin = vec![0.0; body_count];
+        let mut last = vec![None; body_count];
+        let mut slides = false;
         // the rotation Qᵀ owed by the last joint, folded into what follows
         let mut owed = Matrix3::identity();
         let mut bound = Bound::default();
@@ -302,6 +315,7 @@ impl Lanes8 {
                     owed = q.transpose();
                     bound = bound.origin(p.norm());
                     let slide = kind == JointKind::Prismatic;
+                    slides |= slide;
                     bound = if slide {
                         bound.slide(travel[joint])
                     } else {
@@ -332,6 +346,7 @@ impl Lanes8 {
                         .map(|(c, _)| c.norm())
                         .fold(0.0, f64::max);
                     margin[body] = bound.point(far);
+                    last[body] = joint.checked_sub(1);
                     ops.push(Op::Body { body });
                 }
             }
@@ -395,6 +410,10 @@ impl Lanes8 {
             margin,
             boxes,
             prims,
+            last,
+            slides,
+            rho: bound.rho,
+            reach: x,
         })
     }
 
@@ -604,12 +623,31 @@ impl Lanes8 {
     /// body count) and returned initialised.
     #[inline(always)]
     fn fk<'a>(&self, q: &[Lane8], frames: &'a mut [MaybeUninit<Frame8>]) -> &'a [Frame8] {
+        self.fk_with::<false>(q, &[], frames, &mut [])
+    }
+
+    /// [`Lanes8::fk`], and when `SWEEP` the prefix sums of the piece with
+    /// half vector `d` at every joint into `sums` (`padded` module).
+    #[inline(always)]
+    fn fk_with<'a, const SWEEP: bool>(
+        &self,
+        q: &[Lane8],
+        d: &[f32],
+        frames: &'a mut [MaybeUninit<Frame8>],
+        sums: &mut [MaybeUninit<padded::Sums8>],
+    ) -> &'a [Frame8] {
         let mut t = Frame8::IDENTITY;
         let mut joint = 0;
+        let mut sum = padded::Sums8::ZERO;
         for op in &self.ops {
             match op {
                 Op::Joint { rot, p, slide } => {
                     compose(&mut t, rot, p);
+                    if SWEEP {
+                        // the joint's axis: the frame's z through its origin
+                        sum.add(d[joint], [t.r[0][2], t.r[1][2], t.r[2][2]], &t.p);
+                        sums[joint].write(sum);
+                    }
                     let v = &q[joint];
                     joint += 1;
                     if *slide {
@@ -838,6 +876,20 @@ fn dist2(x: &[Lane8; 3], y: &[Lane8; 3]) -> Lane8 {
 /// Lanes whose sphere `s` at `x` meets the leaf.
 #[inline(always)]
 fn sphere_prim<const AVX: bool>(x: &[Lane8; 3], s: &Ball, prim: &Prim) -> u32 {
+    let (d2, radius) = prim_dist2(x, prim);
+    if radius == 0.0 {
+        mask::<AVX>(&d2, s.r2)
+    } else {
+        let reach = s.r + radius;
+        mask::<AVX>(&d2, reach * reach * GROW)
+    }
+}
+
+/// Per lane, the squared distance from `x` to the leaf's core, and the
+/// radius around that core the leaf reaches (its grown radius for a
+/// capsule, 0 for a box).
+#[inline(always)]
+fn prim_dist2(x: &[Lane8; 3], prim: &Prim) -> (Lane8, f32) {
     let mut d2 = [0.0f32; WIDTH];
     match prim {
         Prim::Aabb { lo, hi } => {
@@ -847,7 +899,7 @@ fn sphere_prim<const AVX: bool>(x: &[Lane8; 3], s: &Ball, prim: &Prim) -> u32 {
                     d2[l] += e * e;
                 }
             }
-            mask::<AVX>(&d2, s.r2)
+            (d2, 0.0)
         }
         Prim::Box { m, d, half } => {
             for k in 0..3 {
@@ -866,7 +918,7 @@ fn sphere_prim<const AVX: bool>(x: &[Lane8; 3], s: &Ball, prim: &Prim) -> u32 {
                     d2[l] += e * e;
                 }
             }
-            mask::<AVX>(&d2, s.r2)
+            (d2, 0.0)
         }
         Prim::Capsule { a, d, inv, r } => {
             let mut v = [[0.0f32; WIDTH]; 3];
@@ -888,8 +940,7 @@ fn sphere_prim<const AVX: bool>(x: &[Lane8; 3], s: &Ball, prim: &Prim) -> u32 {
                     d2[l] += w * w;
                 }
             }
-            let reach = s.r + r;
-            mask::<AVX>(&d2, reach * reach * GROW)
+            (d2, *r)
         }
     }
 }

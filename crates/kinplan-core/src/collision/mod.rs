@@ -36,7 +36,6 @@ mod error;
 mod fast;
 mod fast_box;
 mod fixed_frame;
-mod lanes;
 mod lanes8;
 mod lanes8_bound;
 mod mesh_dae;
@@ -63,6 +62,7 @@ pub use model::{AttachedBody, InlineMesh, MAX_BODIES, MAX_LINKS, RobotModel};
 pub use moveit::{JointRequest, MAX_YAML_BYTES, parse_joint_request, parse_planning_scene};
 pub use octree_cells::octree_cells;
 pub(crate) use padded::bisection_order;
+
 pub use padded::{MAX_CHECKS_PER_PIECE, MIN_PIECE, PaddedMotion, padded_motion, padded_motion_valid};
 pub use scene::{Geometry, Obstacle, Scene, SceneLimits};
 pub use scene_checker::{CheckerParams, Part, Proximity, SceneChecker, StateReport};

@@ -23,6 +23,9 @@ const FIRST_PIECE: f64 = 4.0;
 /// Pieces proved together, breadth first (bounds the queue at
 /// `WINDOW · (MAX_CHECKS_PER_PIECE + 1)` entries whatever the motion's length).
 const WINDOW: usize = 64;
+/// Pieces offered to [`StateChecker::padded_free_batch`] at once (the
+/// batched check's lanes).
+const BATCH: usize = 8;
 
 /// True when no state of the straight motion `a → b` collides (the motion
 /// check of docs/planning.md#collision-cost-and-motion-checks, made conservative), proved piece
@@ -113,14 +116,37 @@ pub fn padded_motion<C: StateChecker + ?Sized>(
     let mut order = bisection_order(pieces).peekable();
     let mut queue = VecDeque::new();
     let mut spent = [0usize; WINDOW];
+    let first_half: Vec<f64> = delta.iter().map(|d| 0.5 * d / pieces as f64).collect();
+    let mut rows = [0.0; BATCH * MAX_DOF];
     while order.peek().is_some() {
         spent.fill(0);
+        let window: Vec<usize> = order.by_ref().take(WINDOW).collect();
+        // the window's pieces offered to the batched proof first, a batch
+        // at a time; those it proves free are done
+        let mut proved_free = 0u64;
+        let mut cleared = [0u64; WINDOW];
+        for (k, batch) in window.chunks(BATCH).enumerate() {
+            for (row, &i) in rows.chunks_exact_mut(n).zip(batch) {
+                let m = (i as f64 + 0.5) / pieces as f64;
+                for ((v, x), d) in row.iter_mut().zip(a).zip(delta) {
+                    *v = x + m * d;
+                }
+            }
+            let parts = &mut cleared[k * BATCH..k * BATCH + batch.len()];
+            match checker.padded_free_batch(&rows[..batch.len() * n], &first_half, parts) {
+                Some(free) => proved_free |= u64::from(free) << (k * BATCH),
+                None => break,
+            }
+        }
         queue.extend(
-            order
-                .by_ref()
-                .take(WINDOW)
+            window
+                .iter()
                 .enumerate()
-                .map(|(slot, i)| (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64, slot, 0)),
+                .filter(|(slot, _)| proved_free & (1 << slot) == 0)
+                .map(|(slot, &i)| {
+                    let (s, t) = (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64);
+                    (s, t, slot, cleared[slot])
+                }),
         );
         while let Some((s, t, slot, mut proved)) = queue.pop_front() {
             checks += 1;

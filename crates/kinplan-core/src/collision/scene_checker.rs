@@ -17,7 +17,6 @@ use nalgebra::{Isometry3, Point3, Vector3};
 
 use super::acm::AllowedCollisions;
 use super::bvh::Aabb;
-use super::lanes::{LANES, LaneFrame, Lanes, MAX_LANE_BODIES, MAX_LANE_DOF};
 use super::lanes8::{Flags, Lanes8, MAX_BODIES8, MAX_DOF8, WIDTH};
 use super::model::{JointAxis, MAX_BODIES, MAX_LINKS, RobotModel};
 use super::narrow::{
@@ -26,7 +25,6 @@ use super::narrow::{
 };
 use super::spheres::{SphereModel, SphereParams};
 use super::sweep::SweepBound;
-use super::trig::in_reduced_range;
 use super::world::SceneGeometry;
 use super::{CollisionError, MotionCheck, PadVerdict, StateChecker};
 use crate::robot::JointKind;
@@ -196,13 +194,10 @@ pub struct SceneChecker {
     params: CheckerParams,
     /// How far bodies move per joint step (`None`: unbounded, cannot pad).
     sweep: Option<SweepBound>,
-    /// The sphere model of the batched checks (`None` unbatched).
-    spheres: Option<SphereModel>,
-    /// The sphere model and scene laid out for batches of four padded
-    /// pieces in `f64` ([`StateChecker::padded_free_batch`]), built on first
-    /// use (the motion checks do not call it); `None` beyond the batch limits.
-    lanes: std::sync::OnceLock<Option<Lanes>>,
-    /// The same in eight `f32` lanes ([`StateChecker::states_valid`]).
+    /// The sphere model and the scene laid out for eight states or pieces in
+    /// `f32` lanes ([`StateChecker::states_valid`],
+    /// [`StateChecker::padded_free_batch`]); `None` unbatched or beyond the
+    /// lanes' limits.
     lanes8: Option<Lanes8>,
 }
 
@@ -241,8 +236,6 @@ impl SceneChecker {
             scene_bodies,
             params,
             sweep,
-            spheres,
-            lanes: std::sync::OnceLock::new(),
             lanes8,
         })
     }
@@ -353,17 +346,6 @@ impl SceneChecker {
     #[cfg(test)]
     pub(crate) fn lanes8(&self) -> Option<&Lanes8> {
         self.lanes8.as_ref()
-    }
-
-    /// The four-lane `f64` form, built on first use.
-    pub(crate) fn lanes(&self) -> Option<&Lanes> {
-        self.lanes
-            .get_or_init(|| {
-                self.spheres
-                    .as_ref()
-                    .and_then(|s| Lanes::new(&self.model, s, &self.world))
-            })
-            .as_ref()
     }
 
     /// The bodies tested against the scene and the checked self pairs
@@ -716,7 +698,7 @@ fn scene_bodies(model: &RobotModel, world: &SceneGeometry, sweep: Option<&SweepB
 
 /// The bit of a padded check's `proved` parts that stands for every self
 /// pair (the bits below [`MAX_BODIES`] are the bodies).
-const SELF_PAIRS: u64 = 1 << 63;
+pub(crate) const SELF_PAIRS: u64 = 1 << 63;
 
 /// What [`SceneChecker::hits_padded`] found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -807,56 +789,51 @@ impl StateChecker for SceneChecker {
         }
     }
 
-    /// Batches of [`LANES`] midpoints through the sphere model, every
-    /// sphere of body `b` grown by its global pad over `half_step`
-    /// ([`SweepBound::pads`], never below the farthest any point of the body
-    /// moves within the piece), each self pair by both pads
-    /// (`Lanes::unsure_padded`): a piece whose grown spheres are clear is
-    /// free at every state. Pieces whose midpoint is outside the limits are
-    /// left out.
-    fn padded_free_batch(&self, rows: &[f64], half_step: &[f64]) -> Option<u32> {
-        let (lanes, sweep) = (self.lanes()?, self.sweep.as_ref()?);
+    /// Batches of [`WIDTH`] midpoints through the sphere model in `f32`
+    /// lanes, every sphere grown by how far the body points inside it can
+    /// move along its piece (`Lanes8::unsure_padded`): a piece whose grown
+    /// spheres are clear is free at every state. Pieces whose midpoint is
+    /// outside the limits are left out.
+    fn padded_free_batch(&self, rows: &[f64], half_step: &[f64], cleared: &mut [u64]) -> Option<u32> {
+        let (lanes, sweep) = (self.lanes8.as_ref()?, self.sweep.as_ref()?);
         let dof = lanes.dof();
         if dof == 0
             || half_step.len() != dof
             || !rows.len().is_multiple_of(dof)
             || rows.len() / dof > 32
-            || !rows.iter().all(|&v| in_reduced_range(v))
+            || cleared.len() < rows.len() / dof
         {
             return None;
         }
-        let mut pads = [0.0; MAX_LANE_BODIES];
-        sweep.pads(half_step, &mut pads[..lanes.body_count()]);
-        if !pads.iter().all(|p| p.is_finite()) {
-            return None;
-        }
-        let mut frames = [LaneFrame::IDENTITY; MAX_LANE_BODIES];
+        let terms = lanes.pad_terms(sweep, half_step, &self.self_pairs)?;
         let mut free = 0u32;
-        for (k, batch) in rows.chunks(LANES * dof).enumerate() {
+        for (k, batch) in rows.chunks(WIDTH * dof).enumerate() {
             let n = batch.len() / dof;
-            let mut q = [[0.0; LANES]; MAX_LANE_DOF];
+            let mut q = [[0.0f32; WIDTH]; MAX_DOF8];
             let mut inside = 0u32;
             for (l, row) in batch.chunks_exact(dof).enumerate() {
-                inside |= u32::from(self.within_limits(row)) << l;
-                for (j, &v) in row.iter().enumerate() {
-                    q[j][l] = v;
+                // the limits also keep every value within what the lanes
+                // take; a lane outside them stays at zero, left out
+                if self.within_limits(row) {
+                    inside |= 1 << l;
+                    for (j, &v) in row.iter().enumerate() {
+                        q[j][l] = v as f32;
+                    }
                 }
             }
-            for qj in q[..dof].iter_mut() {
-                let last = qj[n - 1];
-                qj[n..].fill(last);
-            }
+            let mut parts = [0u64; WIDTH];
             let unsure = lanes.unsure_padded(
                 &q[..dof],
-                &pads,
-                &self.world.bvh,
+                &terms,
                 &self.scene_bodies,
                 &self.self_pairs,
-                &mut frames,
+                &mut parts,
                 false,
             );
-            let proved = !unsure & inside & ((1 << n) - 1);
-            free |= proved << (k * LANES);
+            free |= (!unsure & inside & ((1 << n) - 1)) << (k * WIDTH);
+            for (l, c) in cleared[k * WIDTH..k * WIDTH + n].iter_mut().enumerate() {
+                *c = if inside & (1 << l) != 0 { parts[l] } else { 0 };
+            }
         }
         Some(free)
     }

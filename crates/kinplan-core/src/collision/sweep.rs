@@ -310,6 +310,11 @@ impl SweepBound {
         v.norm() + omega.norm() * body.radius + 0.5 * accel
     }
 
+    /// The last joint moving body `b` (`None`: fixed to the base).
+    pub(crate) fn last(&self, b: usize) -> Option<usize> {
+        self.last[b].filter(|_| self.dof > 0)
+    }
+
     /// `L_{j,b}` (m per rad, or 1 for a prismatic joint).
     pub fn lever(&self, body: usize, joint: usize) -> f64 {
         self.levers[body * self.dof + joint]

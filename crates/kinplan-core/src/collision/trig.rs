@@ -51,15 +51,8 @@ pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
     sin_cos_reduced(x)
 }
 
-/// Whether [`sin_cos_reduced`] takes `x` (finite, `|x| ≤` the reduced range).
-#[inline(always)]
-pub(crate) fn in_reduced_range(x: f64) -> bool {
-    x.abs() <= REDUCED_RANGE
-}
-
-/// [`sin_cos`] for `|x| ≤` the reduced range only (see
-/// [`in_reduced_range`]), without the test: branch-free, so a loop over
-/// several arguments runs in vector lanes.
+/// [`sin_cos`] for `|x| ≤` the reduced range only, without the test:
+/// branch-free.
 #[inline(always)]
 pub(crate) fn sin_cos_reduced(x: f64) -> (f64, f64) {
     // k = x·2/π rounded to the nearest integer by the 1.5·2⁵² shift (exact
