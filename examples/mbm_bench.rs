@@ -313,6 +313,14 @@ impl StateChecker for Counting<'_> {
         self.padded.fetch_add(1, Ordering::Relaxed);
         self.inner.padded_verdict_sparing(q, half_step, proved)
     }
+    // a piece the batch proves is counted like one the one-piece check does
+    fn padded_free_batch(&self, rows: &[f64], half_step: &[f64], cleared: &mut [u64]) -> Option<u32> {
+        let free = self.inner.padded_free_batch(rows, half_step, cleared)?;
+        let proved = free.count_ones() as usize;
+        self.states.fetch_add(proved, Ordering::Relaxed);
+        self.padded.fetch_add(proved, Ordering::Relaxed);
+        Some(free)
+    }
     fn motion_check(&self) -> MotionCheck {
         self.inner.motion_check()
     }
