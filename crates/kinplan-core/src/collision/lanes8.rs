@@ -203,6 +203,9 @@ pub(crate) struct Lanes8 {
     rho: f64,
     /// Every placed coordinate is within this of the base (m).
     reach: f64,
+    /// Per body, twice its largest sphere's grown radius (m): a sphere
+    /// centre is within this of some point of the body.
+    largest_radius: Vec<f64>,
 }
 
 /// `x` rounded to an `f32` not below it.
@@ -400,7 +403,18 @@ impl Lanes8 {
             ]);
             prims.push(prim_of(leaf, x));
         }
+        let largest_radius = (0..body_count)
+            .map(|b| {
+                let fine = &fine[start[b]..start[b + 1]];
+                2.0 * fine
+                    .iter()
+                    .chain([&coarse[b]])
+                    .map(|s| f64::from(s.r))
+                    .fold(0.0, f64::max)
+            })
+            .collect();
         Some(Lanes8 {
+            largest_radius,
             ops,
             dof,
             body_count,

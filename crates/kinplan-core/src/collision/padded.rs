@@ -16,10 +16,11 @@ pub const MIN_PIECE: f64 = 1e-5;
 pub const MAX_CHECKS_PER_PIECE: usize = 64;
 /// Longest first piece, in resolutions: a piece is proved with pads that
 /// grow with its length, so longer pieces are cheaper to prove than several
-/// short ones while the halving refines them where obstacles are near
-/// (four resolutions was the best of two, four and eight on the
-/// MotionBenchMaker problems, `benches/RESULTS.md`).
-const FIRST_PIECE: f64 = 4.0;
+/// short ones while the halving refines them where obstacles are near;
+/// shorter pieces are proved by the batch more often (two resolutions was
+/// the best of one to eight on the MotionBenchMaker problems, with the
+/// batched proof and without it, `benches/RESULTS.md`).
+const FIRST_PIECE: f64 = 2.0;
 /// Pieces proved together, breadth first (bounds the queue at
 /// `WINDOW · (MAX_CHECKS_PER_PIECE + 1)` entries whatever the motion's length).
 const WINDOW: usize = 64;
@@ -32,7 +33,7 @@ const BATCH: usize = 8;
 /// by piece (conservative advancement over joint space, Schwarzer, Saha and
 /// Latombe's idea with the distance test replaced by a padded overlap test):
 ///
-/// the motion is cut into `2^k ≥ span/(4·resolution)` equal pieces; a piece
+/// the motion is cut into `2^k ≥ span/(2·resolution)` equal pieces; a piece
 /// `[s, t]` with midpoint `m` and signed half vector `h = (b − a)·(t − s)/2`
 /// is accepted when the robot at `q(m)` is within its limits and free with
 /// every body padded by its sweep bound `δ_b(h)` along the piece

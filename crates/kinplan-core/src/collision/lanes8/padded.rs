@@ -217,12 +217,7 @@ impl Lanes8 {
         to: usize,
     ) -> Option<f32> {
         let sqrt3 = 3f64.sqrt();
-        // how far a sphere of the body reaches past its bounding sphere's centre
-        let e = std::iter::once(&self.coarse[b])
-            .chain(&self.fine[self.start[b]..self.start[b + 1]])
-            .map(|s| f64::from(s.r))
-            .fold(0.0, f64::max)
-            * 2.0;
+        let e = self.largest_radius[b];
         let first = from.map_or(0, |f| f + 1);
         let (mut prefix, mut accel, mut rounding) = (0.0, 0.0, 0.0);
         for (j, dj) in d.iter().enumerate().take(to + 1) {

@@ -585,11 +585,11 @@ impl StateChecker for CountingPads<'_> {
 
 #[test]
 fn a_motion_through_an_obstacle_is_refused_before_grazing_pieces_are_halved() {
-    // The swing (1 cm sphere at 1 m) turns −1.6 → 1.6 rad: 16 first pieces
-    // of 0.2 (four resolutions of 0.05). A cube 0.1 mm off its circle at
+    // The swing (1 cm sphere at 1 m) turns −1.6 → 1.6 rad: 32 first pieces
+    // of 0.1 (two resolutions of 0.05). A cube 0.1 mm off its circle at
     // θ = −1.58 (piece 0, visited first) takes many halvings to prove
-    // clear; a wall across the circle at θ = 1.5 (the midpoint of piece 15,
-    // visited last) blocks the motion outright.
+    // clear; a wall across the circle at θ = 1.55 (the midpoint of piece
+    // 31, visited last) blocks the motion outright.
     let at = |theta: f64, r: f64| Isometry3::translation(theta.cos() * r, theta.sin() * r, 0.0);
     let graze = Obstacle::new(
         "graze",
@@ -600,7 +600,7 @@ fn a_motion_through_an_obstacle_is_refused_before_grazing_pieces_are_halved() {
     );
     let wall = Obstacle::new(
         "wall",
-        at(1.5, 1.0),
+        at(1.55, 1.0),
         Geometry::Box {
             half_extents: Vector3::repeat(0.005),
         },
@@ -613,11 +613,11 @@ fn a_motion_through_an_obstacle_is_refused_before_grazing_pieces_are_halved() {
         padded_motion_valid(&counting, &a, &b, 0.05, crate::Deadline::none()),
         Some(false)
     );
-    // breadth first: the 16 midpoints are checked before any piece is
+    // breadth first: the 32 midpoints are checked before any piece is
     // halved, and the wall's midpoint refuses the motion (depth first would
-    // halve piece 0 first, then check the 15 others)
+    // halve piece 0 first, then check the 31 others)
     let checks = counting.padded.into_inner();
-    assert!(checks <= 16, "{checks} padded checks");
+    assert!(checks <= 32, "{checks} padded checks");
 }
 
 #[test]
