@@ -7,7 +7,7 @@
 //! tar xjf ../shared/bench/mbm/panda_problems.tar.bz2 -C target/mbm
 //! cargo build --release -p kinplan-core --example mbm_bench
 //! target/release/examples/mbm_bench target/mbm/problems [--passes 10] [--stomp 10]
-//!     [--clamp-fingers] [--padded] [--set NAME] [--problems 3,17,42] [--state-cost N] [--batched]
+//!     [--clamp-fingers] [--padded] [--set NAME] [--problems 3,17,42] [--state-cost N] [--unbatched]
 //!     [--out target/mbm_bench]
 //! ```
 //!
@@ -31,9 +31,11 @@
 //! `FILE.ours` (the same form), then prints one JSON line
 //! and stops (`benches/mbm/state_cost_vamp.py` runs it beside VAMP).
 //!
-//! `--batched` checks the states of motions eight at a time through the
-//! sphere model in `f32` vector lanes (`CheckerParams::batched`; same
-//! verdicts).
+//! The states of motions are checked eight at a time through the sphere
+//! model in `f32` vector lanes, and the pieces of padded motions offered to
+//! it eight at a time (`CheckerParams::batched`, the default);
+//! `--unbatched` checks one state and one piece at a time (`--batched` is
+//! the default, kept for older scripts).
 //!
 //! `--problems` keeps only the listed problem numbers (say the band around a
 //! set's median, to profile what the median measures).
@@ -216,7 +218,7 @@ struct Args {
 }
 
 fn args() -> Result<Args, String> {
-    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--problems N,N,...] [--state-cost N] [--states-from FILE] [--batched] [--out PREFIX]";
+    let usage = "usage: mbm_bench <problems dir> [--passes N] [--stomp K] [--clamp-fingers] [--resolution RAD] [--shortcut-resolution RAD] [--padded] [--shortcut-attempts N] [--set NAME] [--problems N,N,...] [--state-cost N] [--states-from FILE] [--unbatched] [--out PREFIX]";
     let mut it = std::env::args().skip(1);
     let mut a = Args {
         root: PathBuf::new(),
@@ -230,7 +232,7 @@ fn args() -> Result<Args, String> {
         only_set: None,
         only_problems: None,
         state_cost: 0,
-        batched: false,
+        batched: true,
         states_from: None,
         out: PathBuf::from("target/mbm_bench"),
     };
@@ -246,6 +248,7 @@ fn args() -> Result<Args, String> {
             "--stomp" => a.stomp = num("--stomp")?,
             "--state-cost" => a.state_cost = num("--state-cost")?,
             "--batched" => a.batched = true,
+            "--unbatched" => a.batched = false,
             "--clamp-fingers" => a.clamp = true,
             "--padded" => a.padded = true,
             "--shortcut-attempts" => a.shortcut_attempts = Some(num("--shortcut-attempts")?),

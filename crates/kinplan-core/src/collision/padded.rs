@@ -127,6 +127,12 @@ pub fn padded_motion<C: StateChecker + ?Sized>(
         let mut proved_free = 0u64;
         let mut cleared = [0u64; WINDOW];
         for (k, batch) in window.chunks(BATCH).enumerate() {
+            // a batch counts as a check per piece against the deadline
+            let asked = checks / 32;
+            checks += batch.len();
+            if checks / 32 != asked && deadline.expired() {
+                return PaddedMotion::Interrupted;
+            }
             for (row, &i) in rows.chunks_exact_mut(n).zip(batch) {
                 let m = (i as f64 + 0.5) / pieces as f64;
                 for ((v, x), d) in row.iter_mut().zip(a).zip(delta) {

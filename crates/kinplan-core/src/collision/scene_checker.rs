@@ -58,8 +58,12 @@ pub struct CheckerParams {
     /// Check the states of a motion eight at a time through the sphere model
     /// in `f32` vector lanes, the states it leaves unsure exactly, only for
     /// the bodies and pairs the spheres did not clear
-    /// ([`StateChecker::states_valid`]; the same verdicts). Default `false`
-    /// (see `benches/RESULTS.md` for where it pays).
+    /// ([`StateChecker::states_valid`]; the same verdicts), and offer the
+    /// pieces of a padded motion to the spheres eight at a time
+    /// ([`StateChecker::padded_free_batch`]; sound, but a piece the spheres
+    /// prove may be one the one-piece check would have halved). Models and
+    /// scenes beyond the lanes' limits are checked exactly whatever this
+    /// says. Default `true`.
     pub batched: bool,
 }
 
@@ -68,7 +72,7 @@ impl Default for CheckerParams {
         CheckerParams {
             motion_resolution: Self::MAX_MOTION_RESOLUTION,
             padded_motion: false,
-            batched: false,
+            batched: true,
         }
     }
 }

@@ -890,7 +890,7 @@ fn a_padded_check_refuses_a_colliding_state_whichever_obstacle_it_meets_first() 
 fn a_refused_motion_says_where_it_was_refused() {
     // The swing (1 cm sphere at 1 m) turning 0 → 1.6 rad against a 1 cm
     // cube on its circle at θ = 1.2: refused within 0.1 rad of it (first
-    // pieces are 0.2 rad long, 1.2 on a border), and proved free on the
+    // pieces are 0.1 rad long, 1.2 on a border), and proved free on the
     // far side.
     let wall = Obstacle::new(
         "wall",
