@@ -46,7 +46,10 @@ const BATCH: usize = 8;
 /// over a piece is clear over its halves). Pieces below [`MIN_PIECE`] or more than
 /// [`MAX_CHECKS_PER_PIECE`] checks per initial piece refuse the motion.
 /// Pieces are visited breadth first (all midpoints before any half), in
-/// windows of 64 pieces in bisection order.
+/// windows of 64 pieces in bisection order. A checker with a batched proof
+/// ([`StateChecker::padded_free_batch`]) is offered a window's first pieces
+/// eight at a time; those it leaves are checked one by one right after
+/// their batch, sparing what it cleared.
 ///
 /// The ends are not checked here (a straight motion between two states
 /// within the limits stays within them). `None` when `deadline` expires
@@ -119,61 +122,79 @@ pub fn padded_motion<C: StateChecker + ?Sized>(
     let mut spent = [0usize; WINDOW];
     let first_half: Vec<f64> = delta.iter().map(|d| 0.5 * d / pieces as f64).collect();
     let mut rows = [0.0; BATCH * MAX_DOF];
+    // One piece's padded check: `Err` ends the motion, else the halves of
+    // an unproved piece join the queue.
+    let mut check = |(s, t, slot, mut proved): (f64, f64, usize, u64),
+                     queue: &mut VecDeque<(f64, f64, usize, u64)>,
+                     spent: &mut [usize; WINDOW],
+                     checks: &mut usize|
+     -> Result<(), PaddedMotion> {
+        *checks += 1;
+        let m = 0.5 * (s + t);
+        if checks.is_multiple_of(32) && deadline.expired() {
+            return Err(PaddedMotion::Interrupted);
+        }
+        if spent[slot] == MAX_CHECKS_PER_PIECE {
+            return Err(refused(m));
+        }
+        spent[slot] += 1;
+        for j in 0..n {
+            q[j] = a[j] + m * delta[j];
+            half[j] = 0.5 * (t - s) * delta[j];
+        }
+        match checker.padded_verdict_sparing(&q[..n], &half[..n], &mut proved) {
+            None | Some(PadVerdict::Collides) => Err(refused(m)),
+            Some(PadVerdict::Free) => Ok(()),
+            Some(PadVerdict::Unproved) if (t - s) * span < MIN_PIECE => Err(refused(m)),
+            Some(PadVerdict::Unproved) => {
+                queue.extend([(s, m, slot, proved), (m, t, slot, proved)]);
+                Ok(())
+            }
+        }
+    };
+    let piece = |i: usize| (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64);
     while order.peek().is_some() {
         spent.fill(0);
         let window: Vec<usize> = order.by_ref().take(WINDOW).collect();
-        // the window's pieces offered to the batched proof first, a batch
-        // at a time; those it proves free are done
-        let mut proved_free = 0u64;
-        let mut cleared = [0u64; WINDOW];
+        // the window's pieces offered to the batched proof a batch at a
+        // time; those it leaves are checked one by one at once (a motion
+        // through an obstacle is refused at its first batch), and their
+        // halves wait for the whole window
+        let mut batched = true;
         for (k, batch) in window.chunks(BATCH).enumerate() {
-            // a batch counts as a check per piece against the deadline
-            let asked = checks / 32;
-            checks += batch.len();
-            if checks / 32 != asked && deadline.expired() {
-                return PaddedMotion::Interrupted;
-            }
-            for (row, &i) in rows.chunks_exact_mut(n).zip(batch) {
-                let m = (i as f64 + 0.5) / pieces as f64;
-                for ((v, x), d) in row.iter_mut().zip(a).zip(delta) {
-                    *v = x + m * d;
+            let (mut free, mut cleared) = (0u32, [0u64; BATCH]);
+            if batched {
+                // a batch counts as a check per piece against the deadline
+                let asked = checks / 32;
+                checks += batch.len();
+                if checks / 32 != asked && deadline.expired() {
+                    return PaddedMotion::Interrupted;
+                }
+                for (row, &i) in rows.chunks_exact_mut(n).zip(batch) {
+                    let m = (i as f64 + 0.5) / pieces as f64;
+                    for ((v, x), d) in row.iter_mut().zip(a).zip(delta) {
+                        *v = x + m * d;
+                    }
+                }
+                let parts = &mut cleared[..batch.len()];
+                match checker.padded_free_batch(&rows[..batch.len() * n], &first_half, parts) {
+                    Some(proved) => free = proved,
+                    None => batched = false,
                 }
             }
-            let parts = &mut cleared[k * BATCH..k * BATCH + batch.len()];
-            match checker.padded_free_batch(&rows[..batch.len() * n], &first_half, parts) {
-                Some(free) => proved_free |= u64::from(free) << (k * BATCH),
-                None => break,
+            for (l, &i) in batch.iter().enumerate() {
+                if free & (1 << l) == 0 {
+                    let (s, t) = piece(i);
+                    let entry = (s, t, k * BATCH + l, cleared[l]);
+                    if let Err(end) = check(entry, &mut queue, &mut spent, &mut checks) {
+                        return end;
+                    }
+                }
             }
         }
-        queue.extend(
-            window
-                .iter()
-                .enumerate()
-                .filter(|(slot, _)| proved_free & (1 << slot) == 0)
-                .map(|(slot, &i)| {
-                    let (s, t) = (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64);
-                    (s, t, slot, cleared[slot])
-                }),
-        );
-        while let Some((s, t, slot, mut proved)) = queue.pop_front() {
-            checks += 1;
-            let m = 0.5 * (s + t);
-            if checks.is_multiple_of(32) && deadline.expired() {
-                return PaddedMotion::Interrupted;
-            }
-            if spent[slot] == MAX_CHECKS_PER_PIECE {
-                return refused(m);
-            }
-            spent[slot] += 1;
-            for j in 0..n {
-                q[j] = a[j] + m * delta[j];
-                half[j] = 0.5 * (t - s) * delta[j];
-            }
-            match checker.padded_verdict_sparing(&q[..n], &half[..n], &mut proved) {
-                None | Some(PadVerdict::Collides) => return refused(m),
-                Some(PadVerdict::Free) => {}
-                Some(PadVerdict::Unproved) if (t - s) * span < MIN_PIECE => return refused(m),
-                Some(PadVerdict::Unproved) => queue.extend([(s, m, slot, proved), (m, t, slot, proved)]),
+        while let Some(entry) = queue.pop_front() {
+            if let Err(end) = check(entry, &mut queue, &mut spent, &mut checks) {
+                return end;
             }
         }
     }
