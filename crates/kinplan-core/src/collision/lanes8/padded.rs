@@ -123,6 +123,32 @@ pub(crate) struct PadTerms {
     pair: [PairPad; MAX_PAIRS],
 }
 
+impl PadTerms {
+    /// Per body its constant term; per checked self pair `(distal, from,
+    /// to, constant)`, `None` when the two do not move apart (tests).
+    #[cfg(test)]
+    #[allow(clippy::type_complexity)]
+    pub(crate) fn constants(
+        &self,
+        pairs: usize,
+    ) -> (Vec<Option<f32>>, Vec<Option<(usize, Option<usize>, usize, f32)>>) {
+        let pair = self.pair[..pairs]
+            .iter()
+            .map(|p| match *p {
+                PairPad::Rigid => None,
+                PairPad::Relative {
+                    distal,
+                    from,
+                    to,
+                    constant,
+                    ..
+                } => Some((distal as usize, from.map(usize::from), to as usize, constant)),
+            })
+            .collect();
+        (self.body.to_vec(), pair)
+    }
+}
+
 /// Checked self pairs the padded batch takes (more: none proved).
 const MAX_PAIRS: usize = 64;
 
@@ -172,13 +198,35 @@ impl Lanes8 {
         for (v, x) in terms.d.iter_mut().zip(d) {
             *v = *x as f32;
         }
+        // per body, prefix sums over the joints (module doc):
+        // x_j = Σ_{i≤j} L_i h_i (3 P_i + h_i), y_j = Σ_{i≤j} L_i h_i,
+        // r_j = Σ_{i≤j} h_i κ_i, and P_j = Σ_{i<j} h_i
+        let mut sums = [[[0.0f64; 3]; MAX_DOF8]; MAX_BODIES8];
+        let mut before = [0.0f64; MAX_DOF8 + 1];
+        for (j, dj) in d.iter().enumerate() {
+            before[j + 1] = before[j] + dj.abs();
+        }
+        let sqrt3 = 3f64.sqrt();
         for b in 0..self.body_count {
             if sweep.last(b) != self.last[b] {
                 return None;
             }
-            if let Some(k) = self.last[b] {
-                terms.body[b] = Some(self.constant(sweep, d, b, None, k)?);
+            let Some(k) = self.last[b] else {
+                continue;
+            };
+            let e = self.largest_radius[b];
+            let (mut x, mut y, mut r) = (0.0, 0.0, 0.0);
+            for (j, dj) in d.iter().enumerate().take(k + 1) {
+                let (h, lever) = (dj.abs(), sweep.lever(b, j));
+                x += lever * h * (3.0 * before[j] + h);
+                y += lever * h;
+                let kappa = 2.0 * sqrt3 * self.rho * (lever + e)
+                    + 2.1 * self.margin[b]
+                    + 64.0 * U * (2.0 * self.reach + lever + e);
+                r += h * kappa;
+                sums[b][j] = [x, y, r];
             }
+            terms.body[b] = Some(constant(x, r, 1.0)?);
         }
         for (slot, &(a, b)) in terms.pair.iter_mut().zip(self_pairs) {
             let (a, b) = (a as usize, b as usize);
@@ -194,46 +242,26 @@ impl Lanes8 {
             if from == Some(to) {
                 continue; // moved by the same joints
             }
+            // the joints from + 1..=to alone, P_j summed from from + 1:
+            // Σ L h (3 (P − P_f) + h) = (x_to − x_f) − 3 P_f (y_to − y_f)
+            let [x, y, r] = sums[distal][to];
+            let constant = match from {
+                None => constant(x, r, 1.0)?,
+                Some(f) => {
+                    let [xf, yf, _] = sums[distal][f];
+                    let p = before[f + 1];
+                    constant((x - xf) - 3.0 * p * (y - yf), r, 2.0)?
+                }
+            };
             *slot = PairPad::Relative {
                 proximal: proximal as u8,
                 distal: distal as u8,
                 from: from.map(|f| f as u8),
                 to: to as u8,
-                constant: self.constant(sweep, d, distal, from, to)?,
+                constant,
             };
         }
         Some(terms)
-    }
-
-    /// The constant term of body `b`'s pad for the joints `from + 1..=to`
-    /// (all up to `to` when `from` is `None`): `A/2` and the rounding terms
-    /// (module doc; counted twice for a difference of prefix sums).
-    fn constant(
-        &self,
-        sweep: &SweepBound,
-        d: &[f64],
-        b: usize,
-        from: Option<usize>,
-        to: usize,
-    ) -> Option<f32> {
-        let sqrt3 = 3f64.sqrt();
-        let e = self.largest_radius[b];
-        let first = from.map_or(0, |f| f + 1);
-        let (mut prefix, mut accel, mut rounding) = (0.0, 0.0, 0.0);
-        for (j, dj) in d.iter().enumerate().take(to + 1) {
-            let (h, lever) = (dj.abs(), sweep.lever(b, j));
-            if j >= first {
-                accel += lever * h * (3.0 * prefix + h);
-                prefix += h;
-            }
-            let kappa = 2.0 * sqrt3 * self.rho * (lever + e)
-                + 2.1 * self.margin[b]
-                + 64.0 * U * (2.0 * self.reach + lever + e);
-            rounding += h * kappa;
-        }
-        let twice = if from.is_some() { 2.0 } else { 1.0 };
-        let constant = (0.5 * accel + twice * rounding) * (1.0 + 1e-12) + SLACK;
-        constant.is_finite().then(|| up(constant))
     }
 
     /// Unsure lanes of the batch of piece midpoints `q` with the half
@@ -450,6 +478,14 @@ impl Relative {
         }
         r
     }
+}
+
+/// A pad's constant term from its acceleration sum `accel` (the `A` of
+/// the module doc) and rounding sum, the rounding counted `twice` for a
+/// difference of prefix sums, rounded up (`f64` rounding in the slack).
+fn constant(accel: f64, rounding: f64, twice: f64) -> Option<f32> {
+    let constant = (0.5 * accel.max(0.0) + twice * rounding) * (1.0 + 1e-12) + SLACK;
+    constant.is_finite().then(|| up(constant))
 }
 
 /// `(a + b)²·GROW` per lane.

@@ -314,3 +314,57 @@ fn pieces_proved_together_are_free_at_every_sampled_state() {
     assert!(proved * 4 > offered, "{proved} of {offered}");
     assert!(spared * 10 > offered, "{spared} of {offered}");
 }
+
+#[test]
+fn pad_constants_equal_their_sums_joint_by_joint() {
+    // The constant terms of the padded batch come from prefix sums; summed
+    // here joint by joint from the formula (module doc of `lanes8::padded`):
+    // A = Σ_{f<j≤to} L_{j,b} h_j (3 Σ_{f<i<j} h_i + h_j), and the rounding
+    // term (a few kinematic margins per radian, below 0.2 mm here) added.
+    let (chain, model, acm) = panda_with_hand();
+    let sweep = SweepBound::new(&model).unwrap();
+    let world =
+        Arc::new(SceneGeometry::build(&Scene::new(vec![], &SceneLimits::default()).unwrap()).unwrap());
+    let checker = SceneChecker::new(model.clone(), &acm, world, batched()).unwrap();
+    let (_, self_pairs) = checker.checked_parts();
+    let lanes = checker.lanes8().unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let dof = chain.dof();
+    let accel = |b: usize, from: Option<usize>, to: usize, d: &[f64]| {
+        let first = from.map_or(0, |f| f + 1);
+        let mut sum = 0.0;
+        for j in first..=to {
+            let p: f64 = d[first..j].iter().map(|v| v.abs()).sum();
+            sum += sweep.lever(b, j) * d[j].abs() * (3.0 * p + d[j].abs());
+        }
+        sum
+    };
+    let mut relative = 0;
+    for _ in 0..50 {
+        let span = rng.random_range(0.001..0.2);
+        let d: Vec<f64> = (0..dof).map(|_| rng.random_range(-span..span)).collect();
+        let terms = lanes.pad_terms(&sweep, &d, self_pairs).unwrap();
+        let (bodies, pairs) = terms.constants(self_pairs.len());
+        let within = |got: f32, want: f64| {
+            let got = f64::from(got);
+            got >= want && got <= want * 1.01 + 2e-4
+        };
+        for (b, c) in bodies.iter().enumerate().take(model.body_count()) {
+            match (sweep.last(b), c) {
+                (None, None) => {}
+                (Some(k), Some(c)) => assert!(within(*c, 0.5 * accel(b, None, k, &d)), "body {b}: {c}"),
+                other => panic!("body {b}: {other:?}"),
+            }
+        }
+        for (i, p) in pairs.iter().enumerate() {
+            let Some((distal, from, to, c)) = *p else { continue };
+            let (a, b) = self_pairs[i];
+            let proximal = if distal == a as usize { b } else { a } as usize;
+            assert_eq!((sweep.last(proximal), sweep.last(distal)), (from, Some(to)));
+            let want = 0.5 * accel(distal, from, to, &d);
+            assert!(within(c, want), "pair {i}: {c} against {want}");
+            relative += usize::from(from.is_some());
+        }
+    }
+    assert!(relative > 100, "{relative} relative pairs");
+}
