@@ -44,6 +44,7 @@ use std::mem::MaybeUninit;
 use super::super::lanes8_bound::{SLACK, U};
 use super::super::scene_checker::SELF_PAIRS;
 use super::super::sweep::SweepBound;
+use super::super::trig32::MAX_TURN;
 use super::{
     Ball, Frame8, Lane8, Lanes8, MAX_BODIES8, MAX_DOF8, MAX_FINE8, MAX_LEAVES8, WIDTH, assume_init, dist2,
     for_bits, place, prim_dist2, uninit_frames, up,
@@ -176,7 +177,9 @@ impl Lanes8 {
     /// The constant pad terms of the pieces with half vector `d` for the
     /// `self_pairs`; `None` when the batch cannot prove pieces of this
     /// model (a sliding joint, more than 64 self pairs, or `sweep` not of
-    /// this model).
+    /// this model) or of this length (a joint's half step beyond
+    /// `trig32::MAX_TURN`, or not a number: the `f32` sums stay finite
+    /// below it).
     pub(crate) fn pad_terms(
         &self,
         sweep: &SweepBound,
@@ -185,7 +188,7 @@ impl Lanes8 {
     ) -> Option<PadTerms> {
         if self.slides
             || d.len() != self.dof
-            || !d.iter().all(|v| v.is_finite())
+            || !d.iter().all(|v| v.abs() <= MAX_TURN)
             || self_pairs.len() > MAX_PAIRS
         {
             return None;
@@ -499,8 +502,9 @@ fn threshold(a: &Lane8, b: &Lane8) -> Lane8 {
     t
 }
 
-/// Lanes whose `d2` is at most their own `t`: one compare and
-/// `vmovmskps` in the AVX2 build (`AVX`), a loop elsewhere; the same bits.
+/// Lanes whose `d2` is not above their own `t` (a NaN on either side
+/// counts as meeting: unsure, never wrong): one compare and `vmovmskps` in
+/// the AVX2 build (`AVX`), a loop elsewhere; the same bits.
 #[inline(always)]
 fn mask_each<const AVX: bool>(d2: &Lane8, t: &Lane8) -> u32 {
     #[cfg(target_arch = "x86_64")]
@@ -511,7 +515,7 @@ fn mask_each<const AVX: bool>(d2: &Lane8, t: &Lane8) -> u32 {
     }
     let mut bits = 0u32;
     for l in 0..WIDTH {
-        bits |= u32::from(d2[l] <= t[l]) << l;
+        bits |= u32::from(d2[l].partial_cmp(&t[l]) != Some(std::cmp::Ordering::Greater)) << l;
     }
     bits
 }
@@ -520,8 +524,8 @@ fn mask_each<const AVX: bool>(d2: &Lane8, t: &Lane8) -> u32 {
 #[target_feature(enable = "avx2")]
 #[inline]
 fn mask_each_avx(d2: &Lane8, t: &Lane8) -> u32 {
-    use std::arch::x86_64::{_CMP_LE_OQ, _mm256_cmp_ps, _mm256_loadu_ps, _mm256_movemask_ps};
+    use std::arch::x86_64::{_CMP_NGT_UQ, _mm256_cmp_ps, _mm256_loadu_ps, _mm256_movemask_ps};
     // SAFETY: `d2` and `t` are eight readable floats each.
     let (v, t) = unsafe { (_mm256_loadu_ps(d2.as_ptr()), _mm256_loadu_ps(t.as_ptr())) };
-    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(v, t)) as u32
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_NGT_UQ>(v, t)) as u32
 }

@@ -368,3 +368,44 @@ fn pad_constants_equal_their_sums_joint_by_joint() {
     }
     assert!(relative > 100, "{relative} relative pairs");
 }
+
+#[test]
+fn hostile_pieces_are_left_to_the_one_piece_check() {
+    // Half vectors not a number, infinite or beyond any joint's travel, and
+    // midpoints outside the limits or not numbers: nothing is proved, no
+    // panic; the same rows with a sane half vector are proved.
+    let (chain, model, acm) = panda_with_hand();
+    let world =
+        Arc::new(SceneGeometry::build(&Scene::new(vec![], &SceneLimits::default()).unwrap()).unwrap());
+    let params = CheckerParams {
+        padded_motion: true,
+        ..batched()
+    };
+    let checker = SceneChecker::new(model, &acm, world, params).unwrap();
+    let home = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
+    let rows = home.repeat(3);
+    let mut cleared = [0u64; 3];
+    let sane = [0.01; 7];
+    assert_eq!(checker.padded_free_batch(&rows, &sane, &mut cleared), Some(0b111));
+    for bad in [f64::NAN, f64::INFINITY, 1e300, 2e4] {
+        let mut half = sane;
+        half[3] = bad;
+        assert_eq!(
+            checker.padded_free_batch(&rows, &half, &mut cleared),
+            None,
+            "{bad}"
+        );
+    }
+    let mut odd = rows.clone();
+    odd[0] = f64::NAN;
+    odd[7] = chain.joints()[0].upper + 1.0;
+    odd[14] = -1e300;
+    assert_eq!(checker.padded_free_batch(&odd, &sane, &mut cleared), Some(0));
+    assert_eq!(cleared, [0; 3]);
+    // too many rows, or too few cleared slots: not offered
+    assert_eq!(
+        checker.padded_free_batch(&home.repeat(33), &sane, &mut [0; 33]),
+        None
+    );
+    assert_eq!(checker.padded_free_batch(&rows, &sane, &mut [0; 2]), None);
+}
