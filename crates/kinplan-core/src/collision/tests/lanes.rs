@@ -206,12 +206,18 @@ fn states_valid_refuses_states_outside_the_limits_and_takes_any_row_count() {
     }
 }
 
-/// A state on the boundary between `free` and `hit` (within 1e-6 of the
-/// line's length), on the free side: near contact.
-fn near_contact(checker: &SceneChecker, free: &[f64], hit: &[f64]) -> Vec<f64> {
+/// The two states straddling the boundary between `free` and `hit` on the
+/// line between them, within `tolerance` of the line's length apart: the
+/// free one and the colliding one (near contact).
+pub(super) fn near_contact(
+    checker: &SceneChecker,
+    free: &[f64],
+    hit: &[f64],
+    tolerance: f64,
+) -> [Vec<f64>; 2] {
     let at = |t: f64| -> Vec<f64> { free.iter().zip(hit).map(|(a, b)| a + t * (b - a)).collect() };
     let (mut lo, mut hi) = (0.0, 1.0);
-    while hi - lo > 1e-6 {
+    while hi - lo > tolerance {
         let mid = 0.5 * (lo + hi);
         if checker.is_valid(&at(mid)) {
             lo = mid
@@ -219,7 +225,7 @@ fn near_contact(checker: &SceneChecker, free: &[f64], hit: &[f64]) -> Vec<f64> {
             hi = mid
         }
     }
-    at(lo)
+    [at(lo), at(hi)]
 }
 
 #[test]
@@ -254,11 +260,11 @@ fn pieces_proved_together_are_free_at_every_sampled_state() {
             let half: Vec<f64> = (0..dof).map(|_| rng.random_range(-span..span)).collect();
             let rows: Vec<Vec<f64>> = (0..13)
                 .map(|i| match (i % 2, hit.is_empty()) {
-                    (0, false) => near_contact(
-                        &checker,
-                        free[(round * 13 + i) % free.len()],
-                        hit[(round + i) % hit.len()],
-                    ),
+                    (0, false) => {
+                        let (f, h) = (free[(round * 13 + i) % free.len()], hit[(round + i) % hit.len()]);
+                        let [near, _] = near_contact(&checker, f, h, 1e-6);
+                        near
+                    }
                     _ => random_state(&chain, &mut rng),
                 })
                 .collect();

@@ -13,7 +13,7 @@ use rand_chacha::ChaCha8Rng;
 
 use super::super::lanes8::{Flags, Frame8, Lane8, Lanes8, MAX_BODIES8, MAX_DOF8, WIDTH};
 use super::super::*;
-use super::lanes::{batched, mixed_chain_urdf, panda_with_hand, random_state, scenes};
+use super::lanes::{batched, mixed_chain_urdf, near_contact, panda_with_hand, random_state, scenes};
 use super::probe_urdf;
 use crate::robot::{Chain, ChainSpec, UrdfLimits, parse_chain};
 
@@ -229,18 +229,7 @@ fn eight_lanes_never_clear_a_colliding_state_near_contact() {
             .cloned()
             .collect();
         for (f, h) in free.iter().zip(&hit) {
-            let (mut lo, mut hi) = (0.0, 1.0);
-            let at = |t: f64| -> Vec<f64> { f.iter().zip(h).map(|(a, b)| a + t * (b - a)).collect() };
-            while hi - lo > 1e-7 {
-                let mid = 0.5 * (lo + hi);
-                if checker.is_valid(&at(mid)) {
-                    lo = mid
-                } else {
-                    hi = mid
-                }
-            }
-            states.push(at(lo));
-            states.push(at(hi));
+            states.extend(near_contact(&checker, f, h, 1e-7));
         }
         let (free, cleared) = check_states(name, &checker, &states);
         eprintln!(
