@@ -809,7 +809,7 @@ impl StateChecker for SceneChecker {
         {
             return None;
         }
-        let terms = lanes.pad_terms(sweep, half_step, &self.self_pairs)?;
+        let terms = lanes.pad_terms(sweep, half_step, &self.scene_bodies, &self.self_pairs)?;
         let mut free = 0u32;
         for (k, batch) in rows.chunks(WIDTH * dof).enumerate() {
             let n = batch.len() / dof;
@@ -826,14 +826,7 @@ impl StateChecker for SceneChecker {
                 }
             }
             let mut parts = [0u64; WIDTH];
-            let unsure = lanes.unsure_padded(
-                &q[..dof],
-                &terms,
-                &self.scene_bodies,
-                &self.self_pairs,
-                &mut parts,
-                false,
-            );
+            let unsure = lanes.unsure_padded(&q[..dof], &terms, &mut parts, false);
             free |= (!unsure & inside & ((1 << n) - 1)) << (k * WIDTH);
             for (l, c) in cleared[k * WIDTH..k * WIDTH + n].iter_mut().enumerate() {
                 *c = if inside & (1 << l) != 0 { parts[l] } else { 0 };

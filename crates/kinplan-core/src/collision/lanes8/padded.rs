@@ -117,14 +117,17 @@ impl Sums8 {
 /// up: per body (`None` for a body fixed to the base), and per checked self
 /// pair the motion of one body relative to the other.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct PadTerms {
+pub(crate) struct PadTerms<'a> {
+    /// The bodies checked against the scene and the checked self pairs.
+    scene_bodies: &'a [u16],
+    self_pairs: &'a [(u16, u16)],
     /// The half vector, in `f32`.
     d: [f32; MAX_DOF8],
     body: [Option<f32>; MAX_BODIES8],
     pair: [PairPad; MAX_PAIRS],
 }
 
-impl PadTerms {
+impl PadTerms<'_> {
     /// Per body its constant term; per checked self pair `(distal, from,
     /// to, constant)`, `None` when the two do not move apart (tests).
     #[cfg(test)]
@@ -174,18 +177,20 @@ enum PairPad {
 }
 
 impl Lanes8 {
-    /// The constant pad terms of the pieces with half vector `d` for the
-    /// `self_pairs`; `None` when the batch cannot prove pieces of this
+    /// The constant pad terms of the pieces with half vector `d`, checked
+    /// against the scene around `scene_bodies` and for the `self_pairs`;
+    /// `None` when the batch cannot prove pieces of this
     /// model (a sliding joint, more than 64 self pairs, or `sweep` not of
     /// this model) or of this length (a joint's half step beyond
     /// `trig32::MAX_TURN`, or not a number: the `f32` sums stay finite
     /// below it).
-    pub(crate) fn pad_terms(
+    pub(crate) fn pad_terms<'a>(
         &self,
         sweep: &SweepBound,
         d: &[f64],
-        self_pairs: &[(u16, u16)],
-    ) -> Option<PadTerms> {
+        scene_bodies: &'a [u16],
+        self_pairs: &'a [(u16, u16)],
+    ) -> Option<PadTerms<'a>> {
         if self.slides
             || d.len() != self.dof
             || !d.iter().all(|v| v.abs() <= MAX_TURN)
@@ -194,6 +199,8 @@ impl Lanes8 {
             return None;
         }
         let mut terms = PadTerms {
+            scene_bodies,
+            self_pairs,
             d: [0.0; MAX_DOF8],
             body: [None; MAX_BODIES8],
             pair: [PairPad::Rigid; MAX_PAIRS],
@@ -268,40 +275,33 @@ impl Lanes8 {
     }
 
     /// Unsure lanes of the batch of piece midpoints `q` with the half
-    /// vector `terms` were made for ([`Lanes8::pad_terms`]; module doc): bit `l` clear when lane `l`'s grown spheres are clear of the
-    /// scene around `scene_bodies` and of each other for the `self_pairs`.
-    /// `cleared[l]` gets what was proved clear in lane `l` even so: bit `b`
-    /// the scene around body `b` (of `scene_bodies`), bit 63 every self
-    /// pair. The AVX2 build when the CPU has it, unless `portable`.
+    /// vector, scene bodies and self pairs `terms` were made for
+    /// ([`Lanes8::pad_terms`]; module doc): bit `l` clear when lane `l`'s
+    /// grown spheres are clear of the scene around the scene bodies and of
+    /// each other for the self pairs. `cleared[l]` gets what was proved
+    /// clear in lane `l` even so: bit `b` the scene around body `b`, bit 63
+    /// every self pair. The AVX2 build when the CPU has it, unless
+    /// `portable`.
     pub(crate) fn unsure_padded(
         &self,
         q: &[Lane8],
         terms: &PadTerms,
-        scene_bodies: &[u16],
-        self_pairs: &[(u16, u16)],
         cleared: &mut [u64; WIDTH],
         portable: bool,
     ) -> u32 {
         #[cfg(target_arch = "x86_64")]
         if !portable && std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has the features the function is built for.
-            return unsafe { self.unsure_padded_avx2(q, terms, scene_bodies, self_pairs, cleared) };
+            return unsafe { self.unsure_padded_avx2(q, terms, cleared) };
         }
         let _ = portable;
-        self.unsure_padded_in::<false>(q, terms, scene_bodies, self_pairs, cleared)
+        self.unsure_padded_in::<false>(q, terms, cleared)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn unsure_padded_avx2(
-        &self,
-        q: &[Lane8],
-        terms: &PadTerms,
-        scene_bodies: &[u16],
-        self_pairs: &[(u16, u16)],
-        cleared: &mut [u64; WIDTH],
-    ) -> u32 {
-        self.unsure_padded_in::<true>(q, terms, scene_bodies, self_pairs, cleared)
+    fn unsure_padded_avx2(&self, q: &[Lane8], terms: &PadTerms, cleared: &mut [u64; WIDTH]) -> u32 {
+        self.unsure_padded_in::<true>(q, terms, cleared)
     }
 
     #[inline(always)]
@@ -309,11 +309,10 @@ impl Lanes8 {
         &self,
         q: &[Lane8],
         terms: &PadTerms,
-        scene_bodies: &[u16],
-        self_pairs: &[(u16, u16)],
         cleared: &mut [u64; WIDTH],
     ) -> u32 {
         const ALL: u32 = (1 << WIDTH) - 1;
+        let (scene_bodies, self_pairs) = (terms.scene_bodies, terms.self_pairs);
         *cleared = [0; WIDTH];
         let mut frames = uninit_frames();
         let mut sums = [const { MaybeUninit::<Sums8>::uninit() }; MAX_DOF8];

@@ -272,7 +272,7 @@ fn pieces_proved_together_are_free_at_every_sampled_state() {
             let free_mask = checker
                 .padded_free_batch(&rows.concat(), &half, &mut cleared)
                 .unwrap();
-            let terms = lanes.pad_terms(&sweep, &half, self_pairs).unwrap();
+            let terms = lanes.pad_terms(&sweep, &half, scene_bodies, self_pairs).unwrap();
             for batch in rows.chunks(8) {
                 let mut q = [[0.0f32; 8]; 16];
                 for (l, row) in batch.iter().enumerate() {
@@ -281,8 +281,8 @@ fn pieces_proved_together_are_free_at_every_sampled_state() {
                     }
                 }
                 let (mut a, mut b) = ([0u64; 8], [0u64; 8]);
-                let simd = lanes.unsure_padded(&q[..dof], &terms, scene_bodies, self_pairs, &mut a, false);
-                let portable = lanes.unsure_padded(&q[..dof], &terms, scene_bodies, self_pairs, &mut b, true);
+                let simd = lanes.unsure_padded(&q[..dof], &terms, &mut a, false);
+                let portable = lanes.unsure_padded(&q[..dof], &terms, &mut b, true);
                 assert_eq!((simd, a), (portable, b), "{name}: the builds disagree");
             }
             for (l, m) in rows.iter().enumerate() {
@@ -349,7 +349,7 @@ fn pad_constants_equal_their_sums_joint_by_joint() {
     for _ in 0..50 {
         let span = rng.random_range(0.001..0.2);
         let d: Vec<f64> = (0..dof).map(|_| rng.random_range(-span..span)).collect();
-        let terms = lanes.pad_terms(&sweep, &d, self_pairs).unwrap();
+        let terms = lanes.pad_terms(&sweep, &d, &[], self_pairs).unwrap();
         let (bodies, pairs) = terms.constants(self_pairs.len());
         let within = |got: f32, want: f64| {
             let got = f64::from(got);
