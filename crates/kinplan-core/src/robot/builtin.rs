@@ -62,7 +62,8 @@ pub fn builtin_urdf(name: &str) -> Result<&'static str, RobotError> {
 /// The MoveIt SRDF of a built-in robot, when it has designed contacts: pairs
 /// of links in contact at the default pose of the real robot, which the
 /// collision checks allow (`collision::AllowedCollisions::allow_named`). The
-/// Panda's come from MoveIt's Panda configuration; `generate.py` writes them.
+/// Panda's come from MoveIt's Panda configuration (`panda_moveit_config`:
+/// finger against finger); `generate.py` writes them.
 pub fn builtin_srdf(name: &str) -> Option<&'static str> {
     match name {
         "franka_panda" => Some(include_str!("builtin/franka_panda.srdf")),

@@ -170,16 +170,18 @@ def with_covers(text, covers, links):
 
 PANDA_ARM_LINKS = ["base_link"] + [f"link_{i}" for i in range(1, 8)]
 
-# The pairs MoveIt's Panda configuration (panda_moveit_config, and the SRDF of
-# example-robot-data) disables as in contact at the default pose on the real
-# meshes: designed contacts, which the built-in model inherits (its own
+# The pairs MoveIt's Panda configuration (panda_moveit_config, the SRDF
+# MotionBenchMaker plans with) disables as in contact at the default pose on the
+# real meshes: designed contacts, which the built-in model inherits (its own
 # shapes are larger than the meshes, so its own default pose says nothing).
-PANDA_DEFAULT_PAIRS = [("link_5", "link_7"), ("link_5", "panda_hand"), ("panda_leftfinger", "panda_rightfinger")]
+# example-robot-data's SRDF also disables link_5 against link_7 and the hand;
+# those meshes do meet when the hand folds back, so they stay checked.
+PANDA_DEFAULT_PAIRS = [("panda_leftfinger", "panda_rightfinger")]
 
 
 def panda_srdf(name, links):
     """A MoveIt SRDF holding the built-in's designed contacts."""
-    out = f'<?xml version="1.0"?>\n<!-- {name}: the pairs MoveIt\'s Panda configuration disables as in contact at the default pose (generate.py) -->\n'
+    out = f'<?xml version="1.0"?>\n<!-- {name}: the pairs MoveIt\'s Panda configuration (panda_moveit_config) disables as in contact at the default pose (generate.py) -->\n'
     out += f'<robot name="{name}">\n'
     for a, b in PANDA_DEFAULT_PAIRS:
         if a in links and b in links:
