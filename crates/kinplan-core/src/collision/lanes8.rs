@@ -187,8 +187,7 @@ pub(crate) struct Lanes8 {
     fine: Vec<Ball>,
     start: Vec<usize>,
     /// Per body, how far the kinematics can misplace a sphere centre (m;
-    /// already in the radii, kept for the tests).
-    #[cfg_attr(not(test), allow(dead_code))]
+    /// already in the radii; the padded batch's rounding terms use it).
     margin: Vec<f64>,
     /// Leaf boxes `[lo, hi]` (each leaf's bounds are broadcast to the lanes,
     /// so one record per leaf).
@@ -203,9 +202,9 @@ pub(crate) struct Lanes8 {
     rho: f64,
     /// Every placed coordinate is within this of the base (m).
     reach: f64,
-    /// Per body, twice its largest sphere's grown radius (m): a sphere
-    /// centre is within this of some point of the body.
-    largest_radius: Vec<f64>,
+    /// Per body, twice its largest sphere's grown radius (m): bounds how far
+    /// a sphere centre lies from the body's points, and a sphere's radius.
+    reach_past: Vec<f64>,
 }
 
 /// `x` rounded to an `f32` not below it.
@@ -354,6 +353,11 @@ impl Lanes8 {
                 }
             }
         }
+        // every joint applied (a trailing joint moving no body has no step in
+        // the program, and the padded batch keeps a sum per joint)
+        if joint != dof {
+            return None;
+        }
         // every body posed exactly once: the batch reads every body's frame
         let mut posed = vec![0; body_count];
         for op in &ops {
@@ -381,7 +385,10 @@ impl Lanes8 {
         }
         // every placed coordinate is within X of the base
         let x = (0..body_count)
-            .map(|b| bound.reach + coarse_of[b].0.norm() + coarse_of[b].1 + margin[b])
+            .map(|b| {
+                let fine = fine_of[b].iter().map(|(c, r)| c.norm() + r).fold(0.0, f64::max);
+                bound.reach + fine.max(coarse_of[b].0.norm() + coarse_of[b].1) + margin[b]
+            })
             .fold(bound.reach, f64::max);
         if !(x.is_finite() && x <= MAX_COORD) {
             return None;
@@ -403,7 +410,7 @@ impl Lanes8 {
             ]);
             prims.push(prim_of(leaf, x));
         }
-        let largest_radius = (0..body_count)
+        let reach_past = (0..body_count)
             .map(|b| {
                 let fine = &fine[start[b]..start[b + 1]];
                 2.0 * fine
@@ -414,7 +421,7 @@ impl Lanes8 {
             })
             .collect();
         Some(Lanes8 {
-            largest_radius,
+            reach_past,
             ops,
             dof,
             body_count,
@@ -788,19 +795,26 @@ fn min(a: f32, b: f32) -> f32 {
     if a < b { a } else { b }
 }
 
-/// Lanes whose `d2` is at most `t`: one compare and `vmovmskps` in the
-/// AVX2 build (`AVX`), a loop elsewhere; the same bits.
+/// Lanes whose `d2` is not above `t` ([`mask_each`] with one threshold).
 #[inline(always)]
 fn mask<const AVX: bool>(d2: &Lane8, t: f32) -> u32 {
+    mask_each::<AVX>(d2, &[t; WIDTH])
+}
+
+/// Lanes whose `d2` is not above their own `t` (a NaN on either side
+/// counts as meeting: unsure, never wrong): one compare and `vmovmskps` in
+/// the AVX2 build (`AVX`), a loop elsewhere; the same bits.
+#[inline(always)]
+fn mask_each<const AVX: bool>(d2: &Lane8, t: &Lane8) -> u32 {
     #[cfg(target_arch = "x86_64")]
     if AVX {
         // SAFETY: `AVX` is set only in the AVX2 build, which runs after the
         // CPU was found to have AVX2.
-        return unsafe { mask_avx(d2, t) };
+        return unsafe { mask_each_avx(d2, t) };
     }
     let mut bits = 0u32;
     for l in 0..WIDTH {
-        bits |= u32::from(d2[l] <= t) << l;
+        bits |= u32::from(d2[l].partial_cmp(&t[l]) != Some(std::cmp::Ordering::Greater)) << l;
     }
     bits
 }
@@ -808,11 +822,11 @@ fn mask<const AVX: bool>(d2: &Lane8, t: f32) -> u32 {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-fn mask_avx(d2: &Lane8, t: f32) -> u32 {
-    use std::arch::x86_64::{_CMP_LE_OQ, _mm256_cmp_ps, _mm256_loadu_ps, _mm256_movemask_ps, _mm256_set1_ps};
-    // SAFETY: `d2` is eight readable floats.
-    let v = unsafe { _mm256_loadu_ps(d2.as_ptr()) };
-    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(v, _mm256_set1_ps(t))) as u32
+fn mask_each_avx(d2: &Lane8, t: &Lane8) -> u32 {
+    use std::arch::x86_64::{_CMP_NGT_UQ, _mm256_cmp_ps, _mm256_loadu_ps, _mm256_movemask_ps};
+    // SAFETY: `d2` and `t` are eight readable floats each.
+    let (v, t) = unsafe { (_mm256_loadu_ps(d2.as_ptr()), _mm256_loadu_ps(t.as_ptr())) };
+    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_NGT_UQ>(v, t)) as u32
 }
 
 /// Calls `f` with every set bit's index.

@@ -33,7 +33,7 @@
 //! past the body's bounding sphere), `|Ω_k|·r` by `|d_j|·√3ρ·e`, and the
 //! `f32` sums by `|d_j|·38u·(2X + L + e)` (`X` bounds every coordinate);
 //! [`Lanes8::pad_terms`] adds `Σ_j |d_j|·κ_{j,b}` with
-//! `κ = 2√3ρ(L + e) + 2.1E + 64u(2X + L + e)` to `A_b/2` in `f64` and
+//! `κ = 2√3ρ(L + e) + 2E(1 + √3ρ) + 64u(2X + L + e)` to `A_b/2` in `f64` and
 //! rounds up, and the pad's own `f32` evaluation (a square root, two sums
 //! and a product: relative `< 8u`) is covered by scaling it by
 //! `1 + 2⁻¹⁶`. The threshold `(R)²·GROW` covers the rounding of
@@ -47,7 +47,7 @@ use super::super::sweep::SweepBound;
 use super::super::trig32::MAX_TURN;
 use super::{
     Ball, Frame8, Lane8, Lanes8, MAX_BODIES8, MAX_DOF8, MAX_FINE8, MAX_LEAVES8, WIDTH, assume_init, dist2,
-    for_bits, place, prim_dist2, uninit_frames, up,
+    for_bits, mask_each, place, prim_dist2, uninit_frames, up,
 };
 
 /// `1 + 2⁻¹⁶`: the pad's `f32` evaluation, scaled up (module doc).
@@ -81,6 +81,17 @@ impl Sums8 {
             self.moment[1][l] += wz * o[0][l] - wx * o[2][l];
             self.moment[2][l] += wx * o[1][l] - wy * o[0][l];
         }
+    }
+
+    /// Sphere `s` placed at `x`, its radius grown per lane by its pad
+    /// ([`Sums8::pad`]) and the pad's `constant` term.
+    #[inline(always)]
+    fn grown(&self, x: &[Lane8; 3], s: &Ball, constant: f32) -> Lane8 {
+        let mut r = self.pad(x, s.r);
+        for v in r.iter_mut() {
+            *v += constant + s.r;
+        }
+        r
     }
 
     /// `self − other`, term by term.
@@ -224,14 +235,14 @@ impl Lanes8 {
             let Some(k) = self.last[b] else {
                 continue;
             };
-            let e = self.largest_radius[b];
+            let e = self.reach_past[b];
             let (mut x, mut y, mut r) = (0.0, 0.0, 0.0);
             for (j, dj) in d.iter().enumerate().take(k + 1) {
                 let (h, lever) = (dj.abs(), sweep.lever(b, j));
                 x += lever * h * (3.0 * before[j] + h);
                 y += lever * h;
                 let kappa = 2.0 * sqrt3 * self.rho * (lever + e)
-                    + 2.1 * self.margin[b]
+                    + 2.0 * self.margin[b] * (1.0 + sqrt3 * self.rho)
                     + 64.0 * U * (2.0 * self.reach + lever + e);
                 r += h * kappa;
                 sums[b][j] = [x, y, r];
@@ -381,11 +392,9 @@ impl Lanes8 {
                     if m & !met == 0 {
                         continue;
                     }
-                    let rigid = Relative {
-                        sums: Sums8::ZERO,
-                        constant: 0.0,
-                    };
-                    self.pair_meets::<AVX>(&rigid, (&frames[a], a), (&frames[b], b)) & m
+                    // no relative motion: the state check's test at the midpoint
+                    let (ca, cb) = (&centres[a].0, &centres[b].0);
+                    self.fine_pairs_meet::<AVX>(&frames[a], a, &frames[b], b, ca, cb) & m
                 }
                 PairPad::Relative {
                     proximal,
@@ -422,13 +431,7 @@ impl Lanes8 {
     #[inline(always)]
     fn grown(&self, sums: &[Sums8], terms: &PadTerms, b: usize, x: &[Lane8; 3], s: &Ball) -> Lane8 {
         match (self.last[b], terms.body[b]) {
-            (Some(k), Some(constant)) => {
-                let mut r = sums[k].pad(x, s.r);
-                for v in r.iter_mut() {
-                    *v += constant + s.r;
-                }
-                r
-            }
+            (Some(k), Some(constant)) => sums[k].grown(x, s, constant),
             _ => [s.r; WIDTH],
         }
     }
@@ -474,11 +477,7 @@ impl Relative {
     /// Sphere `s` placed at `x`, its radius grown by its relative pad.
     #[inline(always)]
     fn grown(&self, x: &[Lane8; 3], s: &Ball) -> Lane8 {
-        let mut r = self.sums.pad(x, s.r);
-        for v in r.iter_mut() {
-            *v += self.constant + s.r;
-        }
-        r
+        self.sums.grown(x, s, self.constant)
     }
 }
 
@@ -499,32 +498,4 @@ fn threshold(a: &Lane8, b: &Lane8) -> Lane8 {
         t[l] = reach * reach * GROW;
     }
     t
-}
-
-/// Lanes whose `d2` is not above their own `t` (a NaN on either side
-/// counts as meeting: unsure, never wrong): one compare and `vmovmskps` in
-/// the AVX2 build (`AVX`), a loop elsewhere; the same bits.
-#[inline(always)]
-fn mask_each<const AVX: bool>(d2: &Lane8, t: &Lane8) -> u32 {
-    #[cfg(target_arch = "x86_64")]
-    if AVX {
-        // SAFETY: `AVX` is set only in the AVX2 build, which runs after the
-        // CPU was found to have AVX2.
-        return unsafe { mask_each_avx(d2, t) };
-    }
-    let mut bits = 0u32;
-    for l in 0..WIDTH {
-        bits |= u32::from(d2[l].partial_cmp(&t[l]) != Some(std::cmp::Ordering::Greater)) << l;
-    }
-    bits
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-fn mask_each_avx(d2: &Lane8, t: &Lane8) -> u32 {
-    use std::arch::x86_64::{_CMP_NGT_UQ, _mm256_cmp_ps, _mm256_loadu_ps, _mm256_movemask_ps};
-    // SAFETY: `d2` and `t` are eight readable floats each.
-    let (v, t) = unsafe { (_mm256_loadu_ps(d2.as_ptr()), _mm256_loadu_ps(t.as_ptr())) };
-    _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_NGT_UQ>(v, t)) as u32
 }
