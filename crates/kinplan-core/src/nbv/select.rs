@@ -368,7 +368,10 @@ pub fn next_best_view(
     } else {
         None
     };
+    let clock_ref = &clock;
     let view_grid_work = move || match (&params.visibility, state_grid, &region) {
+        // not recoded once the request is interrupted: the visibility stage will not run
+        (_, g, _) if clock_ref.interrupted().is_some() => (None, g),
         (Some(vp), Some(g), Some((a, b))) => match (tree.key_of(a), tree.key_of(b)) {
             (Ok(ka), Ok(kb)) => match ViewGrid::from_padded(g, (ka, kb), camera, vp.pixel_stride) {
                 Ok(vg) => (Some(vg), None),
@@ -481,6 +484,7 @@ pub fn next_best_view(
         };
         let mut kept: Vec<NbvCandidate> = Vec::with_capacity(params.max_results);
         let mut rest = scored.into_iter();
+        let pool = std::sync::Mutex::new(Vec::new());
         loop {
             let batch: Vec<NbvCandidate> = rest.by_ref().take(vp.batch).collect();
             if batch.is_empty() {
@@ -490,27 +494,32 @@ pub fn next_best_view(
                 status = s;
                 break;
             }
-            // a workspace per thread's share of the batch (its bit sets span the region)
+            // a workspace per share of the batch (its bit sets span the region), taken from
+            // the pool and given back, so the bit sets are allocated once per thread
             let preds: Vec<Option<ViewPrediction>> = batch
                 .par_iter()
-                .map_init(PredictWorkspace::default, |ws, c| {
-                    if clock.interrupted().is_some() {
-                        return None;
-                    }
-                    Some(match &view_grid {
-                        Some(vg) => predict_on_grid(tree, vg, camera, &c.pose, vp, ws, clock.deadline),
-                        None => predict_view_in(
-                            tree,
-                            grid.as_ref(),
-                            camera,
-                            &c.pose,
-                            vp,
-                            region_keys,
-                            ws,
-                            clock.deadline,
-                        ),
-                    })
-                })
+                .map_init(
+                    || Pooled::take(&pool),
+                    |pooled, c| {
+                        let ws = &mut pooled.ws;
+                        if clock.interrupted().is_some() {
+                            return None;
+                        }
+                        Some(match &view_grid {
+                            Some(vg) => predict_on_grid(tree, vg, camera, &c.pose, vp, ws, clock.deadline),
+                            None => predict_view_in(
+                                tree,
+                                grid.as_ref(),
+                                camera,
+                                &c.pose,
+                                vp,
+                                region_keys,
+                                ws,
+                                clock.deadline,
+                            ),
+                        })
+                    },
+                )
                 .collect();
             for (mut c, p) in batch.into_iter().zip(preds) {
                 let Some(p) = p else { continue };
@@ -621,4 +630,31 @@ pub fn next_best_view(
         reach,
         elapsed_us: us(start),
     })
+}
+
+/// A visibility workspace lent by a pool for one share of a batch and given
+/// back when the share is done, so its bit sets outlive the batch.
+struct Pooled<'a> {
+    ws: PredictWorkspace,
+    pool: &'a std::sync::Mutex<Vec<PredictWorkspace>>,
+}
+
+impl<'a> Pooled<'a> {
+    fn take(pool: &'a std::sync::Mutex<Vec<PredictWorkspace>>) -> Self {
+        let ws = pool
+            .lock()
+            .map(|mut p| p.pop())
+            .ok()
+            .flatten()
+            .unwrap_or_default();
+        Pooled { ws, pool }
+    }
+}
+
+impl Drop for Pooled<'_> {
+    fn drop(&mut self) {
+        if let Ok(mut p) = self.pool.lock() {
+            p.push(std::mem::take(&mut self.ws));
+        }
+    }
 }

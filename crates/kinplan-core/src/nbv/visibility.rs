@@ -185,11 +185,6 @@ pub(crate) fn predict_view_in(
     ws: &mut PredictWorkspace,
     deadline: Deadline<'_>,
 ) -> ViewPrediction {
-    if let (Some(g), Some(keys)) = (grid, region_keys)
-        && let Some(vg) = ViewGrid::new(g, keys, camera, params.pixel_stride)
-    {
-        return predict_on_grid(tree, &vg, camera, pose, params, ws, deadline);
-    }
     let mut cache = SearchCache::default();
     let mut lookup = |k: &OcKey| match grid.and_then(|g| g.index_of(k).map(|i| g.cells[i])) {
         Some(UNKNOWN) => (CellState::Unknown, None),
@@ -280,61 +275,16 @@ pub(crate) struct ViewGrid {
     /// Per ray of the camera's strided pixel grid (rows, then columns): its unit
     /// direction in the optical frame and its parameter at depth `far`.
     rays: Vec<(Vector3<f64>, f64)>,
-    /// The camera and stride the rays were built for.
+    /// The camera and stride the rays were built for (the walks take no other).
     rays_for: (CameraModel, usize),
 }
 
 impl ViewGrid {
-    /// `None` when the region `[rlo, rhi]` is empty, not inside `grid`, or has more
-    /// than [`MAX_BITSET_CELLS`] cells (the caller then takes the key lists).
-    pub fn new(
-        grid: &StateGrid,
-        (rlo, rhi): (OcKey, OcKey),
-        camera: &CameraModel,
-        stride: usize,
-    ) -> Option<Self> {
-        let glo = grid.lo;
-        let mut rdims = [0usize; 3];
-        for i in 0..3 {
-            if rlo[i] > rhi[i] || (rlo[i] as i64) < glo[i] || rhi[i] as i64 >= glo[i] + grid.dims[i] as i64 {
-                return None;
-            }
-            rdims[i] = (rhi[i] - rlo[i]) as usize + 1;
-        }
-        if rdims[0] * rdims[1] * rdims[2] > MAX_BITSET_CELLS {
-            return None;
-        }
-        let [nx, ny, nz] = grid.dims;
-        let dims = grid.dims.map(|d| d + 2);
-        // region offsets in the grid, per axis
-        let o = [0, 1, 2].map(|i| (rlo[i] as i64 - glo[i]) as usize);
-        let e = [0, 1, 2].map(|i| (rhi[i] as i64 - glo[i]) as usize);
-        let mut cells = vec![OUTSIDE; dims[0] * dims[1] * dims[2]];
-        for z in 0..nz {
-            for y in 0..ny {
-                let from = (z * ny + y) * nx;
-                let at = ((z + 1) * dims[1] + y + 1) * dims[0] + 1;
-                let row = &mut cells[at..at + nx];
-                row.copy_from_slice(&grid.cells[from..from + nx]);
-                open_outside_region(row, y, z, &o, &e);
-            }
-        }
-        let stride = stride.max(1);
-        Some(Self {
-            lo: glo,
-            inner: grid.dims,
-            dims,
-            cells,
-            rlo,
-            rdims,
-            rays: camera_rays(camera, stride),
-            rays_for: (*camera, stride),
-        })
-    }
-
-    /// [`new`](Self::new) recoding `grid` in place: its outermost layer becomes the
+    /// The view grid of `grid` recoded in place: its outermost layer becomes the
     /// outside layer, the rest (at least one cell of `grid` on every axis) the grid the
-    /// walks read. The state grid is given back when the region does not fit.
+    /// walks read, with the rays of `camera` at `stride`. The state grid is given back
+    /// when the region `[rlo, rhi]` is empty, not inside the inner grid, or has more
+    /// than [`MAX_BITSET_CELLS`] cells (the caller then takes the key lists).
     pub fn from_padded(
         mut grid: StateGrid,
         (rlo, rhi): (OcKey, OcKey),
@@ -383,22 +333,6 @@ impl ViewGrid {
             rays: camera_rays(camera, stride),
             rays_for: (*camera, stride),
         })
-    }
-
-    /// The rays of `camera` at `stride` ([`camera_rays`]): the grid's own when it was
-    /// built for them, else computed into `local`.
-    fn rays<'a>(
-        &'a self,
-        camera: &CameraModel,
-        stride: usize,
-        local: &'a mut Vec<(Vector3<f64>, f64)>,
-    ) -> &'a [(Vector3<f64>, f64)] {
-        if self.rays_for == (*camera, stride) {
-            &self.rays
-        } else {
-            *local = camera_rays(camera, stride);
-            local
-        }
     }
 
     /// Whether `k` lies inside the state grid.
@@ -495,8 +429,11 @@ pub(crate) fn predict_on_grid(
         return out;
     };
     let lookahead = params.lookahead;
-    let mut own_rays = Vec::new();
-    'ray: for &(local, t1) in grid.rays(camera, stride, &mut own_rays) {
+    assert!(
+        grid.rays_for == (*camera, stride),
+        "a view grid walks the rays it was built for"
+    );
+    'ray: for &(local, t1) in &grid.rays {
         if out.rays % 64 == 63 && deadline.expired() {
             break 'ray;
         }
