@@ -17,9 +17,8 @@ pub const MAX_CHECKS_PER_PIECE: usize = 64;
 /// Longest first piece, in resolutions: a piece is proved with pads that
 /// grow with its length, so longer pieces are cheaper to prove than several
 /// short ones while the halving refines them where obstacles are near;
-/// shorter pieces are proved by the batch more often (two resolutions was
-/// the best of one to eight on the MotionBenchMaker problems, with the
-/// batched proof and without it, `benches/RESULTS.md`).
+/// shorter pieces are proved by the batch more often (the length tried
+/// against others on the MotionBenchMaker problems: `benches/RESULTS.md`).
 const FIRST_PIECE: f64 = 2.0;
 /// Pieces proved together, breadth first (bounds the queue at
 /// `WINDOW · (MAX_CHECKS_PER_PIECE + 1)` entries whatever the motion's length).

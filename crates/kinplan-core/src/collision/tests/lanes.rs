@@ -336,7 +336,7 @@ fn pad_constants_equal_their_sums_joint_by_joint() {
     // The constant terms of the padded batch come from prefix sums; summed
     // here joint by joint from the formula (module doc of `lanes8::padded`):
     // A = Σ_{f<j≤to} L_{j,b} h_j (3 Σ_{f<i<j} h_i + h_j), and the rounding
-    // term (a few kinematic margins per radian, below 0.2 mm here) added.
+    // term (a few kinematic margins per radian of the half step) added.
     let (chain, model, acm) = panda_with_hand();
     let sweep = SweepBound::new(&model).unwrap();
     let world =
