@@ -429,17 +429,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..Row::default()
             };
             if let Some(path) = &a.states_from {
-                // the same scene with the eight-lane check, for its columns
-                let lanes = SceneChecker::new(
-                    checker.model().clone(),
-                    &acm,
-                    checker.world().clone(),
-                    CheckerParams {
-                        batched: true,
+                // the same scene checked state by state and in eight lanes,
+                // one column each, whatever `--unbatched` says
+                let with = |batched| {
+                    let params = CheckerParams {
+                        batched,
                         ..CheckerParams::default()
-                    },
-                )?;
-                println!("{}", states_from(&checker, &lanes, path, dof)?);
+                    };
+                    SceneChecker::new(checker.model().clone(), &acm, checker.world().clone(), params)
+                };
+                println!("{}", states_from(&with(false)?, &with(true)?, path, dof)?);
                 return Ok(());
             }
             if a.state_cost > 0 {
