@@ -7,7 +7,9 @@ One `pinocchio.computeCollisions(model, data, geom, geom_data, q, True)` per
 state: forward kinematics, placements and every collision pair until the
 first contact, all in C++ (coal checks each mesh as its triangles). Pairs:
 every robot geometry against every scene object, and the robot's own pairs
-less those the SRDF disables. Fingers held at 0.04 m each (the problems'
+less those the SRDF disables (`--srdf`: example-robot-data's by default;
+MoveIt's own Panda configuration, the one MotionBenchMaker plans with, checks
+more pairs: pass it, e.g. VAMP's `resources/panda/panda.srdf`). Fingers held at 0.04 m each (the problems'
 open grasps, as `mbm_bench --clamp-fingers`). The Python loop's own cost is
 timed apart (the same loop calling `pinocchio.neutral`) and reported; it is
 not subtracted.
@@ -58,12 +60,12 @@ def scene_objects(path):
 class MeshPanda:
     """The Panda with its meshes in pinocchio, self pairs per the SRDF."""
 
-    def __init__(self):
+    def __init__(self, srdf=None):
         share, root = robot_dir()
         urdf = os.path.join(root, 'urdf', 'panda.urdf')
         self.model = pin.buildModelFromUrdf(urdf)
         self.robot_geom = pin.buildGeomFromUrdf(self.model, urdf, pin.COLLISION, package_dirs=[share])
-        self.srdf = os.path.join(root, 'srdf', 'panda.srdf')
+        self.srdf = srdf or os.path.join(root, 'srdf', 'panda.srdf')
         self.arm = [self.model.getJointId(f'panda_joint{i}') for i in range(1, 8)]
         self.fingers = [self.model.getJointId(f'panda_finger_joint{i}') for i in (1, 2)]
 
@@ -105,10 +107,11 @@ def main():
     ap.add_argument('--sets', default=','.join(SETS))
     ap.add_argument('--problems-per-set', type=int, default=20)
     ap.add_argument('--passes', type=int, default=3)
+    ap.add_argument('--srdf', help="the SRDF whose disabled pairs the robot's own checks leave out")
     ap.add_argument('--json')
     args = ap.parse_args()
 
-    panda = MeshPanda()
+    panda = MeshPanda(args.srdf)
     data = panda.model.createData()
     summary = {}
     print('| set | problems | coal (meshes): all states | coal: free states | Python loop alone | '
@@ -148,6 +151,9 @@ def main():
               f"{med('free') / n:.3f} | {med('vamp_free_mesh_collides') / n:.4f} | "
               f"{med('vamp_refuses_mesh_free') / n:.4f} | {med('ours_free_mesh_collides') / n:.4f} | "
               f"{med('ours_refuses_mesh_free') / n:.4f} |", flush=True)
+    total = lambda key: sum(r[key] for v in summary.values() for r in v['rows'])
+    print(f"in all: {total('states')} states; called free where the meshes collide: "
+          f"VAMP {total('vamp_free_mesh_collides')}, ours {total('ours_free_mesh_collides')}")
     if args.json:
         json.dump(summary, open(args.json, 'w'), indent=1)
 
