@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use criterion::{Criterion, criterion_group, criterion_main};
 use kinplan_core::collision::{
     AcmParams, AllowReason, AllowedCollisions, CheckerParams, Geometry, Obstacle, RobotModel, Scene,
-    SceneChecker, SceneGeometry, SceneLimits, StateChecker,
+    SceneChecker, SceneGeometry, SceneLimits, StateChecker, builtin_mesh,
 };
 use kinplan_core::robot::{Shape, builtin_chain};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
@@ -128,7 +128,16 @@ fn setup() -> (SceneChecker, SceneChecker, Vec<Vec<f64>>) {
                     Shape::Sphere { radius } => json!({"sphere": radius}),
                     Shape::Cylinder { radius, length } => json!({"cylinder": [radius, length]}),
                     Shape::Capsule { radius, length } => json!({"capsule": [radius, length]}),
-                    Shape::MeshReference { .. } => unreachable!("built-in Panda has primitives"),
+                    Shape::MeshReference { filename, scale } => {
+                        // the built-in Panda's polytopes are embedded meshes
+                        let mesh = builtin_mesh(filename).expect("the built-in Panda's meshes are embedded");
+                        let vertices: Vec<[f64; 3]> = mesh
+                            .vertices
+                            .iter()
+                            .map(|p| p.coords.component_mul(scale).into())
+                            .collect();
+                        json!({"mesh": {"vertices": vertices, "indices": mesh.indices}})
+                    }
                 };
                 json!({"link": lc.link, "geometry": g, "origin": pose_json(&s.origin)})
             })

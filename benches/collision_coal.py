@@ -54,6 +54,16 @@ def geometry(g):
         return coal.Cylinder(*g["cylinder"])
     if "capsule" in g:
         return coal.Capsule(*g["capsule"])
+    if "mesh" in g:
+        # a robot mesh is used as its convex hull, as kinplan uses it
+        m = coal.BVHModelOBBRSS()
+        v, t = np.array(g["mesh"]["vertices"]), np.array(g["mesh"]["indices"]).reshape(-1, 3)
+        m.beginModel(len(t), len(v))
+        m.addVertices(v)
+        m.addTriangles(t)
+        m.endModel()
+        m.buildConvexHull(False, "Qt")
+        return m.convex
     raise ValueError(g)
 
 

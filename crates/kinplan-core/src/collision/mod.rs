@@ -29,6 +29,8 @@
 
 mod acm;
 mod attach;
+mod bound;
+mod builtin_meshes;
 mod bvh;
 mod checker;
 mod convert;
@@ -55,6 +57,7 @@ mod world;
 
 pub use acm::{AcmParams, AllowReason, AllowedCollisions, MAX_ACM_PAIR_TESTS};
 pub use attach::attached_bodies;
+pub use builtin_meshes::{BUILTIN_MESH_SCHEME, builtin_mesh};
 pub use checker::{MotionCheck, PadVerdict, StateChecker, interpolate_motion_valid};
 pub use error::CollisionError;
 pub use mesh_file::{MeshFileLimits, read_mesh_file};

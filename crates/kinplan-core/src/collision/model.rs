@@ -9,7 +9,9 @@ use std::sync::Arc;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d_f64::shape::SharedShape;
 
-use super::convert::{pose_to_parry, vec_to_parry};
+use super::bound::enclosing;
+use super::builtin_meshes::builtin_mesh;
+use super::convert::{point_from_parry, pose_to_parry, vec_to_parry};
 use super::fast::RobotFast;
 use super::fixed_frame::{FixedFrame, column, turned};
 use super::scene::{SceneLimits, validate_mesh_points};
@@ -53,8 +55,13 @@ pub struct InlineMesh {
 pub(crate) struct BodyShape {
     pub offset: Isometry3<f64>,
     pub shape: SharedShape,
-    /// The closed-form description in the body frame (spheres, capsules).
+    /// The closed-form description in the body frame (spheres, capsules,
+    /// boxes), or `None` when only parry decides.
     pub fast: RobotFast,
+    /// A closed form holding the shape (body frame): `fast` itself when
+    /// there is one, else a capsule or box around a mesh hull or a
+    /// cylinder ([`super::bound`]). Bounds apart prove the shapes apart.
+    pub bound: RobotFast,
 }
 
 /// A rigid collision body.
@@ -473,12 +480,14 @@ fn body_shapes(
                 length: *length,
             },
             Shape::MeshReference { filename, scale } => {
-                let mesh = meshes.iter().find(|m| &m.filename == filename).ok_or_else(|| {
-                    CollisionError::MeshNotInline {
+                let mesh = meshes
+                    .iter()
+                    .find(|m| &m.filename == filename)
+                    .or_else(|| builtin_mesh(filename))
+                    .ok_or_else(|| CollisionError::MeshNotInline {
                         field: field.clone(),
                         filename: filename.clone(),
-                    }
-                })?;
+                    })?;
                 validate_mesh_points(&mesh.vertices, &mesh.indices, &field, &SceneLimits::default())?;
                 let points: Vec<_> = mesh
                     .vertices
@@ -489,10 +498,20 @@ fn body_shapes(
                     field: field.clone(),
                     reason: format!("mesh `{filename}` has no 3-D convex hull"),
                 })?;
+                let corners: Vec<Point3<f64>> = hull
+                    .as_convex_polyhedron()
+                    .map(|c| {
+                        c.points()
+                            .iter()
+                            .map(|p| cs.origin * point_from_parry(*p))
+                            .collect()
+                    })
+                    .unwrap_or_default();
                 out.push(BodyShape {
                     offset: cs.origin,
                     shape: hull,
                     fast: RobotFast::None,
+                    bound: enclosing(&corners),
                 });
                 continue;
             }
@@ -527,10 +546,20 @@ fn body_shapes(
             },
             _ => RobotFast::None,
         };
+        let bound = match geometry {
+            // the capsule of the same axis and radius holds the cylinder
+            Geometry::Cylinder { radius, length } => RobotFast::Swept {
+                a: cs.origin * Point3::new(0.0, 0.0, -0.5 * length),
+                b: cs.origin * Point3::new(0.0, 0.0, 0.5 * length),
+                r: radius,
+            },
+            _ => fast,
+        };
         out.push(BodyShape {
             offset: cs.origin * fix,
             shape,
             fast,
+            bound,
         });
     }
     Ok(out)

@@ -9,6 +9,10 @@
 //! capsule) use the closed forms of `fast` instead of parry; penetration
 //! into a box and every other pair go to parry.
 //!
+//! A mesh hull or a cylinder, which no closed form decides, is tested
+//! first through the closed-form bound around it (`BodyShape::bound`):
+//! bounds apart are shapes apart, and parry runs only where they meet.
+//!
 //! A pair parry cannot handle (none among the shapes this room builds) is
 //! reported as colliding: the safe answer for a planner.
 
@@ -79,12 +83,15 @@ pub(crate) fn body_body_intersect(a: &Body, pa: &Isometry3<f64>, b: &Body, pb: &
         for sb in &b.shapes {
             let hit = match overlap_robot(&sa.fast, pa, &sb.fast, pb) {
                 Some(hit) => hit,
-                None => intersect(
-                    &pose_to_parry(&(pa * sa.offset)),
-                    &sa.shape,
-                    &pose_to_parry(&(pb * sb.offset)),
-                    &sb.shape,
-                ),
+                None => {
+                    bounds_meet_robot(sa, pa, sb, pb, 0.0)
+                        && intersect(
+                            &pose_to_parry(&(pa * sa.offset)),
+                            &sa.shape,
+                            &pose_to_parry(&(pb * sb.offset)),
+                            &sb.shape,
+                        )
+                }
             };
             if hit {
                 return true;
@@ -116,6 +123,7 @@ pub(crate) fn body_body_contact(
                     a: x,
                     b: y,
                 }),
+                None if !bounds_meet_robot(sa, pa, sb, pb, margin.max(0.0)) => None,
                 None => contact(
                     &qa,
                     &sa.shape,
@@ -142,12 +150,15 @@ pub(crate) fn body_leaf_intersect(a: &Body, pa: &Isometry3<f64>, center: &Vector
 pub(crate) fn shapes_intersect_leaf(a: &Body, pa: &Isometry3<f64>, leaf: &Leaf) -> bool {
     a.shapes.iter().any(|sa| match overlap(&sa.fast, pa, &leaf.fast) {
         Some(hit) => hit,
-        None => intersect(
-            &pose_to_parry(&(pa * sa.offset)),
-            &sa.shape,
-            &leaf.pose,
-            &leaf.shape,
-        ),
+        None => {
+            bound_meets_leaf(sa, pa, leaf, 0.0)
+                && intersect(
+                    &pose_to_parry(&(pa * sa.offset)),
+                    &sa.shape,
+                    &leaf.pose,
+                    &leaf.shape,
+                )
+        }
     })
 }
 
@@ -171,6 +182,7 @@ pub(crate) fn body_leaf_contact(
                 a: x,
                 b: y,
             }),
+            None if !bound_meets_leaf(sa, pa, leaf, margin.max(0.0)) => None,
             None => contact(
                 &pose_to_parry(&(pa * sa.offset)),
                 &sa.shape,
@@ -191,6 +203,26 @@ pub(crate) fn closer(a: Option<Witness>, b: Option<Witness>) -> Option<Witness> 
         (x, None) => x,
         (None, y) => y,
     }
+}
+
+/// False when the closed-form bounds of two robot shapes, the first grown
+/// by `margin` (≥ 0), are apart: then the shapes are more than `margin`
+/// apart. True when they meet or no closed form decides.
+#[inline]
+fn bounds_meet_robot(
+    sa: &BodyShape,
+    pa: &Isometry3<f64>,
+    sb: &BodyShape,
+    pb: &Isometry3<f64>,
+    margin: f64,
+) -> bool {
+    overlap_robot(&grown(&sa.bound, margin), pa, &sb.bound, pb) != Some(false)
+}
+
+/// [`bounds_meet_robot`] for a robot shape and a scene leaf.
+#[inline]
+fn bound_meets_leaf(sa: &BodyShape, pa: &Isometry3<f64>, leaf: &Leaf, margin: f64) -> bool {
+    overlap(&grown(&sa.bound, margin), pa, &leaf.fast) != Some(false)
 }
 
 /// `shape` grown by `margin`: a swept sphere exactly (radius + margin).
@@ -238,13 +270,16 @@ pub(crate) fn body_leaf_within(
         .iter()
         .any(|sa| match overlap(&grown(&sa.fast, margin), pa, &leaf.fast) {
             Some(hit) => hit,
-            None => parry_within(
-                sa,
-                &pose_to_parry(&(pa * sa.offset)),
-                &leaf.pose,
-                &leaf.shape,
-                margin,
-            ),
+            None => {
+                bound_meets_leaf(sa, pa, leaf, margin)
+                    && parry_within(
+                        sa,
+                        &pose_to_parry(&(pa * sa.offset)),
+                        &leaf.pose,
+                        &leaf.shape,
+                        margin,
+                    )
+            }
         })
 }
 
@@ -265,6 +300,7 @@ pub(crate) fn body_body_within(
         b.shapes.iter().any(
             |sb| match overlap_robot(&grown(&sa.fast, margin), pa, &sb.fast, pb) {
                 Some(hit) => hit,
+                None if !bounds_meet_robot(sa, pa, sb, pb, margin) => false,
                 None => {
                     let (qa, qb) = (pose_to_parry(&(pa * sa.offset)), pose_to_parry(&(pb * sb.offset)));
                     match sb.shape.as_cuboid() {

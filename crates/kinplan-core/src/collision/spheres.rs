@@ -26,7 +26,11 @@
 //!   circumsphere). A cell contains the ball of radius `min_k e_k` about its
 //!   centre, so a sphere reaches at most `|e| − min_k e_k` beyond the box;
 //!   the longest cell axis is split until that meets the overshoot;
-//! * anything else (a mesh's convex hull, a cylinder): the grid over the
+//! * a mesh's convex hull or a cylinder: the cover of its closed-form bound
+//!   (the capsule or box around it, see `bound`), which holds it; a sphere
+//!   of centre `c` and radius `ρ` reaches at most `dist(c, shape) + ρ`
+//!   beyond the shape, the overshoot recorded;
+//! * anything without a bound: the grid over the
 //!   shape's bounding box, keeping only the cells that meet the shape
 //!   (parry's intersection test; a cell it cannot decide is kept). Every
 //!   kept cell holds a point of the shape, so a sphere reaches at most
@@ -44,7 +48,7 @@ use parry3d_f64::query;
 use parry3d_f64::shape::Cuboid;
 
 use super::CollisionError;
-use super::convert::pose_to_parry;
+use super::convert::{pose_to_parry, vec_to_parry};
 use super::fast::RobotFast;
 use super::model::{BodyShape, RobotModel};
 
@@ -172,8 +176,32 @@ impl SphereModel {
 /// Appends the cover of one shape (body frame) to `out`; returns how far
 /// its spheres can reach beyond the shape.
 fn cover(shape: &BodyShape, params: &SphereParams, out: &mut Vec<Sphere>) -> f64 {
+    if matches!(shape.fast, RobotFast::None) && !matches!(shape.bound, RobotFast::None) {
+        // a mesh hull or a cylinder, covered through its closed-form bound;
+        // a sphere reaches at most its centre's distance to the shape plus
+        // its radius beyond it (the distance to a convex set grows by at
+        // most the step)
+        let first = out.len();
+        cover_closed(&shape.bound, shape, params, out);
+        let pose = pose_to_parry(&shape.offset);
+        return out[first..]
+            .iter()
+            .map(|s| {
+                shape
+                    .shape
+                    .distance_to_point(&pose, vec_to_parry(&s.center.coords), true)
+                    + s.radius
+            })
+            .fold(0.0, f64::max);
+    }
+    cover_closed(&shape.fast, shape, params, out)
+}
+
+/// [`cover`] of the closed form `closed` (the shape's own, or its bound);
+/// the grid over the bounding box of `shape` when there is none.
+fn cover_closed(closed: &RobotFast, shape: &BodyShape, params: &SphereParams, out: &mut Vec<Sphere>) -> f64 {
     let (o, cap) = (params.max_overshoot, params.max_per_shape);
-    match shape.fast {
+    match *closed {
         RobotFast::Swept { a, b, r } => capsule_cover(&a, &b, r, o, cap, out),
         RobotFast::Box { offset, half } => {
             let n = grid(&half, |e| e.norm() - e.min(), o, cap);

@@ -522,13 +522,64 @@ fn urdf_shape_distance(shape: &urdf_rs::Geometry, p: &Vector3<f64>) -> f64 {
     }
 }
 
+/// The convex polytope an embedded mesh file (`kinplan://builtin/…`, an
+/// OBJ) describes, as its outward faces `(normal, point)`, after checking
+/// that the faces close up (every edge in exactly two faces, once each way)
+/// and that no vertex lies in front of any face (by more than 1 µm), so
+/// the faces bound the
+/// convex hull of the vertices, which the collision model uses. Read from
+/// the file with its own parser, not the library's.
+fn builtin_hull_faces(filename: &str) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+    let path = filename
+        .strip_prefix("kinplan://builtin/")
+        .expect("an embedded mesh");
+    let file = format!("{}/src/robot/builtin/meshes/{path}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(file).unwrap();
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let x: Vec<f64> = it.map(|t| t.parse().unwrap()).collect();
+                v.push(Vector3::new(x[0], x[1], x[2]));
+            }
+            Some("f") => f.push(it.map(|t| t.parse::<usize>().unwrap() - 1).collect::<Vec<_>>()),
+            _ => {}
+        }
+    }
+    let mut edges = std::collections::HashMap::new();
+    let faces: Vec<_> = f
+        .iter()
+        .map(|t| {
+            assert_eq!(t.len(), 3, "{filename}: triangles");
+            for k in 0..3 {
+                *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
+            }
+            let n = (v[t[1]] - v[t[0]]).cross(&(v[t[2]] - v[t[0]])).normalize();
+            for p in &v {
+                let ahead = n.dot(&(p - v[t[0]]));
+                assert!(ahead <= 1e-6, "{filename}: not convex or not outward ({ahead} m)");
+            }
+            (n, v[t[0]])
+        })
+        .collect();
+    for (&(a, b), &count) in &edges {
+        assert!(
+            count == 1 && edges.get(&(b, a)) == Some(&1),
+            "{filename}: edge {a}-{b} not closed"
+        );
+    }
+    faces
+}
+
 /// The built-in Panda's and UR5's collision shapes hold the real arms: every
 /// vertex of the collision meshes MoveIt plans with (example-robot-data,
 /// placed in the built-in link frames by `fit_covers.py`, which checks the
 /// kinematics against pinocchio's) lies inside the one convex shape of its
-/// link, so the shape holds the mesh, and a state the built-in model finds
-/// free is free for the real arm. Read straight from the URDF text, not
-/// through our parser.
+/// link (a primitive, or the grown hull of the mesh the library embeds), so
+/// the shape holds the mesh, and a state the built-in model finds free is
+/// free for the real arm. Read straight from the URDF text and the mesh
+/// files, not through our parsers.
 #[test]
 fn builtin_shapes_hold_the_real_meshes() {
     let panda = include_str!("builtin/panda_mesh_points.txt");
@@ -554,7 +605,13 @@ fn builtin_shapes_hold_the_real_meshes() {
             let pose = Isometry3::new(Vector3::new(xyz[0], xyz[1], xyz[2]), Vector3::zeros())
                 * nalgebra::UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
             let local = pose.inverse_transform_point(&nalgebra::Point3::new(v[0], v[1], v[2]));
-            let d = urdf_shape_distance(&c.geometry, &local.coords);
+            let d = match &c.geometry {
+                urdf_rs::Geometry::Mesh { filename, .. } => builtin_hull_faces(filename)
+                    .iter()
+                    .map(|(n, p)| n.dot(&(local.coords - p)))
+                    .fold(f64::NEG_INFINITY, f64::max),
+                primitive => urdf_shape_distance(primitive, &local.coords),
+            };
             assert!(
                 d <= -1e-4,
                 "{name} {link_name}: mesh vertex {v:?} at {d} m from its shape (must be 0.1 mm inside)"

@@ -241,8 +241,9 @@ fn eight_lanes_never_clear_a_colliding_state_near_contact() {
             "{name}: {} colliding",
             states.len() - free
         );
-        // not vacuous: the spheres clear most free states
-        assert!(4 * cleared > 3 * free, "{name}: {cleared} of {free} cleared");
+        // not vacuous: the spheres clear most free states (the lanes here get
+        // every self pair; the checker leaves out those its pair tables prove)
+        assert!(5 * cleared > 3 * free, "{name}: {cleared} of {free} cleared");
     }
 }
 

@@ -257,49 +257,104 @@ fn checkers_are_shared_between_threads_and_agree() {
     assert_eq!(serial, parallel);
 }
 
-/// The gap between two links' capsules at `q`, computed apart from the
-/// checker: each capsule's axis read from the URDF text (urdf_rs), placed by
+/// The convex polytope the built-in URDF gives link `name` (an embedded OBJ
+/// of outward triangles, read with this test's own parser), posed at `q` by
 /// the chain's link frames (checked against DH products in the robot
-/// tests), and the two axes sampled at 0.1 mm steps; the sampled distance
-/// minus both radii (an upper bound within 1e-4 m of the gap).
-fn capsule_gap(builtin: &str, q: &[f64], a: &str, b: &str) -> f64 {
+/// tests): its vertices and its face planes `(n, o)`, inside where
+/// `n·x ≤ o`, base frame.
+fn posed_polytope(builtin: &str, q: &[f64], name: &str) -> Polytope {
     let robot = urdf_rs::read_from_string(crate::robot::builtin_urdf(builtin).unwrap()).unwrap();
     let chain = builtin_chain(builtin).unwrap();
     let mut frames = Vec::new();
     chain.link_frames_into(q, &mut frames);
-    let axis = |name: &str| {
-        let c = &robot.links.iter().find(|l| l.name == name).unwrap().collision[0];
-        let urdf_rs::Geometry::Capsule { radius, length } = c.geometry else {
-            panic!("{name}: not a capsule")
-        };
-        let (xyz, rpy) = (c.origin.xyz, c.origin.rpy);
-        let pose = frames[chain.links().iter().position(|l| l.name == name).unwrap()]
-            * Isometry3::new(Vector3::new(xyz[0], xyz[1], xyz[2]), Vector3::zeros())
-            * nalgebra::UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
-        let n = (length / 1e-4).ceil() as usize;
-        let points: Vec<Point3<f64>> = (0..=n)
-            .map(|i| pose * Point3::new(0.0, 0.0, length * (i as f64 / n as f64 - 0.5)))
-            .collect();
-        (points, radius)
+    let c = &robot.links.iter().find(|l| l.name == name).unwrap().collision[0];
+    let urdf_rs::Geometry::Mesh { filename, .. } = &c.geometry else {
+        panic!("{name}: not a mesh")
     };
-    let ((pa, ra), (pb, rb)) = (axis(a), axis(b));
-    let nearest = pa
+    let path = filename.strip_prefix("kinplan://builtin/").unwrap();
+    let file = format!("{}/src/robot/builtin/meshes/{path}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(file).unwrap();
+    let (xyz, rpy) = (c.origin.xyz, c.origin.rpy);
+    let pose = frames[chain.links().iter().position(|l| l.name == name).unwrap()]
+        * Isometry3::new(Vector3::new(xyz[0], xyz[1], xyz[2]), Vector3::zeros())
+        * nalgebra::UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]);
+    let mut vertices = Vec::new();
+    let mut planes = Vec::new();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let x: Vec<f64> = it.map(|t| t.parse().unwrap()).collect();
+                vertices.push(pose * Point3::new(x[0], x[1], x[2]));
+            }
+            Some("f") => {
+                let t: Vec<usize> = it.map(|t| t.parse::<usize>().unwrap() - 1).collect();
+                let (a, b, c) = (vertices[t[0]], vertices[t[1]], vertices[t[2]]);
+                let n = (b - a).cross(&(c - a)).normalize();
+                planes.push((n, n.dot(&a.coords)));
+            }
+            _ => {}
+        }
+    }
+    (vertices, planes)
+}
+
+/// A convex polytope's vertices and face planes (`posed_polytope`).
+type Polytope = (Vec<Point3<f64>>, Vec<(Vector3<f64>, f64)>);
+
+/// Bounds on the distance between two convex polytopes, apart from the
+/// checker: below, the widest gap along a face normal of either (the
+/// projection on a unit vector shortens every distance); above, the
+/// nearest pair of vertices. And how deep the deepest vertex of one lies
+/// inside the other (> 0: they overlap).
+fn polytope_gap((va, pa): &Polytope, (vb, pb): &Polytope) -> (f64, f64, f64) {
+    let gap_along = |planes: &[(Vector3<f64>, f64)], other: &[Point3<f64>]| {
+        planes
+            .iter()
+            .map(|(n, o)| {
+                other
+                    .iter()
+                    .map(|v| n.dot(&v.coords) - o)
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let lower = gap_along(pa, vb).max(gap_along(pb, va));
+    let upper = va
         .iter()
-        .flat_map(|x| pb.iter().map(move |y| (x - y).norm()))
+        .flat_map(|x| vb.iter().map(move |y| (x - y).norm()))
         .fold(f64::INFINITY, f64::min);
-    nearest - ra - rb
+    let depth = |planes: &[(Vector3<f64>, f64)], other: &[Point3<f64>]| {
+        other
+            .iter()
+            .map(|v| {
+                planes
+                    .iter()
+                    .map(|(n, o)| o - n.dot(&v.coords))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    (lower, upper, depth(pa, vb).max(depth(pb, va)))
 }
 
 #[test]
 fn panda_folded_wrist_self_collides_and_a_less_folded_one_is_free() {
     // q6 = 0.5 and the elbow folded swing link_7 (the flange housing) into
-    // link_1; less folded, they are apart (the capsules hold the real meshes).
-    let q_folded = [0.0, 0.0, 0.0, -2.9, 0.0, 0.5, 0.0];
-    let q_open = [0.0, 0.0, 0.0, -2.8, 0.0, 0.5, 0.0];
-    let folded = capsule_gap("franka_panda", &q_folded, "link_1", "link_7");
-    let open = capsule_gap("franka_panda", &q_open, "link_1", "link_7");
-    assert!(folded < -0.01, "{folded}");
-    assert!(open > 0.01, "{open}");
+    // link_1; less folded, they are apart (the polytopes hold the real
+    // meshes; the capsules that stood for them overlapped there too).
+    let q_folded = [0.0, 0.0, 0.0, -3.0, 0.0, 0.5, 0.0];
+    let q_open = [0.0, 0.0, 0.0, -2.9, 0.0, 0.5, 0.0];
+    let at = |q: &[f64]| {
+        polytope_gap(
+            &posed_polytope("franka_panda", q, "link_1"),
+            &posed_polytope("franka_panda", q, "link_7"),
+        )
+    };
+    let (_, _, depth) = at(&q_folded);
+    assert!(depth > 0.02, "{depth}");
+    let (lower, upper, _) = at(&q_open);
+    assert!(lower > 0.005, "{lower}");
     // The ACM from sampling allows the pairs that overlap everywhere
     // (neighbours at their joints) and keeps link_1–link_7 checked.
     let c = panda_checker(|m| {
@@ -319,11 +374,16 @@ fn panda_folded_wrist_self_collides_and_a_less_folded_one_is_free() {
         "{report}"
     );
     let p = c.proximity(&q_folded, 1.0).unwrap().unwrap();
-    assert!((p.distance - folded).abs() < 2e-4, "{} vs {folded}", p.distance);
+    assert!(p.distance < 0.0, "{}", p.distance);
     assert!(!c.is_valid(&q_folded));
     assert!(c.is_valid(&q_open), "{}", c.report(&q_open).unwrap());
-    // the nearest checked pair is at most this one's gap away
-    assert!(c.clearance(&q_open, 1.0) <= open + 2e-4);
+    // the nearest checked pair is at most this one's gap away, and when it
+    // is this pair, within the bounds
+    assert!(c.clearance(&q_open, 1.0) <= upper + 1e-9);
+    let p = c.proximity(&q_open, 1.0).unwrap().unwrap();
+    if p.link == "link_1" || p.link == "link_7" {
+        assert!(p.distance >= lower - 1e-6 && p.distance <= upper + 1e-6, "{p:?}");
+    }
 }
 
 fn panda_hand_checker(opening: f64, obstacles: Vec<Obstacle>) -> SceneChecker {
@@ -371,14 +431,26 @@ fn the_panda_hand_carries_two_fingers_at_the_requested_opening() {
             Geometry::Sphere { radius: 0.005 },
         )]
     };
-    // Open 40 mm per finger: the nearest part is the housing's box top
-    // (z = 0.0665, panda_covers.json), 23.5 mm − 5 mm away; the finger boxes'
-    // inner faces are 40 − 0.6 mm − 5 mm away.
+    // Open 40 mm per finger: the nearest part is the housing's top face
+    // (the polytope's highest vertices, which the ball sits above), 90 mm
+    // less its height less 5 mm away; the finger boxes' inner faces are
+    // 40 − 0.6 mm − 5 mm away.
+    let (housing, _) = posed_polytope("franka_panda_hand", &q, "panda_hand");
+    let top = housing
+        .iter()
+        .map(|v| (frames[hand].inverse() * v).z)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let expected = 0.09 - top - 0.005;
+    assert!(expected > 0.015 && expected < 0.02, "{expected}");
     let open = panda_hand_checker(0.04, ball());
     assert!(open.is_valid(&q));
     let p = open.proximity(&q, 1.0).unwrap().unwrap();
     assert_eq!(p.link, "panda_hand");
-    assert!((p.distance - 0.0185).abs() < 1e-9, "{}", p.distance);
+    assert!(
+        (p.distance - expected).abs() < 1e-6,
+        "{} vs {expected}",
+        p.distance
+    );
     // Closed: both fingers enclose the ball.
     let closed = panda_hand_checker(0.0, ball());
     let report = closed.report(&q).unwrap();
@@ -387,7 +459,7 @@ fn the_panda_hand_carries_two_fingers_at_the_requested_opening() {
     // An opening past the 40 mm limit is used as given: the fingers move
     // farther out and the housing stays the nearest part.
     let wide = panda_hand_checker(0.065, ball());
-    assert!((wide.proximity(&q, 1.0).unwrap().unwrap().distance - 0.0185).abs() < 1e-9);
+    assert!((wide.proximity(&q, 1.0).unwrap().unwrap().distance - expected).abs() < 1e-6);
 }
 
 #[test]

@@ -152,7 +152,7 @@ fn capsule_and_box_covers_meet_the_overshoot_with_the_counts_derived_by_hand() {
 }
 
 #[test]
-fn cylinders_and_mesh_hulls_are_covered_by_the_cells_they_meet() {
+fn cylinders_and_mesh_hulls_are_covered_through_their_bounds() {
     let (vertices, indices) = box_mesh(Vector3::new(0.05, 0.12, 0.03));
     let urdf = r#"<robot name="probe">
       <link name="base"/>

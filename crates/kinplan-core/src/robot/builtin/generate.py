@@ -138,8 +138,13 @@ def craig_dh(name, comment, d, a, alpha, flange, limits, speeds, radii):
 
 def cover_link_xml(name, cover):
     """A link whose one collision shape is `cover` (<robot>_covers.json): a
-    capsule between two points or a box between two corners, link frame."""
-    if "capsule" in cover:
+    mesh the library embeds (`kinplan://builtin/<robot>/<link>.obj`, the
+    grown convex hull fit_covers.py wrote), a capsule between two points or a
+    box between two corners, link frame."""
+    if "mesh" in cover:
+        xyz, rpy = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+        geom = f'<mesh filename="{BUILTIN_MESH_SCHEME}{cover["mesh"]}"/>'
+    elif "capsule" in cover:
         c = cover["capsule"]
         xyz, rpy, length = capsule_origin(c["p0"], c["p1"])
         geom = f'<capsule radius="{float(c["radius"])!r}" length="{float(length)!r}"/>'
@@ -148,6 +153,10 @@ def cover_link_xml(name, cover):
         xyz, rpy = [(a + b) / 2 for a, b in zip(lo, hi)], [0.0, 0.0, 0.0]
         geom = f'<box size="{fmt([b - a for a, b in zip(lo, hi)])}"/>'
     return shape_link_xml(name, xyz, rpy, geom)
+
+
+# The URI prefix of the meshes embedded in the library (robot::builtin).
+BUILTIN_MESH_SCHEME = "kinplan://builtin/"
 
 
 def covers_of(robot):
@@ -206,8 +215,8 @@ def panda_hand():
     """franka_panda plus the Franka Hand: `panda_hand` fixed to the flange,
     turned -45 deg about z (as Franka mounts it), and two prismatic fingers
     0.0584 m above the hand frame, opening along +y / -y (0 to 0.04 m each).
-    The hand and each finger are boxes holding their real meshes
-    (panda_covers.json), as the arm's links are.
+    The hand (a polytope) and each finger (a box) hold their real meshes
+    (panda_covers.json), as the arm's links do.
     A tool-centre frame `panda_hand_tcp` sits 0.1034 m along the hand's z."""
     with open(os.path.join(OUT, "franka_panda.urdf")) as f:
         text = f.read()
