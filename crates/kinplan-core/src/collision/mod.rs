@@ -47,6 +47,7 @@ mod moveit;
 mod narrow;
 mod octree_cells;
 mod padded;
+mod pair_table;
 mod scene;
 mod scene_checker;
 mod spheres;

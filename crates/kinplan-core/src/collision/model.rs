@@ -4,7 +4,7 @@
 //! bounding sphere for the broad phase. Posed by forward kinematics into a
 //! stack array, so a query allocates nothing.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d_f64::shape::SharedShape;
@@ -14,7 +14,9 @@ use super::builtin_meshes::builtin_mesh;
 use super::convert::{point_from_parry, pose_to_parry, vec_to_parry};
 use super::fast::RobotFast;
 use super::fixed_frame::{FixedFrame, column, turned};
+use super::pair_table::PairTable;
 use super::scene::{SceneLimits, validate_mesh_points};
+use super::sweep::SweepBound;
 use super::trig::sin_cos;
 use super::world::primitive_shape;
 use super::{CollisionError, Geometry};
@@ -94,6 +96,9 @@ pub struct RobotModel {
     in_joint: Vec<Option<FixedFrame>>,
     /// Each joint's fixed origin and motion, shaped for [`RobotModel::pose_bodies`].
     steps: Vec<JointStep>,
+    /// The proved-free regions of the self pairs one or two joints move
+    /// apart ([`PairTable`]), built on first use.
+    pair_tables: OnceLock<Vec<PairTable>>,
 }
 
 /// One joint of the chain as forward kinematics applies it: `frame =
@@ -244,6 +249,22 @@ impl RobotModel {
             by_link,
             in_joint,
             steps,
+            pair_tables: OnceLock::new(),
+        })
+    }
+
+    /// The [`PairTable`]s of every pair of bodies that qualifies (built on
+    /// the first call, then shared by every checker of the model).
+    pub(crate) fn pair_tables(&self) -> &[PairTable] {
+        self.pair_tables.get_or_init(|| {
+            let Some(sweep) = SweepBound::new(self) else {
+                return Vec::new();
+            };
+            let n = self.bodies.len();
+            (0..n)
+                .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+                .filter_map(|(a, b)| PairTable::build(self, &sweep, a, b))
+                .collect()
         })
     }
 

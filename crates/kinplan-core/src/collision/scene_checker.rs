@@ -191,6 +191,8 @@ pub struct SceneChecker {
     world: Arc<SceneGeometry>,
     /// Body pairs tested for self-collision, `a < b`.
     self_pairs: Vec<(u16, u16)>,
+    /// Per self pair, its index in the model's `PairTable`s, if it has one.
+    tables: Vec<Option<u16>>,
     /// Bodies tested against the scene, distal first (the likeliest to hit
     /// something): every body but those no state can bring to an obstacle
     /// ([`scene_bodies`]).
@@ -222,7 +224,17 @@ impl SceneChecker {
                 upper: model.body_count() as f64,
             });
         }
-        let self_pairs = acm.checked_pairs().map(|(a, b)| (a as u16, b as u16)).collect();
+        let self_pairs: Vec<(u16, u16)> = acm.checked_pairs().map(|(a, b)| (a as u16, b as u16)).collect();
+        let all_tables = model.pair_tables();
+        let tables = self_pairs
+            .iter()
+            .map(|&(a, b)| {
+                let found = all_tables
+                    .iter()
+                    .position(|t| (t.a, t.b) == (a as usize, b as usize));
+                found.map(|i| i as u16)
+            })
+            .collect();
         let sweep = SweepBound::new(&model);
         if params.padded_motion && sweep.is_none() {
             return Err(CollisionError::CannotPad);
@@ -237,6 +249,7 @@ impl SceneChecker {
             model,
             world,
             self_pairs,
+            tables,
             scene_bodies,
             params,
             sweep,
@@ -267,11 +280,11 @@ impl SceneChecker {
         if self.model.body_count() <= SMALL_MODEL {
             let mut poses = [Isometry3::identity(); SMALL_MODEL];
             self.model.body_poses(q, &mut poses);
-            self.hits(&poses)
+            self.hits(q, &poses)
         } else {
             let mut poses = [Isometry3::identity(); MAX_BODIES];
             self.model.body_poses(q, &mut poses);
-            self.hits(&poses)
+            self.hits(q, &poses)
         }
     }
 
@@ -306,15 +319,23 @@ impl SceneChecker {
                 let last = qj[n - 1];
                 qj[n..].fill(last);
             }
-            let unsure = lanes.unsure(
-                &q[..dof],
-                &self.scene_bodies,
-                &self.self_pairs,
-                &mut flags,
-                portable,
-            );
+            // the pairs the tables prove apart in every state stay out of the lanes
+            let mut kept = Kept::default();
+            let n_kept = self.pairs_left(batch, dof, &[], &mut kept);
+            let pairs = n_kept.map_or(&self.self_pairs[..], |n| &kept.pairs[..n]);
+            let unsure = lanes.unsure(&q[..dof], &self.scene_bodies, pairs, &mut flags, portable);
             for (l, row) in batch.chunks_exact(dof).enumerate() {
-                if unsure & (1 << l) != 0 && self.hits_flagged(row, flags.bodies[l], flags.pairs[l]) {
+                if unsure & (1 << l) == 0 {
+                    continue;
+                }
+                // the lanes' pair bits name kept pairs; the check names all
+                let pairs = match n_kept {
+                    None => flags.pairs[l],
+                    Some(n) => (0..n)
+                        .filter(|&k| flags.pairs[l] & (1 << k) != 0)
+                        .fold(0u64, |bits, k| bits | 1 << kept.index[k]),
+                };
+                if self.hits_flagged(row, flags.bodies[l], pairs) {
                     return Some(false);
                 }
             }
@@ -342,7 +363,9 @@ impl SceneChecker {
         }
         self.self_pairs.iter().enumerate().any(|(i, &(a, b))| {
             let (a, b) = (a as usize, b as usize);
-            pairs & (1 << i.min(63)) != 0 && body_body_intersect(&all[a], &poses[a], &all[b], &poses[b])
+            pairs & (1 << i.min(63)) != 0
+                && !self.pair_proved(i, q, &[])
+                && body_body_intersect(&all[a], &poses[a], &all[b], &poses[b])
         })
     }
 
@@ -379,9 +402,38 @@ impl SceneChecker {
         centers
     }
 
-    /// [`SceneChecker::in_collision`] on bodies already posed (`N` ≥ the
-    /// body count).
-    fn hits<const N: usize>(&self, poses: &[Isometry3<f64>; N]) -> bool {
+    /// True when self pair `i`'s `PairTable` proves it apart at every state
+    /// within `half` of `q` (`half` empty: at `q`).
+    fn pair_proved(&self, i: usize, q: &[f64], half: &[f64]) -> bool {
+        self.tables[i].is_some_and(|t| self.model.pair_tables()[t as usize].proves_apart(q, half))
+    }
+
+    /// The self pairs some row of `rows` (states of `dof` values; with
+    /// `half`, the middles of pieces) needs checked: those the tables do not
+    /// prove apart at every row, into `kept[..n]`, with their indices in
+    /// `self_pairs` into `index`; returns `n`. `None` when there are more
+    /// than `KEPT` pairs (the lanes' bits could not name them all): then
+    /// every pair goes to the lanes.
+    fn pairs_left(&self, rows: &[f64], dof: usize, half: &[f64], kept: &mut Kept) -> Option<usize> {
+        if self.self_pairs.len() > KEPT {
+            return None;
+        }
+        let mut n = 0;
+        for (i, &pair) in self.self_pairs.iter().enumerate() {
+            let proved =
+                self.tables[i].is_some() && rows.chunks_exact(dof).all(|row| self.pair_proved(i, row, half));
+            if !proved {
+                kept.pairs[n] = pair;
+                kept.index[n] = i as u16;
+                n += 1;
+            }
+        }
+        Some(n)
+    }
+
+    /// [`SceneChecker::in_collision`] at `q` on bodies already posed (`N` ≥
+    /// the body count).
+    fn hits<const N: usize>(&self, q: &[f64], poses: &[Isometry3<f64>; N]) -> bool {
         let bodies = &self.model.bodies;
         let centers = self.centers(poses);
         for &b in &self.scene_bodies {
@@ -394,10 +446,11 @@ impl SceneChecker {
                 return true;
             }
         }
-        self.self_pairs.iter().any(|&(a, b)| {
+        self.self_pairs.iter().enumerate().any(|(i, &(a, b))| {
             let (a, b) = (a as usize, b as usize);
             let reach = bodies[a].radius + bodies[b].radius;
             (centers[a] - centers[b]).norm_squared() <= reach * reach
+                && !self.pair_proved(i, q, &[])
                 && body_body_intersect(&bodies[a], &poses[a], &bodies[b], &poses[b])
         })
     }
@@ -410,7 +463,7 @@ impl SceneChecker {
     pub fn in_collision_padded(&self, q: &[f64], pads: &[f64; MAX_BODIES]) -> bool {
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
-        self.hits_padded(&poses, pads, |b| pads[b], &mut 0) != PadHit::Clear
+        self.hits_padded(&poses, pads, |b| pads[b], None, &mut 0) != PadHit::Clear
     }
 
     /// [`SceneChecker::in_collision_padded`] on bodies already posed, with
@@ -423,6 +476,10 @@ impl SceneChecker {
     /// its pads, so are the further self pairs ([`PadHit::Touches`] ends the
     /// check), so a state in collision is refused at once.
     ///
+    /// `piece` (the state `q` at the middle and the half step), when the
+    /// pads cover a piece of a motion, lets the `PairTable`s prove self
+    /// pairs apart over it.
+    ///
     /// `proved` lists what is already proved free over the piece the pads
     /// cover and need not be checked: bit `b` the scene around body `b`,
     /// [`SELF_PAIRS`] every self pair. What this check proves is added:
@@ -433,6 +490,7 @@ impl SceneChecker {
         poses: &[Isometry3<f64>; N],
         coarse: &[f64; N],
         mut fine: impl FnMut(usize) -> f64,
+        piece: Option<(&[f64], &[f64])>,
         proved: &mut u64,
     ) -> PadHit {
         let bodies = &self.model.bodies;
@@ -479,8 +537,11 @@ impl SceneChecker {
             return found;
         }
         let mut self_near = false;
-        for &(a, b) in &self.self_pairs {
+        for (i, &(a, b)) in self.self_pairs.iter().enumerate() {
             let (a, b) = (a as usize, b as usize);
+            if piece.is_some_and(|(q, half)| self.pair_proved(i, q, half)) {
+                continue;
+            }
             let (ra, rb) = (bodies[a].radius, bodies[b].radius);
             let pad = if self_near {
                 0.0
@@ -704,6 +765,25 @@ fn scene_bodies(model: &RobotModel, world: &SceneGeometry, sweep: Option<&SweepB
 /// pair (the bits below [`MAX_BODIES`] are the bodies).
 pub(crate) const SELF_PAIRS: u64 = 1 << 63;
 
+/// Most self pairs [`SceneChecker::pairs_left`] sorts (the lanes name each
+/// pair by a bit of a `u64`).
+const KEPT: usize = 63;
+
+/// The self pairs left for the lanes, and their indices among all.
+struct Kept {
+    pairs: [(u16, u16); KEPT],
+    index: [u16; KEPT],
+}
+
+impl Default for Kept {
+    fn default() -> Self {
+        Kept {
+            pairs: [(0, 0); KEPT],
+            index: [0; KEPT],
+        }
+    }
+}
+
 /// What [`SceneChecker::hits_padded`] found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum PadHit {
@@ -759,7 +839,7 @@ impl StateChecker for SceneChecker {
         }
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         self.model.body_poses(q, &mut poses);
-        let valid = self.within_limits(q) && !self.hits(&poses);
+        let valid = self.within_limits(q) && !self.hits(q, &poses);
         let clearance = self
             .nearest_posed(&poses, max_distance)
             .map_or(max_distance, |(w, _, _)| w.distance.min(max_distance));
@@ -809,7 +889,12 @@ impl StateChecker for SceneChecker {
         {
             return None;
         }
-        let terms = lanes.pad_terms(sweep, half_step, &self.scene_bodies, &self.self_pairs)?;
+        // the pairs the tables prove apart over every piece stay out of the
+        // lanes: a lane clearing the others proves all self pairs
+        let mut kept = Kept::default();
+        let n_kept = self.pairs_left(rows, dof, half_step, &mut kept);
+        let pairs = n_kept.map_or(&self.self_pairs[..], |n| &kept.pairs[..n]);
+        let terms = lanes.pad_terms(sweep, half_step, &self.scene_bodies, pairs)?;
         let mut free = 0u32;
         for (k, batch) in rows.chunks(WIDTH * dof).enumerate() {
             let n = batch.len() / dof;
@@ -880,10 +965,12 @@ impl SceneChecker {
             };
             pad.min(coarse[b])
         };
-        Some(match self.hits_padded(&poses, &coarse, tight, proved) {
-            PadHit::Clear => PadVerdict::Free,
-            PadHit::Touches => PadVerdict::Collides,
-            PadHit::Near => PadVerdict::Unproved,
-        })
+        Some(
+            match self.hits_padded(&poses, &coarse, tight, Some((q, half_step)), proved) {
+                PadHit::Clear => PadVerdict::Free,
+                PadHit::Touches => PadVerdict::Collides,
+                PadHit::Near => PadVerdict::Unproved,
+            },
+        )
     }
 }

@@ -14,6 +14,7 @@ use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
 mod lanes;
 mod lanes8;
+mod pair_table;
 mod robot;
 mod spheres;
 mod sweep;
