@@ -7,6 +7,7 @@
 use std::sync::{Arc, OnceLock};
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::SharedShape;
 
 use super::bound::enclosing;
@@ -14,7 +15,7 @@ use super::builtin_meshes::builtin_mesh;
 use super::convert::{point_from_parry, pose_to_parry, vec_to_parry};
 use super::fast::RobotFast;
 use super::fixed_frame::{FixedFrame, column, turned};
-use super::pair_table::PairTable;
+use super::pair_table::{PairTable, TABLE_BUDGET};
 use super::scene::{SceneLimits, validate_mesh_points};
 use super::sweep::SweepBound;
 use super::trig::sin_cos;
@@ -261,9 +262,10 @@ impl RobotModel {
                 return Vec::new();
             };
             let n = self.bodies.len();
+            let mut budget = TABLE_BUDGET;
             (0..n)
                 .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
-                .filter_map(|(a, b)| PairTable::build(self, &sweep, a, b))
+                .filter_map(|(a, b)| PairTable::build(self, &sweep, a, b, &mut budget))
                 .collect()
         })
     }
@@ -519,21 +521,30 @@ fn body_shapes(
                     field: field.clone(),
                     reason: format!("mesh `{filename}` has no 3-D convex hull"),
                 })?;
-                let corners: Vec<Point3<f64>> = hull
-                    .as_convex_polyhedron()
-                    .map(|c| {
-                        c.points()
-                            .iter()
-                            .map(|p| cs.origin * point_from_parry(*p))
-                            .collect()
-                    })
-                    .unwrap_or_default();
-                out.push(BodyShape {
-                    offset: cs.origin,
-                    shape: hull,
-                    fast: RobotFast::None,
-                    bound: enclosing(&corners),
-                });
+                let every: Vec<Point3<f64>> =
+                    points.iter().map(|p| cs.origin * point_from_parry(*p)).collect();
+                let bound = enclosing(&every);
+                match farthest_outside(&hull, &points) {
+                    Some(0.0) => out.push(BodyShape {
+                        offset: cs.origin,
+                        shape: hull,
+                        fast: RobotFast::None,
+                        bound,
+                    }),
+                    // parry's hull left points outside: grow it by the farthest
+                    Some(d) => out.push(BodyShape {
+                        offset: cs.origin,
+                        shape: SharedShape::round_convex_hull(&points, d * (1.0 + 1e-9) + 1e-12)
+                            .expect("the hull exists"),
+                        fast: RobotFast::None,
+                        bound,
+                    }),
+                    // too many points to check: the closed-form bound is the shape
+                    None => out.push(bound_shape(bound).ok_or_else(|| CollisionError::Degenerate {
+                        field: field.clone(),
+                        reason: format!("mesh `{filename}` has no finite bound"),
+                    })?),
+                }
                 continue;
             }
         };
@@ -584,4 +595,63 @@ fn body_shapes(
         });
     }
     Ok(out)
+}
+
+/// Most point-against-face tests [`farthest_outside`] makes.
+const MAX_HULL_CHECK: usize = 50_000_000;
+
+/// How far the farthest of `points` lies outside `hull` (0 when all are
+/// inside): parry's hull of a thin mesh can leave some of its points a
+/// little outside. Each point is tested against the face planes, and one
+/// found outside is projected onto the hull. `None` when that would take
+/// more than [`MAX_HULL_CHECK`] tests, or the hull is not a polyhedron.
+fn farthest_outside(hull: &SharedShape, points: &[parry3d_f64::math::Vector]) -> Option<f64> {
+    let poly = hull.as_convex_polyhedron()?;
+    let corners = poly.points();
+    let planes: Vec<_> = poly
+        .faces()
+        .iter()
+        .map(|f| {
+            let on = corners[poly.vertices_adj_to_face()[f.first_vertex_or_edge as usize] as usize];
+            (f.normal, f.normal.dot(on))
+        })
+        .collect();
+    if points.len().saturating_mul(planes.len()) > MAX_HULL_CHECK {
+        return None;
+    }
+    let mut farthest = 0.0f64;
+    for p in points {
+        if planes.iter().any(|(n, h)| n.dot(*p) > *h) {
+            farthest = farthest.max(poly.distance_to_local_point(*p, true));
+        }
+    }
+    Some(farthest)
+}
+
+/// A body shape that is its closed form `bound` (a capsule or a box, body
+/// frame); `None` for no bound.
+fn bound_shape(bound: RobotFast) -> Option<BodyShape> {
+    let (offset, shape) = match bound {
+        RobotFast::Swept { a, b, r } => {
+            let (mid, axis) = (nalgebra::center(&a, &b), b - a);
+            let turn = UnitQuaternion::rotation_between(&Vector3::y(), &axis).unwrap_or_else(|| {
+                UnitQuaternion::from_axis_angle(
+                    &Vector3::x_axis(),
+                    if axis.y < 0.0 { std::f64::consts::PI } else { 0.0 },
+                )
+            });
+            (
+                Isometry3::from_parts(Translation3::from(mid.coords), turn),
+                SharedShape::capsule_y(0.5 * axis.norm(), r),
+            )
+        }
+        RobotFast::Box { offset, half } => (offset, SharedShape::cuboid(half.x, half.y, half.z)),
+        RobotFast::None => return None,
+    };
+    Some(BodyShape {
+        offset,
+        shape,
+        fast: bound,
+        bound,
+    })
 }

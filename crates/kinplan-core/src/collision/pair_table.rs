@@ -36,6 +36,11 @@ const FINE_REACH: f64 = 0.006;
 const COARSE: usize = 12;
 /// Most fine cells per table.
 const MAX_FINE_CELLS: usize = 1 << 14;
+/// The work a model's tables may take, in cell × vertex tests: a table
+/// costs its fine cells times the vertices of both bodies (boxes and round
+/// shapes count 8), and pairs are given tables in order while the budget
+/// lasts, so a model of many large meshes spends a bounded time here.
+pub(crate) const TABLE_BUDGET: usize = 1 << 24;
 
 /// The proved-free cells of one self pair (module doc).
 #[derive(Debug, Clone)]
@@ -56,8 +61,15 @@ pub(crate) struct PairTable {
 }
 
 impl PairTable {
-    /// The table of bodies `a < b` of `model`, when the module's conditions hold.
-    pub(crate) fn build(model: &RobotModel, sweep: &SweepBound, a: usize, b: usize) -> Option<PairTable> {
+    /// The table of bodies `a < b` of `model`, when the module's conditions
+    /// hold and its cost fits in `budget` (which it then spends).
+    pub(crate) fn build(
+        model: &RobotModel,
+        sweep: &SweepBound,
+        a: usize,
+        b: usize,
+        budget: &mut usize,
+    ) -> Option<PairTable> {
         let bodies = &model.bodies;
         let joints = model.chain().joints();
         let costly = |x: usize| {
@@ -109,6 +121,16 @@ impl PairTable {
             per_coarse[k] = (per_coarse[k] / 2).max(1);
         }
         let cells = [coarse[0] * per_coarse[0], coarse[1] * per_coarse[1]];
+        let vertices = |x: usize| -> usize {
+            let shape =
+                |s: &super::model::BodyShape| s.shape.as_convex_polyhedron().map_or(8, |c| c.points().len());
+            bodies[x].shapes.iter().map(shape).sum()
+        };
+        let cost = (cells[0] * cells[1]).saturating_mul(vertices(a) + vertices(b));
+        if cost > *budget {
+            return None;
+        }
+        *budget -= cost;
         let lo = [joints[js[0]].lower, joints[js[1]].lower];
         let width = [
             span(0) / cells[0] as f64,
@@ -141,7 +163,9 @@ impl PairTable {
                 q[js[1]] = centre[1];
             }
             model.body_poses(&q, &mut poses);
+            // grown a hair for the rounding of the cell lookup
             let reach = half[0] * lever(0) + if two { half[1] * lever(1) } else { 0.0 };
+            let reach = reach * (1.0 + 1e-9) + 1e-12;
             !body_body_within(
                 &bodies[a],
                 &poses[a],

@@ -84,7 +84,17 @@ pub fn shape_extreme_points(shape: &Shape) -> Vec<Point3<f64>> {
             out.push(Point3::new(0.0, 0.0, -(half + radius)));
             out
         }
-        Shape::MeshReference { .. } => vec![Point3::origin()],
+        // a built-in robot's embedded mesh gives its vertices; a mesh file
+        // the chain alone does not carry stands at its origin
+        Shape::MeshReference { filename, scale } => crate::collision::builtin_mesh(filename).map_or_else(
+            || vec![Point3::origin()],
+            |m| {
+                m.vertices
+                    .iter()
+                    .map(|p| Point3::from(p.coords.component_mul(scale)))
+                    .collect()
+            },
+        ),
     }
 }
 

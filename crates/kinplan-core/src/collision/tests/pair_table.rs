@@ -8,8 +8,8 @@ use nalgebra::Isometry3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+use super::super::convert::pose_to_parry;
 use super::super::model::MAX_BODIES;
-use super::super::narrow::body_body_contact;
 use super::super::*;
 use crate::robot::{builtin_chain, builtin_urdf};
 
@@ -28,12 +28,27 @@ fn random_state(model: &RobotModel, rng: &mut ChaCha8Rng) -> Vec<f64> {
         .collect()
 }
 
-/// Signed distance of bodies `a` and `b` at `q`, by parry (capped at 1 m).
+/// Distance of bodies `a` and `b` at `q` (0 when they touch), by parry's
+/// own query on every pair of their shapes, without the checker's bounds.
 fn gap(model: &RobotModel, q: &[f64], a: usize, b: usize) -> f64 {
     let mut poses = [Isometry3::identity(); MAX_BODIES];
     model.body_poses(q, &mut poses);
     let bodies = &model.bodies;
-    body_body_contact(&bodies[a], &poses[a], &bodies[b], &poses[b], 1.0).map_or(1.0, |w| w.distance)
+    let mut nearest = f64::INFINITY;
+    for sa in &bodies[a].shapes {
+        for sb in &bodies[b].shapes {
+            let (pa, pb) = (
+                pose_to_parry(&(poses[a] * sa.offset)),
+                pose_to_parry(&(poses[b] * sb.offset)),
+            );
+            nearest = nearest.min(
+                parry3d_f64::query::distance(&pa, &*sa.shape, &pb, &*sb.shape)
+                    .unwrap()
+                    .distance,
+            );
+        }
+    }
+    nearest
 }
 
 fn name(model: &RobotModel, b: usize) -> &str {
