@@ -32,6 +32,9 @@ use crate::robot::JointKind;
 
 /// How far (m) a distal body may move within a fine cell.
 const FINE_REACH: f64 = 0.006;
+/// How far (m) a distal body may move within a fine cell of a table over
+/// one joint.
+const FINE_REACH_ONE: f64 = 0.0005;
 /// Coarse cells per joint.
 const COARSE: usize = 12;
 /// Most fine cells per table.
@@ -104,8 +107,9 @@ impl PairTable {
         let span = |k: usize| joints[js[k]].upper - joints[js[k]].lower;
         let lever = |k: usize| sweep.lever(distal, js[k]);
         // fine cells so that each joint moves the distal body at most
-        // FINE_REACH / |J| within a cell, in whole coarse cells
-        let share = FINE_REACH / moving.len() as f64;
+        // FINE_REACH / |J| within a cell (a table over one joint, which costs
+        // little, down to FINE_REACH_ONE), in whole coarse cells
+        let share = if two { FINE_REACH / 2.0 } else { FINE_REACH_ONE };
         let mut per_coarse = [1usize; 2];
         for (k, cells) in per_coarse.iter_mut().enumerate().take(moving.len()) {
             // at most MAX_FINE_CELLS per joint, so the products below stay small
