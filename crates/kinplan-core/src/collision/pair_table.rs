@@ -150,16 +150,7 @@ impl PairTable {
             free: vec![0; (cells[0] * cells[1]).div_ceil(64)],
         };
         // the other joints at the middle of their ranges (any value would do)
-        let mut q: Vec<f64> = joints
-            .iter()
-            .map(|j| {
-                if j.lower.is_finite() && j.upper.is_finite() {
-                    0.5 * (j.lower + j.upper)
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let mut q = model.chain().mid_limits();
         let mut poses = [Isometry3::identity(); MAX_BODIES];
         let mut proved_apart = |centre: [f64; 2], half: [f64; 2]| {
             q[js[0]] = centre[0];

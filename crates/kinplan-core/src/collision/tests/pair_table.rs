@@ -21,11 +21,7 @@ fn panda_hand() -> Arc<RobotModel> {
 }
 
 fn random_state(model: &RobotModel, rng: &mut ChaCha8Rng) -> Vec<f64> {
-    let joints = model.chain().joints();
-    joints
-        .iter()
-        .map(|j| rng.random_range(j.lower..=j.upper))
-        .collect()
+    super::lanes::random_state(model.chain(), rng)
 }
 
 /// Distance of bodies `a` and `b` at `q` (0 when they touch), by parry's
