@@ -118,6 +118,20 @@ def test_a_plan_recording_holds_the_links_where_kinplans_fk_puts_them(c, tmp_pat
     np.testing.assert_allclose(strip[-1], ur5.fk(GOAL)[:3, 3], atol=1e-6)
 
 
+def test_the_built_in_pandas_meshes_are_drawn(c, tmp_path):
+    panda = c.robot("franka_panda")
+    path = tmp_path / "panda.rrd"
+    with viz.Recording("test", save=str(path)) as rec:
+        rec.robot(panda, np.array([0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0]))
+    data = read(path)
+    # link_5's polytope: the service's vertices, placed in the link frame (its origin is the identity)
+    link = next(l for l in panda.describe().raw.links if l.name == "link_5")
+    sent = np.array([[v.x, v.y, v.z] for v in link.collision[0].mesh.vertices])
+    drawn = np.array(rows(data["/world/robot/link_5/collision_0"], "Mesh3D:vertex_positions")[0][1])
+    assert len(sent) >= 4
+    np.testing.assert_allclose(drawn, sent, atol=1e-6)
+
+
 def test_a_colliding_plan_turns_links_red_and_ccstomp_shows_its_tube(c, tmp_path):
     ur5 = c.robot("ur5")
     scene = ball_scene(ur5)

@@ -25,15 +25,15 @@ _sym_db = _symbol_database.Default()
 from kinplan.v1 import common_pb2 as kinplan_dot_v1_dot_common__pb2
 
 
-DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\x16kinplan/v1/robot.proto\x12\nkinplan.v1\x1a\x17kinplan/v1/common.proto\"\x13\n\x11ListRobotsRequest\"c\n\x0cRobotSummary\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x0b\n\x03\x64of\x18\x02 \x01(\r\x12\x13\n\x0b\x64\x65scription\x18\x03 \x01(\t\x12\x11\n\tbase_link\x18\x04 \x01(\t\x12\x10\n\x08tip_link\x18\x05 \x01(\t\">\n\x12ListRobotsResponse\x12(\n\x06robots\x18\x01 \x03(\x0b\x32\x18.kinplan.v1.RobotSummary\"\x8a\x01\n\x14\x44\x65scribeRobotRequest\x12#\n\x05robot\x18\x01 \x01(\x0b\x32\x14.kinplan.v1.RobotRef\x12\x14\n\x0cinclude_urdf\x18\x02 \x01(\x08\x12\x15\n\rkeep_capsules\x18\x03 \x01(\x08\x12 \n\x18include_collision_bodies\x18\x04 \x01(\x08\"\xb4\x01\n\tJointInfo\x12\x0c\n\x04name\x18\x01 \x01(\t\x12#\n\x04type\x18\x02 \x01(\x0e\x32\x15.kinplan.v1.JointType\x12 \n\x06origin\x18\x03 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x1e\n\x04\x61xis\x18\x04 \x01(\x0b\x32\x10.kinplan.v1.Vec3\x12\r\n\x05lower\x18\x05 \x01(\x01\x12\r\n\x05upper\x18\x06 \x01(\x01\x12\x14\n\x0cmax_velocity\x18\x07 \x01(\x01\"\xf0\x01\n\x11\x43ollisionGeometry\x12 \n\x06origin\x18\x01 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x1e\n\x03\x62ox\x18\x02 \x01(\x0b\x32\x0f.kinplan.v1.BoxH\x00\x12$\n\x06sphere\x18\x03 \x01(\x0b\x32\x12.kinplan.v1.SphereH\x00\x12(\n\x08\x63ylinder\x18\x04 \x01(\x0b\x32\x14.kinplan.v1.CylinderH\x00\x12&\n\x07\x63\x61psule\x18\x05 \x01(\x0b\x32\x13.kinplan.v1.CapsuleH\x00\x12\x18\n\x0emesh_reference\x18\x06 \x01(\tH\x00\x42\x07\n\x05shape\"\x82\x01\n\x08LinkInfo\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x14\n\x0cparent_joint\x18\x02 \x01(\x05\x12 \n\x06offset\x18\x03 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x30\n\tcollision\x18\x04 \x03(\x0b\x32\x1d.kinplan.v1.CollisionGeometry\"\xad\x03\n\x15\x44\x65scribeRobotResponse\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x10\n\x08model_id\x18\x02 \x01(\x0c\x12\x11\n\tbase_link\x18\x03 \x01(\t\x12\x10\n\x08tip_link\x18\x04 \x01(\t\x12%\n\x06joints\x18\x05 \x03(\x0b\x32\x15.kinplan.v1.JointInfo\x12#\n\x05links\x18\x06 \x03(\x0b\x32\x14.kinplan.v1.LinkInfo\x12$\n\ntip_offset\x18\x07 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x0c\n\x04urdf\x18\x08 \x01(\t\x12\x37\n\x10\x63ollision_bodies\x18\t \x03(\x0b\x32\x1d.kinplan.v1.CollisionBodyInfo\x12,\n\x0cnamed_states\x18\n \x03(\x0b\x32\x16.kinplan.v1.NamedState\x12\x17\n\x0f\x61nalytic_family\x18\x0b \x01(\t\x12\x17\n\x0f\x61nalytic_reason\x18\x0c \x01(\t\x12\x1b\n\x13\x61nalytic_held_joint\x18\r \x01(\x05\x12\x19\n\x11\x61nalytic_reversed\x18\x0e \x01(\x08\"Q\n\nNamedState\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\r\n\x05group\x18\x02 \x01(\t\x12\x13\n\x0bjoint_names\x18\x03 \x03(\t\x12\x11\n\tpositions\x18\x04 \x03(\x01\"E\n\x11\x43ollisionBodyInfo\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x12\n\ncarried_by\x18\x02 \x01(\t\x12\x0e\n\x06shapes\x18\x03 \x01(\r\"o\n\x18\x46orwardKinematicsRequest\x12#\n\x05robot\x18\x01 \x01(\x0b\x32\x14.kinplan.v1.RobotRef\x12\x17\n\x0fjoint_positions\x18\x02 \x03(\x01\x12\x15\n\rinclude_links\x18\x03 \x01(\x08\"8\n\x08LinkPose\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x1e\n\x04pose\x18\x02 \x01(\x0b\x32\x10.kinplan.v1.Pose\"w\n\x19\x46orwardKinematicsResponse\x12#\n\ttool_pose\x18\x01 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12#\n\x05links\x18\x02 \x03(\x0b\x32\x14.kinplan.v1.LinkPose\x12\x10\n\x08model_id\x18\x03 \x01(\x0c\"O\n\x0fJacobianRequest\x12#\n\x05robot\x18\x01 \x01(\x0b\x32\x14.kinplan.v1.RobotRef\x12\x17\n\x0fjoint_positions\x18\x02 \x03(\x01\"o\n\x10JacobianResponse\x12$\n\x08jacobian\x18\x01 \x01(\x0b\x32\x12.kinplan.v1.Matrix\x12#\n\ttool_pose\x18\x02 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x10\n\x08model_id\x18\x03 \x01(\x0c\"\x8c\x01\n\x1d\x46orwardKinematicsBatchRequest\x12#\n\x05robot\x18\x01 \x01(\x0b\x32\x14.kinplan.v1.RobotRef\x12+\n\x0fjoint_positions\x18\x02 \x01(\x0b\x32\x12.kinplan.v1.Matrix\x12\x19\n\x11include_jacobians\x18\x03 \x01(\x08\"\x81\x01\n\x1e\x46orwardKinematicsBatchResponse\x12&\n\ntool_poses\x18\x01 \x01(\x0b\x32\x12.kinplan.v1.Matrix\x12%\n\tjacobians\x18\x02 \x01(\x0b\x32\x12.kinplan.v1.Matrix\x12\x10\n\x08model_id\x18\x03 \x01(\x0c*u\n\tJointType\x12\x1a\n\x16JOINT_TYPE_UNSPECIFIED\x10\x00\x12\x17\n\x13JOINT_TYPE_REVOLUTE\x10\x01\x12\x19\n\x15JOINT_TYPE_CONTINUOUS\x10\x02\x12\x18\n\x14JOINT_TYPE_PRISMATIC\x10\x03\x32\xcb\x03\n\x0cRobotService\x12K\n\nListRobots\x12\x1d.kinplan.v1.ListRobotsRequest\x1a\x1e.kinplan.v1.ListRobotsResponse\x12T\n\rDescribeRobot\x12 .kinplan.v1.DescribeRobotRequest\x1a!.kinplan.v1.DescribeRobotResponse\x12`\n\x11\x46orwardKinematics\x12$.kinplan.v1.ForwardKinematicsRequest\x1a%.kinplan.v1.ForwardKinematicsResponse\x12\x45\n\x08Jacobian\x12\x1b.kinplan.v1.JacobianRequest\x1a\x1c.kinplan.v1.JacobianResponse\x12o\n\x16\x46orwardKinematicsBatch\x12).kinplan.v1.ForwardKinematicsBatchRequest\x1a*.kinplan.v1.ForwardKinematicsBatchResponseb\x06proto3')
+DESCRIPTOR = _descriptor_pool.Default().AddSerializedFile(b'\n\x16kinplan/v1/robot.proto\x12\nkinplan.v1\x1a\x17kinplan/v1/common.proto\"\x13\n\x11ListRobotsRequest\"c\n\x0cRobotSummary\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x0b\n\x03\x64of\x18\x02 \x01(\r\x12\x13\n\x0b\x64\x65scription\x18\x03 \x01(\t\x12\x11\n\tbase_link\x18\x04 \x01(\t\x12\x10\n\x08tip_link\x18\x05 \x01(\t\">\n\x12ListRobotsResponse\x12(\n\x06robots\x18\x01 \x03(\x0b\x32\x18.kinplan.v1.RobotSummary\"\x8a\x01\n\x14\x44\x65scribeRobotRequest\x12#\n\x05robot\x18\x01 \x01(\x0b\x32\x14.kinplan.v1.RobotRef\x12\x14\n\x0cinclude_urdf\x18\x02 \x01(\x08\x12\x15\n\rkeep_capsules\x18\x03 \x01(\x08\x12 \n\x18include_collision_bodies\x18\x04 \x01(\x08\"\xb4\x01\n\tJointInfo\x12\x0c\n\x04name\x18\x01 \x01(\t\x12#\n\x04type\x18\x02 \x01(\x0e\x32\x15.kinplan.v1.JointType\x12 \n\x06origin\x18\x03 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x1e\n\x04\x61xis\x18\x04 \x01(\x0b\x32\x10.kinplan.v1.Vec3\x12\r\n\x05lower\x18\x05 \x01(\x01\x12\r\n\x05upper\x18\x06 \x01(\x01\x12\x14\n\x0cmax_velocity\x18\x07 \x01(\x01\"\x9a\x02\n\x11\x43ollisionGeometry\x12 \n\x06origin\x18\x01 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x1e\n\x03\x62ox\x18\x02 \x01(\x0b\x32\x0f.kinplan.v1.BoxH\x00\x12$\n\x06sphere\x18\x03 \x01(\x0b\x32\x12.kinplan.v1.SphereH\x00\x12(\n\x08\x63ylinder\x18\x04 \x01(\x0b\x32\x14.kinplan.v1.CylinderH\x00\x12&\n\x07\x63\x61psule\x18\x05 \x01(\x0b\x32\x13.kinplan.v1.CapsuleH\x00\x12\x18\n\x0emesh_reference\x18\x06 \x01(\tH\x00\x12(\n\x04mesh\x18\x07 \x01(\x0b\x32\x18.kinplan.v1.TriangleMeshH\x00\x42\x07\n\x05shape\"\x82\x01\n\x08LinkInfo\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x14\n\x0cparent_joint\x18\x02 \x01(\x05\x12 \n\x06offset\x18\x03 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x30\n\tcollision\x18\x04 \x03(\x0b\x32\x1d.kinplan.v1.CollisionGeometry\"\xad\x03\n\x15\x44\x65scribeRobotResponse\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x10\n\x08model_id\x18\x02 \x01(\x0c\x12\x11\n\tbase_link\x18\x03 \x01(\t\x12\x10\n\x08tip_link\x18\x04 \x01(\t\x12%\n\x06joints\x18\x05 \x03(\x0b\x32\x15.kinplan.v1.JointInfo\x12#\n\x05links\x18\x06 \x03(\x0b\x32\x14.kinplan.v1.LinkInfo\x12$\n\ntip_offset\x18\x07 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x0c\n\x04urdf\x18\x08 \x01(\t\x12\x37\n\x10\x63ollision_bodies\x18\t \x03(\x0b\x32\x1d.kinplan.v1.CollisionBodyInfo\x12,\n\x0cnamed_states\x18\n \x03(\x0b\x32\x16.kinplan.v1.NamedState\x12\x17\n\x0f\x61nalytic_family\x18\x0b \x01(\t\x12\x17\n\x0f\x61nalytic_reason\x18\x0c \x01(\t\x12\x1b\n\x13\x61nalytic_held_joint\x18\r \x01(\x05\x12\x19\n\x11\x61nalytic_reversed\x18\x0e \x01(\x08\"Q\n\nNamedState\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\r\n\x05group\x18\x02 \x01(\t\x12\x13\n\x0bjoint_names\x18\x03 \x03(\t\x12\x11\n\tpositions\x18\x04 \x03(\x01\"E\n\x11\x43ollisionBodyInfo\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x12\n\ncarried_by\x18\x02 \x01(\t\x12\x0e\n\x06shapes\x18\x03 \x01(\r\"o\n\x18\x46orwardKinematicsRequest\x12#\n\x05robot\x18\x01 \x01(\x0b\x32\x14.kinplan.v1.RobotRef\x12\x17\n\x0fjoint_positions\x18\x02 \x03(\x01\x12\x15\n\rinclude_links\x18\x03 \x01(\x08\"8\n\x08LinkPose\x12\x0c\n\x04name\x18\x01 \x01(\t\x12\x1e\n\x04pose\x18\x02 \x01(\x0b\x32\x10.kinplan.v1.Pose\"w\n\x19\x46orwardKinematicsResponse\x12#\n\ttool_pose\x18\x01 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12#\n\x05links\x18\x02 \x03(\x0b\x32\x14.kinplan.v1.LinkPose\x12\x10\n\x08model_id\x18\x03 \x01(\x0c\"O\n\x0fJacobianRequest\x12#\n\x05robot\x18\x01 \x01(\x0b\x32\x14.kinplan.v1.RobotRef\x12\x17\n\x0fjoint_positions\x18\x02 \x03(\x01\"o\n\x10JacobianResponse\x12$\n\x08jacobian\x18\x01 \x01(\x0b\x32\x12.kinplan.v1.Matrix\x12#\n\ttool_pose\x18\x02 \x01(\x0b\x32\x10.kinplan.v1.Pose\x12\x10\n\x08model_id\x18\x03 \x01(\x0c\"\x8c\x01\n\x1d\x46orwardKinematicsBatchRequest\x12#\n\x05robot\x18\x01 \x01(\x0b\x32\x14.kinplan.v1.RobotRef\x12+\n\x0fjoint_positions\x18\x02 \x01(\x0b\x32\x12.kinplan.v1.Matrix\x12\x19\n\x11include_jacobians\x18\x03 \x01(\x08\"\x81\x01\n\x1e\x46orwardKinematicsBatchResponse\x12&\n\ntool_poses\x18\x01 \x01(\x0b\x32\x12.kinplan.v1.Matrix\x12%\n\tjacobians\x18\x02 \x01(\x0b\x32\x12.kinplan.v1.Matrix\x12\x10\n\x08model_id\x18\x03 \x01(\x0c*u\n\tJointType\x12\x1a\n\x16JOINT_TYPE_UNSPECIFIED\x10\x00\x12\x17\n\x13JOINT_TYPE_REVOLUTE\x10\x01\x12\x19\n\x15JOINT_TYPE_CONTINUOUS\x10\x02\x12\x18\n\x14JOINT_TYPE_PRISMATIC\x10\x03\x32\xcb\x03\n\x0cRobotService\x12K\n\nListRobots\x12\x1d.kinplan.v1.ListRobotsRequest\x1a\x1e.kinplan.v1.ListRobotsResponse\x12T\n\rDescribeRobot\x12 .kinplan.v1.DescribeRobotRequest\x1a!.kinplan.v1.DescribeRobotResponse\x12`\n\x11\x46orwardKinematics\x12$.kinplan.v1.ForwardKinematicsRequest\x1a%.kinplan.v1.ForwardKinematicsResponse\x12\x45\n\x08Jacobian\x12\x1b.kinplan.v1.JacobianRequest\x1a\x1c.kinplan.v1.JacobianResponse\x12o\n\x16\x46orwardKinematicsBatch\x12).kinplan.v1.ForwardKinematicsBatchRequest\x1a*.kinplan.v1.ForwardKinematicsBatchResponseb\x06proto3')
 
 _globals = globals()
 _builder.BuildMessageAndEnumDescriptors(DESCRIPTOR, _globals)
 _builder.BuildTopDescriptorsAndMessages(DESCRIPTOR, 'kinplan.v1.robot_pb2', _globals)
 if not _descriptor._USE_C_DESCRIPTORS:
   DESCRIPTOR._loaded_options = None
-  _globals['_JOINTTYPE']._serialized_start=2296
-  _globals['_JOINTTYPE']._serialized_end=2413
+  _globals['_JOINTTYPE']._serialized_start=2338
+  _globals['_JOINTTYPE']._serialized_end=2455
   _globals['_LISTROBOTSREQUEST']._serialized_start=63
   _globals['_LISTROBOTSREQUEST']._serialized_end=82
   _globals['_ROBOTSUMMARY']._serialized_start=84
@@ -45,29 +45,29 @@ if not _descriptor._USE_C_DESCRIPTORS:
   _globals['_JOINTINFO']._serialized_start=391
   _globals['_JOINTINFO']._serialized_end=571
   _globals['_COLLISIONGEOMETRY']._serialized_start=574
-  _globals['_COLLISIONGEOMETRY']._serialized_end=814
-  _globals['_LINKINFO']._serialized_start=817
-  _globals['_LINKINFO']._serialized_end=947
-  _globals['_DESCRIBEROBOTRESPONSE']._serialized_start=950
-  _globals['_DESCRIBEROBOTRESPONSE']._serialized_end=1379
-  _globals['_NAMEDSTATE']._serialized_start=1381
-  _globals['_NAMEDSTATE']._serialized_end=1462
-  _globals['_COLLISIONBODYINFO']._serialized_start=1464
-  _globals['_COLLISIONBODYINFO']._serialized_end=1533
-  _globals['_FORWARDKINEMATICSREQUEST']._serialized_start=1535
-  _globals['_FORWARDKINEMATICSREQUEST']._serialized_end=1646
-  _globals['_LINKPOSE']._serialized_start=1648
-  _globals['_LINKPOSE']._serialized_end=1704
-  _globals['_FORWARDKINEMATICSRESPONSE']._serialized_start=1706
-  _globals['_FORWARDKINEMATICSRESPONSE']._serialized_end=1825
-  _globals['_JACOBIANREQUEST']._serialized_start=1827
-  _globals['_JACOBIANREQUEST']._serialized_end=1906
-  _globals['_JACOBIANRESPONSE']._serialized_start=1908
-  _globals['_JACOBIANRESPONSE']._serialized_end=2019
-  _globals['_FORWARDKINEMATICSBATCHREQUEST']._serialized_start=2022
-  _globals['_FORWARDKINEMATICSBATCHREQUEST']._serialized_end=2162
-  _globals['_FORWARDKINEMATICSBATCHRESPONSE']._serialized_start=2165
-  _globals['_FORWARDKINEMATICSBATCHRESPONSE']._serialized_end=2294
-  _globals['_ROBOTSERVICE']._serialized_start=2416
-  _globals['_ROBOTSERVICE']._serialized_end=2875
+  _globals['_COLLISIONGEOMETRY']._serialized_end=856
+  _globals['_LINKINFO']._serialized_start=859
+  _globals['_LINKINFO']._serialized_end=989
+  _globals['_DESCRIBEROBOTRESPONSE']._serialized_start=992
+  _globals['_DESCRIBEROBOTRESPONSE']._serialized_end=1421
+  _globals['_NAMEDSTATE']._serialized_start=1423
+  _globals['_NAMEDSTATE']._serialized_end=1504
+  _globals['_COLLISIONBODYINFO']._serialized_start=1506
+  _globals['_COLLISIONBODYINFO']._serialized_end=1575
+  _globals['_FORWARDKINEMATICSREQUEST']._serialized_start=1577
+  _globals['_FORWARDKINEMATICSREQUEST']._serialized_end=1688
+  _globals['_LINKPOSE']._serialized_start=1690
+  _globals['_LINKPOSE']._serialized_end=1746
+  _globals['_FORWARDKINEMATICSRESPONSE']._serialized_start=1748
+  _globals['_FORWARDKINEMATICSRESPONSE']._serialized_end=1867
+  _globals['_JACOBIANREQUEST']._serialized_start=1869
+  _globals['_JACOBIANREQUEST']._serialized_end=1948
+  _globals['_JACOBIANRESPONSE']._serialized_start=1950
+  _globals['_JACOBIANRESPONSE']._serialized_end=2061
+  _globals['_FORWARDKINEMATICSBATCHREQUEST']._serialized_start=2064
+  _globals['_FORWARDKINEMATICSBATCHREQUEST']._serialized_end=2204
+  _globals['_FORWARDKINEMATICSBATCHRESPONSE']._serialized_start=2207
+  _globals['_FORWARDKINEMATICSBATCHRESPONSE']._serialized_end=2336
+  _globals['_ROBOTSERVICE']._serialized_start=2458
+  _globals['_ROBOTSERVICE']._serialized_end=2917
 # @@protoc_insertion_point(module_scope)

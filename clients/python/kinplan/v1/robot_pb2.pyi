@@ -74,20 +74,22 @@ class JointInfo(_message.Message):
     def __init__(self, name: _Optional[str] = ..., type: _Optional[_Union[JointType, str]] = ..., origin: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., axis: _Optional[_Union[_common_pb2.Vec3, _Mapping]] = ..., lower: _Optional[float] = ..., upper: _Optional[float] = ..., max_velocity: _Optional[float] = ...) -> None: ...
 
 class CollisionGeometry(_message.Message):
-    __slots__ = ("origin", "box", "sphere", "cylinder", "capsule", "mesh_reference")
+    __slots__ = ("origin", "box", "sphere", "cylinder", "capsule", "mesh_reference", "mesh")
     ORIGIN_FIELD_NUMBER: _ClassVar[int]
     BOX_FIELD_NUMBER: _ClassVar[int]
     SPHERE_FIELD_NUMBER: _ClassVar[int]
     CYLINDER_FIELD_NUMBER: _ClassVar[int]
     CAPSULE_FIELD_NUMBER: _ClassVar[int]
     MESH_REFERENCE_FIELD_NUMBER: _ClassVar[int]
+    MESH_FIELD_NUMBER: _ClassVar[int]
     origin: _common_pb2.Pose
     box: _common_pb2.Box
     sphere: _common_pb2.Sphere
     cylinder: _common_pb2.Cylinder
     capsule: _common_pb2.Capsule
     mesh_reference: str
-    def __init__(self, origin: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., box: _Optional[_Union[_common_pb2.Box, _Mapping]] = ..., sphere: _Optional[_Union[_common_pb2.Sphere, _Mapping]] = ..., cylinder: _Optional[_Union[_common_pb2.Cylinder, _Mapping]] = ..., capsule: _Optional[_Union[_common_pb2.Capsule, _Mapping]] = ..., mesh_reference: _Optional[str] = ...) -> None: ...
+    mesh: _common_pb2.TriangleMesh
+    def __init__(self, origin: _Optional[_Union[_common_pb2.Pose, _Mapping]] = ..., box: _Optional[_Union[_common_pb2.Box, _Mapping]] = ..., sphere: _Optional[_Union[_common_pb2.Sphere, _Mapping]] = ..., cylinder: _Optional[_Union[_common_pb2.Cylinder, _Mapping]] = ..., capsule: _Optional[_Union[_common_pb2.Capsule, _Mapping]] = ..., mesh_reference: _Optional[str] = ..., mesh: _Optional[_Union[_common_pb2.TriangleMesh, _Mapping]] = ...) -> None: ...
 
 class LinkInfo(_message.Message):
     __slots__ = ("name", "parent_joint", "offset", "collision")

@@ -190,9 +190,10 @@ class Recording:
 
     def robot(self, robot: Any, q: Optional[Any] = None, *, path: str = "world/robot",
               color: Optional[Sequence[int]] = None, urdf_file: Optional[str] = None) -> None:
-        """Draws ``robot``'s collision bodies (the capsules, spheres, boxes
-        and cylinders of ``robot.describe()``: kinplan's own geometry; a mesh
-        a URDF names is not read, and its link is drawn as its frame only)
+        """Draws ``robot``'s collision bodies (the capsules, spheres, boxes,
+        cylinders and built-in meshes of ``robot.describe()``: kinplan's own
+        geometry; a mesh file a URDF names is not read, and its link is drawn
+        as its frame only)
         under ``path/<link>``; each link entity carries its pose. With
         ``urdf_file`` (the robot's URDF on disk, its mesh files where it
         names them), the URDF's visual and collision geometry instead, read
@@ -619,10 +620,15 @@ def _frame_with_z(z: np.ndarray) -> np.ndarray:
 
 def _shape_archetype(kind: Optional[str], g: Any, T: np.ndarray, rgba: Sequence[int]) -> Any:
     """The Rerun archetype of one kinplan shape (its proto message ``g``
-    with ``box`` / ``sphere`` / ``cylinder`` / ``capsule``) posed by ``T``
-    (4x4); None for a shape drawn otherwise (mesh, octree, mesh_reference)."""
+    with ``box`` / ``sphere`` / ``cylinder`` / ``capsule``, or a robot's
+    ``mesh``) posed by ``T`` (4x4); None for a shape drawn otherwise (a
+    scene mesh, octree, mesh_reference)."""
     q = quaternions(T[:3, :3])
     p = T[:3, 3]
+    if kind == "mesh" and hasattr(g, "origin"):
+        v = np.array([[x.x, x.y, x.z] for x in g.mesh.vertices]).reshape(-1, 3) @ T[:3, :3].T + p
+        return rr.Mesh3D(vertex_positions=v, triangle_indices=np.array(g.mesh.indices).reshape(-1, 3),
+                         albedo_factor=rgba)
     if kind == "box":
         s = g.box.size
         return rr.Boxes3D(centers=[p], half_sizes=[[s.x / 2, s.y / 2, s.z / 2]], quaternions=[q], colors=[rgba],

@@ -84,6 +84,51 @@ fn shape_out(shape: &Shape) -> pb::collision_geometry::Shape {
             radius: *radius,
             length: *length,
         }),
-        Shape::MeshReference { filename, .. } => S::MeshReference(filename.clone()),
+        Shape::MeshReference { filename, scale } => match kinplan_core::collision::builtin_mesh(filename) {
+            // a built-in robot's mesh goes out whole; another is only named
+            Some(mesh) => S::Mesh(pb::TriangleMesh {
+                vertices: mesh
+                    .vertices
+                    .iter()
+                    .map(|p| vec3_out(&p.coords.component_mul(scale)))
+                    .collect(),
+                indices: mesh.indices.clone(),
+            }),
+            None => S::MeshReference(filename.clone()),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::describe;
+    use crate::pb::collision_geometry::Shape as S;
+
+    /// The built-in Panda's links go out with their embedded meshes, vertex
+    /// for vertex as the OBJ file the library carries writes them.
+    #[test]
+    fn a_built_in_mesh_is_described_whole() {
+        let chain = kinplan_core::robot::builtin_chain("franka_panda").unwrap();
+        let out = describe(&chain, Vec::new());
+        let link = out.links.iter().find(|l| l.name == "link_5").unwrap();
+        let Some(S::Mesh(mesh)) = &link.collision[0].shape else {
+            panic!("{:?}", link.collision[0].shape)
+        };
+        let obj = include_str!("../../../../kinplan-core/src/robot/builtin/meshes/panda/link_5.obj");
+        let vertices: Vec<Vec<f64>> = obj
+            .lines()
+            .filter_map(|l| l.strip_prefix("v "))
+            .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(mesh.vertices.len(), vertices.len());
+        assert_eq!(
+            mesh.indices.len(),
+            3 * obj.lines().filter(|l| l.starts_with("f ")).count()
+        );
+        for (ours, theirs) in mesh.vertices.iter().zip(&vertices) {
+            assert!(
+                (ours.x - theirs[0]).abs() + (ours.y - theirs[1]).abs() + (ours.z - theirs[2]).abs() < 1e-12
+            );
+        }
     }
 }
