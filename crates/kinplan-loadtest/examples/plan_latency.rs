@@ -12,7 +12,10 @@
 //!   `rrt_connect` time is the search, its proof and the greedy vertex
 //!   passes;
 //! - *as URDF*: the default request with the same robot sent as URDF text
-//!   instead of by name, the path a user's own robot takes.
+//!   instead of by name, the path a user's own robot takes; with the
+//!   `--user-*` flags, another URDF of the same arm (joints named as the
+//!   problems name them) with the collision mesh files it names and its SRDF,
+//!   e.g. example-robot-data's Panda.
 //!
 //! Before the problems, an idle round trip on the same connection for
 //! reference: `ForwardKinematics` of the same built-in robot at its zero
@@ -79,27 +82,86 @@ struct Args {
     problems: PathBuf,
     passes: usize,
     set: Option<String>,
+    /// The robot the "as URDF" column sends instead of the built-in's text.
+    user: Option<UserRobot>,
+}
+
+/// A robot as a user sends it: URDF text, the collision mesh files it
+/// names (`package://` URIs read under a root directory), its SRDF, and
+/// the chain's end links.
+struct UserRobot {
+    urdf: String,
+    srdf: String,
+    meshes: Vec<pb::MeshFile>,
+    base_link: String,
+    tip_link: String,
+}
+
+impl UserRobot {
+    fn read(urdf: &str, srdf: &str, root: &str, base_link: &str, tip_link: &str) -> Result<Self, String> {
+        let text = std::fs::read_to_string(urdf).map_err(|e| format!("{urdf}: {e}"))?;
+        let mut meshes: Vec<pb::MeshFile> = Vec::new();
+        for part in text.split("<collision").skip(1) {
+            let part = &part[..part.find("</collision>").unwrap_or(part.len())];
+            if let Some(at) = part.find("filename=\"") {
+                let uri = &part[at + 10..];
+                let uri = &uri[..uri.find('"').ok_or("unterminated filename")?];
+                if meshes.iter().all(|m| m.uri != uri) {
+                    let path = format!("{root}/{}", uri.trim_start_matches("package://"));
+                    let data = std::fs::read(&path).map_err(|e| format!("{path}: {e}"))?;
+                    meshes.push(pb::MeshFile {
+                        uri: uri.to_string(),
+                        data,
+                    });
+                }
+            }
+        }
+        Ok(UserRobot {
+            urdf: text,
+            srdf: std::fs::read_to_string(srdf).map_err(|e| format!("{srdf}: {e}"))?,
+            meshes,
+            base_link: base_link.into(),
+            tip_link: tip_link.into(),
+        })
+    }
 }
 
 fn args() -> Result<Args, String> {
-    let usage = "usage: plan_latency <kinplan binary> <problems dir> [--passes N] [--set NAME]";
+    let usage = "usage: plan_latency <kinplan binary> <problems dir> [--passes N] [--set NAME] \
+                 [--user-urdf PATH --user-srdf PATH --package-root DIR --user-base LINK --user-tip LINK]";
     let mut it = std::env::args().skip(1);
     let binary = it.next().ok_or(usage)?;
     let problems = PathBuf::from(it.next().ok_or(usage)?);
     let (mut passes, mut set) = (5, None);
+    let mut user: HashMap<String, String> = HashMap::new();
     while let Some(flag) = it.next() {
         let value = it.next().ok_or(usage)?;
         match flag.as_str() {
             "--passes" => passes = value.parse().map_err(|_| "--passes: a count")?,
             "--set" => set = Some(value),
+            "--user-urdf" | "--user-srdf" | "--package-root" | "--user-base" | "--user-tip" => {
+                user.insert(flag, value);
+            }
             _ => return Err(usage.into()),
         }
     }
+    let user = match user.len() {
+        0 => None,
+        5 => Some(UserRobot::read(
+            &user["--user-urdf"],
+            &user["--user-srdf"],
+            &user["--package-root"],
+            &user["--user-base"],
+            &user["--user-tip"],
+        )?),
+        _ => return Err(usage.into()),
+    };
     Ok(Args {
         binary,
         problems,
         passes: passes.max(1),
         set,
+        user,
     })
 }
 
@@ -130,7 +192,21 @@ fn object(o: &Obstacle) -> Result<pb::CollisionObject, String> {
     })
 }
 
-fn robot_ref(as_urdf: bool) -> pb::RobotRef {
+fn robot_ref(as_urdf: bool, user: Option<&UserRobot>) -> pb::RobotRef {
+    if let (true, Some(u)) = (as_urdf, user) {
+        return pb::RobotRef {
+            source: Some(pb::robot_ref::Source::Urdf(u.urdf.clone())),
+            base_link: u.base_link.clone(),
+            tip_link: u.tip_link.clone(),
+            held_joints: FINGERS
+                .iter()
+                .map(|f| (f.to_string(), FINGER_OPENING))
+                .collect::<HashMap<_, _>>(),
+            srdf: u.srdf.clone(),
+            meshes: u.meshes.clone(),
+            ..Default::default()
+        };
+    }
     let source = if as_urdf {
         pb::robot_ref::Source::Urdf(builtin_urdf(ROBOT).expect("built-in URDF").to_string())
     } else {
@@ -282,7 +358,7 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
     let channel = connect(port).await?;
     let mut robot = RobotServiceClient::new(channel.clone());
     let fk = pb::ForwardKinematicsRequest {
-        robot: Some(robot_ref(false)),
+        robot: Some(robot_ref(false, None)),
         joint_positions: vec![0.0; 7],
         include_links: false,
     };
@@ -315,7 +391,7 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut cols: [Vec<f64>; 8] = Default::default();
         let (mut valid, mut solved) = (0, 0);
         for (k, scene, start, goal) in &problems {
-            let by_name = request(robot_ref(false), scene, start, goal, *k, None);
+            let by_name = request(robot_ref(false, None), scene, start, goal, *k, None);
             // Warm: the model and scene caches, as a client's second call finds them.
             let first = client.plan(by_name.clone()).await?.into_inner();
             let status = pb::PlanStatus::try_from(first.status).unwrap_or_default();
@@ -323,8 +399,8 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
                 continue;
             }
             valid += 1;
-            let search = request(robot_ref(false), scene, start, goal, *k, Some(0));
-            let urdf = request(robot_ref(true), scene, start, goal, *k, None);
+            let search = request(robot_ref(false, None), scene, start, goal, *k, Some(0));
+            let urdf = request(robot_ref(true, a.user.as_ref()), scene, start, goal, *k, None);
             client.plan(urdf.clone()).await?;
             let d = time_request(&mut client, &by_name, a.passes).await?;
             let s = time_request(&mut client, &search, a.passes).await?;
