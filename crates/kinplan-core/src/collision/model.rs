@@ -655,3 +655,76 @@ fn bound_shape(bound: RobotFast) -> Option<BodyShape> {
         bound,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::{RobotFast, bound_shape};
+    use crate::collision::convert::{pose_to_parry, vec_to_parry};
+
+    /// The shape that stands for a mesh too large to check is its bound:
+    /// parry's shape holds a point exactly when the closed form does (away
+    /// from the surface), for capsules along every direction and turned boxes.
+    #[test]
+    fn a_bound_standing_for_a_mesh_is_the_same_shape_in_parry() {
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let bounds = [
+            RobotFast::Swept {
+                a: Point3::new(0.1, -0.2, 0.3),
+                b: Point3::new(-0.3, 0.25, 0.1),
+                r: 0.07,
+            },
+            RobotFast::Swept {
+                a: Point3::new(0.0, 0.2, 0.0),
+                b: Point3::new(0.0, -0.2, 0.0),
+                r: 0.05,
+            },
+            RobotFast::Swept {
+                a: Point3::new(0.2, 0.1, 0.0),
+                b: Point3::new(0.2, 0.1, 0.0),
+                r: 0.05,
+            },
+            RobotFast::Box {
+                offset: Isometry3::from_parts(
+                    Translation3::new(0.1, 0.0, -0.2),
+                    UnitQuaternion::from_euler_angles(0.3, -0.7, 1.1),
+                ),
+                half: Vector3::new(0.2, 0.05, 0.1),
+            },
+        ];
+        for bound in bounds {
+            let shape = bound_shape(bound).unwrap();
+            let pose = pose_to_parry(&shape.offset);
+            for _ in 0..2000 {
+                let p = Point3::new(
+                    rng.random_range(-0.6..0.6),
+                    rng.random_range(-0.6..0.6),
+                    rng.random_range(-0.6..0.6),
+                );
+                let outside = match bound {
+                    RobotFast::Swept { a, b, r } => {
+                        let ab = b - a;
+                        let t = if ab.norm() > 0.0 {
+                            ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        (p - (a + ab * t)).norm() - r
+                    }
+                    RobotFast::Box { offset, half } => {
+                        (offset.inverse_transform_point(&p).coords.abs() - half).max()
+                    }
+                    RobotFast::None => unreachable!(),
+                };
+                if outside.abs() > 1e-9 {
+                    let inside = shape.shape.contains_point(&pose, vec_to_parry(&p.coords));
+                    assert_eq!(inside, outside < 0.0, "{bound:?} at {p:?}");
+                }
+            }
+        }
+        assert!(bound_shape(RobotFast::None).is_none());
+    }
+}
