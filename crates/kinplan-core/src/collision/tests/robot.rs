@@ -812,7 +812,7 @@ fn builtin_panda_allows_only_its_designed_contacts() {
 }
 
 /// parry's convex hull of a thin cloud can leave some of its points outside
-/// (by millimetres for a 2.5 mm × 2.5 m sliver); the model grows such a hull
+/// (a sliver, thin against its length); the model grows such a hull
 /// until it holds them. Checked by support functions: along every sampled
 /// direction, the body's shapes reach at least as far as the farthest point.
 #[test]

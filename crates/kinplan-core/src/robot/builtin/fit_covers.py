@@ -21,10 +21,10 @@ others against the tool frame, so the kinematics agree. Then it writes
   projected across the axis, caps as short as the vertices allow, the radius
   grown while that shrinks the volume), a box for the fingers (the
   vertices' bounds in the link frame); every size grown by `MARGIN` and
-  rounded outwards to 0.1 mm. A capsule or a box leaves centimetres between
+  rounded outwards to 0.1 mm. A capsule or a box leaves room between
   itself and a rounded or flat mesh, and at the Panda's wrist, where link 5,
-  link 7 and the hand come within about 2 cm of each other in most states,
-  those centimetres made the built-in model refuse a third of all states;
+  link 7 and the hand stay close in most states, that room made the
+  built-in model refuse many states the meshes find free (benches/RESULTS.md);
   the polytopes refuse little more than the meshes do;
 - `<robot>_mesh_points.txt`: the vertices, `link x y z` per line in metres,
   which the Rust tests hold the committed URDFs against.
