@@ -150,7 +150,7 @@ fn capsule_along(points: &[Point3<f64>], u: &Vector3<f64>) -> (f64, RobotFast) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use nalgebra::{Point3, Rotation3, Vector3};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -160,7 +160,7 @@ mod tests {
     /// How far `p` lies outside the closed form (≤ 0: inside), by the
     /// definitions: distance to the segment less the radius, or the box's
     /// local coordinates against its half extents.
-    fn outside(shape: &RobotFast, p: &Point3<f64>) -> f64 {
+    pub(crate) fn outside(shape: &RobotFast, p: &Point3<f64>) -> f64 {
         match *shape {
             RobotFast::Swept { a, b, r } => {
                 let ab = b - a;

@@ -663,6 +663,7 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::{RobotFast, bound_shape};
+    use crate::collision::bound::tests::outside;
     use crate::collision::convert::{pose_to_parry, vec_to_parry};
 
     /// The shape that stands for a mesh too large to check is its bound:
@@ -704,21 +705,7 @@ mod tests {
                     rng.random_range(-0.6..0.6),
                     rng.random_range(-0.6..0.6),
                 );
-                let outside = match bound {
-                    RobotFast::Swept { a, b, r } => {
-                        let ab = b - a;
-                        let t = if ab.norm() > 0.0 {
-                            ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
-                        } else {
-                            0.0
-                        };
-                        (p - (a + ab * t)).norm() - r
-                    }
-                    RobotFast::Box { offset, half } => {
-                        (offset.inverse_transform_point(&p).coords.abs() - half).max()
-                    }
-                    RobotFast::None => unreachable!(),
-                };
+                let outside = outside(&bound, &p);
                 if outside.abs() > 1e-9 {
                     let inside = shape.shape.contains_point(&pose, vec_to_parry(&p.coords));
                     assert_eq!(inside, outside < 0.0, "{bound:?} at {p:?}");

@@ -51,9 +51,11 @@ pub(crate) struct PairTable {
     /// The pair's bodies, `a < b`.
     pub a: usize,
     pub b: usize,
-    /// The joints that move one body relative to the other (one or two;
-    /// with one, the second axis has a single cell).
+    /// The joints that move one body relative to the other: the first
+    /// `axes` (one or two) of these; with one, the second axis of the grid
+    /// has a single cell.
     joints: [usize; 2],
+    axes: usize,
     lo: [f64; 2],
     /// Fine cell widths (rad).
     width: [f64; 2],
@@ -144,6 +146,7 @@ impl PairTable {
             a,
             b,
             joints: js,
+            axes: moving.len(),
             lo,
             width,
             cells,
@@ -198,22 +201,18 @@ impl PairTable {
     /// within `half` of `q` (`half` empty: at `q` alone).
     pub(crate) fn proves_apart(&self, q: &[f64], half: &[f64]) -> bool {
         let mut range = [(0usize, 0usize); 2];
-        for k in 0..2 {
+        for (k, cells) in range.iter_mut().enumerate().take(self.axes) {
             let j = self.joints[k];
             let (Some(&v), h) = (q.get(j), half.get(j).map_or(0.0, |h| h.abs())) else {
                 return false;
             };
-            if self.cells[k] == 1 && k == 1 {
-                range[1] = (0, 0);
-                continue;
-            }
             let lo = (v - h - self.lo[k]) / self.width[k];
             let hi = (v + h - self.lo[k]) / self.width[k];
             // NaN and anything outside the table fail here
             if !(lo >= 0.0 && hi <= self.cells[k] as f64) {
                 return false;
             }
-            range[k] = (
+            *cells = (
                 (lo as usize).min(self.cells[k] - 1),
                 (hi as usize).min(self.cells[k] - 1),
             );
