@@ -12,7 +12,8 @@
 //!
 //! Semantics: touching counts as collision; scene meshes are surfaces
 //! (a robot part wholly inside a closed mesh does not touch it); robot
-//! meshes are used as convex hulls; motions are checked at interpolated
+//! meshes are used as convex hulls, or as a polytope of at most 20 faces
+//! around the hull when the hull has more (`outer_polytope`); motions are checked at interpolated
 //! states at most 0.05 rad apart — by default each state as it is (not
 //! conservative between states), or piece by piece with every body padded
 //! by how far it can move within the piece ([`MotionCheck::Padded`],
@@ -46,6 +47,7 @@ mod model;
 mod moveit;
 mod narrow;
 mod octree_cells;
+mod outer_polytope;
 mod padded;
 mod pair_table;
 mod scene;

@@ -1,5 +1,5 @@
 //! The robot as collision bodies: every link's primitives (and meshes given
-//! inline, as convex hulls) in the link frame, plus bodies hanging off the
+//! inline, as convex hulls or polytopes of few faces around them) in the link frame, plus bodies hanging off the
 //! chain by fixed or locked joints (a gripper's fingers), each with a
 //! bounding sphere for the broad phase. Posed by forward kinematics into a
 //! stack array, so a query allocates nothing.
@@ -15,6 +15,7 @@ use super::builtin_meshes::builtin_mesh;
 use super::convert::{point_from_parry, pose_to_parry, vec_to_parry};
 use super::fast::RobotFast;
 use super::fixed_frame::{FixedFrame, column, turned};
+use super::outer_polytope::{PLANES, outer_polytope};
 use super::pair_table::{PairTable, TABLE_BUDGET};
 use super::scene::{SceneLimits, validate_mesh_points};
 use super::sweep::SweepBound;
@@ -44,7 +45,8 @@ pub struct AttachedBody {
 }
 
 /// The vertices and triangles of a mesh file a URDF names, supplied by the
-/// caller. Robot meshes are used as their convex hull.
+/// caller. A robot mesh is used as its convex hull, or as a polytope of
+/// few faces around the hull when that has fewer corners ([`outer_polytope`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct InlineMesh {
     pub filename: String,
@@ -525,11 +527,24 @@ fn body_shapes(
                     points.iter().map(|p| cs.origin * point_from_parry(*p)).collect();
                 let bound = enclosing(&every);
                 match farthest_outside(&hull, &points) {
-                    Some(0.0) => out.push(BodyShape {
-                        offset: cs.origin,
-                        shape: hull,
-                        fast: RobotFast::None,
-                        bound,
+                    Some(0.0) => out.push(match fewer_faced(&hull, &points) {
+                        Some(polytope) => {
+                            let corners = polytope.as_convex_polyhedron().expect("a polytope").points();
+                            let corners: Vec<Point3<f64>> =
+                                corners.iter().map(|p| cs.origin * point_from_parry(*p)).collect();
+                            BodyShape {
+                                offset: cs.origin,
+                                shape: polytope,
+                                fast: RobotFast::None,
+                                bound: enclosing(&corners),
+                            }
+                        }
+                        None => BodyShape {
+                            offset: cs.origin,
+                            shape: hull,
+                            fast: RobotFast::None,
+                            bound,
+                        },
                     }),
                     // parry's hull left points outside: grow it by the farthest
                     Some(d) => out.push(BodyShape {
@@ -626,6 +641,40 @@ fn farthest_outside(hull: &SharedShape, points: &[parry3d_f64::math::Vector]) ->
         }
     }
     Some(farthest)
+}
+
+/// The polytope of few faces around a mesh ([`outer_polytope`]), when the
+/// mesh's hull has more faces than such a polytope and more corners than
+/// it, and every point of the mesh is checked inside it; `None` otherwise.
+fn fewer_faced(hull: &SharedShape, points: &[parry3d_f64::math::Vector]) -> Option<SharedShape> {
+    let poly = hull.as_convex_polyhedron()?;
+    if poly.faces().len() <= PLANES {
+        return None;
+    }
+    let corners = poly.points();
+    let around = poly.vertices_adj_to_face();
+    let mut faces: Vec<(f64, Vector3<f64>)> = poly
+        .faces()
+        .iter()
+        .map(|f| {
+            let loop_ = &around[f.first_vertex_or_edge as usize..][..f.num_vertices_or_edges as usize];
+            let at = |k: usize| point_from_parry(corners[loop_[k] as usize]);
+            let twice_area: f64 = (1..loop_.len().saturating_sub(1))
+                .map(|k| (at(k) - at(0)).cross(&(at(k + 1) - at(0))).norm())
+                .sum();
+            (twice_area, Vector3::new(f.normal.x, f.normal.y, f.normal.z))
+        })
+        .collect();
+    faces.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let normals: Vec<Vector3<f64>> = faces.into_iter().map(|(_, n)| n).collect();
+    let mesh: Vec<Point3<f64>> = points.iter().map(|p| point_from_parry(*p)).collect();
+    let fitted = outer_polytope(&mesh, &normals)?;
+    if fitted.len() >= corners.len() {
+        return None;
+    }
+    let polytope =
+        SharedShape::convex_hull(&fitted.iter().map(|p| vec_to_parry(&p.coords)).collect::<Vec<_>>())?;
+    (farthest_outside(&polytope, points) == Some(0.0)).then_some(polytope)
 }
 
 /// A body shape that is its closed form `bound` (a capsule or a box, body

@@ -881,3 +881,181 @@ fn a_thin_mesh_is_held_whole_by_its_body() {
         }
     }
 }
+
+/// A cylinder mesh of 96 sides (192 rim corners and the caps' centres).
+fn tessellated_cylinder(r: f64, h: f64) -> (RobotModel, Vec<Point3<f64>>) {
+    let sides = 96;
+    let mut vertices = Vec::new();
+    for z in [-0.5 * h, 0.5 * h] {
+        for k in 0..sides {
+            let a = std::f64::consts::TAU * k as f64 / sides as f64;
+            vertices.push(Point3::new(r * a.cos(), r * a.sin(), z));
+        }
+    }
+    vertices.push(Point3::new(0.0, 0.0, -0.5 * h));
+    vertices.push(Point3::new(0.0, 0.0, 0.5 * h));
+    let mut indices = Vec::new();
+    for k in 0..sides as u32 {
+        let (a, b) = (k, (k + 1) % sides as u32);
+        let n = sides as u32;
+        indices.extend([a, b, b + n, a, b + n, a + n, 2 * n, b, a, 2 * n + 1, a + n, b + n]);
+    }
+    let mesh = InlineMesh {
+        filename: "package://probe/cylinder.stl".into(),
+        vertices: vertices.clone(),
+        indices,
+    };
+    let urdf = probe_urdf(r#"<mesh filename="package://probe/cylinder.stl"/>"#);
+    let chain = Arc::new(parse_chain(&urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
+    (RobotModel::with_parts(chain, &[], &[mesh]).unwrap(), vertices)
+}
+
+/// A finely tessellated mesh is checked as a polytope of few corners:
+/// every mesh vertex lies inside it (support functions along sampled
+/// directions reach at least as far), its closed-form bound holds the
+/// polytope's corners, and it is barely larger than the cylinder (its
+/// volume, hand-derived `πr²h`, against the polytope's, summed from
+/// parry's hull triangles).
+#[test]
+fn a_tessellated_mesh_is_checked_as_a_polytope_of_few_corners() {
+    use rand::{Rng, SeedableRng};
+    let (r, h) = (0.06, 0.3);
+    let (model, vertices) = tessellated_cylinder(r, h);
+    let shape = &model.bodies[0].shapes[0];
+    let poly = shape.shape.as_convex_polyhedron().expect("a polytope");
+    // the mesh's hull has 192 corners
+    assert!(poly.points().len() <= 36, "{} corners", poly.points().len());
+    let pose = super::super::convert::pose_to_parry(&shape.offset);
+    let support = shape.shape.as_support_map().unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    for _ in 0..2000 {
+        let d = Vector3::new(
+            rng.random_range(-1.0..1.0f64),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize();
+        let farthest = vertices
+            .iter()
+            .map(|p| p.coords.dot(&d))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let at = support.support_point(&pose, super::super::convert::vec_to_parry(&d));
+        let reach = super::super::convert::point_from_parry(at).coords.dot(&d);
+        assert!(farthest <= reach, "{farthest} beyond {reach} along {d:?}");
+    }
+    for p in poly.points() {
+        let corner = shape.offset * super::super::convert::point_from_parry(*p);
+        assert!(
+            super::super::bound::tests::outside(&shape.bound, &corner) <= 1e-12,
+            "{corner:?}"
+        );
+    }
+    let volume: f64 = {
+        let (points, triangles) = (poly.points(), poly.to_trimesh().1);
+        triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| super::super::convert::point_from_parry(points[i as usize]).coords);
+                a.dot(&b.cross(&c)) / 6.0
+            })
+            .sum()
+    };
+    let cylinder = std::f64::consts::PI * r * r * h;
+    assert!(
+        volume > cylinder && volume < 1.08 * cylinder,
+        "{volume} against {cylinder}"
+    );
+}
+
+/// What the polytope calls free, the mesh's own hull (parry's, built
+/// here from the vertices) finds free too, and it refuses few states the
+/// hull finds free: two copies of the tessellated cylinder, and one
+/// against a box and a ball, at random poses, overlap and within 1 cm.
+#[test]
+fn a_mesh_polytope_only_refuses_more_than_its_hull() {
+    use rand::{Rng, SeedableRng};
+
+    use super::super::narrow::{
+        body_body_intersect, body_body_within, body_leaf_intersect, body_leaf_within,
+    };
+    let (model, vertices) = tessellated_cylinder(0.06, 0.3);
+    let polytope = model.bodies[0].clone();
+    let mut hull = polytope.clone();
+    let points: Vec<_> = vertices
+        .iter()
+        .map(|p| super::super::convert::vec_to_parry(&p.coords))
+        .collect();
+    hull.shapes[0].shape = parry3d_f64::shape::SharedShape::convex_hull(&points).unwrap();
+    hull.shapes[0].bound = super::super::bound::enclosing(&vertices);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let mut pose = || {
+        Isometry3::from_parts(
+            Translation3::new(
+                rng.random_range(-0.35..0.35),
+                rng.random_range(-0.35..0.35),
+                rng.random_range(-0.35..0.35),
+            ),
+            nalgebra::UnitQuaternion::from_euler_angles(
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-3.0..3.0),
+            ),
+        )
+    };
+    let obstacles = vec![
+        Obstacle::new(
+            "box",
+            pose(),
+            Geometry::Box {
+                half_extents: Vector3::new(0.05, 0.1, 0.02),
+            },
+        ),
+        Obstacle::new("ball", pose(), Geometry::Sphere { radius: 0.04 }),
+    ];
+    let world = SceneGeometry::build(&Scene::new(obstacles, &SceneLimits::default()).unwrap()).unwrap();
+    // (free for the hull, refused by the polytope) per test
+    let mut tally = [(0usize, 0usize); 4];
+    let mut count = |k: usize, hull_hit: bool, polytope_hit: bool| {
+        assert!(
+            polytope_hit || !hull_hit,
+            "test {k}: the polytope calls a hull contact free"
+        );
+        if !hull_hit {
+            tally[k].0 += 1;
+            tally[k].1 += polytope_hit as usize;
+        }
+    };
+    for _ in 0..20_000 {
+        let pa = pose();
+        let centre = super::super::narrow::sphere_center(&hull, &pa);
+        for leaf in &world.leaves {
+            count(
+                0,
+                body_leaf_intersect(&hull, &pa, &centre, leaf),
+                body_leaf_intersect(&polytope, &pa, &centre, leaf),
+            );
+            count(
+                1,
+                body_leaf_within(&hull, &pa, &centre, leaf, 0.01),
+                body_leaf_within(&polytope, &pa, &centre, leaf, 0.01),
+            );
+        }
+        let pb = pose();
+        count(
+            2,
+            body_body_intersect(&hull, &pa, &hull, &pb),
+            body_body_intersect(&polytope, &pa, &polytope, &pb),
+        );
+        count(
+            3,
+            body_body_within(&hull, &pa, &hull, &pb, 0.01),
+            body_body_within(&polytope, &pa, &polytope, &pb, 0.01),
+        );
+    }
+    for (k, (free, refused)) in tally.iter().enumerate() {
+        assert!(
+            *free > 5000 && *refused > 0 && *refused * 50 < *free,
+            "test {k}: {refused} of {free}"
+        );
+    }
+}
