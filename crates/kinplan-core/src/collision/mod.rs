@@ -36,6 +36,7 @@ mod bvh;
 mod checker;
 mod convert;
 mod error;
+mod face_axes;
 mod fast;
 mod fast_box;
 mod fixed_frame;

@@ -13,6 +13,7 @@ use parry3d_f64::shape::SharedShape;
 use super::bound::enclosing;
 use super::builtin_meshes::builtin_mesh;
 use super::convert::{point_from_parry, pose_to_parry, vec_to_parry};
+use super::face_axes::FaceAxes;
 use super::fast::RobotFast;
 use super::fixed_frame::{FixedFrame, column, turned};
 use super::outer_polytope::{PLANES, outer_polytope};
@@ -67,6 +68,9 @@ pub(crate) struct BodyShape {
     /// there is one, else a capsule or box around a mesh hull or a
     /// cylinder ([`super::bound`]). Bounds apart prove the shapes apart.
     pub bound: RobotFast,
+    /// The separating-axis filter of a polytope shape, tried against scene
+    /// leaves before the exact test ([`FaceAxes`]); `None` for other shapes.
+    pub faces: Option<Arc<FaceAxes>>,
 }
 
 /// A rigid collision body.
@@ -523,28 +527,30 @@ fn body_shapes(
                     field: field.clone(),
                     reason: format!("mesh `{filename}` has no 3-D convex hull"),
                 })?;
+                // a polytope of few faces, itself checked to hold every point
+                if let Some(polytope) = fewer_faced(&hull, &points) {
+                    let corners = polytope.as_convex_polyhedron().expect("a polytope").points();
+                    let corners: Vec<Point3<f64>> =
+                        corners.iter().map(|p| cs.origin * point_from_parry(*p)).collect();
+                    out.push(BodyShape {
+                        offset: cs.origin,
+                        shape: polytope,
+                        fast: RobotFast::None,
+                        bound: enclosing(&corners),
+                        faces: None,
+                    });
+                    continue;
+                }
                 let every: Vec<Point3<f64>> =
                     points.iter().map(|p| cs.origin * point_from_parry(*p)).collect();
                 let bound = enclosing(&every);
                 match farthest_outside(&hull, &points) {
-                    Some(0.0) => out.push(match fewer_faced(&hull, &points) {
-                        Some(polytope) => {
-                            let corners = polytope.as_convex_polyhedron().expect("a polytope").points();
-                            let corners: Vec<Point3<f64>> =
-                                corners.iter().map(|p| cs.origin * point_from_parry(*p)).collect();
-                            BodyShape {
-                                offset: cs.origin,
-                                shape: polytope,
-                                fast: RobotFast::None,
-                                bound: enclosing(&corners),
-                            }
-                        }
-                        None => BodyShape {
-                            offset: cs.origin,
-                            shape: hull,
-                            fast: RobotFast::None,
-                            bound,
-                        },
+                    Some(0.0) => out.push(BodyShape {
+                        offset: cs.origin,
+                        shape: hull,
+                        fast: RobotFast::None,
+                        bound,
+                        faces: None,
                     }),
                     // parry's hull left points outside: grow it by the farthest
                     Some(d) => out.push(BodyShape {
@@ -553,6 +559,7 @@ fn body_shapes(
                             .expect("the hull exists"),
                         fast: RobotFast::None,
                         bound,
+                        faces: None,
                     }),
                     // too many points to check: the closed-form bound is the shape
                     None => out.push(bound_shape(bound).ok_or_else(|| CollisionError::Degenerate {
@@ -607,7 +614,11 @@ fn body_shapes(
             shape,
             fast,
             bound,
+            faces: None,
         });
+    }
+    for s in &mut out {
+        s.faces = FaceAxes::of(&s.shape).map(Arc::new);
     }
     Ok(out)
 }
@@ -644,8 +655,11 @@ fn farthest_outside(hull: &SharedShape, points: &[parry3d_f64::math::Vector]) ->
 }
 
 /// The polytope of few faces around a mesh ([`outer_polytope`]), when the
-/// mesh's hull has more faces than such a polytope and more corners than
-/// it, and every point of the mesh is checked inside it; `None` otherwise.
+/// mesh's hull (parry's, whose face normals are the candidate planes) has
+/// more faces than such a polytope and more corners than it, and every
+/// point of the mesh is checked inside the polytope; `None` otherwise.
+/// Checked against the points, not the hull, it also stands where
+/// parry's hull of a thin mesh leaves points outside.
 fn fewer_faced(hull: &SharedShape, points: &[parry3d_f64::math::Vector]) -> Option<SharedShape> {
     let poly = hull.as_convex_polyhedron()?;
     if poly.faces().len() <= PLANES {
@@ -702,6 +716,7 @@ fn bound_shape(bound: RobotFast) -> Option<BodyShape> {
         shape,
         fast: bound,
         bound,
+        faces: None,
     })
 }
 

@@ -42,6 +42,19 @@ fn intersect(p1: &Pose, s1: &SharedShape, p2: &Pose, s2: &SharedShape) -> bool {
     query::intersection_test(p1, &**s1, p2, &**s2).map_or(true, |i| i.intersecting)
 }
 
+/// True unless two parry shapes are more than `margin` (≥ 0) apart: GJK's
+/// closest points with `margin` as the prediction, which stops at a
+/// separating lower bound and, unlike `contact`, runs no penetration
+/// search (EPA) when the shapes overlap. A pair parry cannot handle is
+/// within.
+#[inline]
+fn within(p1: &Pose, s1: &SharedShape, p2: &Pose, s2: &SharedShape, margin: f64) -> bool {
+    !matches!(
+        query::closest_points(p1, &**s1, p2, &**s2, margin),
+        Ok(query::ClosestPoints::Disjoint)
+    )
+}
+
 /// The contact of two parry shapes when their signed distance is below
 /// `margin`. A nearest-pair search passes the best distance so far as the
 /// margin, which is a negative penetration depth once a pair overlaps; parry's
@@ -152,6 +165,7 @@ pub(crate) fn shapes_intersect_leaf(a: &Body, pa: &Isometry3<f64>, leaf: &Leaf) 
         Some(hit) => hit,
         None => {
             bound_meets_leaf(sa, pa, leaf, 0.0)
+                && !faces_apart(sa, pa, leaf, 0.0)
                 && intersect(
                     &pose_to_parry(&(pa * sa.offset)),
                     &sa.shape,
@@ -183,6 +197,7 @@ pub(crate) fn body_leaf_contact(
                 b: y,
             }),
             None if !bound_meets_leaf(sa, pa, leaf, margin.max(0.0)) => None,
+            None if faces_apart(sa, pa, leaf, margin) => None,
             None => contact(
                 &pose_to_parry(&(pa * sa.offset)),
                 &sa.shape,
@@ -225,6 +240,18 @@ fn bound_meets_leaf(sa: &BodyShape, pa: &Isometry3<f64>, leaf: &Leaf, margin: f6
     overlap(&grown(&sa.bound, margin), pa, &leaf.fast) != Some(false)
 }
 
+/// True when a robot shape's face axes ([`super::face_axes`]) prove it
+/// more than `margin` (m) from a scene leaf; false when it has none, the
+/// margin is negative, or they decide nothing.
+#[inline]
+fn faces_apart(sa: &BodyShape, pa: &Isometry3<f64>, leaf: &Leaf, margin: f64) -> bool {
+    margin >= 0.0
+        && sa
+            .faces
+            .as_ref()
+            .is_some_and(|f| f.apart(&(pa * sa.offset), &leaf.fast, margin))
+}
+
 /// `shape` grown by `margin`: a swept sphere exactly (radius + margin).
 fn grown(shape: &RobotFast, margin: f64) -> RobotFast {
     match *shape {
@@ -239,15 +266,15 @@ fn grown(shape: &RobotFast, margin: f64) -> RobotFast {
 
 /// True when body shape `s` at `pose` (world), grown by `margin`, overlaps
 /// `other` at `other_pose`: a cuboid grows to half extents + margin (a box
-/// around the rounded one, so never smaller), anything else by parry's
-/// contact within `margin`.
+/// around the rounded one, so never smaller), anything else as [`within`]
+/// says.
 fn parry_within(s: &BodyShape, pose: &Pose, other_pose: &Pose, other: &SharedShape, margin: f64) -> bool {
     match s.shape.as_cuboid() {
         Some(c) => {
             let big = Cuboid::new(c.half_extents + Vector::splat(margin));
             query::intersection_test(pose, &big, other_pose, &**other).map_or(true, |i| i.intersecting)
         }
-        None => contact(pose, &s.shape, other_pose, other, margin).is_some(),
+        None => within(pose, &s.shape, other_pose, other, margin),
     }
 }
 
@@ -272,6 +299,7 @@ pub(crate) fn body_leaf_within(
             Some(hit) => hit,
             None => {
                 bound_meets_leaf(sa, pa, leaf, margin)
+                    && !faces_apart(sa, pa, leaf, margin)
                     && parry_within(
                         sa,
                         &pose_to_parry(&(pa * sa.offset)),
