@@ -19,7 +19,9 @@ coal checks a mesh as its triangles, so a box wholly inside a link is "free" for
 it; such pairs are counted (box centre inside a watertight mesh, by trimesh) and
 the refusal rate is given with and without them. A refusal is also checked
 against coal's own convex hull of each mesh (qhull): one that touches no hull is
-not explained by kinplan's convex-hull cover and is listed in the JSON.
+not explained by a convex-hull cover (kinplan fits a polytope of at most 20
+faces around a hull of more, which refuses a little more) and is listed in the
+JSON.
 
 Times: coal = one pinocchio.computeCollisions call (FK, geometry placements,
 narrow phase, stop at first contact), C++ from Python; kinplan = one CheckState

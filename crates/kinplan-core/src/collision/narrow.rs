@@ -11,7 +11,10 @@
 //!
 //! A mesh hull or a cylinder, which no closed form decides, is tested
 //! first through the closed-form bound around it (`BodyShape::bound`):
-//! bounds apart are shapes apart, and parry runs only where they meet.
+//! bounds apart are shapes apart. A polytope against a scene leaf is then
+//! tried on its face axes (`super::face_axes`), and parry runs only where
+//! neither decides. Within-margin tests ask parry's closest points with
+//! the margin as prediction (GJK alone), not its contact.
 //!
 //! A pair parry cannot handle (none among the shapes this room builds) is
 //! reported as colliding: the safe answer for a planner.

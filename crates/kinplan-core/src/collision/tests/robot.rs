@@ -852,33 +852,52 @@ fn a_thin_mesh_is_held_whole_by_its_body() {
         let Ok(model) = RobotModel::with_parts(chain, &[], &[mesh]) else {
             continue; // no 3-D hull: refused by name elsewhere
         };
-        let body = &model.bodies[0];
-        for _ in 0..200 {
-            let d = Vector3::new(
-                rng.random_range(-1.0..1.0f64),
-                rng.random_range(-1.0..1.0),
-                rng.random_range(-1.0..1.0),
-            )
-            .normalize();
-            let farthest = vertices
-                .iter()
-                .map(|p| p.coords.dot(&d))
-                .fold(f64::NEG_INFINITY, f64::max);
-            let reach = body
-                .shapes
-                .iter()
-                .map(|s| {
-                    let pose = super::super::convert::pose_to_parry(&s.offset);
-                    let support = s.shape.as_support_map().expect("a convex shape");
-                    let at = support.support_point(&pose, super::super::convert::vec_to_parry(&d));
-                    super::super::convert::point_from_parry(at).coords.dot(&d)
-                })
-                .fold(f64::NEG_INFINITY, f64::max);
-            assert!(
-                farthest <= reach + 1e-12,
-                "case {case}: {farthest} beyond {reach} along {d:?}"
-            );
-        }
+        holds_points(
+            &model.bodies[0],
+            &vertices,
+            &mut rng,
+            200,
+            &format!("case {case}"),
+        );
+    }
+}
+
+/// Asserts that along `samples` random directions the body's shapes
+/// reach at least as far as the farthest of `vertices`: a convex body
+/// holds points exactly when its support function bounds theirs.
+fn holds_points(
+    body: &super::super::model::Body,
+    vertices: &[Point3<f64>],
+    rng: &mut rand_chacha::ChaCha8Rng,
+    samples: usize,
+    what: &str,
+) {
+    use rand::Rng;
+    for _ in 0..samples {
+        let d = Vector3::new(
+            rng.random_range(-1.0..1.0f64),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize();
+        let farthest = vertices
+            .iter()
+            .map(|p| p.coords.dot(&d))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let reach = body
+            .shapes
+            .iter()
+            .map(|s| {
+                let pose = super::super::convert::pose_to_parry(&s.offset);
+                let support = s.shape.as_support_map().expect("a convex shape");
+                let at = support.support_point(&pose, super::super::convert::vec_to_parry(&d));
+                super::super::convert::point_from_parry(at).coords.dot(&d)
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert!(
+            farthest <= reach + 1e-12,
+            "{what}: {farthest} beyond {reach} along {d:?}"
+        );
     }
 }
 
@@ -918,31 +937,15 @@ fn tessellated_cylinder(r: f64, h: f64) -> (RobotModel, Vec<Point3<f64>>) {
 /// parry's hull triangles).
 #[test]
 fn a_tessellated_mesh_is_checked_as_a_polytope_of_few_corners() {
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     let (r, h) = (0.06, 0.3);
     let (model, vertices) = tessellated_cylinder(r, h);
     let shape = &model.bodies[0].shapes[0];
     let poly = shape.shape.as_convex_polyhedron().expect("a polytope");
     // the mesh's hull has 192 corners
     assert!(poly.points().len() <= 36, "{} corners", poly.points().len());
-    let pose = super::super::convert::pose_to_parry(&shape.offset);
-    let support = shape.shape.as_support_map().unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-    for _ in 0..2000 {
-        let d = Vector3::new(
-            rng.random_range(-1.0..1.0f64),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        )
-        .normalize();
-        let farthest = vertices
-            .iter()
-            .map(|p| p.coords.dot(&d))
-            .fold(f64::NEG_INFINITY, f64::max);
-        let at = support.support_point(&pose, super::super::convert::vec_to_parry(&d));
-        let reach = super::super::convert::point_from_parry(at).coords.dot(&d);
-        assert!(farthest <= reach, "{farthest} beyond {reach} along {d:?}");
-    }
+    holds_points(&model.bodies[0], &vertices, &mut rng, 2000, "the cylinder");
     for p in poly.points() {
         let corner = shape.offset * super::super::convert::point_from_parry(*p);
         assert!(
