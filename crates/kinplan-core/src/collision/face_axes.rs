@@ -85,18 +85,23 @@ impl FaceAxes {
     /// Against the box `[−half, half]`; `rel` maps the polytope's frame
     /// into the box's.
     fn apart_from_box(&self, rel: &Isometry3<f64>, half: &Vector3<f64>, gap: f64) -> bool {
-        let (mut lo, mut hi) = (Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY));
-        for c in &self.corners {
-            let p = rel * c;
-            lo = lo.inf(&p.coords);
-            hi = hi.sup(&p.coords);
-        }
-        if (0..3).any(|k| lo[k] > half[k] + gap || hi[k] < -half[k] - gap) {
-            return true;
-        }
-        // the box's centre and axes in the polytope's frame: x = Rᵀ(y − t)
-        let turn = rel.rotation.to_rotation_matrix();
+        let turn = rel.rotation.to_rotation_matrix().into_inner();
         let t = rel.translation.vector;
+        // the box's axes, one at a time: the corners' coordinates along it
+        for k in 0..3 {
+            let row = turn.row(k).transpose();
+            let (lo, hi) = self
+                .corners
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
+                    let s = row.dot(&c.coords);
+                    (lo.min(s), hi.max(s))
+                });
+            if lo + t[k] > half[k] + gap || hi + t[k] < -half[k] - gap {
+                return true;
+            }
+        }
+        // the polytope's face normals: the box's centre and axes in its frame, x = Rᵀ(y − t)
         self.planes.iter().any(|(n, h)| {
             let m = turn * n;
             let reach = half.x * m.x.abs() + half.y * m.y.abs() + half.z * m.z.abs();
