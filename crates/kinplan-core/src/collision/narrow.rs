@@ -25,7 +25,7 @@ use parry3d_f64::query;
 use parry3d_f64::shape::{Cuboid, SharedShape};
 
 use super::convert::{point_from_parry, pose_to_parry};
-use super::fast::{RobotFast, distance, distance_robot, overlap, overlap_robot};
+use super::fast::{LeafFast, RobotFast, distance, distance_robot, overlap, overlap_robot};
 use super::model::{Body, BodyShape};
 use super::world::Leaf;
 
@@ -101,6 +101,7 @@ pub(crate) fn body_body_intersect(a: &Body, pa: &Isometry3<f64>, b: &Body, pb: &
                 Some(hit) => hit,
                 None => {
                     bounds_meet_robot(sa, pa, sb, pb, 0.0)
+                        && !faces_apart_robot(sa, pa, sb, pb, 0.0)
                         && intersect(
                             &pose_to_parry(&(pa * sa.offset)),
                             &sa.shape,
@@ -140,6 +141,7 @@ pub(crate) fn body_body_contact(
                     b: y,
                 }),
                 None if !bounds_meet_robot(sa, pa, sb, pb, margin.max(0.0)) => None,
+                None if faces_apart_robot(sa, pa, sb, pb, margin) => None,
                 None => contact(
                     &qa,
                     &sa.shape,
@@ -255,6 +257,37 @@ fn faces_apart(sa: &BodyShape, pa: &Isometry3<f64>, leaf: &Leaf, margin: f64) ->
             .is_some_and(|f| f.apart(&(pa * sa.offset), &leaf.fast, margin))
 }
 
+/// [`faces_apart`] for two robot shapes: one a polytope with face axes,
+/// the other a closed form (box, capsule or sphere) posed in the world.
+#[inline]
+fn faces_apart_robot(
+    sa: &BodyShape,
+    pa: &Isometry3<f64>,
+    sb: &BodyShape,
+    pb: &Isometry3<f64>,
+    margin: f64,
+) -> bool {
+    let one_way = |s: &BodyShape, ps: &Isometry3<f64>, o: &BodyShape, po: &Isometry3<f64>| {
+        let Some(faces) = s.faces.as_ref() else {
+            return false;
+        };
+        let other = match o.fast {
+            RobotFast::Box { offset, half } => LeafFast::Box {
+                pose: po * offset,
+                half,
+            },
+            RobotFast::Swept { a, b, r } => LeafFast::Swept {
+                a: po * a,
+                b: po * b,
+                r,
+            },
+            RobotFast::None => return false,
+        };
+        faces.apart(&(ps * s.offset), &other, margin)
+    };
+    margin >= 0.0 && (one_way(sa, pa, sb, pb) || one_way(sb, pb, sa, pa))
+}
+
 /// `shape` grown by `margin`: a swept sphere exactly (radius + margin).
 fn grown(shape: &RobotFast, margin: f64) -> RobotFast {
     match *shape {
@@ -332,6 +365,7 @@ pub(crate) fn body_body_within(
             |sb| match overlap_robot(&grown(&sa.fast, margin), pa, &sb.fast, pb) {
                 Some(hit) => hit,
                 None if !bounds_meet_robot(sa, pa, sb, pb, margin) => false,
+                None if faces_apart_robot(sa, pa, sb, pb, margin) => false,
                 None => {
                     let (qa, qb) = (pose_to_parry(&(pa * sa.offset)), pose_to_parry(&(pb * sb.offset)));
                     match sb.shape.as_cuboid() {

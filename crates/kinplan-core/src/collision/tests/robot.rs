@@ -1062,3 +1062,94 @@ fn a_mesh_polytope_only_refuses_more_than_its_hull() {
         );
     }
 }
+
+/// The face axes change no overlap verdict between robot bodies, and a
+/// within-1-cm verdict only where parry's distance is beyond 1 cm (the
+/// test without them grows a box by the margin into a larger box): the
+/// built-in Panda with its hand and fingers (polytopes against the
+/// fingers' boxes) at random states, every pair, with the filter and with
+/// it removed.
+#[test]
+fn face_axes_change_no_self_verdict() {
+    use rand::{Rng, SeedableRng};
+
+    use super::super::narrow::{body_body_intersect, body_body_within};
+    let chain = builtin_chain("franka_panda_hand").unwrap();
+    let urdf = crate::robot::builtin_urdf("franka_panda_hand").unwrap();
+    let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
+    let attached = attached_bodies(urdf, &chain, &fingers).unwrap();
+    let model = RobotModel::with_parts(chain, &attached, &[]).unwrap();
+    assert!(
+        model
+            .bodies
+            .iter()
+            .flat_map(|b| &b.shapes)
+            .any(|s| s.faces.is_some())
+    );
+    let mut bare = model.bodies.clone();
+    for s in bare.iter_mut().flat_map(|b| b.shapes.iter_mut()) {
+        s.faces = None;
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let mut poses = [Isometry3::identity(); super::super::model::MAX_BODIES];
+    let (mut hits, mut near, mut spared) = (0, 0, 0);
+    for _ in 0..3000 {
+        let q: Vec<f64> = model
+            .chain()
+            .limits()
+            .map(|(lo, hi)| rng.random_range(lo..=hi))
+            .collect();
+        model.body_poses(&q, &mut poses);
+        for a in 0..model.bodies.len() {
+            for b in a + 1..model.bodies.len() {
+                let (ba, bb) = (&model.bodies[a], &model.bodies[b]);
+                let hit = body_body_intersect(&bare[a], &poses[a], &bare[b], &poses[b]);
+                assert_eq!(
+                    body_body_intersect(ba, &poses[a], bb, &poses[b]),
+                    hit,
+                    "{a} {b} at {q:?}"
+                );
+                let within = body_body_within(&bare[a], &poses[a], &bare[b], &poses[b], 0.01);
+                if body_body_within(ba, &poses[a], bb, &poses[b], 0.01) != within {
+                    // only where the test without the filter grows a box by
+                    // the margin into a larger box, which the face axes do not
+                    assert!(within, "{a} {b} at {q:?}: the filter found contact");
+                    let distance = exact_distance(ba, &poses[a], bb, &poses[b]);
+                    assert!(distance > 0.01, "{a} {b} at {q:?}: proved apart at {distance}");
+                    spared += 1;
+                }
+                hits += hit as usize;
+                near += within as usize;
+            }
+        }
+    }
+    assert!(
+        hits > 100 && near > hits && spared < near / 10,
+        "{hits} {near} {spared}"
+    );
+}
+
+/// The smallest distance between two bodies' shapes (parry), m.
+fn exact_distance(
+    a: &super::super::model::Body,
+    pa: &Isometry3<f64>,
+    b: &super::super::model::Body,
+    pb: &Isometry3<f64>,
+) -> f64 {
+    use super::super::convert::pose_to_parry;
+    let mut best = f64::INFINITY;
+    for sa in &a.shapes {
+        for sb in &b.shapes {
+            let d = parry3d_f64::query::distance(
+                &pose_to_parry(&(pa * sa.offset)),
+                &*sa.shape,
+                &pose_to_parry(&(pb * sb.offset)),
+                &*sb.shape,
+            )
+            .unwrap()
+            .distance;
+            best = best.min(d);
+        }
+    }
+    best
+}
