@@ -1,6 +1,7 @@
 //! A separating-axis filter for a robot polytope (a mesh hull, or the
 //! polytope of few faces around one) against a scene box, cylinder,
-//! capsule or sphere, tried before the exact (GJK) test.
+//! capsule or sphere, or another robot body's box, capsule or sphere,
+//! tried before the exact (GJK) test.
 //!
 //! For any unit axis `u`, if `max_{x∈A} u·x + m < min_{y∈B} u·y`, then every
 //! `x ∈ A`, `y ∈ B` have `|y − x| ≥ u·(y − x) > m`: the shapes are more than
