@@ -52,10 +52,41 @@ fn intersect(p1: &Pose, s1: &SharedShape, p2: &Pose, s2: &SharedShape) -> bool {
 /// within.
 #[inline]
 fn within(p1: &Pose, s1: &SharedShape, p2: &Pose, s2: &SharedShape, margin: f64) -> bool {
+    if let Some(mesh) = s2.as_trimesh() {
+        return mesh_within(p1, s1, p2, mesh, margin);
+    }
+    if let Some(mesh) = s1.as_trimesh() {
+        return mesh_within(p2, s2, p1, mesh, margin);
+    }
     !matches!(
         query::closest_points(p1, &**s1, p2, &**s2, margin),
         Ok(query::ClosestPoints::Disjoint)
     )
+}
+
+/// [`within`] for a triangle mesh, triangle by triangle: parry's mesh query
+/// keeps a triangle only when GJK's witness points lie within the margin,
+/// and an early GJK stop can overstate their distance; per triangle,
+/// `Disjoint` is GJK's proof of a separating gap. Triangles whose boxes
+/// miss the shape's box grown by `margin` are apart already.
+fn mesh_within(
+    ps: &Pose,
+    shape: &SharedShape,
+    pm: &Pose,
+    mesh: &parry3d_f64::shape::TriMesh,
+    margin: f64,
+) -> bool {
+    use parry3d_f64::bounding_volume::BoundingVolume;
+    let in_mesh = pm.inverse() * ps;
+    let reach = shape.compute_aabb(&in_mesh).loosened(margin);
+    let here = Pose::IDENTITY;
+    mesh.bvh().intersect_aabb(&reach).any(|i| {
+        let triangle = mesh.triangle(i);
+        !matches!(
+            query::closest_points(&in_mesh, &**shape, &here, &triangle, margin),
+            Ok(query::ClosestPoints::Disjoint)
+        )
+    })
 }
 
 /// The contact of two parry shapes when their signed distance is below
