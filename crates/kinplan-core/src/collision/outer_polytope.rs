@@ -219,7 +219,13 @@ pub(crate) fn outer_polytope(
             }
             let (n, h) = candidates[k];
             let cut = poly.reaches_past(&n, h).then(|| poly.clipped(&n, h));
-            bound[k] = cut.as_ref().map_or(0.0, |c| volume - c.volume());
+            // a gain that is not a number counts as none, so the round ends
+            let gain = cut.as_ref().map_or(0.0, |c| volume - c.volume());
+            bound[k] = if gain.is_nan() {
+                0.0
+            } else {
+                gain.clamp(0.0, f64::MAX)
+            };
             let others = (0..bound.len())
                 .filter(|&j| j != k)
                 .map(|j| bound[j])
