@@ -83,6 +83,16 @@ impl FaceAxes {
         }
     }
 
+    /// The least and greatest `u·c` over the corners `c`.
+    fn extent_along(&self, u: &Vector3<f64>) -> (f64, f64) {
+        self.corners
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
+                let s = u.dot(&c.coords);
+                (lo.min(s), hi.max(s))
+            })
+    }
+
     /// Against the box `[−half, half]`; `rel` maps the polytope's frame
     /// into the box's.
     fn apart_from_box(&self, rel: &Isometry3<f64>, half: &Vector3<f64>, gap: f64) -> bool {
@@ -91,13 +101,7 @@ impl FaceAxes {
         // the box's axes, one at a time: the corners' coordinates along it
         for k in 0..3 {
             let row = turn.row(k).transpose();
-            let (lo, hi) = self
-                .corners
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
-                    let s = row.dot(&c.coords);
-                    (lo.min(s), hi.max(s))
-                });
+            let (lo, hi) = self.extent_along(&row);
             if lo + t[k] > half[k] + gap || hi + t[k] < -half[k] - gap {
                 return true;
             }
@@ -117,13 +121,7 @@ impl FaceAxes {
         let Some(w) = axis.try_normalize(1e-12) else {
             return false;
         };
-        let (lo, hi) = self
-            .corners
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
-                let s = w.dot(&c.coords);
-                (lo.min(s), hi.max(s))
-            });
+        let (lo, hi) = self.extent_along(&w);
         if hi + gap < w.dot(&a.coords) || lo - gap > w.dot(&b.coords) {
             return true;
         }
