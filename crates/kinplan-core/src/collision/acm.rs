@@ -8,6 +8,12 @@
 //!    `samples` uniformly random states;
 //! 3. **never**: pairs in collision in none of the samples.
 //!
+//! Before sampling, a pair whose relative pose one or two joints change is
+//! allowed as **proved** when its table (`pair_table`) proves it apart in
+//! every cell of those joints' ranges, whatever the other joints; such a
+//! pair is apart in every state, not only in the samples. In the other
+//! tables a proved cell answers a sample without the exact test.
+//!
 //! Steps 2–3 are a sampling heuristic: a pair that collides in fewer than
 //! about 1/`samples` of the joint space is allowed as "never" (MoveIt's
 //! default density of 10 000 samples has the same blind spot). The result
@@ -29,6 +35,7 @@ use rayon::prelude::*;
 use super::CollisionError;
 use super::model::{MAX_BODIES, RobotModel};
 use super::narrow::body_body_intersect;
+use super::pair_table::PairTable;
 use crate::Deadline;
 use nalgebra::Isometry3;
 
@@ -38,6 +45,9 @@ pub enum AllowReason {
     Adjacent,
     Always,
     Never,
+    /// Proved apart in every state within the joint limits: the pair's
+    /// table (`pair_table`) proves every cell free.
+    Proved,
     /// Allowed by the caller (an SRDF's `disable_collisions`, a built-in's).
     User,
 }
@@ -143,7 +153,8 @@ impl AllowedCollisions {
     }
 
     /// [`Self::sampled`], stopping with [`CollisionError::Stopped`] once
-    /// `deadline` says so (polled before every sample).
+    /// `deadline` says so (polled before every sample, and while the model's
+    /// pair tables are built, which the sampling uses).
     pub fn sampled_until(
         model: &RobotModel,
         params: &AcmParams,
@@ -162,12 +173,27 @@ impl AllowedCollisions {
                 }
             })
             .collect();
-        let pairs: Vec<(usize, usize)> = acm.checked_pairs().collect();
+        // A pair whose table proves every cell free is apart everywhere; in
+        // the other tables a proved cell spares the exact test.
+        let tables = model
+            .pair_tables_until(deadline)
+            .map_err(|stop| CollisionError::Stopped {
+                what: "proving the robot's self pairs apart (pair tables)".into(),
+                stop,
+            })?;
+        let mut pairs: Vec<(usize, usize, Option<&PairTable>)> = Vec::new();
+        for (a, b) in acm.checked_pairs().collect::<Vec<_>>() {
+            match tables.iter().find(|t| (t.a, t.b) == (a, b)) {
+                Some(table) if table.all_free() => acm.allow(a, b, AllowReason::Proved),
+                table => pairs.push((a, b, table)),
+            }
+        }
         let colliding = |q: &[f64], out: &mut [u32]| {
             let mut poses = [Isometry3::identity(); MAX_BODIES];
             model.body_poses(q, &mut poses);
-            for (k, &(a, b)) in pairs.iter().enumerate() {
-                let hit = body_body_intersect(&model.bodies[a], &poses[a], &model.bodies[b], &poses[b]);
+            for (k, &(a, b, table)) in pairs.iter().enumerate() {
+                let hit = !table.is_some_and(|t| t.proves_apart(q, &[]))
+                    && body_body_intersect(&model.bodies[a], &poses[a], &model.bodies[b], &poses[b]);
                 out[k] += hit as u32;
             }
         };
@@ -205,7 +231,7 @@ impl AllowedCollisions {
                 stop,
             })?;
         let always = (params.always_fraction * params.samples as f64).ceil() as u32;
-        for (k, &(a, b)) in pairs.iter().enumerate() {
+        for (k, &(a, b, _)) in pairs.iter().enumerate() {
             if counts[k] >= always {
                 acm.allow(a, b, AllowReason::Always);
             } else if counts[k] == 0 {

@@ -24,6 +24,8 @@ use super::trig::sin_cos;
 use super::world::primitive_shape;
 use super::{CollisionError, Geometry};
 use crate::robot::{Chain, CollisionShape, JointKind, Shape};
+use crate::{Deadline, Stop};
+use rayon::prelude::*;
 
 /// Most collision bodies (links with geometry) a model may have: one bit
 /// each in a `u64` of the padded check, whose top bit is its self pairs.
@@ -263,17 +265,43 @@ impl RobotModel {
     /// The [`PairTable`]s of every pair of bodies that qualifies (built on
     /// the first call, then shared by every checker of the model).
     pub(crate) fn pair_tables(&self) -> &[PairTable] {
-        self.pair_tables.get_or_init(|| {
-            let Some(sweep) = SweepBound::new(self) else {
-                return Vec::new();
-            };
-            let n = self.bodies.len();
-            let mut budget = TABLE_BUDGET;
-            (0..n)
-                .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
-                .filter_map(|(a, b)| PairTable::build(self, &sweep, a, b, &mut budget))
-                .collect()
-        })
+        // with no deadline the build always finishes
+        self.pair_tables_until(Deadline::none()).unwrap_or(&[])
+    }
+
+    /// [`Self::pair_tables`], stopping (and keeping nothing) once `deadline`
+    /// says so; polled before every coarse cell.
+    pub(crate) fn pair_tables_until(&self, deadline: Deadline<'_>) -> Result<&[PairTable], Stop> {
+        if let Some(tables) = self.pair_tables.get() {
+            return Ok(tables);
+        }
+        let built = self.build_pair_tables(deadline)?;
+        Ok(self.pair_tables.get_or_init(|| built))
+    }
+
+    fn build_pair_tables(&self, deadline: Deadline<'_>) -> Result<Vec<PairTable>, Stop> {
+        let Some(sweep) = SweepBound::new(self) else {
+            return Ok(Vec::new());
+        };
+        let n = self.bodies.len();
+        let mut budget = TABLE_BUDGET;
+        let mut planned: Vec<_> = (0..n)
+            .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+            .filter_map(|(a, b)| PairTable::planned(self, &sweep, a, b, &mut budget))
+            .collect();
+        // every row of coarse cells of every table is proved on its own, so
+        // side by side
+        let rows: Vec<(usize, usize)> = (0..planned.len())
+            .flat_map(|t| (0..PairTable::ROWS).map(move |row| (t, row)))
+            .collect();
+        let proved = rows
+            .par_iter()
+            .map(|&(t, row)| planned[t].0.proved_row(self, planned[t].1, row, deadline))
+            .collect::<Result<Vec<_>, Stop>>()?;
+        for (&(t, _), blocks) in rows.iter().zip(proved) {
+            blocks.into_iter().for_each(|block| planned[t].0.mark(block));
+        }
+        Ok(planned.into_iter().map(|(table, _)| table).collect())
     }
 
     pub fn chain(&self) -> &Arc<Chain> {

@@ -18,8 +18,11 @@
 //! state whose joints of `J` lie in the cell, whatever the other joints.
 //! A cell not proved says nothing; the exact test decides there.
 //!
-//! The grid is filled coarse to fine: a coarse cell proved free proves its
-//! fine cells without testing them. Tables are built only for pairs with a
+//! The grid is filled coarse to fine: each coarse cell is tested whole,
+//! and where that fails, its halves along the joint that moves the distal
+//! body farther across it, down to single fine cells; a block proved free
+//! proves its fine cells without testing them. The rows of coarse cells
+//! are proved side by side (rayon), each on its own. Tables are built only for pairs with a
 //! shape no closed form decides (a mesh hull, a cylinder), where the exact
 //! test is costly.
 
@@ -29,6 +32,7 @@ use super::model::{MAX_BODIES, RobotModel};
 use super::narrow::body_body_within;
 use super::sweep::SweepBound;
 use crate::robot::JointKind;
+use crate::{Deadline, Stop};
 
 /// How far (m) a distal body may move within a fine cell.
 const FINE_REACH: f64 = 0.006;
@@ -41,8 +45,9 @@ const COARSE: usize = 12;
 const MAX_FINE_CELLS: usize = 1 << 14;
 /// The work a model's tables may take, in cell × vertex tests: a table
 /// costs its fine cells times the vertices of both bodies (boxes and round
-/// shapes count 8), and pairs are given tables in order while the budget
-/// lasts, so a model of many large meshes spends a bounded time here.
+/// shapes count 8; its block tests are at most twice its fine cells), and
+/// pairs are given tables in order while the budget lasts, so a model of
+/// many large meshes spends a bounded time here.
 pub(crate) const TABLE_BUDGET: usize = 1 << 24;
 
 /// The proved-free cells of one self pair (module doc).
@@ -65,16 +70,75 @@ pub(crate) struct PairTable {
     free: Vec<u64>,
 }
 
+/// A block of fine cells: `n[k]` cells from index `i[k]` along each axis.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Region {
+    i: [usize; 2],
+    n: [usize; 2],
+}
+
+impl Region {
+    /// The block's centre along axis `k`, in fine cells from the table's start.
+    fn mid(&self, k: usize) -> f64 {
+        self.i[k] as f64 + 0.5 * self.n[k] as f64
+    }
+
+    /// `Σ_k h_k L_k`: how far the distal body may move from where it is at
+    /// the block's centre, given the reach of one fine cell per axis.
+    fn reach(&self, reach_per_cell: &[f64; 2]) -> f64 {
+        0.5 * (self.n[0] as f64 * reach_per_cell[0] + self.n[1] as f64 * reach_per_cell[1])
+    }
+
+    /// The two halves across the axis along which the block reaches
+    /// farther (of those more than one cell wide); `None` for a single cell.
+    fn halves(&self, reach_per_cell: &[f64; 2]) -> Option<(Region, Region)> {
+        let splittable = |k: usize| self.n[k] > 1;
+        let k = match (splittable(0), splittable(1)) {
+            (false, false) => return None,
+            (true, false) => 0,
+            (false, true) => 1,
+            (true, true) => {
+                usize::from(self.n[1] as f64 * reach_per_cell[1] > self.n[0] as f64 * reach_per_cell[0])
+            }
+        };
+        let (mut low, mut high) = (*self, *self);
+        low.n[k] = self.n[k] / 2;
+        high.i[k] = self.i[k] + low.n[k];
+        high.n[k] = self.n[k] - low.n[k];
+        Some((low, high))
+    }
+}
+
+/// Collects in `proved` the blocks of `region` that `apart` proves: the
+/// whole region first, then, where that fails, its halves along its longer
+/// reach, down to single fine cells (so a region of `n` fine cells costs at
+/// most `2n − 1` tests).
+fn prove(
+    region: Region,
+    reach_per_cell: &[f64; 2],
+    apart: &mut impl FnMut(Region) -> bool,
+    proved: &mut Vec<Region>,
+) {
+    if apart(region) {
+        proved.push(region);
+    } else if let Some((low, high)) = region.halves(reach_per_cell) {
+        prove(low, reach_per_cell, apart, proved);
+        prove(high, reach_per_cell, apart, proved);
+    }
+}
+
 impl PairTable {
     /// The table of bodies `a < b` of `model`, when the module's conditions
-    /// hold and its cost fits in `budget` (which it then spends).
-    pub(crate) fn build(
+    /// hold and its cost fits in `budget` (which it then spends): laid out,
+    /// with no cell proved yet, beside how far the distal body may move per
+    /// fine cell along each axis (what [`PairTable::proved_row`] needs).
+    pub(crate) fn planned(
         model: &RobotModel,
         sweep: &SweepBound,
         a: usize,
         b: usize,
         budget: &mut usize,
-    ) -> Option<PairTable> {
+    ) -> Option<(PairTable, [f64; 2])> {
         let bodies = &model.bodies;
         let joints = model.chain().joints();
         let costly = |x: usize| {
@@ -142,7 +206,7 @@ impl PairTable {
             span(0) / cells[0] as f64,
             if two { span(1) / cells[1] as f64 } else { 0.0 },
         ];
-        let mut table = PairTable {
+        let table = PairTable {
             a,
             b,
             joints: js,
@@ -152,18 +216,93 @@ impl PairTable {
             cells,
             free: vec![0; (cells[0] * cells[1]).div_ceil(64)],
         };
-        // the other joints at the middle of their ranges (any value would do)
+        let reach_per_cell = [width[0] * lever(0), if two { width[1] * lever(1) } else { 0.0 }];
+        Some((table, reach_per_cell))
+    }
+
+    /// Coarse cells along the grid's first axis: the rows of
+    /// [`PairTable::proved_row`].
+    pub(crate) const ROWS: usize = COARSE;
+
+    /// The blocks of fine cells proved free in row `row` of coarse cells of
+    /// a [`planned`](PairTable::planned) table (`reach_per_cell` is what
+    /// `planned` returned with it), for [`PairTable::mark`]. Rows are proved
+    /// on their own, so side by side.
+    /// Stops once `deadline` says so, polled before every coarse cell.
+    pub(crate) fn proved_row(
+        &self,
+        model: &RobotModel,
+        reach_per_cell: [f64; 2],
+        row: usize,
+        deadline: Deadline<'_>,
+    ) -> Result<Vec<Region>, Stop> {
+        let mut apart = self.apart_test(model, reach_per_cell);
+        self.proved_row_with(row, &reach_per_cell, &mut apart, deadline)
+    }
+
+    /// [`PairTable::proved_row`] with the block test `apart`.
+    fn proved_row_with(
+        &self,
+        row: usize,
+        reach_per_cell: &[f64; 2],
+        apart: &mut impl FnMut(Region) -> bool,
+        deadline: Deadline<'_>,
+    ) -> Result<Vec<Region>, Stop> {
+        let coarse = [COARSE, if self.axes == 2 { COARSE } else { 1 }];
+        let per_coarse = [self.cells[0] / coarse[0], self.cells[1] / coarse[1]];
+        let mut proved = Vec::new();
+        for ck in 0..coarse[1] {
+            if let Some(stop) = deadline.stop() {
+                return Err(stop);
+            }
+            let cell = Region {
+                i: [row * per_coarse[0], ck * per_coarse[1]],
+                n: per_coarse,
+            };
+            prove(cell, reach_per_cell, apart, &mut proved);
+        }
+        Ok(proved)
+    }
+
+    /// Marks the fine cells of `block` free.
+    pub(crate) fn mark(&mut self, block: Region) {
+        for i in block.i[0]..block.i[0] + block.n[0] {
+            for k in block.i[1]..block.i[1] + block.n[1] {
+                let bit = i * self.cells[1] + k;
+                self.free[bit / 64] |= 1 << (bit % 64);
+            }
+        }
+    }
+
+    /// True when every cell of the table is proved free: the pair is apart
+    /// in every state within the joints' limits.
+    pub(crate) fn all_free(&self) -> bool {
+        let cells = self.cells[0] * self.cells[1];
+        self.free.iter().map(|w| w.count_ones() as usize).sum::<usize>() == cells
+    }
+
+    /// The test of a block of cells: true when the bodies, posed at the
+    /// block's centre with the other joints at the middle of their ranges
+    /// (any value would do), are farther apart than the block's reach.
+    fn apart_test<'m>(
+        &self,
+        model: &'m RobotModel,
+        reach_per_cell: [f64; 2],
+    ) -> impl FnMut(Region) -> bool + use<'m> {
+        let bodies = &model.bodies;
+        let (a, b, js, lo, width) = (self.a, self.b, self.joints, self.lo, self.width);
+        let two = self.axes == 2;
         let mut q = model.chain().mid_limits();
         let mut poses = [Isometry3::identity(); MAX_BODIES];
-        let mut proved_apart = |centre: [f64; 2], half: [f64; 2]| {
+        move |r: Region| {
+            let centre = [lo[0] + r.mid(0) * width[0], lo[1] + r.mid(1) * width[1]];
             q[js[0]] = centre[0];
             if two {
                 q[js[1]] = centre[1];
             }
             model.body_poses(&q, &mut poses);
             // grown a hair for the rounding of the cell lookup
-            let reach = half[0] * lever(0) + if two { half[1] * lever(1) } else { 0.0 };
-            let reach = reach * (1.0 + 1e-9) + 1e-12;
+            let reach = r.reach(&reach_per_cell) * (1.0 + 1e-9) + 1e-12;
             !body_body_within(
                 &bodies[a],
                 &poses[a],
@@ -171,30 +310,7 @@ impl PairTable {
                 &poses[b],
                 reach.max(f64::MIN_POSITIVE),
             )
-        };
-        let coarse_w = [width[0] * per_coarse[0] as f64, width[1] * per_coarse[1] as f64];
-        for ci in 0..coarse[0] {
-            for ck in 0..coarse[1] {
-                let centre = [
-                    lo[0] + (ci as f64 + 0.5) * coarse_w[0],
-                    lo[1] + (ck as f64 + 0.5) * coarse_w[1],
-                ];
-                let whole = proved_apart(centre, [0.5 * coarse_w[0], 0.5 * coarse_w[1]]);
-                for fi in ci * per_coarse[0]..(ci + 1) * per_coarse[0] {
-                    for fk in ck * per_coarse[1]..(ck + 1) * per_coarse[1] {
-                        let centre = [
-                            lo[0] + (fi as f64 + 0.5) * width[0],
-                            lo[1] + (fk as f64 + 0.5) * width[1],
-                        ];
-                        if whole || proved_apart(centre, [0.5 * width[0], 0.5 * width[1]]) {
-                            let bit = fi * cells[1] + fk;
-                            table.free[bit / 64] |= 1 << (bit % 64);
-                        }
-                    }
-                }
-            }
         }
-        Some(table)
     }
 
     /// True when the pair is proved apart at every state whose joints lie
@@ -223,5 +339,68 @@ impl PairTable {
                 self.free[bit / 64] & (1 << (bit % 64)) != 0
             })
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collision::SweepBound;
+    use crate::robot::{builtin_chain, builtin_urdf};
+    use std::sync::Arc;
+
+    /// Halving blocks down to single cells loses no cell that a test of that
+    /// cell alone proves, and spends fewer tests than one per cell.
+    #[test]
+    fn halving_proves_every_cell_its_own_test_proves() {
+        let chain = builtin_chain("franka_panda_hand").unwrap();
+        let urdf = builtin_urdf("franka_panda_hand").unwrap();
+        let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
+        let model = Arc::new(RobotModel::of_urdf(chain, urdf, &fingers, &[]).unwrap());
+        let sweep = SweepBound::new(&model).unwrap();
+        let n = model.body_count();
+        let mut budget = TABLE_BUDGET;
+        let planned: Vec<_> = (0..n)
+            .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+            .filter_map(|(a, b)| PairTable::planned(&model, &sweep, a, b, &mut budget))
+            .collect();
+        assert!(planned.len() >= 2, "{}", planned.len());
+        for (mut table, reach_per_cell) in planned {
+            let mut alone = table.apart_test(&model, reach_per_cell);
+            let mut tests = 0;
+            let mut counted = |r: Region| {
+                tests += 1;
+                alone(r)
+            };
+            let proved: Vec<Region> = (0..PairTable::ROWS)
+                .flat_map(|row| {
+                    table
+                        .proved_row_with(row, &reach_per_cell, &mut counted, Deadline::none())
+                        .unwrap()
+                })
+                .collect();
+            proved.into_iter().for_each(|r| table.mark(r));
+            let mut alone = table.apart_test(&model, reach_per_cell);
+            let (mut free_alone, mut free) = (0, 0);
+            for i in 0..table.cells[0] {
+                for k in 0..table.cells[1] {
+                    let bit = i * table.cells[1] + k;
+                    let set = table.free[bit / 64] & (1 << (bit % 64)) != 0;
+                    free += usize::from(set);
+                    if alone(Region { i: [i, k], n: [1, 1] }) {
+                        free_alone += 1;
+                        assert!(set, "pair {}-{}: cell ({i}, {k}) lost", table.a, table.b);
+                    }
+                }
+            }
+            let cells = table.cells[0] * table.cells[1];
+            assert!(free >= free_alone && free > 0, "{free} {free_alone}");
+            assert!(
+                tests < cells,
+                "pair {}-{}: {tests} tests for {cells} cells",
+                table.a,
+                table.b
+            );
+        }
     }
 }

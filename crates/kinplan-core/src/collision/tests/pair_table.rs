@@ -135,6 +135,37 @@ fn a_pair_proved_apart_over_a_piece_is_apart_at_every_state_in_it() {
 }
 
 #[test]
+fn a_pair_allowed_as_proved_is_apart_in_the_exact_geometry_everywhere() {
+    let model = panda_hand();
+    let acm = AllowedCollisions::sampled(
+        &model,
+        &AcmParams {
+            samples: 500,
+            ..AcmParams::default()
+        },
+    )
+    .unwrap();
+    let n = model.body_count();
+    let proved: Vec<(usize, usize)> = (0..n)
+        .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+        .filter(|&(a, b)| acm.reason(a, b) == Some(AllowReason::Proved))
+        .collect();
+    // link_1–link_3 and the other pairs two joints apart along the arm
+    assert!(proved.len() >= 3, "{proved:?}");
+    let mut rng = ChaCha8Rng::seed_from_u64(44);
+    let mut nearest = f64::INFINITY;
+    for _ in 0..5000 {
+        let q = random_state(&model, &mut rng);
+        for &(a, b) in &proved {
+            let d = gap(&model, &q, a, b);
+            assert!(d > 0.0, "{q:?}: {} {} at {d} m", name(&model, a), name(&model, b));
+            nearest = nearest.min(d);
+        }
+    }
+    eprintln!("{proved:?}: nearest {nearest} m");
+}
+
+#[test]
 fn states_outside_a_table_or_not_finite_are_not_proved() {
     let model = panda_hand();
     let t = &model.pair_tables()[0];

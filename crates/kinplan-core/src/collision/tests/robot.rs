@@ -62,8 +62,9 @@ fn sampled_acm_keeps_adjacency_is_deterministic_and_keeps_reachable_pairs_checke
     // The base sphere and link_1 sphere are adjacent; the base (r 0.12 at
     // the origin) and link_7 can meet when the arm folds down, so that pair
     // must stay checked; link_1 and link_3 are 0.316 m apart along the
-    // upper arm and can never meet (radii 0.09 + 0.08): allowed as never.
-    assert_eq!(a.reason(1, 3), Some(AllowReason::Never));
+    // upper arm and can never meet (radii 0.09 + 0.08), which joint 2's
+    // table proves: allowed as proved, not merely never seen colliding.
+    assert_eq!(a.reason(1, 3), Some(AllowReason::Proved));
     assert!(a.reason(0, 7).is_none(), "{:?}", a.reason(0, 7));
     assert!(AllowedCollisions::sampled(&model, &AcmParams { samples: 0, ..params }).is_err());
 }
@@ -74,12 +75,27 @@ fn sampling_the_acm_stops_when_its_deadline_says_so() {
     let model = RobotModel::new(builtin_chain("franka_panda").unwrap()).unwrap();
     let params = AcmParams::default();
     let past = crate::Deadline::at(std::time::Instant::now());
+    let stopped = |what: &str| {
+        Err(CollisionError::Stopped {
+            what: what.into(),
+            stop: crate::Stop::Deadline,
+        })
+    };
+    // first while the pair tables are built, which keeps none of them
+    let tables = "proving the robot's self pairs apart (pair tables)";
     assert_eq!(
         AllowedCollisions::sampled_until(&model, &params, past),
-        Err(CollisionError::Stopped {
-            what: "sampling the allowed-collision matrix".into(),
-            stop: crate::Stop::Deadline
-        })
+        stopped(tables)
+    );
+    assert_eq!(
+        AllowedCollisions::sampled_until(&model, &params, past),
+        stopped(tables)
+    );
+    // with the tables built, in the sampling
+    assert!(!model.pair_tables().is_empty());
+    assert_eq!(
+        AllowedCollisions::sampled_until(&model, &params, past),
+        stopped("sampling the allowed-collision matrix")
     );
     let cancelled = AtomicBool::new(true);
     let err =
