@@ -192,9 +192,21 @@ impl RobotModel {
         // Body carried by each link, for attached bodies' parents.
         let mut last_body_at_link: Vec<Option<usize>> = vec![None; chain.links().len()];
         let mut last: Option<usize> = None;
-        for (li, lc) in chain.collision().iter().enumerate() {
-            let field = format!("links[{}]", lc.link);
-            let shapes = body_shapes(&lc.shapes, meshes, &field)?;
+        // Each body's shapes are built on their own (a mesh's hull and fitted
+        // polytope are the costly part), so side by side; the first error in
+        // body order is the one reported.
+        let link_shapes: Vec<_> = chain
+            .collision()
+            .par_iter()
+            .map(|lc| body_shapes(&lc.shapes, meshes, &format!("links[{}]", lc.link)))
+            .collect();
+        let attached_shapes: Vec<_> = attached
+            .par_iter()
+            .enumerate()
+            .map(|(k, a)| body_shapes(&a.shapes, meshes, &format!("attached[{k}]")))
+            .collect();
+        for ((li, lc), shapes) in chain.collision().iter().enumerate().zip(link_shapes) {
+            let shapes = shapes?;
             if !shapes.is_empty() {
                 bodies.push(make_body(
                     lc.link.clone(),
@@ -207,7 +219,7 @@ impl RobotModel {
             }
             last_body_at_link[li] = last;
         }
-        for (k, a) in attached.iter().enumerate() {
+        for ((k, a), shapes) in attached.iter().enumerate().zip(attached_shapes) {
             let field = format!("attached[{k}]");
             let li = chain
                 .links()
@@ -224,7 +236,7 @@ impl RobotModel {
                     field: format!("{field}.offset"),
                 });
             }
-            let shapes = body_shapes(&a.shapes, meshes, &field)?;
+            let shapes = shapes?;
             if !shapes.is_empty() {
                 bodies.push(make_body(
                     a.name.clone(),
