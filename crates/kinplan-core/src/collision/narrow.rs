@@ -408,3 +408,102 @@ pub(crate) fn body_body_within(
         )
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collision::fast::segment_segment_distance_squared;
+    use parry3d_f64::query::PointQuery;
+    use parry3d_f64::shape::Triangle;
+
+    /// A placement an independent fuzz of these tests found: a small
+    /// polytope whose distance to a one-triangle mesh is below a 1e-4 m
+    /// margin, where parry's closest-points query over the whole mesh says
+    /// `Disjoint` (its witness points, from an early GJK stop, lie farther
+    /// apart than the shapes). The distance is bounded here by features:
+    /// every polytope corner against the triangle, every triangle corner
+    /// against the polytope, every pair of corners against every edge.
+    #[test]
+    fn a_polytope_just_within_a_mesh_triangle_is_within() {
+        let corners = [
+            [-0.17873805936104797, 0.29810488350731557, -0.08609290981665668],
+            [-0.17883616019504517, 0.29826212966616045, -0.08631377579841897],
+            [-0.18017251609687354, 0.29995369881825046, -0.08451589648307711],
+            [-0.18007441526287635, 0.2997964526594056, -0.08429503050131483],
+            [-0.17747876883781655, 0.2989925617368185, -0.0859920736752756],
+            [-0.17759156081523228, 0.2991733563791723, -0.08624601556151423],
+            [-0.17892791671706065, 0.3008649255312623, -0.08444813624617238],
+            [-0.17881512473964492, 0.30068413088890844, -0.08419419435993375],
+            [-0.17929897614104057, 0.299857455015777, -0.08377604519747996],
+            [-0.17911049044508742, 0.2999928714530697, -0.08376335374261297],
+            [-0.17777413454325905, 0.29830130230097973, -0.08556123305795482],
+            [-0.1779626202392122, 0.29816588586368703, -0.08557392451282181],
+            [-0.17982450743273126, 0.30069983090193403, -0.08495923579797342],
+            [-0.17963602173677812, 0.3008352473392268, -0.08494654434310643],
+            [-0.17829966583494974, 0.2991436781871368, -0.08674442365844828],
+            [-0.1784881515309029, 0.2990082617498441, -0.08675711511331527],
+            [-0.177587775537615, 0.29852860735518544, -0.08563657752607418],
+            [-0.1774882120152082, 0.29875866606687684, -0.08577902753198177],
+            [-0.1777966759251897, 0.2992531039122089, -0.08647350872587489],
+            [-0.17803282208894197, 0.29924197397860586, -0.0866385633347936],
+            [-0.1786205318368946, 0.29888205928798284, -0.08673677282009662],
+            [-0.17875815540421552, 0.2986988116725701, -0.08666665579615042],
+            [-0.1788431746567412, 0.2984694384547928, -0.08651404005754959],
+            [-0.1785621212159764, 0.29801893694334125, -0.08588127128696041],
+            [-0.17833210718122927, 0.29801589753394847, -0.08570744316549518],
+            [-0.1781217906844833, 0.29808262540675023, -0.0856138980209312],
+            [-0.17892413143944338, 0.3002201765072754, -0.08383869821073232],
+            [-0.17882456791703658, 0.3004502352189668, -0.08398114821663992],
+            [-0.17913303182701806, 0.30094467306429884, -0.08467562941053304],
+            [-0.17936917799077032, 0.3009335431306958, -0.08484068401945176],
+            [-0.17995688773872298, 0.3005736284400728, -0.08493889350475477],
+            [-0.1800945113060439, 0.3003903808246601, -0.08486877648080857],
+            [-0.18017953055856958, 0.30016100760688275, -0.08471616074220774],
+            [-0.17989847711780477, 0.2997105060954312, -0.08408339197161856],
+            [-0.17966846308305764, 0.2997074666860384, -0.08390956385015333],
+            [-0.17945814658631168, 0.2997741945588402, -0.08381601870558934],
+        ]
+        .map(|[x, y, z]| Vector::new(x, y, z));
+        let triangle = [
+            [-0.18022100559207233, 0.2999427629637568, -0.08451049500718058],
+            [-0.20753672728909672, 0.22967947802830596, -0.18450326936897457],
+            [-0.35492677407840967, 0.21115594050881684, -0.17434495496838448],
+        ]
+        .map(|[x, y, z]| Vector::new(x, y, z));
+        let polytope = SharedShape::convex_hull(&corners).unwrap();
+        let mesh = SharedShape::trimesh(triangle.to_vec(), vec![[0, 1, 2]]).unwrap();
+        let (tri, poly) = (
+            Triangle::new(triangle[0], triangle[1], triangle[2]),
+            polytope.as_convex_polyhedron().unwrap(),
+        );
+        let point = |v: &Vector| Point3::new(v.x, v.y, v.z);
+        let mut upper = f64::INFINITY;
+        for c in &corners {
+            upper = upper.min(tri.distance_to_local_point(*c, true));
+        }
+        for v in &triangle {
+            upper = upper.min(poly.distance_to_local_point(*v, true));
+        }
+        for (i, a) in corners.iter().enumerate() {
+            for b in &corners[i + 1..] {
+                for k in 0..3 {
+                    let (c, d) = (triangle[k], triangle[(k + 1) % 3]);
+                    let squared =
+                        segment_segment_distance_squared(&point(a), &point(b), &point(&c), &point(&d));
+                    upper = upper.min(squared.sqrt());
+                }
+            }
+        }
+        assert!(upper < 1e-4, "{upper}");
+        let here = Pose::IDENTITY;
+        assert!(within(&here, &polytope, &here, &mesh, 1e-4));
+        assert!(within(&here, &mesh, &here, &polytope, 1e-4));
+        // and not within once moved a centimetre clear of the triangle
+        let away = Pose::from_translation(Vector::new(0.05, 0.0, 0.0));
+        let clear = query::distance(&away, &*polytope, &here, &*mesh)
+            .unwrap()
+            .distance;
+        assert!(clear > 1e-3, "{clear}");
+        assert!(!within(&away, &polytope, &here, &mesh, 1e-4));
+    }
+}
