@@ -151,6 +151,12 @@ class LocalServer:
             return bool(self._thread_server.running())
         return self._proc is not None and self._proc.poll() is None
 
+    @property
+    def pid(self) -> Optional[int]:
+        """The server process's id (for its memory or CPU figures); ``None``
+        when it runs in a thread of this process or is not running."""
+        return self._proc.pid if self._proc is not None else None
+
     def __enter__(self) -> "LocalServer":
         return self.start()
 

@@ -1,6 +1,7 @@
 """The client's plumbing against real server processes: LocalServer, ping,
 wait_for_ready, addresses, the exception hierarchy (pickled too), and calls
 spread over two replicas surviving the loss of one."""
+import os
 import pickle
 
 import numpy as np
@@ -57,6 +58,10 @@ def test_a_local_server_starts_answers_and_stops(in_thread):
 def test_wait_for_ready_gives_up_with_unavailable():
     with kinplan.LocalServer() as server:
         address = server.address
+        pid = server.pid
+        assert pid is not None and pid != os.getpid()
+        os.kill(pid, 0)  # the server process is there
+    assert server.pid is None
     with pytest.raises(kinplan.Unavailable):
         kinplan.Client(address, timeout=0.5, wait_for_ready=True)
 

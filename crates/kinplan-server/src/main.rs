@@ -60,6 +60,11 @@ struct ServeArgs {
     #[arg(long, env = "KINPLAN_CPU_NICE", default_value_t = 10,
           value_parser = clap::value_parser!(i32).range(0..=19))]
     cpu_nice: i32,
+    /// Let the allocator's heap use transparent huge pages where the host
+    /// allows them. Off by default: the kernel zeroes (and may compact
+    /// memory for) each 2 MiB page inside the call that first touches it.
+    #[arg(long, env = "KINPLAN_HUGE_PAGES")]
+    huge_pages: bool,
     /// Largest request or response message, bytes.
     #[arg(long, env = "KINPLAN_MAX_MESSAGE_BYTES", default_value_t = 16 * 1024 * 1024)]
     max_message_bytes: usize,
@@ -199,6 +204,9 @@ fn seconds(value: f64, flag: &str) -> Result<Duration, String> {
 }
 
 fn run(args: ServeArgs) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    if !args.huge_pages {
+        kinplan_server::runtime::memory::disable_transparent_huge_pages();
+    }
     // Accepts connections, handles signals and serves metrics; the calls run
     // on the I/O threads `serve` starts.
     let runtime = tokio::runtime::Builder::new_current_thread()

@@ -4,6 +4,7 @@
 pub mod collision_models;
 pub mod compute;
 pub mod deadline;
+pub mod memory;
 pub mod models;
 pub mod priority;
 pub mod request_numbers;
