@@ -10,9 +10,12 @@
 //!
 //! Before sampling, a pair whose relative pose one or two joints change is
 //! allowed as **proved** when its table (`pair_table`) proves it apart in
-//! every cell of those joints' ranges, whatever the other joints; such a
-//! pair is apart in every state, not only in the samples. In the other
-//! tables a proved cell answers a sample without the exact test.
+//! every cell of those joints' ranges, whatever the other joints, and so is
+//! a pair whose relative pose no joint changes (a finger held beside the
+//! hand) when one exact test finds it apart; such a pair is apart in every
+//! state, not only in the samples. In the other tables a proved cell
+//! answers a sample without the exact test. The pairs left to the "never"
+//! rule are those three or more joints move relative to each other.
 //!
 //! Steps 2–3 are a sampling heuristic: a pair that collides in fewer than
 //! about 1/`samples` of the joint space is allowed as "never" (MoveIt's
@@ -34,8 +37,9 @@ use rayon::prelude::*;
 
 use super::CollisionError;
 use super::model::{MAX_BODIES, RobotModel};
-use super::narrow::body_body_intersect;
+use super::narrow::{body_body_intersect, body_body_within};
 use super::pair_table::PairTable;
+use super::sweep::SweepBound;
 use crate::Deadline;
 use nalgebra::Isometry3;
 
@@ -46,7 +50,8 @@ pub enum AllowReason {
     Always,
     Never,
     /// Proved apart in every state within the joint limits: the pair's
-    /// table (`pair_table`) proves every cell free.
+    /// table (`pair_table`) proves every cell free, or no joint moves one
+    /// body relative to the other and they are apart.
     Proved,
     /// Allowed by the caller (an SRDF's `disable_collisions`, a built-in's).
     User,
@@ -174,7 +179,22 @@ impl AllowedCollisions {
             })
             .collect();
         // A pair whose table proves every cell free is apart everywhere; in
-        // the other tables a proved cell spares the exact test.
+        // the other tables a proved cell spares the exact test. A pair that
+        // no joint moves relative to each other (the same last joint) keeps
+        // one relative pose, so one test decides it for every state.
+        let sweep = SweepBound::new(model);
+        let rigid = |a: usize, b: usize| sweep.as_ref().is_some_and(|s| s.last(a) == s.last(b));
+        let mut poses = [Isometry3::identity(); MAX_BODIES];
+        model.body_poses(&chain.mid_limits(), &mut poses);
+        let apart_here = |a: usize, b: usize| {
+            !body_body_within(
+                &model.bodies[a],
+                &poses[a],
+                &model.bodies[b],
+                &poses[b],
+                f64::MIN_POSITIVE,
+            )
+        };
         let tables = model
             .pair_tables_until(deadline)
             .map_err(|stop| CollisionError::Stopped {
@@ -185,6 +205,7 @@ impl AllowedCollisions {
         for (a, b) in acm.checked_pairs().collect::<Vec<_>>() {
             match tables.iter().find(|t| (t.a, t.b) == (a, b)) {
                 Some(table) if table.all_free() => acm.allow(a, b, AllowReason::Proved),
+                None if rigid(a, b) && apart_here(a, b) => acm.allow(a, b, AllowReason::Proved),
                 table => pairs.push((a, b, table)),
             }
         }
