@@ -65,7 +65,7 @@ pub use builtin_meshes::{BUILTIN_MESH_SCHEME, builtin_mesh};
 pub use checker::{MotionCheck, PadVerdict, StateChecker, interpolate_motion_valid};
 pub use error::CollisionError;
 pub use mesh_file::{MeshFileLimits, read_mesh_file};
-pub use model::{AttachedBody, InlineMesh, MAX_BODIES, MAX_LINKS, RobotModel};
+pub use model::{AttachedBody, InlineMesh, MAX_BODIES, MAX_LINKS, MAX_MESH_VERTICES, RobotModel};
 pub use moveit::{JointRequest, MAX_YAML_BYTES, parse_joint_request, parse_planning_scene};
 pub use octree_cells::octree_cells;
 pub(crate) use padded::bisection_order;

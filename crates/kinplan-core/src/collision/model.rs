@@ -33,6 +33,12 @@ pub const MAX_BODIES: usize = 63;
 const _: () = assert!(MAX_BODIES < 64);
 /// Most links a chain may have to get a collision model.
 pub const MAX_LINKS: usize = 96;
+/// Most mesh vertices a model's shapes may take, summed over every
+/// collision element that names a mesh (a mesh named twice counts twice):
+/// each such element gets its own hull and fitted polytope, so this bounds
+/// the build by the request's size and not by how often a URDF repeats a
+/// reference.
+pub const MAX_MESH_VERTICES: usize = 1_000_000;
 
 /// Geometry attached rigidly to a chain link but not on the chain itself,
 /// e.g. a finger held at a fixed opening.
@@ -170,8 +176,20 @@ impl RobotModel {
         locked: &[(&str, f64)],
         meshes: &[InlineMesh],
     ) -> Result<Self, CollisionError> {
+        Self::of_urdf_until(chain, urdf, locked, meshes, Deadline::none())
+    }
+
+    /// [`Self::of_urdf`], stopping with [`CollisionError::Stopped`] once
+    /// `deadline` says so (polled before every mesh element's shape).
+    pub fn of_urdf_until(
+        chain: Arc<Chain>,
+        urdf: &str,
+        locked: &[(&str, f64)],
+        meshes: &[InlineMesh],
+        deadline: Deadline<'_>,
+    ) -> Result<Self, CollisionError> {
         let attached = super::attach::attached_bodies(urdf, &chain, locked)?;
-        Self::with_parts(chain, &attached, meshes)
+        Self::with_parts_until(chain, &attached, meshes, deadline)
     }
 
     /// The collision model of `chain`, plus `attached` bodies and the
@@ -181,11 +199,45 @@ impl RobotModel {
         attached: &[AttachedBody],
         meshes: &[InlineMesh],
     ) -> Result<Self, CollisionError> {
+        Self::with_parts_until(chain, attached, meshes, Deadline::none())
+    }
+
+    /// [`Self::with_parts`], stopping with [`CollisionError::Stopped`] once
+    /// `deadline` says so (polled before every mesh element's shape).
+    pub fn with_parts_until(
+        chain: Arc<Chain>,
+        attached: &[AttachedBody],
+        meshes: &[InlineMesh],
+        deadline: Deadline<'_>,
+    ) -> Result<Self, CollisionError> {
         if chain.links().len() > MAX_LINKS {
             return Err(CollisionError::TooMany {
                 field: "chain.links".into(),
                 count: chain.links().len(),
                 limit: MAX_LINKS,
+            });
+        }
+        let named_vertices: usize = chain
+            .collision()
+            .iter()
+            .flat_map(|lc| &lc.shapes)
+            .chain(attached.iter().flat_map(|a| &a.shapes))
+            .filter_map(|cs| match &cs.shape {
+                Shape::MeshReference { filename, .. } => Some(filename),
+                _ => None,
+            })
+            .map(|filename| {
+                let inline = meshes.iter().find(|m| &m.filename == filename);
+                inline
+                    .or_else(|| builtin_mesh(filename))
+                    .map_or(0, |m| m.vertices.len())
+            })
+            .fold(0usize, usize::saturating_add);
+        if named_vertices > MAX_MESH_VERTICES {
+            return Err(CollisionError::TooMany {
+                field: "mesh vertices named by links[].collision (each naming element counts)".into(),
+                count: named_vertices,
+                limit: MAX_MESH_VERTICES,
             });
         }
         let mut bodies: Vec<Body> = Vec::new();
@@ -198,12 +250,12 @@ impl RobotModel {
         let link_shapes: Vec<_> = chain
             .collision()
             .par_iter()
-            .map(|lc| body_shapes(&lc.shapes, meshes, &format!("links[{}]", lc.link)))
+            .map(|lc| body_shapes(&lc.shapes, meshes, &format!("links[{}]", lc.link), deadline))
             .collect();
         let attached_shapes: Vec<_> = attached
             .par_iter()
             .enumerate()
-            .map(|(k, a)| body_shapes(&a.shapes, meshes, &format!("attached[{k}]")))
+            .map(|(k, a)| body_shapes(&a.shapes, meshes, &format!("attached[{k}]"), deadline))
             .collect();
         for ((li, lc), shapes) in chain.collision().iter().enumerate().zip(link_shapes) {
             let shapes = shapes?;
@@ -531,6 +583,7 @@ fn body_shapes(
     shapes: &[CollisionShape],
     meshes: &[InlineMesh],
     field: &str,
+    deadline: Deadline<'_>,
 ) -> Result<Vec<BodyShape>, CollisionError> {
     let mut out = Vec::with_capacity(shapes.len());
     for (k, cs) in shapes.iter().enumerate() {
@@ -549,6 +602,12 @@ fn body_shapes(
                 length: *length,
             },
             Shape::MeshReference { filename, scale } => {
+                if let Some(stop) = deadline.stop() {
+                    return Err(CollisionError::Stopped {
+                        what: "building the robot's collision bodies (mesh hulls)".into(),
+                        stop,
+                    });
+                }
                 let mesh = meshes
                     .iter()
                     .find(|m| &m.filename == filename)

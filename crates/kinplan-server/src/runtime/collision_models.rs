@@ -31,8 +31,9 @@ impl CollisionSetup {
     /// ([`AcmParams::samples_within`]).
     ///
     /// Stops with [`CollisionError::Stopped`] once `deadline` says so: it is
-    /// polled before every mesh file, after the bodies are built and during
-    /// the sampling.
+    /// polled before every mesh file is read, before every mesh element's
+    /// hull, after the bodies are built, while the pair tables are built and
+    /// during the sampling.
     pub fn build(
         chain: Arc<Chain>,
         model: Option<(&ModelSource, &[(String, f64)])>,
@@ -62,7 +63,7 @@ impl CollisionSetup {
                         read_mesh_file(uri, data, &limits)
                     })
                     .collect::<Result<Vec<_>, _>>()?;
-                RobotModel::of_urdf(chain, &source.urdf, &held, &meshes)?
+                RobotModel::of_urdf_until(chain, &source.urdf, &held, &meshes, deadline)?
             }
             None => RobotModel::new(chain)?,
         });

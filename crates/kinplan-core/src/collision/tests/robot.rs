@@ -1169,3 +1169,89 @@ fn exact_distance(
     }
     best
 }
+
+/// A UV sphere mesh of radius 0.05 m: `rings × around` vertices.
+fn uv_sphere(filename: &str, rings: usize, around: usize) -> InlineMesh {
+    let mut vertices = Vec::new();
+    for i in 0..rings {
+        let polar = std::f64::consts::PI * (i as f64 + 0.5) / rings as f64;
+        for j in 0..around {
+            let azimuth = 2.0 * std::f64::consts::PI * j as f64 / around as f64;
+            vertices.push(Point3::new(
+                0.05 * polar.sin() * azimuth.cos(),
+                0.05 * polar.sin() * azimuth.sin(),
+                0.05 * polar.cos(),
+            ));
+        }
+    }
+    let mut indices = Vec::new();
+    for i in 0..rings - 1 {
+        for j in 0..around {
+            let a = (i * around + j) as u32;
+            let b = (i * around + (j + 1) % around) as u32;
+            let up = around as u32;
+            indices.extend([a, b, b + up, a, b + up, a + up]);
+        }
+    }
+    InlineMesh {
+        filename: filename.into(),
+        vertices,
+        indices,
+    }
+}
+
+/// The URDF of the probe with `n` collision elements, each naming `filename`.
+fn naming_n_times(filename: &str, n: usize) -> String {
+    let element = format!(r#"<mesh filename="{filename}"/>"#);
+    let elements = vec![element; n].join("</geometry></collision><collision><geometry>");
+    probe_urdf(&elements)
+}
+
+#[test]
+fn a_mesh_named_beyond_the_vertex_budget_is_refused_before_any_hull() {
+    let mesh = uv_sphere("package://r/m.stl", 100, 200);
+    let n = MAX_MESH_VERTICES / mesh.vertices.len() + 1;
+    let urdf = naming_n_times(&mesh.filename, n);
+    let chain = Arc::new(parse_chain(&urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
+    let started = std::time::Instant::now();
+    let err = RobotModel::with_parts(chain, &[], std::slice::from_ref(&mesh)).expect_err("refused");
+    // one hull of this mesh alone takes longer than the refusal may
+    assert!(
+        started.elapsed() < std::time::Duration::from_millis(50),
+        "{:?}",
+        started.elapsed()
+    );
+    assert!(
+        matches!(&err, CollisionError::TooMany { count, limit, .. }
+            if *count == n * mesh.vertices.len() && *limit == MAX_MESH_VERTICES),
+        "{err}"
+    );
+    assert!(err.to_string().contains("links[].collision"), "{err}");
+    // within the budget the same mesh builds
+    let urdf = naming_n_times(&mesh.filename, 1);
+    let chain = Arc::new(parse_chain(&urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
+    assert!(RobotModel::with_parts(chain, &[], std::slice::from_ref(&mesh)).is_ok());
+}
+
+#[test]
+fn building_mesh_shapes_stops_at_the_deadline() {
+    let mesh = uv_sphere("package://r/m.stl", 9, 18);
+    let urdf = naming_n_times(&mesh.filename, 3);
+    let chain = Arc::new(parse_chain(&urdf, &ChainSpec::default(), UrdfLimits::default()).unwrap());
+    let past = crate::Deadline::at(std::time::Instant::now());
+    let err = RobotModel::with_parts_until(chain.clone(), &[], std::slice::from_ref(&mesh), past)
+        .expect_err("stopped");
+    assert!(
+        matches!(
+            &err,
+            CollisionError::Stopped {
+                stop: crate::Stop::Deadline,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    let built =
+        RobotModel::with_parts_until(chain, &[], std::slice::from_ref(&mesh), crate::Deadline::none());
+    assert_eq!(built.unwrap().body_count(), 1);
+}
