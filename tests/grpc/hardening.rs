@@ -511,6 +511,74 @@ async fn a_collision_model_build_stops_at_the_deadline() {
     );
 }
 
+/// Regression: each collision element naming a mesh got its own hull and
+/// polytope fit, so a URDF naming one mesh file thousands of times (a few
+/// hundred bytes each) multiplied the work of one file by thousands, with no
+/// deadline polled in between. The mesh vertices the elements name are now
+/// bounded together, and refused before any hull is built.
+#[tokio::test]
+async fn a_urdf_naming_one_mesh_many_times_is_refused_before_any_hull() {
+    let server = start(ServerConfig::default()).await;
+    // a ball of 100 rings of 200 vertices, named by 60 elements of one link
+    let uri = "package://many/ball.obj";
+    let (rings, around) = (100, 200);
+    let mut ball = String::new();
+    for i in 0..rings {
+        let polar = std::f64::consts::PI * (i as f64 + 0.5) / rings as f64;
+        for j in 0..around {
+            let azimuth = 2.0 * std::f64::consts::PI * j as f64 / around as f64;
+            let (x, y, z) = (
+                polar.sin() * azimuth.cos(),
+                polar.sin() * azimuth.sin(),
+                polar.cos(),
+            );
+            ball += &format!("v {} {} {}\n", 0.05 * x, 0.05 * y, 0.05 * z);
+        }
+    }
+    for i in 0..rings - 1 {
+        for j in 0..around {
+            let a = i * around + j + 1;
+            let b = i * around + (j + 1) % around + 1;
+            ball += &format!("f {a} {b} {}\nf {a} {} {}\n", b + around, b + around, a + around);
+        }
+    }
+    let element = format!(r#"<collision><geometry><mesh filename="{uri}"/></geometry></collision>"#);
+    let urdf = format!(
+        r#"<robot name="many"><link name="base"/><link name="arm">{}</link>
+           <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+             <limit lower="-3" upper="3" effort="1" velocity="1"/></joint></robot>"#,
+        element.repeat(60)
+    );
+    let mut planning = pb::planning_service_client::PlanningServiceClient::new(server.channel.clone());
+    let check = pb::CheckStateRequest {
+        robot: Some(pb::RobotRef {
+            source: Some(pb::robot_ref::Source::Urdf(urdf)),
+            meshes: vec![pb::MeshFile {
+                uri: uri.into(),
+                data: ball.into_bytes(),
+            }],
+            ..Default::default()
+        }),
+        states: vec![pb::JointState { positions: vec![0.3] }],
+        ..Default::default()
+    };
+    let started = Instant::now();
+    let err = planning.check_state(check).await.unwrap_err();
+    assert_eq!(err.code(), Code::InvalidArgument, "{err:?}");
+    assert!(
+        err.message().contains("mesh vertices named by links[].collision"),
+        "{err:?}"
+    );
+    assert!(err.message().contains("1200000"), "{err:?}");
+    // reading the one file is all the work done (the 60 hulls alone take
+    // seconds in a debug build)
+    assert!(
+        started.elapsed() < Duration::from_secs(3),
+        "{:?}",
+        started.elapsed()
+    );
+}
+
 /// Health answers within 10 ms while every pool thread is busy (measured with
 /// the release binary, see the report; the assertion here allows for a debug
 /// build on a loaded 2-core machine, yet fails if health waits for the pool).
