@@ -71,6 +71,29 @@ def tetra_and_sphere() -> p.CheckStateRequest:
                                scene=c.Scene(objects=[mesh, ball]))
 
 
+def one_mesh_named(times: int) -> p.CheckStateRequest:
+    """A one-joint arm whose link names one ball mesh of 20,000 vertices
+    `times` times (each element a few dozen bytes of URDF)."""
+    uri, rings, around = "package://many/ball.obj", 100, 200
+    lines = []
+    for i in range(rings):
+        polar = math.pi * (i + 0.5) / rings
+        for j in range(around):
+            azimuth = 2 * math.pi * j / around
+            lines.append(f"v {0.05 * math.sin(polar) * math.cos(azimuth)} "
+                         f"{0.05 * math.sin(polar) * math.sin(azimuth)} {0.05 * math.cos(polar)}")
+    for i in range(rings - 1):
+        for j in range(around):
+            a, b = i * around + j + 1, i * around + (j + 1) % around + 1
+            lines += [f"f {a} {b} {b + around}", f"f {a} {b + around} {a + around}"]
+    element = f'<collision><geometry><mesh filename="{uri}"/></geometry></collision>'
+    urdf = (f'<robot name="many"><link name="base"/><link name="arm">{element * times}</link>'
+            '<joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>'
+            '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint></robot>')
+    robot = c.RobotRef(urdf=urdf, meshes=[c.MeshFile(uri=uri, data="\n".join(lines).encode())])
+    return p.CheckStateRequest(robot=robot, states=[p.JointState(positions=[0.3])])
+
+
 CASES = [
     # (name, service, method, request, deadline s)
     ("STOMP 2,000 timesteps, 0.5 s budget", "plan", "Plan", stomp_plan(2000, 0.5), 30.0),
@@ -80,14 +103,19 @@ CASES = [
     ("CheckState: mesh then sphere, penetrated", "plan", "CheckState", tetra_and_sphere(), 5.0),
     ("OctreeInfo of a root with 8 leaves", "explore", "OctreeInfo",
      e.OctreeInfoRequest(octree=c.Octree(id="OcTree", resolution=0.1, binary=True, data=b"\x66\x66")), 5.0),
+    ("CheckState: one 20,000-vertex mesh named 300 times", "plan", "CheckState", one_mesh_named(300), 10.0),
+    ("the same mesh named 45 times (within the budget), 1 s deadline", "plan", "CheckState",
+     one_mesh_named(45), 1.0),
 ]
 
 
-def run(binary: str) -> None:
+def run(binary: str, only: list[str]) -> None:
     print(f"\n{binary}")
     print("| case | answer | wall s | peak RSS MiB | CPU s in the 2 s after the answer |")
     print("|---|---|---|---|---|")
     for name, service, method, request, deadline in CASES:
+        if only and not any(o in name for o in only):
+            continue
         port = free_port()
         server = subprocess.Popen([binary, "serve", "--listen", f"127.0.0.1:{port}"],
                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -119,8 +147,10 @@ def run(binary: str) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--bin", action="append", required=True, help="a kinplan server binary (repeatable)")
-    for b in ap.parse_args().bin:
-        run(b)
+    ap.add_argument("--case", action="append", default=[], help="run only the cases whose name holds this (repeatable)")
+    args = ap.parse_args()
+    for b in args.bin:
+        run(b, args.case)
 
 
 if __name__ == "__main__":
