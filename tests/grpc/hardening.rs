@@ -427,6 +427,31 @@ async fn work_stops_soon_after_a_missed_deadline() {
     assert_idle("SolveIkBatch", idle_after(&running).await);
 }
 
+/// An OBJ UV sphere of radius 0.05 m: `rings` rings of `around` vertices.
+fn ball_obj(rings: usize, around: usize) -> String {
+    let mut ball = String::new();
+    for i in 0..rings {
+        let polar = std::f64::consts::PI * (i as f64 + 0.5) / rings as f64;
+        for j in 0..around {
+            let azimuth = 2.0 * std::f64::consts::PI * j as f64 / around as f64;
+            let (x, y, z) = (
+                polar.sin() * azimuth.cos(),
+                polar.sin() * azimuth.sin(),
+                polar.cos(),
+            );
+            ball += &format!("v {} {} {}\n", 0.05 * x, 0.05 * y, 0.05 * z);
+        }
+    }
+    for i in 0..rings - 1 {
+        for j in 0..around {
+            let a = i * around + j + 1;
+            let b = i * around + (j + 1) % around + 1;
+            ball += &format!("f {a} {b} {}\nf {a} {} {}\n", b + around, b + around, a + around);
+        }
+    }
+    ball
+}
+
 /// Regression: building a robot's collision model (its bodies and the
 /// sampled allowed-collision matrix, up to two million pair tests) ignored
 /// the deadline and ran on the pool for seconds after the answer, for every
@@ -456,28 +481,7 @@ async fn a_collision_model_build_stops_at_the_deadline() {
         );
     }
     urdf += "</robot>";
-    // a UV sphere of radius 0.05: 9 rings of 18 vertices
-    let mut ball = String::new();
-    let (rings, around) = (9, 18);
-    for i in 0..rings {
-        let polar = std::f64::consts::PI * (i as f64 + 0.5) / rings as f64;
-        for j in 0..around {
-            let azimuth = 2.0 * std::f64::consts::PI * j as f64 / around as f64;
-            ball += &format!(
-                "v {} {} {}\n",
-                0.05 * polar.sin() * azimuth.cos(),
-                0.05 * polar.sin() * azimuth.sin(),
-                0.05 * polar.cos()
-            );
-        }
-    }
-    for i in 0..rings - 1 {
-        for j in 0..around {
-            let a = i * around + j + 1;
-            let b = i * around + (j + 1) % around + 1;
-            ball += &format!("f {a} {b} {}\nf {a} {} {}\n", b + around, b + around, a + around);
-        }
-    }
+    let ball = ball_obj(9, 18);
     let mut planning = pb::planning_service_client::PlanningServiceClient::new(server.channel.clone());
     let check = pb::CheckStateRequest {
         robot: Some(pb::RobotRef {
@@ -513,7 +517,7 @@ async fn a_collision_model_build_stops_at_the_deadline() {
 
 /// Regression: each collision element naming a mesh got its own hull and
 /// polytope fit, so a URDF naming one mesh file thousands of times (a few
-/// hundred bytes each) multiplied the work of one file by thousands, with no
+/// dozen bytes each) multiplied the work of one file by thousands, with no
 /// deadline polled in between. The mesh vertices the elements name are now
 /// bounded together, and refused before any hull is built.
 #[tokio::test]
@@ -521,27 +525,7 @@ async fn a_urdf_naming_one_mesh_many_times_is_refused_before_any_hull() {
     let server = start(ServerConfig::default()).await;
     // a ball of 100 rings of 200 vertices, named by 60 elements of one link
     let uri = "package://many/ball.obj";
-    let (rings, around) = (100, 200);
-    let mut ball = String::new();
-    for i in 0..rings {
-        let polar = std::f64::consts::PI * (i as f64 + 0.5) / rings as f64;
-        for j in 0..around {
-            let azimuth = 2.0 * std::f64::consts::PI * j as f64 / around as f64;
-            let (x, y, z) = (
-                polar.sin() * azimuth.cos(),
-                polar.sin() * azimuth.sin(),
-                polar.cos(),
-            );
-            ball += &format!("v {} {} {}\n", 0.05 * x, 0.05 * y, 0.05 * z);
-        }
-    }
-    for i in 0..rings - 1 {
-        for j in 0..around {
-            let a = i * around + j + 1;
-            let b = i * around + (j + 1) % around + 1;
-            ball += &format!("f {a} {b} {}\nf {a} {} {}\n", b + around, b + around, a + around);
-        }
-    }
+    let ball = ball_obj(100, 200);
     let element = format!(r#"<collision><geometry><mesh filename="{uri}"/></geometry></collision>"#);
     let urdf = format!(
         r#"<robot name="many"><link name="base"/><link name="arm">{}</link>
