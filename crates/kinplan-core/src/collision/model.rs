@@ -19,6 +19,7 @@ use super::fixed_frame::{FixedFrame, column, turned};
 use super::outer_polytope::{PLANES, outer_polytope};
 use super::pair_table::{PairTable, TABLE_BUDGET};
 use super::scene::{SceneLimits, validate_mesh_points};
+use super::spheres::{LANE_SPHERES, SphereModel};
 use super::sweep::SweepBound;
 use super::trig::sin_cos;
 use super::world::primitive_shape;
@@ -114,6 +115,9 @@ pub struct RobotModel {
     /// The proved-free regions of the self pairs one or two joints move
     /// apart ([`PairTable`]), built on first use.
     pair_tables: OnceLock<Vec<PairTable>>,
+    /// The sphere model of the batched checks, built on first use (`None`
+    /// where it cannot be built).
+    lane_spheres: OnceLock<Option<SphereModel>>,
 }
 
 /// One joint of the chain as forward kinematics applies it: `frame =
@@ -323,7 +327,17 @@ impl RobotModel {
             in_joint,
             steps,
             pair_tables: OnceLock::new(),
+            lane_spheres: OnceLock::new(),
         })
+    }
+
+    /// The sphere model of the batched checks ([`LANE_SPHERES`]), built on
+    /// the first call and then shared by every checker of the model; `None`
+    /// where the model has none.
+    pub(crate) fn lane_spheres(&self) -> Option<&SphereModel> {
+        self.lane_spheres
+            .get_or_init(|| SphereModel::build(self, &LANE_SPHERES).ok())
+            .as_ref()
     }
 
     /// The [`PairTable`]s of every pair of bodies that qualifies (built on

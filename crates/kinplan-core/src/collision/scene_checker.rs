@@ -23,7 +23,6 @@ use super::narrow::{
     Witness, body_body_contact, body_body_intersect, body_body_within, body_leaf_contact,
     body_leaf_intersect, body_leaf_within, shapes_intersect_leaf, sphere_center,
 };
-use super::spheres::{SphereModel, SphereParams};
 use super::sweep::SweepBound;
 use super::world::SceneGeometry;
 use super::{CollisionError, MotionCheck, PadVerdict, StateChecker};
@@ -35,14 +34,6 @@ const SMALL_CHAIN: usize = 16;
 /// buffers of this size instead of [`MAX_BODIES`]: an arm with a gripper
 /// has about a dozen, and every check would otherwise fill four arrays of 63.
 const SMALL_MODEL: usize = 16;
-
-/// The sphere model of the batched checks: coarser than the default (few
-/// spheres per body keep the batch cheap; the exact check settles what they
-/// leave unsure).
-const LANE_SPHERES: SphereParams = SphereParams {
-    max_overshoot: 0.02,
-    max_per_shape: 16,
-};
 
 /// Options of a [`SceneChecker`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -240,11 +231,8 @@ impl SceneChecker {
             return Err(CollisionError::CannotPad);
         }
         let scene_bodies = scene_bodies(&model, &world, sweep.as_ref());
-        let spheres = params
-            .batched
-            .then(|| SphereModel::build(&model, &LANE_SPHERES).ok())
-            .flatten();
-        let lanes8 = spheres.as_ref().and_then(|s| Lanes8::new(&model, s, &world));
+        let spheres = params.batched.then(|| model.lane_spheres()).flatten();
+        let lanes8 = spheres.and_then(|s| Lanes8::new(&model, s, &world));
         Ok(SceneChecker {
             model,
             world,

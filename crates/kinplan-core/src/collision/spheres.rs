@@ -119,6 +119,14 @@ pub struct SphereModel {
     overshoot: Vec<f64>,
 }
 
+/// The sphere model of the batched checks: coarser than the default (few
+/// spheres per body keep the batch cheap; the exact check settles what they
+/// leave unsure). Built once per robot model ([`RobotModel::lane_spheres`]).
+pub(crate) const LANE_SPHERES: SphereParams = SphereParams {
+    max_overshoot: 0.02,
+    max_per_shape: 16,
+};
+
 impl SphereModel {
     /// The sphere model of `model` (module doc).
     pub fn build(model: &RobotModel, params: &SphereParams) -> Result<Self, CollisionError> {
