@@ -452,6 +452,23 @@ fn ball_obj(rings: usize, around: usize) -> String {
     ball
 }
 
+/// A CheckState of one state `positions` of the robot `urdf`, with the one
+/// mesh file `uri` it names.
+fn check_with_mesh(urdf: String, uri: &str, mesh: String, positions: Vec<f64>) -> pb::CheckStateRequest {
+    pb::CheckStateRequest {
+        robot: Some(pb::RobotRef {
+            source: Some(pb::robot_ref::Source::Urdf(urdf)),
+            meshes: vec![pb::MeshFile {
+                uri: uri.into(),
+                data: mesh.into_bytes(),
+            }],
+            ..Default::default()
+        }),
+        states: vec![pb::JointState { positions }],
+        ..Default::default()
+    }
+}
+
 /// Regression: building a robot's collision model (its bodies and the
 /// sampled allowed-collision matrix, up to two million pair tests) ignored
 /// the deadline and ran on the pool for seconds after the answer, for every
@@ -483,20 +500,7 @@ async fn a_collision_model_build_stops_at_the_deadline() {
     urdf += "</robot>";
     let ball = ball_obj(9, 18);
     let mut planning = pb::planning_service_client::PlanningServiceClient::new(server.channel.clone());
-    let check = pb::CheckStateRequest {
-        robot: Some(pb::RobotRef {
-            source: Some(pb::robot_ref::Source::Urdf(urdf)),
-            meshes: vec![pb::MeshFile {
-                uri: uri.into(),
-                data: ball.into_bytes(),
-            }],
-            ..Default::default()
-        }),
-        states: vec![pb::JointState {
-            positions: vec![0.3; links],
-        }],
-        ..Default::default()
-    };
+    let check = check_with_mesh(urdf, uri, ball, vec![0.3; links]);
     let (request, deadline) = with_deadline(check, 150);
     let answer = planning.check_state(request).await;
     let err = answer.as_ref().err().map(|e| e.message().to_string());
@@ -534,18 +538,7 @@ async fn a_urdf_naming_one_mesh_many_times_is_refused_before_any_hull() {
         element.repeat(60)
     );
     let mut planning = pb::planning_service_client::PlanningServiceClient::new(server.channel.clone());
-    let check = pb::CheckStateRequest {
-        robot: Some(pb::RobotRef {
-            source: Some(pb::robot_ref::Source::Urdf(urdf)),
-            meshes: vec![pb::MeshFile {
-                uri: uri.into(),
-                data: ball.into_bytes(),
-            }],
-            ..Default::default()
-        }),
-        states: vec![pb::JointState { positions: vec![0.3] }],
-        ..Default::default()
-    };
+    let check = check_with_mesh(urdf, uri, ball, vec![0.3]);
     let started = Instant::now();
     let err = planning.check_state(check).await.unwrap_err();
     assert_eq!(err.code(), Code::InvalidArgument, "{err:?}");
