@@ -5,10 +5,9 @@
 //! request (`/sys/kernel/mm/transparent_hugepage/enabled` = `madvise`, a
 //! common default), the first touch of each 2 MiB page zeroes all of it,
 //! and may compact memory first (`defrag` = `madvise`), inside whichever
-//! call touched it: a robot's first collision check, which fills fresh
-//! memory, was seen to take tens of milliseconds longer on some runs than
-//! on others (the figures are in `benches/RESULTS.md`). The server turns
-//! them off for itself unless told otherwise.
+//! call touched it, such as a robot's first collision check, which fills
+//! fresh memory (measured in `benches/RESULTS.md`). The server turns them
+//! off for itself unless told otherwise.
 
 /// Turns transparent huge pages off for this process (Linux
 /// `PR_SET_THP_DISABLE`: every later page fault gets a base page, whatever
