@@ -230,12 +230,7 @@ impl RobotModel {
                 Shape::MeshReference { filename, .. } => Some(filename),
                 _ => None,
             })
-            .map(|filename| {
-                let inline = meshes.iter().find(|m| &m.filename == filename);
-                inline
-                    .or_else(|| builtin_mesh(filename))
-                    .map_or(0, |m| m.vertices.len())
-            })
+            .map(|filename| named_mesh(meshes, filename).map_or(0, |m| m.vertices.len()))
             .fold(0usize, usize::saturating_add);
         if named_vertices > MAX_MESH_VERTICES {
             return Err(CollisionError::TooMany {
@@ -374,12 +369,12 @@ impl RobotModel {
             .collect();
         let proved = rows
             .par_iter()
-            .map(|&(t, row)| planned[t].0.proved_row(self, planned[t].1, row, deadline))
+            .map(|&(t, row)| planned[t].proved_row(self, row, deadline))
             .collect::<Result<Vec<_>, Stop>>()?;
         for (&(t, _), blocks) in rows.iter().zip(proved) {
-            blocks.into_iter().for_each(|block| planned[t].0.mark(block));
+            blocks.into_iter().for_each(|block| planned[t].mark(block));
         }
-        Ok(planned.into_iter().map(|(table, _)| table).collect())
+        Ok(planned)
     }
 
     pub fn chain(&self) -> &Arc<Chain> {
@@ -591,6 +586,15 @@ fn make_body(
     }
 }
 
+/// The mesh a collision element names: the file sent with the request
+/// under that name, else a built-in robot's embedded mesh.
+fn named_mesh<'a>(meshes: &'a [InlineMesh], filename: &str) -> Option<&'a InlineMesh> {
+    meshes
+        .iter()
+        .find(|m| m.filename == filename)
+        .or_else(|| builtin_mesh(filename))
+}
+
 /// parry shapes of URDF collision elements; zero-size primitives (a URDF
 /// may declare them) are skipped.
 fn body_shapes(
@@ -622,14 +626,10 @@ fn body_shapes(
                         stop,
                     });
                 }
-                let mesh = meshes
-                    .iter()
-                    .find(|m| &m.filename == filename)
-                    .or_else(|| builtin_mesh(filename))
-                    .ok_or_else(|| CollisionError::MeshNotInline {
-                        field: field.clone(),
-                        filename: filename.clone(),
-                    })?;
+                let mesh = named_mesh(meshes, filename).ok_or_else(|| CollisionError::MeshNotInline {
+                    field: field.clone(),
+                    filename: filename.clone(),
+                })?;
                 validate_mesh_points(&mesh.vertices, &mesh.indices, &field, &SceneLimits::default())?;
                 let points: Vec<_> = mesh
                     .vertices

@@ -66,6 +66,9 @@ pub(crate) struct PairTable {
     width: [f64; 2],
     /// Fine cells per joint.
     cells: [usize; 2],
+    /// How far (m) the distal body may move within one fine cell along
+    /// each axis (`width · L`; 0 for a missing second axis).
+    reach_per_cell: [f64; 2],
     /// Bit `i·cells[1] + k`: fine cell `(i, k)` proved free.
     free: Vec<u64>,
 }
@@ -130,15 +133,14 @@ fn prove(
 impl PairTable {
     /// The table of bodies `a < b` of `model`, when the module's conditions
     /// hold and its cost fits in `budget` (which it then spends): laid out,
-    /// with no cell proved yet, beside how far the distal body may move per
-    /// fine cell along each axis (what [`PairTable::proved_row`] needs).
+    /// with no cell proved yet ([`PairTable::proved_row`] proves them).
     pub(crate) fn planned(
         model: &RobotModel,
         sweep: &SweepBound,
         a: usize,
         b: usize,
         budget: &mut usize,
-    ) -> Option<(PairTable, [f64; 2])> {
+    ) -> Option<PairTable> {
         let bodies = &model.bodies;
         let joints = model.chain().joints();
         let costly = |x: usize| {
@@ -206,7 +208,7 @@ impl PairTable {
             span(0) / cells[0] as f64,
             if two { span(1) / cells[1] as f64 } else { 0.0 },
         ];
-        let table = PairTable {
+        Some(PairTable {
             a,
             b,
             joints: js,
@@ -214,10 +216,9 @@ impl PairTable {
             lo,
             width,
             cells,
+            reach_per_cell: [width[0] * lever(0), if two { width[1] * lever(1) } else { 0.0 }],
             free: vec![0; (cells[0] * cells[1]).div_ceil(64)],
-        };
-        let reach_per_cell = [width[0] * lever(0), if two { width[1] * lever(1) } else { 0.0 }];
-        Some((table, reach_per_cell))
+        })
     }
 
     /// Coarse cells along the grid's first axis: the rows of
@@ -225,26 +226,23 @@ impl PairTable {
     pub(crate) const ROWS: usize = COARSE;
 
     /// The blocks of fine cells proved free in row `row` of coarse cells of
-    /// a [`planned`](PairTable::planned) table (`reach_per_cell` is what
-    /// `planned` returned with it), for [`PairTable::mark`]. Rows are proved
-    /// on their own, so side by side.
-    /// Stops once `deadline` says so, polled before every coarse cell.
+    /// a [`planned`](PairTable::planned) table, for [`PairTable::mark`];
+    /// rows are proved on their own, so side by side. Stops once `deadline`
+    /// says so, polled before every coarse cell.
     pub(crate) fn proved_row(
         &self,
         model: &RobotModel,
-        reach_per_cell: [f64; 2],
         row: usize,
         deadline: Deadline<'_>,
     ) -> Result<Vec<Region>, Stop> {
-        let mut apart = self.apart_test(model, reach_per_cell);
-        self.proved_row_with(row, &reach_per_cell, &mut apart, deadline)
+        let mut apart = self.apart_test(model);
+        self.proved_row_with(row, &mut apart, deadline)
     }
 
     /// [`PairTable::proved_row`] with the block test `apart`.
     fn proved_row_with(
         &self,
         row: usize,
-        reach_per_cell: &[f64; 2],
         apart: &mut impl FnMut(Region) -> bool,
         deadline: Deadline<'_>,
     ) -> Result<Vec<Region>, Stop> {
@@ -259,7 +257,7 @@ impl PairTable {
                 i: [row * per_coarse[0], ck * per_coarse[1]],
                 n: per_coarse,
             };
-            prove(cell, reach_per_cell, apart, &mut proved);
+            prove(cell, &self.reach_per_cell, apart, &mut proved);
         }
         Ok(proved)
     }
@@ -284,13 +282,16 @@ impl PairTable {
     /// The test of a block of cells: true when the bodies, posed at the
     /// block's centre with the other joints at the middle of their ranges
     /// (any value would do), are farther apart than the block's reach.
-    fn apart_test<'m>(
-        &self,
-        model: &'m RobotModel,
-        reach_per_cell: [f64; 2],
-    ) -> impl FnMut(Region) -> bool + use<'m> {
+    fn apart_test<'m>(&self, model: &'m RobotModel) -> impl FnMut(Region) -> bool + use<'m> {
         let bodies = &model.bodies;
-        let (a, b, js, lo, width) = (self.a, self.b, self.joints, self.lo, self.width);
+        let (a, b, js, lo, width, reach_per_cell) = (
+            self.a,
+            self.b,
+            self.joints,
+            self.lo,
+            self.width,
+            self.reach_per_cell,
+        );
         let two = self.axes == 2;
         let mut q = model.chain().mid_limits();
         let mut poses = [Isometry3::identity(); MAX_BODIES];
@@ -346,17 +347,12 @@ impl PairTable {
 mod tests {
     use super::*;
     use crate::collision::SweepBound;
-    use crate::robot::{builtin_chain, builtin_urdf};
-    use std::sync::Arc;
 
     /// Halving blocks down to single cells loses no cell that a test of that
     /// cell alone proves, and spends fewer tests than one per cell.
     #[test]
     fn halving_proves_every_cell_its_own_test_proves() {
-        let chain = builtin_chain("franka_panda_hand").unwrap();
-        let urdf = builtin_urdf("franka_panda_hand").unwrap();
-        let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
-        let model = Arc::new(RobotModel::of_urdf(chain, urdf, &fingers, &[]).unwrap());
+        let model = crate::collision::tests::panda_hand_open();
         let sweep = SweepBound::new(&model).unwrap();
         let n = model.body_count();
         let mut budget = TABLE_BUDGET;
@@ -365,8 +361,8 @@ mod tests {
             .filter_map(|(a, b)| PairTable::planned(&model, &sweep, a, b, &mut budget))
             .collect();
         assert!(planned.len() >= 2, "{}", planned.len());
-        for (mut table, reach_per_cell) in planned {
-            let mut alone = table.apart_test(&model, reach_per_cell);
+        for mut table in planned {
+            let mut alone = table.apart_test(&model);
             let mut tests = 0;
             let mut counted = |r: Region| {
                 tests += 1;
@@ -375,12 +371,12 @@ mod tests {
             let proved: Vec<Region> = (0..PairTable::ROWS)
                 .flat_map(|row| {
                     table
-                        .proved_row_with(row, &reach_per_cell, &mut counted, Deadline::none())
+                        .proved_row_with(row, &mut counted, Deadline::none())
                         .unwrap()
                 })
                 .collect();
             proved.into_iter().for_each(|r| table.mark(r));
-            let mut alone = table.apart_test(&model, reach_per_cell);
+            let mut alone = table.apart_test(&model);
             let (mut free_alone, mut free) = (0, 0);
             for i in 0..table.cells[0] {
                 for k in 0..table.cells[1] {

@@ -19,6 +19,15 @@ mod robot;
 mod spheres;
 mod sweep;
 
+/// The built-in Panda with its hand, the fingers held 4 cm open (as the
+/// benchmark runs it): every link the chain carries collides.
+pub(super) fn panda_hand_open() -> RobotModel {
+    let chain = builtin_chain("franka_panda_hand").unwrap();
+    let urdf = crate::robot::builtin_urdf("franka_panda_hand").unwrap();
+    let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
+    RobotModel::of_urdf(chain, urdf, &fingers, &[]).unwrap()
+}
+
 /// URDF of the xyz probe whose link carries `geometry` (URDF XML).
 pub(super) fn probe_urdf(geometry: &str) -> String {
     let joint = |name: &str, parent: &str, child: &str, axis: &str| {
