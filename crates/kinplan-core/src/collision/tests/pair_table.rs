@@ -11,13 +11,9 @@ use rand_chacha::ChaCha8Rng;
 use super::super::convert::pose_to_parry;
 use super::super::model::MAX_BODIES;
 use super::super::*;
-use crate::robot::{builtin_chain, builtin_urdf};
 
 fn panda_hand() -> Arc<RobotModel> {
-    let chain = builtin_chain("franka_panda_hand").unwrap();
-    let urdf = builtin_urdf("franka_panda_hand").unwrap();
-    let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
-    Arc::new(RobotModel::of_urdf(chain, urdf, &fingers, &[]).unwrap())
+    Arc::new(super::panda_hand_open())
 }
 
 fn random_state(model: &RobotModel, rng: &mut ChaCha8Rng) -> Vec<f64> {

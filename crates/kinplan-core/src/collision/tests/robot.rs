@@ -6,7 +6,7 @@ use std::sync::Arc;
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
 use super::super::*;
-use super::{box_mesh, checker, probe_urdf};
+use super::{box_mesh, checker, panda_hand_open, probe_urdf};
 use crate::robot::{ChainSpec, UrdfLimits, builtin_chain, parse_chain};
 
 fn panda_checker(acm: impl Fn(&RobotModel) -> AllowedCollisions) -> SceneChecker {
@@ -789,11 +789,7 @@ fn a_robot_of_max_bodies_collides_with_its_last_body_and_one_more_is_refused() {
 /// the hand and the fingers, as MoveIt checks the real meshes.
 #[test]
 fn builtin_panda_allows_only_its_designed_contacts() {
-    let chain = builtin_chain("franka_panda_hand").unwrap();
-    let urdf = crate::robot::builtin_urdf("franka_panda_hand").unwrap();
-    let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
-    let attached = attached_bodies(urdf, &chain, &fingers).unwrap();
-    let model = RobotModel::with_parts(chain, &attached, &[]).unwrap();
+    let model = panda_hand_open();
     let params = AcmParams {
         samples: 2000,
         ..AcmParams::default()
@@ -1090,11 +1086,7 @@ fn face_axes_change_no_self_verdict() {
     use rand::{Rng, SeedableRng};
 
     use super::super::narrow::{body_body_intersect, body_body_within};
-    let chain = builtin_chain("franka_panda_hand").unwrap();
-    let urdf = crate::robot::builtin_urdf("franka_panda_hand").unwrap();
-    let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
-    let attached = attached_bodies(urdf, &chain, &fingers).unwrap();
-    let model = RobotModel::with_parts(chain, &attached, &[]).unwrap();
+    let model = panda_hand_open();
     assert!(
         model
             .bodies

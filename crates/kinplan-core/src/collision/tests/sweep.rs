@@ -735,10 +735,7 @@ fn the_bound_along_a_piece_holds_for_the_corners_of_the_hand_and_fingers() {
     // The Panda with its hand (a box) and fingers (boxes) held open: every
     // corner and every capsule point sampled along random pieces stays
     // within the bound taken over the shapes' extreme points.
-    let chain = builtin_chain("franka_panda_hand").unwrap();
-    let urdf = crate::robot::builtin_urdf("franka_panda_hand").unwrap();
-    let fingers = [("panda_finger_joint1", 0.04), ("panda_finger_joint2", 0.04)];
-    let model = RobotModel::of_urdf(chain, urdf, &fingers, &[]).unwrap();
+    let model = super::panda_hand_open();
     let sweep = SweepBound::new(&model).unwrap();
     let joints = model.chain().joints().to_vec();
     let mut rng = ChaCha8Rng::seed_from_u64(29);
