@@ -1,7 +1,7 @@
 //! A separating-axis filter for a robot polytope (a mesh hull, or the
 //! polytope of few faces around one) against a scene box, cylinder,
 //! capsule or sphere, or another robot body's box, capsule or sphere,
-//! tried before the exact (GJK) test.
+//! tried before parry's distance query.
 //!
 //! For any unit axis `u`, if `max_{x∈A} u·x + m < min_{y∈B} u·y`, then every
 //! `x ∈ A`, `y ∈ B` have `|y − x| ≥ u·(y − x) > m`: the shapes are more than
@@ -21,6 +21,7 @@ use parry3d_f64::shape::SharedShape;
 
 use super::convert::point_from_parry;
 use super::fast::LeafFast;
+use super::gjk::Corners;
 
 /// Most face planes a polytope may have for the filter to be kept: past
 /// that, testing every plane costs about what GJK does.
@@ -31,7 +32,7 @@ const SLACK: f64 = 1e-9;
 /// A polytope's corners and face planes `n·x ≤ h` (shape frame).
 #[derive(Debug, Clone)]
 pub(crate) struct FaceAxes {
-    corners: Vec<Point3<f64>>,
+    corners: Corners,
     planes: Vec<(Vector3<f64>, f64)>,
 }
 
@@ -57,7 +58,15 @@ impl FaceAxes {
             })
             .filter(|(n, h)| n.iter().chain([h]).all(|x| x.is_finite()))
             .collect();
-        Some(Self { corners, planes })
+        Some(Self {
+            corners: Corners::new(&corners),
+            planes,
+        })
+    }
+
+    /// The polytope's corners (shape frame).
+    pub(crate) fn corners(&self) -> &Corners {
+        &self.corners
     }
 
     /// True when the polytope at `pose` (world) is proved more than
@@ -83,16 +92,6 @@ impl FaceAxes {
         }
     }
 
-    /// The least and greatest `u·c` over the corners `c`.
-    fn extent_along(&self, u: &Vector3<f64>) -> (f64, f64) {
-        self.corners
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
-                let s = u.dot(&c.coords);
-                (lo.min(s), hi.max(s))
-            })
-    }
-
     /// Against the box `[−half, half]`; `rel` maps the polytope's frame
     /// into the box's.
     fn apart_from_box(&self, rel: &Isometry3<f64>, half: &Vector3<f64>, gap: f64) -> bool {
@@ -101,7 +100,7 @@ impl FaceAxes {
         // the box's axes, one at a time: the corners' coordinates along it
         for k in 0..3 {
             let row = turn.row(k).transpose();
-            let (lo, hi) = self.extent_along(&row);
+            let (lo, hi) = self.corners.extent_along(&row);
             if lo + t[k] > half[k] + gap || hi + t[k] < -half[k] - gap {
                 return true;
             }
@@ -121,7 +120,7 @@ impl FaceAxes {
         let Some(w) = axis.try_normalize(1e-12) else {
             return false;
         };
-        let (lo, hi) = self.extent_along(&w);
+        let (lo, hi) = self.corners.extent_along(&w);
         if hi + gap < w.dot(&a.coords) || lo - gap > w.dot(&b.coords) {
             return true;
         }

@@ -40,6 +40,7 @@ mod face_axes;
 mod fast;
 mod fast_box;
 mod fixed_frame;
+mod gjk;
 mod lanes8;
 mod lanes8_bound;
 mod mesh_dae;

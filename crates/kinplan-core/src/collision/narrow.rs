@@ -11,10 +11,13 @@
 //!
 //! A mesh hull or a cylinder, which no closed form decides, is tested
 //! first through the closed-form bound around it (`BodyShape::bound`):
-//! bounds apart are shapes apart. A polytope against a scene leaf is then
-//! tried on its face axes (`super::face_axes`), and parry runs only where
-//! neither decides. Within-margin tests ask parry's closest points with
-//! the margin as prediction (GJK alone), not its contact.
+//! bounds apart are shapes apart. Where the bound does not decide, the
+//! boolean and within-margin tests of a polytope against a box, sphere,
+//! capsule, cylinder or another polytope go to the yes-or-no GJK of
+//! `super::gjk`, which stops at the first step that decides; the distance
+//! queries first try the polytope's face axes (`super::face_axes`). parry
+//! runs for the rest; its within-margin tests ask closest points with the
+//! margin as prediction (GJK alone), not its contact.
 //!
 //! A pair parry cannot handle (none among the shapes this room builds) is
 //! reported as colliding: the safe answer for a planner.
@@ -26,6 +29,7 @@ use parry3d_f64::shape::{Cuboid, SharedShape};
 
 use super::convert::{point_from_parry, pose_to_parry};
 use super::fast::{LeafFast, RobotFast, distance, distance_robot, overlap, overlap_robot};
+use super::gjk::{self, Convex};
 use super::model::{Body, BodyShape};
 use super::world::Leaf;
 
@@ -132,13 +136,14 @@ pub(crate) fn body_body_intersect(a: &Body, pa: &Isometry3<f64>, b: &Body, pb: &
                 Some(hit) => hit,
                 None => {
                     bounds_meet_robot(sa, pa, sb, pb, 0.0)
-                        && !faces_apart_robot(sa, pa, sb, pb, 0.0)
-                        && intersect(
-                            &pose_to_parry(&(pa * sa.offset)),
-                            &sa.shape,
-                            &pose_to_parry(&(pb * sb.offset)),
-                            &sb.shape,
-                        )
+                        && gjk_robot_within(sa, pa, sb, pb, 0.0).unwrap_or_else(|| {
+                            intersect(
+                                &pose_to_parry(&(pa * sa.offset)),
+                                &sa.shape,
+                                &pose_to_parry(&(pb * sb.offset)),
+                                &sb.shape,
+                            )
+                        })
                 }
             };
             if hit {
@@ -201,13 +206,14 @@ pub(crate) fn shapes_intersect_leaf(a: &Body, pa: &Isometry3<f64>, leaf: &Leaf) 
         Some(hit) => hit,
         None => {
             bound_meets_leaf(sa, pa, leaf, 0.0)
-                && !faces_apart(sa, pa, leaf, 0.0)
-                && intersect(
-                    &pose_to_parry(&(pa * sa.offset)),
-                    &sa.shape,
-                    &leaf.pose,
-                    &leaf.shape,
-                )
+                && gjk_leaf_within(sa, pa, &leaf.fast, 0.0).unwrap_or_else(|| {
+                    intersect(
+                        &pose_to_parry(&(pa * sa.offset)),
+                        &sa.shape,
+                        &leaf.pose,
+                        &leaf.shape,
+                    )
+                })
         }
     })
 }
@@ -302,21 +308,66 @@ fn faces_apart_robot(
         let Some(faces) = s.faces.as_ref() else {
             return false;
         };
-        let other = match o.fast {
-            RobotFast::Box { offset, half } => LeafFast::Box {
-                pose: po * offset,
-                half,
-            },
-            RobotFast::Swept { a, b, r } => LeafFast::Swept {
-                a: po * a,
-                b: po * b,
-                r,
-            },
-            RobotFast::None => return false,
+        let Some(other) = posed(&o.fast, po) else {
+            return false;
         };
         faces.apart(&(ps * s.offset), &other, margin)
     };
     margin >= 0.0 && (one_way(sa, pa, sb, pb) || one_way(sb, pb, sa, pa))
+}
+
+/// A robot shape's closed form posed in the world (body at `pose`), in the
+/// form a scene leaf has; `None` when it has none.
+fn posed(fast: &RobotFast, pose: &Isometry3<f64>) -> Option<LeafFast> {
+    match *fast {
+        RobotFast::Box { offset, half } => Some(LeafFast::Box {
+            pose: pose * offset,
+            half,
+        }),
+        RobotFast::Swept { a, b, r } => Some(LeafFast::Swept {
+            a: pose * a,
+            b: pose * b,
+            r,
+        }),
+        RobotFast::None => None,
+    }
+}
+
+/// [`gjk::within`] for a robot polytope (body at `pa`) against a scene
+/// leaf's closed form; `None` when the shape is no polytope with corners
+/// or the leaf has no closed form.
+#[inline]
+fn gjk_leaf_within(sa: &BodyShape, pa: &Isometry3<f64>, leaf: &LeafFast, margin: f64) -> Option<bool> {
+    let faces = sa.faces.as_ref()?;
+    let pose = pa * sa.offset;
+    let (other, radius) = Convex::of_leaf(&pose, leaf)?;
+    Some(gjk::within(faces.corners(), &other, margin + radius))
+}
+
+/// [`gjk::within`] for two robot shapes, one of them a polytope with
+/// corners and the other a polytope, box, capsule or sphere; `None`
+/// otherwise.
+#[inline]
+fn gjk_robot_within(
+    sa: &BodyShape,
+    pa: &Isometry3<f64>,
+    sb: &BodyShape,
+    pb: &Isometry3<f64>,
+    margin: f64,
+) -> Option<bool> {
+    let (poly, pp, other, po) = if sa.faces.is_some() {
+        (sa, pa, sb, pb)
+    } else {
+        (sb, pb, sa, pa)
+    };
+    let faces = poly.faces.as_ref()?;
+    let pose = pp * poly.offset;
+    if let Some(other_faces) = other.faces.as_ref() {
+        let shape = Convex::of_corners(&pose, other_faces.corners(), &(po * other.offset));
+        return Some(gjk::within(faces.corners(), &shape, margin));
+    }
+    let (shape, radius) = Convex::of_leaf(&pose, &posed(&other.fast, po)?)?;
+    Some(gjk::within(faces.corners(), &shape, margin + radius))
 }
 
 /// `shape` grown by `margin`: a swept sphere exactly (radius + margin).
@@ -366,14 +417,15 @@ pub(crate) fn body_leaf_within(
             Some(hit) => hit,
             None => {
                 bound_meets_leaf(sa, pa, leaf, margin)
-                    && !faces_apart(sa, pa, leaf, margin)
-                    && parry_within(
-                        sa,
-                        &pose_to_parry(&(pa * sa.offset)),
-                        &leaf.pose,
-                        &leaf.shape,
-                        margin,
-                    )
+                    && gjk_leaf_within(sa, pa, &leaf.fast, margin).unwrap_or_else(|| {
+                        parry_within(
+                            sa,
+                            &pose_to_parry(&(pa * sa.offset)),
+                            &leaf.pose,
+                            &leaf.shape,
+                            margin,
+                        )
+                    })
             }
         })
 }
@@ -396,7 +448,7 @@ pub(crate) fn body_body_within(
             |sb| match overlap_robot(&grown(&sa.fast, margin), pa, &sb.fast, pb) {
                 Some(hit) => hit,
                 None if !bounds_meet_robot(sa, pa, sb, pb, margin) => false,
-                None if faces_apart_robot(sa, pa, sb, pb, margin) => false,
+                None if let Some(near) = gjk_robot_within(sa, pa, sb, pb, margin) => near,
                 None => {
                     let (qa, qb) = (pose_to_parry(&(pa * sa.offset)), pose_to_parry(&(pb * sb.offset)));
                     match sb.shape.as_cuboid() {
