@@ -120,7 +120,7 @@ pub fn padded_motion<C: StateChecker + ?Sized>(
     let mut queue = VecDeque::new();
     let mut spent = [0usize; WINDOW];
     let first_half: Vec<f64> = delta.iter().map(|d| 0.5 * d / pieces as f64).collect();
-    let mut rows = [0.0; BATCH * MAX_DOF];
+    let mut rows = vec![0.0; BATCH * n];
     // One piece's padded check: `Err` ends the motion, else the halves of
     // an unproved piece join the queue.
     let mut check = |(s, t, slot, mut proved): (f64, f64, usize, u64),

@@ -219,10 +219,31 @@ impl Lanes8 {
         for (v, x) in terms.d.iter_mut().zip(d) {
             *v = *x as f32;
         }
+        // the checked self pairs by distal body (bit: slot in `self_pairs`),
+        // with the joints that move the distal body relative to the other
+        let mut distal_of = [0u64; MAX_BODIES8];
+        let mut chain = [(0usize, None, 0usize); MAX_PAIRS];
+        for (slot, &(a, b)) in self_pairs.iter().enumerate() {
+            let (a, b) = (a as usize, b as usize);
+            // `None` (fixed to the base) orders first
+            let (proximal, distal) = if self.last[a] <= self.last[b] {
+                (a, b)
+            } else {
+                (b, a)
+            };
+            let (from, Some(to)) = (self.last[proximal], self.last[distal]) else {
+                continue; // both fixed to the base
+            };
+            if from == Some(to) {
+                continue; // moved by the same joints
+            }
+            distal_of[distal] |= 1 << slot;
+            chain[slot] = (proximal, from, to);
+        }
         // per body, prefix sums over the joints (module doc):
         // x_j = Σ_{i≤j} L_i h_i (3 P_i + h_i), y_j = Σ_{i≤j} L_i h_i,
         // r_j = Σ_{i≤j} h_i κ_i, and P_j = Σ_{i<j} h_i
-        let mut sums = [[[0.0f64; 3]; MAX_DOF8]; MAX_BODIES8];
+        let mut sums = [[0.0f64; 3]; MAX_DOF8];
         let mut before = [0.0f64; MAX_DOF8 + 1];
         for (j, dj) in d.iter().enumerate() {
             before[j + 1] = before[j] + dj.abs();
@@ -245,42 +266,34 @@ impl Lanes8 {
                     + 2.0 * self.margin[b] * (1.0 + sqrt3 * self.rho)
                     + 64.0 * U * (2.0 * self.reach + lever + e);
                 r += h * kappa;
-                sums[b][j] = [x, y, r];
+                sums[j] = [x, y, r];
             }
             terms.body[b] = Some(constant(x, r, 1.0)?);
-        }
-        for (slot, &(a, b)) in terms.pair.iter_mut().zip(self_pairs) {
-            let (a, b) = (a as usize, b as usize);
-            // `None` (fixed to the base) orders first
-            let (proximal, distal) = if self.last[a] <= self.last[b] {
-                (a, b)
-            } else {
-                (b, a)
-            };
-            let (from, Some(to)) = (self.last[proximal], self.last[distal]) else {
-                continue; // both fixed to the base
-            };
-            if from == Some(to) {
-                continue; // moved by the same joints
+            // the pairs whose distal body this is
+            let mut bits = distal_of[b];
+            while bits != 0 {
+                let slot = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let (proximal, from, to) = chain[slot];
+                // the joints from + 1..=to alone, P_j summed from from + 1:
+                // Σ L h (3 (P − P_f) + h) = (x_to − x_f) − 3 P_f (y_to − y_f)
+                let [x, y, r] = sums[to];
+                let constant = match from {
+                    None => constant(x, r, 1.0)?,
+                    Some(f) => {
+                        let [xf, yf, _] = sums[f];
+                        let p = before[f + 1];
+                        constant((x - xf) - 3.0 * p * (y - yf), r, 2.0)?
+                    }
+                };
+                terms.pair[slot] = PairPad::Relative {
+                    proximal: proximal as u8,
+                    distal: b as u8,
+                    from: from.map(|f| f as u8),
+                    to: to as u8,
+                    constant,
+                };
             }
-            // the joints from + 1..=to alone, P_j summed from from + 1:
-            // Σ L h (3 (P − P_f) + h) = (x_to − x_f) − 3 P_f (y_to − y_f)
-            let [x, y, r] = sums[distal][to];
-            let constant = match from {
-                None => constant(x, r, 1.0)?,
-                Some(f) => {
-                    let [xf, yf, _] = sums[distal][f];
-                    let p = before[f + 1];
-                    constant((x - xf) - 3.0 * p * (y - yf), r, 2.0)?
-                }
-            };
-            *slot = PairPad::Relative {
-                proximal: proximal as u8,
-                distal: distal as u8,
-                from: from.map(|f| f as u8),
-                to: to as u8,
-                constant,
-            };
         }
         Some(terms)
     }
