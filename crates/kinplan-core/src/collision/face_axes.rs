@@ -133,31 +133,15 @@ impl FaceAxes {
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
     use parry3d_f64::query;
     use parry3d_f64::shape::SharedShape;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
     use super::FaceAxes;
     use crate::collision::builtin_mesh;
     use crate::collision::convert::{pose_to_parry, vec_to_parry};
-    use crate::collision::{Geometry, Obstacle, Scene, SceneGeometry, SceneLimits};
-
-    fn pose(rng: &mut ChaCha8Rng, reach: f64) -> Isometry3<f64> {
-        Isometry3::from_parts(
-            Translation3::new(
-                rng.random_range(-reach..reach),
-                rng.random_range(-reach..reach),
-                rng.random_range(-reach..reach),
-            ),
-            UnitQuaternion::from_euler_angles(
-                rng.random_range(-3.2..3.2),
-                rng.random_range(-3.2..3.2),
-                rng.random_range(-3.2..3.2),
-            ),
-        )
-    }
+    use crate::collision::tests::{random_pose, random_primitive};
 
     /// The filter never proves apart what parry's distance puts within
     /// the margin, and it decides most pairs parry puts beyond it: the
@@ -174,30 +158,10 @@ mod tests {
             let shape = SharedShape::convex_hull(&points).unwrap();
             let faces = FaceAxes::of(&shape).expect("a polytope of few faces");
             for _ in 0..60 {
-                let size = |rng: &mut ChaCha8Rng| rng.random_range(0.01..0.15);
-                let geometry = match rng.random_range(0..4) {
-                    0 => Geometry::Box {
-                        half_extents: Vector3::new(size(&mut rng), size(&mut rng), size(&mut rng)),
-                    },
-                    1 => Geometry::Cylinder {
-                        radius: size(&mut rng),
-                        length: 2.0 * size(&mut rng),
-                    },
-                    2 => Geometry::Capsule {
-                        radius: size(&mut rng),
-                        length: 2.0 * size(&mut rng),
-                    },
-                    _ => Geometry::Sphere {
-                        radius: size(&mut rng),
-                    },
-                };
-                let obstacle = Obstacle::new("o", pose(&mut rng, 0.3), geometry);
-                let world =
-                    SceneGeometry::build(&Scene::new(vec![obstacle], &SceneLimits::default()).unwrap())
-                        .unwrap();
+                let world = random_primitive(&mut rng, 0.3);
                 let leaf = &world.leaves[0];
                 for _ in 0..100 {
-                    let at = pose(&mut rng, 0.3);
+                    let at = random_pose(&mut rng, 0.3);
                     let d = query::distance(&pose_to_parry(&at), &*shape, &leaf.pose, &*leaf.shape)
                         .unwrap()
                         .distance;

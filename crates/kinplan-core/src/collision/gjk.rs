@@ -22,8 +22,7 @@
 //! The origin inside the simplex, a step that gains nothing (the distance
 //! lies between `v·w/|v|` and `|v|`, which straddle `m` to rounding) or
 //! [`MAX_STEPS`] steps answer within: the safe side. Unlike a full
-//! closest-points query it stops at the first step that decides, which for
-//! a shape a margin away is usually the second or third.
+//! closest-points query it stops at the first step that decides.
 //!
 //! Everything runs in the polytope's own frame: its support is a scan of
 //! its corners; the other shape is carried into that frame once.
@@ -400,31 +399,16 @@ fn on_tetrahedron(p: &[Vector3<f64>; 4]) -> Option<(Vector3<f64>, Kept)> {
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+    use nalgebra::{Point3, UnitQuaternion, Vector3};
     use parry3d_f64::query;
     use parry3d_f64::shape::SharedShape;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
     use super::{Convex, Corners, within};
     use crate::collision::builtin_mesh;
     use crate::collision::convert::{point_from_parry, pose_to_parry, vec_to_parry};
-    use crate::collision::{Geometry, Obstacle, Scene, SceneGeometry, SceneLimits};
-
-    fn pose(rng: &mut ChaCha8Rng, reach: f64) -> Isometry3<f64> {
-        Isometry3::from_parts(
-            Translation3::new(
-                rng.random_range(-reach..reach),
-                rng.random_range(-reach..reach),
-                rng.random_range(-reach..reach),
-            ),
-            UnitQuaternion::from_euler_angles(
-                rng.random_range(-3.2..3.2),
-                rng.random_range(-3.2..3.2),
-                rng.random_range(-3.2..3.2),
-            ),
-        )
-    }
+    use crate::collision::tests::{random_pose, random_primitive};
 
     /// The hull of a built-in Panda link: its parry shape and its corners.
     fn link_hull(link: &str) -> (SharedShape, Corners) {
@@ -532,30 +516,10 @@ mod tests {
         };
         for (shape, corners) in &hulls {
             for _ in 0..40 {
-                let size = |rng: &mut ChaCha8Rng| rng.random_range(0.01..0.15);
-                let geometry = match rng.random_range(0..4) {
-                    0 => Geometry::Box {
-                        half_extents: Vector3::new(size(&mut rng), size(&mut rng), size(&mut rng)),
-                    },
-                    1 => Geometry::Cylinder {
-                        radius: size(&mut rng),
-                        length: 2.0 * size(&mut rng),
-                    },
-                    2 => Geometry::Capsule {
-                        radius: size(&mut rng),
-                        length: 2.0 * size(&mut rng),
-                    },
-                    _ => Geometry::Sphere {
-                        radius: size(&mut rng),
-                    },
-                };
-                let obstacle = Obstacle::new("o", pose(&mut rng, 0.25), geometry);
-                let world =
-                    SceneGeometry::build(&Scene::new(vec![obstacle], &SceneLimits::default()).unwrap())
-                        .unwrap();
+                let world = random_primitive(&mut rng, 0.25);
                 let leaf = &world.leaves[0];
                 for _ in 0..100 {
-                    let at = pose(&mut rng, 0.25);
+                    let at = random_pose(&mut rng, 0.25);
                     let d = query::distance(&pose_to_parry(&at), &**shape, &leaf.pose, &*leaf.shape)
                         .unwrap()
                         .distance;
@@ -567,7 +531,7 @@ mod tests {
             }
             for (other_shape, other_corners) in &hulls {
                 for _ in 0..400 {
-                    let (at, other_at) = (pose(&mut rng, 0.2), pose(&mut rng, 0.2));
+                    let (at, other_at) = (random_pose(&mut rng, 0.2), random_pose(&mut rng, 0.2));
                     let d = query::distance(
                         &pose_to_parry(&at),
                         &**shape,

@@ -28,6 +28,44 @@ pub(super) fn panda_hand_open() -> RobotModel {
     RobotModel::of_urdf(chain, urdf, &fingers, &[]).unwrap()
 }
 
+/// A pose with each coordinate within `reach` (m) and random Euler angles.
+pub(super) fn random_pose(rng: &mut ChaCha8Rng, reach: f64) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(
+            rng.random_range(-reach..reach),
+            rng.random_range(-reach..reach),
+            rng.random_range(-reach..reach),
+        ),
+        UnitQuaternion::from_euler_angles(
+            rng.random_range(-3.2..3.2),
+            rng.random_range(-3.2..3.2),
+            rng.random_range(-3.2..3.2),
+        ),
+    )
+}
+
+/// A scene of one random box, cylinder, capsule or sphere (sizes 1–15 cm,
+/// lengths twice that) at a random pose within `reach` (m).
+pub(super) fn random_primitive(rng: &mut ChaCha8Rng, reach: f64) -> SceneGeometry {
+    let size = |rng: &mut ChaCha8Rng| rng.random_range(0.01..0.15);
+    let geometry = match rng.random_range(0..4) {
+        0 => Geometry::Box {
+            half_extents: Vector3::new(size(rng), size(rng), size(rng)),
+        },
+        1 => Geometry::Cylinder {
+            radius: size(rng),
+            length: 2.0 * size(rng),
+        },
+        2 => Geometry::Capsule {
+            radius: size(rng),
+            length: 2.0 * size(rng),
+        },
+        _ => Geometry::Sphere { radius: size(rng) },
+    };
+    let obstacle = Obstacle::new("o", random_pose(rng, reach), geometry);
+    SceneGeometry::build(&Scene::new(vec![obstacle], &SceneLimits::default()).unwrap()).unwrap()
+}
+
 /// URDF of the xyz probe whose link carries `geometry` (URDF XML).
 pub(super) fn probe_urdf(geometry: &str) -> String {
     let joint = |name: &str, parent: &str, child: &str, axis: &str| {
