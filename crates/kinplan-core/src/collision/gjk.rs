@@ -190,9 +190,27 @@ impl Corners {
         Vector3::new(self.x[0], self.y[0], self.z[0])
     }
 
-    /// The corner farthest along `d`.
+    /// The corner farthest along `d`: the AVX2 build of the scan when the
+    /// CPU has it, the baseline build otherwise (no multiply and add are
+    /// fused, so both give the same bits).
     #[inline]
     pub(crate) fn farthest(&self, d: &Vector3<f64>) -> Vector3<f64> {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has the features the function is built for.
+            return unsafe { self.farthest_avx2(d) };
+        }
+        self.farthest_in(d)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn farthest_avx2(&self, d: &Vector3<f64>) -> Vector3<f64> {
+        self.farthest_in(d)
+    }
+
+    #[inline(always)]
+    fn farthest_in(&self, d: &Vector3<f64>) -> Vector3<f64> {
         let mut best = [f64::NEG_INFINITY; LANES];
         let mut at = [0usize; LANES];
         let columns = self
@@ -433,6 +451,29 @@ mod tests {
                 Point3::new(side(1), side(2), side(4))
             })
             .collect()
+    }
+
+    /// The support scan finds a corner as far along the direction as any
+    /// (a plain loop over the hull's points), and the vector build picks
+    /// the same corner as the portable one: 10,000 random directions on
+    /// each of five link hulls.
+    #[test]
+    fn the_support_scan_finds_the_farthest_corner_in_either_build() {
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        for link in ["link_1", "link_3", "link_5", "link_7", "panda_hand"] {
+            let (shape, corners) = link_hull(link);
+            let points = shape.as_convex_polyhedron().unwrap().points().to_vec();
+            for _ in 0..10_000 {
+                let d = random_pose(&mut rng, 1.0).translation.vector;
+                let found = corners.farthest(&d);
+                let best = points
+                    .iter()
+                    .map(|p| d.dot(&point_from_parry(*p).coords))
+                    .fold(f64::NEG_INFINITY, f64::max);
+                assert_eq!(d.dot(&found), best, "{link} along {d:?}");
+                assert_eq!(found, corners.farthest_in(&d), "{link} along {d:?}");
+            }
+        }
     }
 
     /// Hand-placed shapes 0.1 m from a unit cube: within a margin of
