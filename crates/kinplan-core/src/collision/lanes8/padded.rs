@@ -164,6 +164,16 @@ impl PadTerms<'_> {
     }
 }
 
+/// The bodies of a self pair that joints move apart, and the last joint
+/// moving each ([`Lanes8::pad_terms`]).
+#[derive(Debug, Clone, Copy)]
+struct PairChain {
+    proximal: usize,
+    distal: usize,
+    from: Option<usize>,
+    to: usize,
+}
+
 /// Checked self pairs the padded batch takes (more: none proved).
 const MAX_PAIRS: usize = 64;
 
@@ -219,26 +229,12 @@ impl Lanes8 {
         for (v, x) in terms.d.iter_mut().zip(d) {
             *v = *x as f32;
         }
-        // the checked self pairs by distal body (bit: slot in `self_pairs`),
-        // with the joints that move the distal body relative to the other
+        // the checked self pairs by distal body (bit: slot in `self_pairs`)
         let mut distal_of = [0u64; MAX_BODIES8];
-        let mut chain = [(0usize, None, 0usize); MAX_PAIRS];
-        for (slot, &(a, b)) in self_pairs.iter().enumerate() {
-            let (a, b) = (a as usize, b as usize);
-            // `None` (fixed to the base) orders first
-            let (proximal, distal) = if self.last[a] <= self.last[b] {
-                (a, b)
-            } else {
-                (b, a)
-            };
-            let (from, Some(to)) = (self.last[proximal], self.last[distal]) else {
-                continue; // both fixed to the base
-            };
-            if from == Some(to) {
-                continue; // moved by the same joints
+        for (slot, &pair) in self_pairs.iter().enumerate() {
+            if let Some(chain) = self.pair_chain(pair) {
+                distal_of[chain.distal] |= 1 << slot;
             }
-            distal_of[distal] |= 1 << slot;
-            chain[slot] = (proximal, from, to);
         }
         // per body, prefix sums over the joints (module doc):
         // x_j = Σ_{i≤j} L_i h_i (3 P_i + h_i), y_j = Σ_{i≤j} L_i h_i,
@@ -274,7 +270,12 @@ impl Lanes8 {
             while bits != 0 {
                 let slot = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
-                let (proximal, from, to) = chain[slot];
+                let Some(PairChain {
+                    proximal, from, to, ..
+                }) = self.pair_chain(self_pairs[slot])
+                else {
+                    continue; // not set in `distal_of`
+                };
                 // the joints from + 1..=to alone, P_j summed from from + 1:
                 // Σ L h (3 (P − P_f) + h) = (x_to − x_f) − 3 P_f (y_to − y_f)
                 let [x, y, r] = sums[to];
@@ -296,6 +297,27 @@ impl Lanes8 {
             }
         }
         Some(terms)
+    }
+
+    /// How the self pair `(a, b)` moves: its distal body (the one more
+    /// joints move), the last joint moving the proximal one (`None`: fixed
+    /// to the base) and the distal one's; `None` when neither body moves
+    /// relative to the other.
+    fn pair_chain(&self, (a, b): (u16, u16)) -> Option<PairChain> {
+        let (a, b) = (a as usize, b as usize);
+        // `None` (fixed to the base) orders first
+        let (proximal, distal) = if self.last[a] <= self.last[b] {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let (from, to) = (self.last[proximal], self.last[distal]?);
+        (from != Some(to)).then_some(PairChain {
+            proximal,
+            distal,
+            from,
+            to,
+        })
     }
 
     /// Unsure lanes of the batch of piece midpoints `q` with the half
