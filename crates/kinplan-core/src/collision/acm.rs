@@ -13,9 +13,12 @@
 //! every cell of those joints' ranges, whatever the other joints, and so is
 //! a pair whose relative pose no joint changes (a finger held beside the
 //! hand) when one exact test finds it apart; such a pair is apart in every
-//! state, not only in the samples. In the other tables a proved cell
-//! answers a sample without the exact test. The pairs left to the "never"
-//! rule are those three or more joints move relative to each other.
+//! state, not only in the samples (and one that test finds in collision is
+//! in collision in every sample: "always"). In the other tables a proved
+//! cell answers a sample without the exact test. The pairs left to the
+//! "never" rule are those three or more joints move relative to each other.
+//! A pair already seen both in and out of collision often enough that it can
+//! be neither "never" nor "always" is not tested in the later samples.
 //!
 //! Steps 2–3 are a sampling heuristic: a pair that collides in fewer than
 //! about 1/`samples` of the joint space is allowed as "never" (MoveIt's
@@ -40,7 +43,7 @@ use super::model::{MAX_BODIES, RobotModel};
 use super::narrow::{body_body_intersect, body_body_within};
 use super::pair_table::PairTable;
 use super::sweep::SweepBound;
-use crate::Deadline;
+use crate::{Deadline, Stop};
 use nalgebra::Isometry3;
 
 /// Why a pair of bodies is not checked.
@@ -201,57 +204,37 @@ impl AllowedCollisions {
                 what: "proving the robot's self pairs apart (pair tables)".into(),
                 stop,
             })?;
+        let touching_here = |a: usize, b: usize| {
+            body_body_intersect(&model.bodies[a], &poses[a], &model.bodies[b], &poses[b])
+        };
         let mut pairs: Vec<(usize, usize, Option<&PairTable>)> = Vec::new();
         for (a, b) in acm.checked_pairs().collect::<Vec<_>>() {
             match tables.iter().find(|t| (t.a, t.b) == (a, b)) {
                 Some(table) if table.all_free() => acm.allow(a, b, AllowReason::Proved),
                 None if rigid(a, b) && apart_here(a, b) => acm.allow(a, b, AllowReason::Proved),
+                // in collision in this pose, so in every sample
+                None if rigid(a, b) && touching_here(a, b) => acm.allow(a, b, AllowReason::Always),
                 table => pairs.push((a, b, table)),
             }
         }
-        let colliding = |q: &[f64], out: &mut [u32]| {
-            let mut poses = [Isometry3::identity(); MAX_BODIES];
-            model.body_poses(q, &mut poses);
-            for (k, &(a, b, table)) in pairs.iter().enumerate() {
-                let hit = !table.is_some_and(|t| t.proves_apart(q, &[]))
-                    && body_body_intersect(&model.bodies[a], &poses[a], &model.bodies[b], &poses[b]);
-                out[k] += hit as u32;
-            }
-        };
         // Random states, drawn sequentially so the set does not depend on
         // the thread count.
         let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
-        let dof = bounds.len();
-        let states: Vec<f64> = (0..params.samples * dof)
+        let dof = bounds.len().max(1);
+        let states: Vec<f64> = (0..params.samples * bounds.len())
             .map(|i| {
-                let (lo, hi) = bounds[i % dof];
+                let (lo, hi) = bounds[i % bounds.len()];
                 rng.random_range(lo..=hi)
             })
             .collect();
-        let counts = states
-            .par_chunks(dof.max(1) * 64)
-            .map(|block| {
-                let mut c = vec![0u32; pairs.len()];
-                for q in block.chunks(dof.max(1)) {
-                    if let Some(stop) = deadline.stop() {
-                        return Err(stop);
-                    }
-                    colliding(q, &mut c);
-                }
-                Ok(c)
-            })
-            .try_reduce(
-                || vec![0u32; pairs.len()],
-                |mut x, y| {
-                    x.iter_mut().zip(y).for_each(|(a, b)| *a += b);
-                    Ok(x)
-                },
-            )
-            .map_err(|stop| CollisionError::Stopped {
-                what: "sampling the allowed-collision matrix".into(),
-                stop,
-            })?;
         let always = (params.always_fraction * params.samples as f64).ceil() as u32;
+        let counts =
+            sample_counts(model, &pairs, &states, dof, params.samples, always, deadline).map_err(|stop| {
+                CollisionError::Stopped {
+                    what: "sampling the allowed-collision matrix".into(),
+                    stop,
+                }
+            })?;
         for (k, &(a, b, _)) in pairs.iter().enumerate() {
             if counts[k] >= always {
                 acm.allow(a, b, AllowReason::Always);
@@ -328,4 +311,68 @@ impl AllowedCollisions {
             .flat_map(move |a| (a + 1..self.n).map(move |b| (a, b)))
             .filter(|&(a, b)| !self.is_allowed(a, b))
     }
+}
+
+/// Samples tested at a time before the pairs already decided leave.
+const SAMPLE_BLOCK: usize = 1_000;
+
+/// For each of `pairs`, in how many of the `samples` states (`dof` values
+/// each) its bodies are in collision (a proved cell of its table answers
+/// "apart" without the exact test), as far as the verdict needs it.
+///
+/// The states go in blocks of [`SAMPLE_BLOCK`]. A pair seen in collision
+/// that has also been apart in more than `samples − always` states can be
+/// neither "never" (count 0) nor "always" (count ≥ `always`) any more, so
+/// it leaves the later blocks: its count stays partial, and every verdict
+/// is the one all the samples give.
+fn sample_counts(
+    model: &RobotModel,
+    pairs: &[(usize, usize, Option<&PairTable>)],
+    states: &[f64],
+    dof: usize,
+    samples: usize,
+    always: u32,
+    deadline: Deadline<'_>,
+) -> Result<Vec<u32>, Stop> {
+    let misses_to_decide = samples.saturating_sub(always as usize);
+    let mut counts = vec![0u32; pairs.len()];
+    let mut open: Vec<usize> = (0..pairs.len()).collect();
+    let mut seen = 0;
+    for block in states.chunks(dof * SAMPLE_BLOCK) {
+        if open.is_empty() {
+            break;
+        }
+        let hits = block
+            .par_chunks(dof * 64)
+            .map(|chunk| {
+                let mut hits = vec![0u32; open.len()];
+                let mut poses = [Isometry3::identity(); MAX_BODIES];
+                for q in chunk.chunks(dof) {
+                    if let Some(stop) = deadline.stop() {
+                        return Err(stop);
+                    }
+                    model.body_poses(q, &mut poses);
+                    for (hit, &k) in hits.iter_mut().zip(&open) {
+                        let (a, b, table) = pairs[k];
+                        *hit += (!table.is_some_and(|t| t.proves_apart(q, &[]))
+                            && body_body_intersect(&model.bodies[a], &poses[a], &model.bodies[b], &poses[b]))
+                            as u32;
+                    }
+                }
+                Ok(hits)
+            })
+            .try_reduce(
+                || vec![0u32; open.len()],
+                |mut x, y| {
+                    x.iter_mut().zip(y).for_each(|(a, b)| *a += b);
+                    Ok(x)
+                },
+            )?;
+        seen += block.len() / dof;
+        for (&k, h) in open.iter().zip(hits) {
+            counts[k] += h;
+        }
+        open.retain(|&k| counts[k] == 0 || seen - counts[k] as usize <= misses_to_decide);
+    }
+    Ok(counts)
 }

@@ -823,6 +823,123 @@ fn builtin_panda_allows_only_its_designed_contacts() {
     assert_eq!(builtin.reason(wrist, left), None);
 }
 
+/// The sampled matrix of `model` against a plain count: the same random
+/// states (the same seed and draw order), every non-adjacent pair tested
+/// exactly in every state, no table and no early decision. A pair the
+/// sampling calls "never" or "always" has that count, a pair it calls
+/// "proved" is never in collision, and every other pair is checked.
+/// Returns the pairs in collision now and then, and those first in
+/// collision after the first block of samples.
+fn sampled_against_every_sample(model: &RobotModel, params: &AcmParams) -> (usize, usize) {
+    use rand::{Rng, SeedableRng};
+    let acm = AllowedCollisions::sampled(model, params).unwrap();
+    let bounds: Vec<(f64, f64)> = model.chain().limits().collect();
+    assert!(bounds.iter().all(|(lo, hi)| lo.is_finite() && hi.is_finite()));
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(params.seed);
+    let states: Vec<f64> = (0..params.samples * bounds.len())
+        .map(|i| {
+            let (lo, hi) = bounds[i % bounds.len()];
+            rng.random_range(lo..=hi)
+        })
+        .collect();
+    let n = model.body_count();
+    let mut counts = vec![0usize; n * n];
+    let mut late = 0;
+    let mut poses = [Isometry3::identity(); super::super::model::MAX_BODIES];
+    for (i, q) in states.chunks(bounds.len()).enumerate() {
+        model.body_poses(q, &mut poses);
+        for a in 0..n {
+            for b in a + 1..n {
+                let hit = super::super::narrow::body_body_intersect(
+                    &model.bodies[a],
+                    &poses[a],
+                    &model.bodies[b],
+                    &poses[b],
+                );
+                late += (hit && counts[a * n + b] == 0 && i >= 1000) as usize;
+                counts[a * n + b] += hit as usize;
+            }
+        }
+    }
+    let always = (params.always_fraction * params.samples as f64).ceil() as usize;
+    let mut sometimes = 0;
+    for a in 0..n {
+        for b in a + 1..n {
+            let count = counts[a * n + b];
+            match acm.reason(a, b) {
+                Some(AllowReason::Adjacent) => assert!(model.adjacent(a, b)),
+                Some(AllowReason::Proved) | Some(AllowReason::Never) => assert_eq!(count, 0, "{a}-{b}"),
+                Some(AllowReason::Always) => assert!(count >= always, "{a}-{b}: {count}"),
+                None => {
+                    assert!(count > 0 && count < always, "{a}-{b}: {count}");
+                    sometimes += 1;
+                }
+                Some(AllowReason::User) => panic!("{a}-{b}: no user pairs here"),
+            }
+        }
+    }
+    (sometimes, late)
+}
+
+/// The Panda with its hand (pairs in collision now and then, decided after
+/// the first block of samples); a probe beside a fixed post, rarely in
+/// collision, some pairs first after the first block; two boxes rigid and
+/// touching (always, from one test).
+#[test]
+fn the_sampled_matrix_is_the_one_every_sample_gives() {
+    let model = panda_hand_open();
+    for (samples, always_fraction) in [(3000, 0.95), (2500, 0.02)] {
+        let params = AcmParams {
+            samples,
+            always_fraction,
+            seed: 11,
+        };
+        let (sometimes, _) = sampled_against_every_sample(&model, &params);
+        assert!(sometimes >= 3, "{sometimes} pairs in collision now and then");
+    }
+    let with_links = |links: &str| {
+        let urdf = probe_urdf(r#"<sphere radius="0.05"/>"#).replace("</robot>", &format!("{links}</robot>"));
+        let spec = ChainSpec {
+            base_link: Some("base".into()),
+            tip_link: Some("probe".into()),
+        };
+        let chain = Arc::new(parse_chain(&urdf, &spec, UrdfLimits::default()).unwrap());
+        RobotModel::of_urdf(chain, &urdf, &[], &[]).unwrap()
+    };
+    let post = with_links(
+        r#"<link name="post"><collision><geometry><box size="1.6 1.6 1.6"/></geometry></collision></link>
+           <joint name="fp" type="fixed"><parent link="base"/><child link="post"/></joint>"#,
+    );
+    let late: usize = (0..8)
+        .map(|seed| {
+            let params = AcmParams {
+                samples: 3000,
+                always_fraction: 0.95,
+                seed,
+            };
+            sampled_against_every_sample(&post, &params).1
+        })
+        .sum();
+    assert!(late >= 1, "no pair first in collision after the first block");
+    // two boxes that overlap, fixed to the probe: rigid and touching
+    let geometry = r#"<box size="0.1 0.1 0.1"/>"#;
+    let boxes = with_links(&format!(
+        r#"<link name="a"><collision><geometry>{geometry}</geometry></collision></link>
+           <link name="b"><collision><geometry>{geometry}</geometry></collision></link>
+           <joint name="fa" type="fixed"><parent link="probe"/><child link="a"/></joint>
+           <joint name="fb" type="fixed"><parent link="probe"/><child link="b"/><origin xyz="0.05 0 0"/></joint>"#
+    ));
+    let index = |name: &str| boxes.body_names().position(|n| n == name).unwrap();
+    let (a, b) = (index("a"), index("b"));
+    assert!(!boxes.adjacent(a, b));
+    let params = AcmParams {
+        samples: 200,
+        ..AcmParams::default()
+    };
+    let acm = AllowedCollisions::sampled(&boxes, &params).unwrap();
+    assert_eq!(acm.reason(a, b), Some(AllowReason::Always));
+}
+
 /// parry's convex hull of a thin cloud can leave some of its points outside
 /// (a sliver, thin against its length); the model grows such a hull
 /// until it holds them. Checked by support functions: along every sampled
