@@ -17,6 +17,9 @@
 //! Cost: at most `PLANES − 6` rounds over at most `MAX_CANDIDATES` planes,
 //! each clip linear in the polytope's size (at most `PLANES` faces).
 
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
 use nalgebra::{Point3, Vector3};
 
 /// Most planes of a fitted polytope (the six of the box included).
@@ -26,6 +29,36 @@ pub(crate) const MAX_CANDIDATES: usize = 384;
 /// Each plane is moved out by this much (m), so rounding in the corners'
 /// intersection cannot leave a point of the mesh outside.
 pub(crate) const MARGIN: f64 = 1e-5;
+
+/// A candidate plane's bound on its gain, ordered by gain, then by index
+/// (of equal gains the later candidate first).
+#[derive(Debug, Clone, Copy)]
+struct Bound {
+    gain: f64,
+    index: usize,
+}
+
+impl Ord for Bound {
+    fn cmp(&self, other: &Self) -> Ordering {
+        self.gain
+            .total_cmp(&other.gain)
+            .then(self.index.cmp(&other.index))
+    }
+}
+
+impl PartialOrd for Bound {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for Bound {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+
+impl Eq for Bound {}
 
 /// A convex polytope as its faces, each a loop of corners in cyclic order.
 #[derive(Debug, Clone)]
@@ -206,15 +239,21 @@ pub(crate) fn outer_polytope(
     // Lazy greedy: what a plane cuts from a polytope only shrinks as the
     // polytope shrinks, so a gain found in an earlier round bounds the gain
     // now, and a plane whose fresh gain is at least every other's bound is
-    // the greedy choice.
+    // the greedy choice. The bounds sit in a heap, rebuilt each round (a
+    // chosen plane leaves the list by `swap_remove`).
     let mut bound = vec![f64::INFINITY; candidates.len()];
     for _ in 6..PLANES {
         let volume = poly.volume();
+        let mut heap: BinaryHeap<Bound> = bound
+            .iter()
+            .enumerate()
+            .map(|(index, &gain)| Bound { gain, index })
+            .collect();
         let chosen = loop {
-            let Some(k) = (0..bound.len()).max_by(|&a, &b| bound[a].total_cmp(&bound[b])) else {
+            let Some(Bound { gain, index: k }) = heap.pop() else {
                 break None;
             };
-            if bound[k] <= 0.0 {
+            if gain <= 0.0 {
                 break None;
             }
             let (n, h) = candidates[k];
@@ -226,13 +265,14 @@ pub(crate) fn outer_polytope(
             } else {
                 gain.clamp(0.0, f64::MAX)
             };
-            let others = (0..bound.len())
-                .filter(|&j| j != k)
-                .map(|j| bound[j])
-                .fold(0.0, f64::max);
+            let others = heap.peek().map_or(0.0, |b| b.gain.max(0.0));
             if bound[k] > 0.0 && bound[k] >= others {
                 break cut.map(|c| (k, c));
             }
+            heap.push(Bound {
+                gain: bound[k],
+                index: k,
+            });
         };
         let Some((k, cut)) = chosen else { break };
         poly = cut;
@@ -248,7 +288,7 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    use super::{MARGIN, Polytope, outer_polytope};
+    use super::{MARGIN, MAX_CANDIDATES, PLANES, Polytope, outer_polytope};
 
     /// Volume of the unit cube cut by `x + y + z ≤ 1`: the corner
     /// tetrahedron of volume 1/6 is what remains.
@@ -317,6 +357,78 @@ mod tests {
             .sum();
         let ball = 4.0 / 3.0 * std::f64::consts::PI;
         assert!(volume < 1.45 * ball && volume > ball, "volume {volume}");
+    }
+
+    /// The greedy choice made plainly, every candidate's cut measured in
+    /// every round: the corners of the lazy fit are the same, bit for bit,
+    /// on random clouds (each its own directions as the candidate planes).
+    #[test]
+    fn the_lazy_fit_makes_the_plain_greedy_choice() {
+        fn plain_greedy(points: &[Point3<f64>], normals: &[Vector3<f64>]) -> Vec<Point3<f64>> {
+            let lo = points
+                .iter()
+                .fold(Vector3::repeat(f64::INFINITY), |s, p| s.inf(&p.coords));
+            let hi = points
+                .iter()
+                .fold(Vector3::repeat(f64::NEG_INFINITY), |s, p| s.sup(&p.coords));
+            let tol = 1e-9 * (hi - lo).norm().max(1e-6);
+            let margin = Vector3::repeat(MARGIN);
+            let mut poly = Polytope::cuboid(lo - margin, hi + margin, tol);
+            let mut planes: Vec<(Vector3<f64>, f64)> = Vec::new();
+            for n in normals {
+                let n = n.normalize();
+                if !planes.iter().any(|(m, _)| (m - n).norm() < 1e-9) {
+                    let h = points
+                        .iter()
+                        .map(|p| n.dot(&p.coords))
+                        .fold(f64::NEG_INFINITY, f64::max);
+                    planes.push((n, h + MARGIN));
+                }
+            }
+            planes.truncate(MAX_CANDIDATES);
+            for _ in 6..PLANES {
+                let volume = poly.volume();
+                let gains: Vec<f64> = planes
+                    .iter()
+                    .map(|(n, h)| match poly.reaches_past(n, *h) {
+                        true => (volume - poly.clipped(n, *h).volume()).max(0.0),
+                        false => 0.0,
+                    })
+                    .collect();
+                let Some(k) = (0..gains.len()).max_by(|&a, &b| gains[a].total_cmp(&gains[b])) else {
+                    break;
+                };
+                if gains[k] <= 0.0 {
+                    break;
+                }
+                poly = poly.clipped(&planes[k].0, planes[k].1);
+                planes.swap_remove(k);
+            }
+            poly.corners()
+        }
+        let mut rng = ChaCha8Rng::seed_from_u64(12);
+        for case in 0..40 {
+            let count = rng.random_range(8..200);
+            let stretch = Vector3::new(
+                rng.random_range(0.01..0.3),
+                rng.random_range(0.01..0.3),
+                rng.random_range(0.01..0.3),
+            );
+            let points: Vec<Point3<f64>> = (0..count)
+                .map(|_| {
+                    let v = Vector3::new(
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                    );
+                    Point3::from(v.normalize().component_mul(&stretch))
+                })
+                .collect();
+            let normals: Vec<Vector3<f64>> =
+                points.iter().map(|p| p.coords.component_div(&stretch)).collect();
+            let lazy = outer_polytope(&points, &normals).unwrap();
+            assert_eq!(lazy, plain_greedy(&points, &normals), "case {case}");
+        }
     }
 
     #[test]
