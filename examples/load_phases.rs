@@ -1,11 +1,12 @@
 //! Where loading a robot sent with its meshes spends its time: the mesh
 //! files read, the collision bodies (hulls, fitted polytopes), the pair
 //! tables with the sampled allowed-collision matrix, and the sampling alone
-//! (the tables kept). Median of `--rounds` loads, one thread and the pool.
+//! (the tables kept). Median of `--rounds` loads, on pools of one and two
+//! threads (or of `--threads`).
 //!
 //! ```text
 //! cargo run --release -p kinplan-core --example load_phases -- \
-//!     <urdf> <package root> <base link> <tip link> [--rounds N]
+//!     <urdf> <package root> <base link> <tip link> [--rounds N] [--threads N]
 //! ```
 
 use std::sync::Arc;
@@ -18,11 +19,16 @@ use kinplan_core::robot::{ChainSpec, UrdfLimits, parse_chain};
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [urdf_path, root, base, tip, ..] = &args[..] else {
-        return Err("usage: load_phases <urdf> <package root> <base link> <tip link> [--rounds N]".into());
+        return Err("usage: load_phases <urdf> <package root> <base link> <tip link> [--rounds N] [--threads N]".into());
     };
-    let rounds: usize = match args.iter().position(|a| a == "--rounds") {
-        Some(i) => args.get(i + 1).ok_or("--rounds needs a count")?.parse()?,
+    let option = |name: &str| args.iter().position(|a| a == name).map(|i| args.get(i + 1));
+    let rounds: usize = match option("--rounds") {
+        Some(value) => value.ok_or("--rounds needs a count")?.parse()?,
         None => 21,
+    };
+    let threads: Vec<usize> = match option("--threads") {
+        Some(value) => vec![value.ok_or("--threads needs a count")?.parse()?],
+        None => vec![1, 2],
     };
     let urdf = std::fs::read_to_string(urdf_path)?;
     // the meshes of <collision> elements (a client sends no visual meshes)
@@ -54,7 +60,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         v.sort_by(f64::total_cmp);
         v[v.len() / 2]
     };
-    for threads in [1, 2] {
+    for threads in threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         let mut phases = vec![Vec::new(); 4];
         for _ in 0..rounds {
