@@ -26,6 +26,14 @@
 //!
 //! Everything runs in the polytope's own frame: its support is a scan of
 //! its corners; the other shape is carried into that frame once.
+//!
+//! A warm start ([`within_keyed`] inside a [`WarmChecks`]) first tries the
+//! direction `d` that last proved the same pair apart: `d·w > (m + ε)|d|`
+//! for `w = s_C(−d)` is the same certificate; otherwise `w` starts the
+//! simplex.
+
+use std::cell::RefCell;
+use std::marker::PhantomData;
 
 use nalgebra::{Isometry3, Matrix3, Point3, Vector3};
 
@@ -266,29 +274,120 @@ impl Corners {
 /// proved more than `margin` (m, ≥ 0) apart by a separating direction (the
 /// module doc).
 pub(crate) fn within(corners: &Corners, other: &Convex, margin: f64) -> bool {
+    within_from(corners, other, margin, None).0
+}
+
+/// [`within`], trying `hint` first as the separating direction, and with
+/// the direction that proved the shapes apart (or `None`).
+pub(crate) fn within_from(
+    corners: &Corners,
+    other: &Convex,
+    margin: f64,
+    hint: Option<Vector3<f64>>,
+) -> (bool, Option<Vector3<f64>>) {
     let beyond = margin + SLACK;
     let mut simplex = Simplex::default();
     let mut v = corners.first() - other.any_point();
+    if let Some(d) = hint.filter(|d| d.norm_squared() > 0.0) {
+        let w = corners.farthest(&-d) - other.support(&d);
+        if d.dot(&w) > beyond * d.norm() {
+            return (false, Some(d));
+        }
+        simplex.push(w);
+        v = w;
+    }
     for _ in 0..MAX_STEPS {
         let vv = v.norm_squared();
         if vv <= margin * margin {
-            return true;
+            return (true, None);
         }
         let w = corners.farthest(&-v) - other.support(&v);
         let vw = v.dot(&w);
         if vw > beyond * vv.sqrt() {
-            return false;
+            return (false, Some(v));
         }
         if vv - vw <= 1e-12 * vv {
-            return true;
+            return (true, None);
         }
         simplex.push(w);
         match simplex.reduce() {
             Some(nearest) => v = nearest,
-            None => return true,
+            None => return (true, None),
         }
     }
-    true
+    (true, None)
+}
+
+/// Slots of the per-thread table of separating directions.
+const HINT_SLOTS: usize = 512;
+
+/// Separating directions kept on one thread while a [`WarmChecks`] lasts.
+struct Hints {
+    /// Open [`WarmChecks`] on this thread (hints are kept only while > 0).
+    depth: u32,
+    /// Which opening of the outermost [`WarmChecks`] a slot was filled in.
+    generation: u64,
+    /// Per slot: the pair's key, the generation, the direction.
+    slots: [(usize, u64, [f64; 3]); HINT_SLOTS],
+}
+
+thread_local! {
+    static HINTS: RefCell<Hints> = const {
+        RefCell::new(Hints {
+            depth: 0,
+            generation: 0,
+            slots: [(0, 0, [0.0; 3]); HINT_SLOTS],
+        })
+    };
+}
+
+/// While a value of this type lives, the exact tests on this thread start
+/// from the direction that last proved the same pair of shapes apart in
+/// that time (nearby states of one search are separated along nearly the
+/// same direction, so one support step often settles the pair). The
+/// verdict never rests on a hint, but where the search cannot decide
+/// (its step limit) a hint may prove a pair apart that a cold start
+/// leaves "within", so hold it only around work done in one sequence on
+/// one thread (one search, one table row): that keeps every result a
+/// function of the inputs. Opened again inside, it keeps the outer hints.
+pub(crate) struct WarmChecks {
+    /// Not `Send`: it must end on the thread it began on.
+    _thread: PhantomData<*const ()>,
+}
+
+impl WarmChecks {
+    pub(crate) fn begin() -> Self {
+        HINTS.with_borrow_mut(|h| {
+            if h.depth == 0 {
+                h.generation += 1;
+            }
+            h.depth += 1;
+        });
+        WarmChecks { _thread: PhantomData }
+    }
+}
+
+impl Drop for WarmChecks {
+    fn drop(&mut self) {
+        HINTS.with_borrow_mut(|h| h.depth -= 1);
+    }
+}
+
+/// [`within`] for the pair of shapes named by `key`, started from the
+/// direction that last proved them apart within the current
+/// [`WarmChecks`] on this thread (a cold start outside one).
+pub(crate) fn within_keyed(corners: &Corners, other: &Convex, margin: f64, key: usize) -> bool {
+    let slot = key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (usize::BITS - HINT_SLOTS.trailing_zeros());
+    let (warm, hint) = HINTS.with_borrow(|h| {
+        let (k, generation, d) = h.slots[slot];
+        let hint = (h.depth > 0 && k == key && generation == h.generation).then(|| Vector3::from(d));
+        (h.depth > 0, hint)
+    });
+    let (near, apart_along) = within_from(corners, other, margin, hint);
+    if let Some(d) = apart_along.filter(|_| warm) {
+        HINTS.with_borrow_mut(|h| h.slots[slot] = (key, h.generation, [d.x, d.y, d.z]));
+    }
+    near
 }
 
 /// Up to four points of the difference set.
@@ -417,13 +516,13 @@ fn on_tetrahedron(p: &[Vector3<f64>; 4]) -> Option<(Vector3<f64>, Kept)> {
 
 #[cfg(test)]
 mod tests {
-    use nalgebra::{Point3, UnitQuaternion, Vector3};
+    use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
     use parry3d_f64::query;
     use parry3d_f64::shape::SharedShape;
-    use rand::SeedableRng;
+    use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    use super::{Convex, Corners, within};
+    use super::{Convex, Corners, WarmChecks, within, within_from, within_keyed};
     use crate::collision::builtin_mesh;
     use crate::collision::convert::{point_from_parry, pose_to_parry, vec_to_parry};
     use crate::collision::tests::{random_pose, random_primitive};
@@ -589,6 +688,60 @@ mod tests {
             }
         }
         assert!(beyond > 20_000 && close > 5_000, "{beyond} beyond, {close} close");
+        assert!(proved * 1000 >= beyond * 999, "{proved} of {beyond} proved apart");
+    }
+
+    /// Warm starts against parry's distance: link hulls walked in small
+    /// steps (5 mm, 0.02 rad) past random primitives inside a
+    /// [`WarmChecks`], so each test starts from the last step's separating
+    /// direction, and each placement also tried from a random direction
+    /// (a wrong hint). Never apart within the margin; apart for all but a
+    /// handful beyond it.
+    #[test]
+    fn a_warm_start_right_or_wrong_keeps_the_verdict_sound() {
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let _warm = WarmChecks::begin();
+        let (mut beyond, mut proved) = (0usize, 0usize);
+        for link in ["link_1", "link_5", "panda_hand"] {
+            let (shape, corners) = link_hull(link);
+            for walk in 0..30 {
+                let world = random_primitive(&mut rng, 0.25);
+                let leaf = &world.leaves[0];
+                let mut at = random_pose(&mut rng, 0.25);
+                let key = 1 + walk;
+                for _ in 0..100 {
+                    let step = Isometry3::new(
+                        Vector3::new(
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                        ) * 0.005,
+                        Vector3::new(
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                        ) * 0.02,
+                    );
+                    at *= step;
+                    let d = query::distance(&pose_to_parry(&at), &*shape, &leaf.pose, &*leaf.shape)
+                        .unwrap()
+                        .distance;
+                    let (other, radius) = Convex::of_leaf(&at, &leaf.fast).expect("a closed form");
+                    let margin = 0.005;
+                    let wrong = random_pose(&mut rng, 1.0).translation.vector;
+                    let warm = within_keyed(&corners, &other, margin + radius, key);
+                    let (from_wrong, _) = within_from(&corners, &other, margin + radius, Some(wrong));
+                    for says_within in [warm, from_wrong] {
+                        assert!(says_within || d > margin, "{link}: apart at distance {d}");
+                        if d > margin + 1e-6 {
+                            beyond += 1;
+                            proved += !says_within as usize;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(beyond > 5_000, "{beyond} beyond");
         assert!(proved * 1000 >= beyond * 999, "{proved} of {beyond} proved apart");
     }
 }

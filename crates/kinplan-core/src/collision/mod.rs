@@ -65,6 +65,7 @@ pub use attach::attached_bodies;
 pub use builtin_meshes::{BUILTIN_MESH_SCHEME, builtin_mesh};
 pub use checker::{MotionCheck, PadVerdict, StateChecker, interpolate_motion_valid};
 pub use error::CollisionError;
+pub(crate) use gjk::WarmChecks;
 pub use mesh_file::{MeshFileLimits, read_mesh_file};
 pub use model::{AttachedBody, InlineMesh, MAX_BODIES, MAX_LINKS, MAX_MESH_VERTICES, RobotModel};
 pub use moveit::{JointRequest, MAX_YAML_BYTES, parse_joint_request, parse_planning_scene};

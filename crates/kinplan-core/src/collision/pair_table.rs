@@ -28,6 +28,7 @@
 
 use nalgebra::Isometry3;
 
+use super::gjk::WarmChecks;
 use super::model::{MAX_BODIES, RobotModel};
 use super::narrow::body_body_within;
 use super::sweep::SweepBound;
@@ -235,6 +236,8 @@ impl PairTable {
         row: usize,
         deadline: Deadline<'_>,
     ) -> Result<Vec<Region>, Stop> {
+        // the row's blocks are tested one after another on this thread
+        let _warm = WarmChecks::begin();
         let mut apart = self.apart_test(model);
         self.proved_row_with(row, &mut apart, deadline)
     }

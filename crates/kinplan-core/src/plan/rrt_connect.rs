@@ -13,7 +13,7 @@ use super::error::{PlanError, PlanField, check_vector};
 use super::noise::{standard_normal, stream};
 use super::rrt_tree::{Grown, grow};
 use crate::Deadline;
-use crate::collision::{PaddedMotion, StateChecker, padded_motion, padded_motion_valid};
+use crate::collision::{PaddedMotion, StateChecker, WarmChecks, padded_motion, padded_motion_valid};
 use crate::robot::{Chain, JointKind};
 
 /// How RRT-Connect ended.
@@ -96,6 +96,8 @@ pub fn rrt_connect<C: StateChecker + ?Sized>(
         start: Instant::now(),
         deadline,
     };
+    // the search runs on this thread alone, one check after another
+    let _warm = WarmChecks::begin();
     Ok(rrt_connect_path(
         chain, checker, start, goal, params, seed, &clock,
     ))
