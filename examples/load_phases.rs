@@ -19,7 +19,10 @@ use kinplan_core::robot::{ChainSpec, UrdfLimits, parse_chain};
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [urdf_path, root, base, tip, ..] = &args[..] else {
-        return Err("usage: load_phases <urdf> <package root> <base link> <tip link> [--rounds N] [--threads N]".into());
+        return Err(
+            "usage: load_phases <urdf> <package root> <base link> <tip link> [--rounds N] [--threads N]"
+                .into(),
+        );
     };
     let option = |name: &str| args.iter().position(|a| a == name).map(|i| args.get(i + 1));
     let rounds: usize = match option("--rounds") {
