@@ -78,6 +78,12 @@ struct Field {
     kind: Kind,
 }
 
+/// Builds the schema now, so that a server does it before it reports
+/// serving rather than on its first call.
+pub fn prepare() {
+    schema();
+}
+
 /// Fields of every kinplan message by full name (`.kinplan.v1.Pose`).
 fn schema() -> &'static HashMap<String, HashMap<u64, Field>> {
     static SCHEMA: OnceLock<HashMap<String, HashMap<u64, Field>>> = OnceLock::new();

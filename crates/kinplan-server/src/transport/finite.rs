@@ -34,6 +34,12 @@ struct Schema {
 /// NaN is refused everywhere.
 const INFINITE_ALLOWED: &[(&str, &str)] = &[("JointInfo", "lower"), ("JointInfo", "upper")];
 
+/// Builds the schema now, so that a server does it before it reports
+/// serving rather than on its first call.
+pub(crate) fn prepare() {
+    schema();
+}
+
 fn schema() -> &'static Schema {
     static SCHEMA: OnceLock<Schema> = OnceLock::new();
     SCHEMA.get_or_init(|| {

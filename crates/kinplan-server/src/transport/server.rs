@@ -133,6 +133,13 @@ pub async fn serve(
     let shared = kinplan_shared(&config);
     let (routes, services) = kinplan_routes(&shared, &config);
     let compute = shared.compute.clone();
+    // the contract's schemas (request admission, finite replies), built once
+    // before serving instead of on the first call
+    tokio::task::spawn_blocking(|| {
+        crate::runtime::request_numbers::prepare();
+        crate::transport::finite::prepare();
+    })
+    .await?;
     let (health, health_service) = tonic_health::server::health_reporter();
     for name in services {
         health.set_service_status(name, ServingStatus::Serving).await;
