@@ -199,17 +199,14 @@ fn in_cyclic_order(mut points: Vec<Point3<f64>>, n: &Vector3<f64>) -> Vec<Point3
     points
 }
 
-/// The corners of the polytope of the module doc around `points`, with
-/// `face_normals` (unit outward normals of the points' hull, largest faces
-/// first) as the candidate planes; `None` when the points are empty or
-/// not finite.
-pub(crate) fn outer_polytope(
+/// Where the fit starts: the points' box grown by [`MARGIN`], and the
+/// candidate planes `(n, h)`: the distinct finite directions of
+/// `face_normals` (at most [`MAX_CANDIDATES`]), each through the farthest
+/// point along it plus [`MARGIN`].
+fn box_and_planes(
     points: &[Point3<f64>],
     face_normals: &[Vector3<f64>],
-) -> Option<Vec<Point3<f64>>> {
-    if points.is_empty() || !points.iter().all(|p| p.coords.iter().all(|x| x.is_finite())) {
-        return None;
-    }
+) -> (Polytope, Vec<(Vector3<f64>, f64)>) {
     let support = |n: &Vector3<f64>| {
         points
             .iter()
@@ -224,7 +221,7 @@ pub(crate) fn outer_polytope(
         .fold(Vector3::repeat(f64::NEG_INFINITY), |s, p| s.sup(&p.coords));
     let tol = 1e-9 * (hi - lo).norm().max(1e-6);
     let margin = Vector3::repeat(MARGIN);
-    let mut poly = Polytope::cuboid(lo - margin, hi + margin, tol);
+    let poly = Polytope::cuboid(lo - margin, hi + margin, tol);
     let mut candidates: Vec<(Vector3<f64>, f64)> = Vec::new();
     for n in face_normals {
         let n = n.normalize();
@@ -236,6 +233,21 @@ pub(crate) fn outer_polytope(
             break;
         }
     }
+    (poly, candidates)
+}
+
+/// The corners of the polytope of the module doc around `points`, with
+/// `face_normals` (unit outward normals of the points' hull, largest faces
+/// first) as the candidate planes; `None` when the points are empty or
+/// not finite.
+pub(crate) fn outer_polytope(
+    points: &[Point3<f64>],
+    face_normals: &[Vector3<f64>],
+) -> Option<Vec<Point3<f64>>> {
+    if points.is_empty() || !points.iter().all(|p| p.coords.iter().all(|x| x.is_finite())) {
+        return None;
+    }
+    let (mut poly, mut candidates) = box_and_planes(points, face_normals);
     // Lazy greedy: what a plane cuts from a polytope only shrinks as the
     // polytope shrinks, so a gain found in an earlier round bounds the gain
     // now, and a plane whose fresh gain is at least every other's bound is
@@ -288,7 +300,7 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
-    use super::{MARGIN, MAX_CANDIDATES, PLANES, Polytope, outer_polytope};
+    use super::{MARGIN, PLANES, Polytope, box_and_planes, outer_polytope};
 
     /// Volume of the unit cube cut by `x + y + z ≤ 1`: the corner
     /// tetrahedron of volume 1/6 is what remains.
@@ -359,33 +371,14 @@ mod tests {
         assert!(volume < 1.45 * ball && volume > ball, "volume {volume}");
     }
 
-    /// The greedy choice made plainly, every candidate's cut measured in
-    /// every round: the corners of the lazy fit are the same, bit for bit,
-    /// on random clouds (each its own directions as the candidate planes).
+    /// The greedy choice made plainly from the same box and planes, every
+    /// candidate's cut measured in every round: the corners of the lazy fit
+    /// are the same, bit for bit, on random clouds (each its own directions
+    /// as the candidate planes).
     #[test]
     fn the_lazy_fit_makes_the_plain_greedy_choice() {
         fn plain_greedy(points: &[Point3<f64>], normals: &[Vector3<f64>]) -> Vec<Point3<f64>> {
-            let lo = points
-                .iter()
-                .fold(Vector3::repeat(f64::INFINITY), |s, p| s.inf(&p.coords));
-            let hi = points
-                .iter()
-                .fold(Vector3::repeat(f64::NEG_INFINITY), |s, p| s.sup(&p.coords));
-            let tol = 1e-9 * (hi - lo).norm().max(1e-6);
-            let margin = Vector3::repeat(MARGIN);
-            let mut poly = Polytope::cuboid(lo - margin, hi + margin, tol);
-            let mut planes: Vec<(Vector3<f64>, f64)> = Vec::new();
-            for n in normals {
-                let n = n.normalize();
-                if !planes.iter().any(|(m, _)| (m - n).norm() < 1e-9) {
-                    let h = points
-                        .iter()
-                        .map(|p| n.dot(&p.coords))
-                        .fold(f64::NEG_INFINITY, f64::max);
-                    planes.push((n, h + MARGIN));
-                }
-            }
-            planes.truncate(MAX_CANDIDATES);
+            let (mut poly, mut planes) = box_and_planes(points, normals);
             for _ in 6..PLANES {
                 let volume = poly.volume();
                 let gains: Vec<f64> = planes
