@@ -348,8 +348,10 @@ thread_local! {
 /// verdict never rests on a hint, but where the search cannot decide
 /// (its step limit) a hint may prove a pair apart that a cold start
 /// leaves "within", so hold it only around work done in one sequence on
-/// one thread (one search, one table row): that keeps every result a
-/// function of the inputs. Opened again inside, it keeps the outer hints.
+/// one thread (one search, one table row), with no parallel join inside (a
+/// thread waiting in a join may run other work meanwhile): that keeps
+/// every result a function of the inputs. Opened again inside, it keeps
+/// the outer hints.
 pub(crate) struct WarmChecks {
     /// Not `Send`: it must end on the thread it began on.
     _thread: PhantomData<*const ()>,

@@ -96,7 +96,8 @@ pub fn rrt_connect<C: StateChecker + ?Sized>(
         start: Instant::now(),
         deadline,
     };
-    // the search runs on this thread alone, one check after another
+    // the search runs on this thread alone, one check after another (the
+    // checker's pair tables, built in parallel, exist before it starts)
     let _warm = WarmChecks::begin();
     Ok(rrt_connect_path(
         chain, checker, start, goal, params, seed, &clock,
