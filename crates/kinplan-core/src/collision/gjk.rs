@@ -375,6 +375,13 @@ impl Drop for WarmChecks {
     }
 }
 
+/// A key naming the pair of shapes held at `a` and `b` for
+/// [`within_keyed`]: their addresses, which stay put while the model and
+/// scene holding them live.
+pub(crate) fn pair_key<A, B>(a: &A, b: &B) -> usize {
+    (a as *const A as usize) ^ (b as *const B as usize).rotate_left(29)
+}
+
 /// [`within`] for the pair of shapes named by `key`, started from the
 /// direction that last proved them apart within the current
 /// [`WarmChecks`] on this thread (a cold start outside one).

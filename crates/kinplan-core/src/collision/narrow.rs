@@ -341,7 +341,7 @@ fn gjk_leaf_within(sa: &BodyShape, pa: &Isometry3<f64>, leaf: &LeafFast, margin:
     let faces = sa.faces.as_ref()?;
     let pose = pa * sa.offset;
     let (other, radius) = Convex::of_leaf(&pose, leaf)?;
-    let key = (faces.corners() as *const _ as usize) ^ (leaf as *const LeafFast as usize).rotate_left(29);
+    let key = gjk::pair_key(faces.corners(), leaf);
     Some(gjk::within_keyed(faces.corners(), &other, margin + radius, key))
 }
 
@@ -365,8 +365,7 @@ fn gjk_robot_within(
     let pose = pp * poly.offset;
     if let Some(other_faces) = other.faces.as_ref() {
         let shape = Convex::of_corners(&pose, other_faces.corners(), &(po * other.offset));
-        let key = (faces.corners() as *const _ as usize)
-            ^ (other_faces.corners() as *const _ as usize).rotate_left(29);
+        let key = gjk::pair_key(faces.corners(), other_faces.corners());
         return Some(gjk::within_keyed(faces.corners(), &shape, margin, key));
     }
     let (shape, radius) = Convex::of_leaf(&pose, &posed(&other.fast, po)?)?;
