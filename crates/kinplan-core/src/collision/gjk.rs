@@ -528,13 +528,13 @@ mod tests {
     use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
     use parry3d_f64::query;
     use parry3d_f64::shape::SharedShape;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
     use super::{Convex, Corners, WarmChecks, within, within_from, within_keyed};
     use crate::collision::builtin_mesh;
     use crate::collision::convert::{point_from_parry, pose_to_parry, vec_to_parry};
-    use crate::collision::tests::{random_pose, random_primitive};
+    use crate::collision::tests::{random_pose, random_primitive, random_vector};
 
     /// The hull of a built-in Panda link: its parry shape and its corners.
     fn link_hull(link: &str) -> (SharedShape, Corners) {
@@ -719,18 +719,7 @@ mod tests {
                 let mut at = random_pose(&mut rng, 0.25);
                 let key = 1 + walk;
                 for _ in 0..100 {
-                    let step = Isometry3::new(
-                        Vector3::new(
-                            rng.random_range(-1.0..1.0),
-                            rng.random_range(-1.0..1.0),
-                            rng.random_range(-1.0..1.0),
-                        ) * 0.005,
-                        Vector3::new(
-                            rng.random_range(-1.0..1.0),
-                            rng.random_range(-1.0..1.0),
-                            rng.random_range(-1.0..1.0),
-                        ) * 0.02,
-                    );
+                    let step = Isometry3::new(random_vector(&mut rng, 0.005), random_vector(&mut rng, 0.02));
                     at *= step;
                     let d = query::distance(&pose_to_parry(&at), &*shape, &leaf.pose, &*leaf.shape)
                         .unwrap()

@@ -301,6 +301,7 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     use super::{MARGIN, PLANES, Polytope, box_and_planes, outer_polytope};
+    use crate::collision::tests::random_vector;
 
     /// Volume of the unit cube cut by `x + y + z ≤ 1`: the corner
     /// tetrahedron of volume 1/6 is what remains.
@@ -408,14 +409,7 @@ mod tests {
                 rng.random_range(0.01..0.3),
             );
             let points: Vec<Point3<f64>> = (0..count)
-                .map(|_| {
-                    let v = Vector3::new(
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                    );
-                    Point3::from(v.normalize().component_mul(&stretch))
-                })
+                .map(|_| Point3::from(random_vector(&mut rng, 1.0).normalize().component_mul(&stretch)))
                 .collect();
             let normals: Vec<Vector3<f64>> =
                 points.iter().map(|p| p.coords.component_div(&stretch)).collect();

@@ -28,14 +28,19 @@ pub(super) fn panda_hand_open() -> RobotModel {
     RobotModel::of_urdf(chain, urdf, &fingers, &[]).unwrap()
 }
 
+/// A vector with each coordinate within `reach`.
+pub(super) fn random_vector(rng: &mut ChaCha8Rng, reach: f64) -> Vector3<f64> {
+    Vector3::new(
+        rng.random_range(-reach..reach),
+        rng.random_range(-reach..reach),
+        rng.random_range(-reach..reach),
+    )
+}
+
 /// A pose with each coordinate within `reach` (m) and random Euler angles.
 pub(super) fn random_pose(rng: &mut ChaCha8Rng, reach: f64) -> Isometry3<f64> {
     Isometry3::from_parts(
-        Translation3::new(
-            rng.random_range(-reach..reach),
-            rng.random_range(-reach..reach),
-            rng.random_range(-reach..reach),
-        ),
+        Translation3::from(random_vector(rng, reach)),
         UnitQuaternion::from_euler_angles(
             rng.random_range(-3.2..3.2),
             rng.random_range(-3.2..3.2),
