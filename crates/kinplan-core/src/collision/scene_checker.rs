@@ -342,9 +342,11 @@ impl SceneChecker {
         self.model.body_poses(q, &mut poses);
         let all = &self.model.bodies;
         let mut bits = bodies;
+        // the last bodies first, as in `scene_bodies`: a state that
+        // collides mostly does so at the tool's end
         while bits != 0 {
-            let b = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
+            let b = (u32::BITS - 1 - bits.leading_zeros()) as usize;
+            bits &= !(1 << b);
             if self.body_hits_scene(b, &poses[b], &sphere_center(&all[b], &poses[b])) {
                 return true;
             }
