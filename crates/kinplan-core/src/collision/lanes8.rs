@@ -931,14 +931,11 @@ fn prim_dist2(x: &[Lane8; 3], prim: &Prim) -> (Lane8, f32) {
         }
         Prim::Box { m, d, half } => {
             for k in 0..3 {
-                // box coordinate k; the zero entries of a box turned about
-                // one axis skipped
+                // box coordinate k
                 let mut local = [-d[k]; WIDTH];
                 for j in 0..3 {
-                    if m[j][k] != 0.0 {
-                        for l in 0..WIDTH {
-                            local[l] += m[j][k] * x[j][l];
-                        }
+                    for l in 0..WIDTH {
+                        local[l] += m[j][k] * x[j][l];
                     }
                 }
                 for l in 0..WIDTH {
