@@ -66,37 +66,53 @@ impl ModelSource {
             + self.meshes.iter().map(|(u, d)| u.len() + d.len()).sum::<usize>()
     }
 
-    /// The model id: SHA-256 of the URDF text alone when there are no mesh
-    /// files and no SRDF (as before they could be sent), else of
-    /// `"kinplan-model-v1\0" · len·urdf · len·srdf · Σ_files(len·uri · len·data)`
-    /// with the files sorted by URI, every length a little-endian u64 and an
-    /// absent SRDF empty.
+    /// The model id ([`model_id`]).
     fn id(&self) -> ModelId {
-        if self.meshes.is_empty() && self.srdf.is_none() {
-            return Sha256::digest(self.urdf.as_bytes()).into();
-        }
-        let mut h = Sha256::new();
-        h.update(b"kinplan-model-v1\0");
-        let mut part = |bytes: &[u8]| {
-            h.update((bytes.len() as u64).to_le_bytes());
-            h.update(bytes);
-        };
-        part(self.urdf.as_bytes());
-        part(self.srdf.as_ref().map_or("", |s| s.text.as_str()).as_bytes());
-        for (uri, data) in self.meshes.iter() {
-            part(uri.as_bytes());
-            part(data);
-        }
-        h.finalize().into()
+        model_id(
+            &self.urdf,
+            self.srdf.as_ref().map(|s| s.text.as_str()),
+            self.meshes
+                .iter()
+                .map(|(uri, data)| (uri.as_str(), data.as_slice())),
+        )
     }
+}
+
+/// The model id: SHA-256 of the URDF text alone when there are no mesh files
+/// and no SRDF (as before they could be sent), else of
+/// `"kinplan-model-v1\0" · len·urdf · len·srdf · Σ_files(len·uri · len·data)`
+/// with the files sorted by URI, every length a little-endian u64 and an
+/// absent SRDF empty.
+fn model_id<'a>(
+    urdf: &str,
+    srdf: Option<&str>,
+    meshes: impl ExactSizeIterator<Item = (&'a str, &'a [u8])>,
+) -> ModelId {
+    if meshes.len() == 0 && srdf.is_none() {
+        return Sha256::digest(urdf.as_bytes()).into();
+    }
+    let mut h = Sha256::new();
+    h.update(b"kinplan-model-v1\0");
+    let mut part = |bytes: &[u8]| {
+        h.update((bytes.len() as u64).to_le_bytes());
+        h.update(bytes);
+    };
+    part(urdf.as_bytes());
+    part(srdf.unwrap_or("").as_bytes());
+    for (uri, data) in meshes {
+        part(uri.as_bytes());
+        part(data);
+    }
+    h.finalize().into()
 }
 
 /// Most mesh files one model may carry.
 pub const MAX_MESH_FILES: usize = 256;
 
 /// The mesh files of a request, sorted by URI: at most [`MAX_MESH_FILES`],
-/// each within the mesh reader's byte limit, no URI twice.
-fn meshes_in(files: &[pb::MeshFile]) -> Result<MeshFiles, Status> {
+/// each within the mesh reader's byte limit, no URI twice. Borrowed: a
+/// model already held is found by its id without copying them.
+fn meshes_in(files: &[pb::MeshFile]) -> Result<Vec<&pb::MeshFile>, Status> {
     if files.len() > MAX_MESH_FILES {
         return Err(invalid(
             "robot.meshes",
@@ -104,7 +120,6 @@ fn meshes_in(files: &[pb::MeshFile]) -> Result<MeshFiles, Status> {
         ));
     }
     let max = kinplan_core::collision::MeshFileLimits::default().max_bytes;
-    let mut out: Vec<(String, Vec<u8>)> = Vec::with_capacity(files.len());
     for (i, f) in files.iter().enumerate() {
         if f.uri.is_empty() {
             return Err(invalid(format!("robot.meshes[{i}].uri"), "is required"));
@@ -115,13 +130,53 @@ fn meshes_in(files: &[pb::MeshFile]) -> Result<MeshFiles, Status> {
                 format!("{} bytes exceed the limit of {max}", f.data.len()),
             ));
         }
-        out.push((f.uri.clone(), f.data.clone()));
     }
-    out.sort_by(|a, b| a.0.cmp(&b.0));
-    if let Some(w) = out.windows(2).find(|w| w[0].0 == w[1].0) {
-        return Err(invalid(format!("robot.meshes[{}]", w[0].0), "is given twice"));
+    let mut sorted: Vec<&pb::MeshFile> = files.iter().collect();
+    sorted.sort_by(|a, b| a.uri.cmp(&b.uri));
+    if let Some(w) = sorted.windows(2).find(|w| w[0].uri == w[1].uri) {
+        return Err(invalid(format!("robot.meshes[{}]", w[0].uri), "is given twice"));
     }
-    Ok(Arc::from(out))
+    Ok(sorted)
+}
+
+/// An inline model as the request carries it (validated, files sorted by
+/// URI), and its id.
+struct Inline<'a> {
+    urdf: &'a str,
+    srdf: Option<&'a str>,
+    meshes: Vec<&'a pb::MeshFile>,
+}
+
+impl Inline<'_> {
+    fn id(&self) -> ModelId {
+        model_id(
+            self.urdf,
+            self.srdf,
+            self.meshes.iter().map(|f| (f.uri.as_str(), f.data.as_slice())),
+        )
+    }
+
+    /// The model's owned source, its SRDF read (refused here when bad): built
+    /// only when the model is not held already.
+    fn source(&self, limits: &UrdfLimits) -> Result<ModelSource, Status> {
+        let meshes: Vec<(String, Vec<u8>)> = self
+            .meshes
+            .iter()
+            .map(|f| (f.uri.clone(), f.data.clone()))
+            .collect();
+        let srdf = match self.srdf {
+            None => None,
+            Some(text) => Some(Arc::new(SrdfSource {
+                text: text.to_string(),
+                parsed: parse_srdf(text, limits).map_err(|e| robot_error(e, ""))?,
+            })),
+        };
+        Ok(ModelSource {
+            urdf: Arc::from(self.urdf),
+            meshes: Arc::from(meshes),
+            srdf,
+        })
+    }
 }
 
 /// The chain of the SRDF group `group`: its (first) `<chain>`.
@@ -311,6 +366,7 @@ impl ModelStore {
                 "names the chain: leave base_link and tip_link empty",
             ));
         }
+        let mut inline = None;
         let (id, text) = match &robot.source {
             None => return Err(invalid("robot", "one of name, urdf or model_id is required")),
             Some(Source::Name(name)) => {
@@ -328,39 +384,22 @@ impl ModelStore {
                 (source.id(), Some(source))
             }
             Some(Source::Urdf(text)) => {
-                if text.len() > self.limits.max_bytes {
-                    return Err(invalid(
-                        "robot.urdf",
-                        format!(
-                            "{} bytes exceed the limit of {}",
-                            text.len(),
-                            self.limits.max_bytes
-                        ),
-                    ));
+                for (field, len) in [("robot.urdf", text.len()), ("robot.srdf", robot.srdf.len())] {
+                    if len > self.limits.max_bytes {
+                        return Err(invalid(
+                            field,
+                            format!("{len} bytes exceed the limit of {}", self.limits.max_bytes),
+                        ));
+                    }
                 }
-                if robot.srdf.len() > self.limits.max_bytes {
-                    return Err(invalid(
-                        "robot.srdf",
-                        format!(
-                            "{} bytes exceed the limit of {}",
-                            robot.srdf.len(),
-                            self.limits.max_bytes
-                        ),
-                    ));
-                }
-                let source = ModelSource {
-                    urdf: Arc::from(text.as_str()),
+                let sent = Inline {
+                    urdf: text,
+                    srdf: Some(robot.srdf.as_str()).filter(|s| !s.is_empty()),
                     meshes: meshes_in(&robot.meshes)?,
-                    // read when sent: refused now, not at the first call that needs it
-                    srdf: match robot.srdf.as_str() {
-                        "" => None,
-                        text => Some(Arc::new(SrdfSource {
-                            text: text.to_string(),
-                            parsed: parse_srdf(text, &self.limits).map_err(|e| robot_error(e, ""))?,
-                        })),
-                    },
                 };
-                (source.id(), Some(source))
+                let id = sent.id();
+                inline = Some(sent);
+                (id, None)
             }
             Some(Source::ModelId(bytes)) => {
                 let id: ModelId = bytes.as_slice().try_into().map_err(|_| {
@@ -374,16 +413,22 @@ impl ModelStore {
             Some(Source::Name(_)) => Vec::new(),
             _ => id.to_vec(),
         };
+        // The source behind the id: held already, or read from the request
+        // (its files copied, its SRDF parsed, so a bad one is refused on the
+        // call that sends it); a model this replica holds is not read again.
+        let held_or_sent = || match self.texts.lock().expect("cache lock").get(&id) {
+            Some(held) => Ok(held),
+            None => match &inline {
+                Some(sent) => sent.source(&self.limits),
+                None => Err(not_found(
+                    "robot.model_id",
+                    "this server does not hold that model; send the URDF again",
+                )),
+            },
+        };
         let text = match text {
             Some(t) => Some(t),
-            None if !robot.group.is_empty() => {
-                Some(self.texts.lock().expect("cache lock").get(&id).ok_or_else(|| {
-                    not_found(
-                        "robot.model_id",
-                        "this server does not hold that model; send the URDF again",
-                    )
-                })?)
-            }
+            None if !robot.group.is_empty() => Some(held_or_sent()?),
             None => None,
         };
         if !robot.group.is_empty() {
@@ -401,12 +446,7 @@ impl ModelStore {
         }
         let text = match text {
             Some(t) => t,
-            None => self.texts.lock().expect("cache lock").get(&id).ok_or_else(|| {
-                not_found(
-                    "robot.model_id",
-                    "this server does not hold that model; send the URDF again",
-                )
-            })?,
+            None => held_or_sent()?,
         };
         let chain = self.parse(text.urdf.clone(), spec, compute, budget).await?;
         let text_bytes = text.bytes();
@@ -511,5 +551,67 @@ mod tests {
             assert!(store.bytes() <= max, "{} bytes after {k} models", store.bytes());
         }
         assert!(store.bytes() > max / 4, "the cache still holds models");
+    }
+
+    /// An inline model with mesh files and an SRDF: its id is SHA-256 over
+    /// the documented layout (written out here byte by byte), whatever order
+    /// the files come in; sent again it is the model held (the same chain
+    /// and source, not read again); the same URDF with a broken SRDF is
+    /// another model, refused on the call that sends it.
+    #[tokio::test]
+    async fn an_inline_model_is_named_by_its_content_and_read_once() {
+        let store = ModelStore::new(UrdfLimits::default(), 8, 64 << 20);
+        let compute = Compute::new(1, 4, None);
+        let budget = Budget::new(None);
+        let urdf = kinplan_core::robot::builtin_urdf("ur5").unwrap();
+        let srdf = r#"<robot name="ur5"><disable_collisions link1="base_link" link2="shoulder_link" reason="Adjacent"/></robot>"#;
+        let file = |uri: &str, data: &[u8]| pb::MeshFile {
+            uri: uri.into(),
+            data: data.to_vec(),
+        };
+        let sent = |srdf: &str, files: Vec<pb::MeshFile>| pb::RobotRef {
+            source: Some(Source::Urdf(urdf.into())),
+            srdf: srdf.into(),
+            meshes: files,
+            ..Default::default()
+        };
+        let (a, b) = (
+            file("package://m/b.stl", b"bee"),
+            file("package://m/a.stl", b"ay"),
+        );
+        let first = store
+            .resolve(Some(&sent(srdf, vec![a.clone(), b.clone()])), &compute, &budget)
+            .await
+            .unwrap();
+
+        let mut bytes = b"kinplan-model-v1\0".to_vec();
+        for part in [
+            urdf.as_bytes(),
+            srdf.as_bytes(),
+            b"package://m/a.stl",
+            b"ay",
+            b"package://m/b.stl",
+            b"bee",
+        ] {
+            bytes.extend_from_slice(&(part.len() as u64).to_le_bytes());
+            bytes.extend_from_slice(part);
+        }
+        assert_eq!(first.model_id, Sha256::digest(&bytes).to_vec());
+
+        let again = store
+            .resolve(Some(&sent(srdf, vec![b, a.clone()])), &compute, &budget)
+            .await
+            .unwrap();
+        assert_eq!(again.model_id, first.model_id);
+        assert!(Arc::ptr_eq(&again.chain, &first.chain));
+        assert!(Arc::ptr_eq(&again.source.meshes, &first.source.meshes));
+
+        let err = store
+            .resolve(Some(&sent("<robot", vec![a])), &compute, &budget)
+            .await
+            .err()
+            .expect("a broken SRDF is refused");
+        assert_eq!(err.code(), tonic::Code::InvalidArgument);
+        assert!(err.message().to_lowercase().contains("srdf"), "{}", err.message());
     }
 }
