@@ -15,7 +15,10 @@
 //!   instead of by name, the path a user's own robot takes; with the
 //!   `--user-*` flags, another URDF of the same arm (joints named as the
 //!   problems name them) with the collision mesh files it names and its SRDF,
-//!   e.g. example-robot-data's Panda.
+//!   e.g. example-robot-data's Panda;
+//! - *by model id*: that robot named by the model id the server returned for
+//!   it (`DescribeRobot`), as the clients send a URDF robot after its first
+//!   call.
 //!
 //! Before the problems, an idle round trip on the same connection for
 //! reference: `ForwardKinematics` of the same built-in robot at its zero
@@ -375,11 +378,25 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
         "idle round trip (ForwardKinematics, {FK_CALLS} calls, same connection): median {:.0} µs\n",
         median(&mut round_trips)
     );
+    // the user's robot as the clients name it after the first call
+    let described = robot
+        .describe_robot(pb::DescribeRobotRequest {
+            robot: Some(robot_ref(true, a.user.as_ref())),
+            ..Default::default()
+        })
+        .await?
+        .into_inner();
+    let by_id = pb::RobotRef {
+        source: Some(pb::robot_ref::Source::ModelId(described.model_id)),
+        srdf: String::new(),
+        meshes: Vec::new(),
+        ..robot_ref(true, a.user.as_ref())
+    };
     let mut client = PlanningServiceClient::new(channel);
     println!(
-        "| set | solved / valid | default: wall | server total | of which RRT-Connect | overhead | no random shortcuts: wall | server RRT-Connect | overhead | as URDF: wall | URDF / name |"
+        "| set | solved / valid | default: wall | server total | of which RRT-Connect | overhead | no random shortcuts: wall | server RRT-Connect | overhead | as URDF: wall | URDF / name | by model id: wall | id / name |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let us = |v: f64| format!("{v:.0} µs");
     for set in SETS {
         if a.set.as_deref().is_some_and(|s| s != set) {
@@ -387,8 +404,8 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let problems = load_set(&a.problems.join(format!("{set}_panda")))?;
         // default wall, total, RRT-Connect, overhead; no-random-shortcut wall,
-        // RRT-Connect, overhead; as-URDF wall
-        let mut cols: [Vec<f64>; 8] = Default::default();
+        // RRT-Connect, overhead; as-URDF wall; by-model-id wall
+        let mut cols: [Vec<f64>; 9] = Default::default();
         let (mut valid, mut solved) = (0, 0);
         for (k, scene, start, goal) in &problems {
             let by_name = request(robot_ref(false, None), scene, start, goal, *k, None);
@@ -401,21 +418,23 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
             valid += 1;
             let search = request(robot_ref(false, None), scene, start, goal, *k, Some(0));
             let urdf = request(robot_ref(true, a.user.as_ref()), scene, start, goal, *k, None);
+            let named = request(by_id.clone(), scene, start, goal, *k, None);
             client.plan(urdf.clone()).await?;
             let d = time_request(&mut client, &by_name, a.passes).await?;
             let s = time_request(&mut client, &search, a.passes).await?;
             let u = time_request(&mut client, &urdf, a.passes).await?;
-            if let (Some(d), Some(s), Some(u)) = (d, s, u) {
+            let i = time_request(&mut client, &named, a.passes).await?;
+            if let (Some(d), Some(s), Some(u), Some(i)) = (d, s, u, i) {
                 solved += 1;
-                let row = [d[0], d[1], d[2], d[0] - d[1], s[0], s[2], s[0] - s[1], u[0]];
+                let row = [d[0], d[1], d[2], d[0] - d[1], s[0], s[2], s[0] - s[1], u[0], i[0]];
                 for (col, v) in cols.iter_mut().zip(row) {
                     col.push(v);
                 }
             }
         }
-        let [dw, dt, dr, dover, sw, sr, sover, uw] = cols.each_mut().map(|c| median(c));
+        let [dw, dt, dr, dover, sw, sr, sover, uw, iw] = cols.each_mut().map(|c| median(c));
         println!(
-            "| {set} | {solved} / {valid} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2}× |",
+            "| {set} | {solved} / {valid} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2}× | {} | {:.2}× |",
             us(dw),
             us(dt),
             us(dr),
@@ -425,6 +444,8 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
             us(sover),
             us(uw),
             uw / dw,
+            us(iw),
+            iw / dw,
         );
     }
     Ok(())
