@@ -67,7 +67,7 @@ impl ModelSource {
     }
 
     /// The model id ([`model_id`]).
-    fn id(&self) -> ModelId {
+    async fn id(&self) -> ModelId {
         model_id(
             &self.urdf,
             self.srdf.as_ref().map(|s| s.text.as_str()),
@@ -75,6 +75,7 @@ impl ModelSource {
                 .iter()
                 .map(|(uri, data)| (uri.as_str(), data.as_slice())),
         )
+        .await
     }
 }
 
@@ -82,28 +83,42 @@ impl ModelSource {
 /// and no SRDF (as before they could be sent), else of
 /// `"kinplan-model-v1\0" · len·urdf · len·srdf · Σ_files(len·uri · len·data)`
 /// with the files sorted by URI, every length a little-endian u64 and an
-/// absent SRDF empty.
-fn model_id<'a>(
+/// absent SRDF empty. Hashed [`HASH_SLICE`] bytes at a time, the runtime
+/// given back between slices: a request of many megabytes of meshes does not
+/// hold up the other calls its I/O thread serves.
+async fn model_id<'a>(
     urdf: &str,
     srdf: Option<&str>,
     meshes: impl ExactSizeIterator<Item = (&'a str, &'a [u8])>,
 ) -> ModelId {
-    if meshes.len() == 0 && srdf.is_none() {
-        return Sha256::digest(urdf.as_bytes()).into();
-    }
     let mut h = Sha256::new();
+    if meshes.len() == 0 && srdf.is_none() {
+        hash_yielding(&mut h, urdf.as_bytes()).await;
+        return h.finalize().into();
+    }
     h.update(b"kinplan-model-v1\0");
-    let mut part = |bytes: &[u8]| {
-        h.update((bytes.len() as u64).to_le_bytes());
-        h.update(bytes);
-    };
-    part(urdf.as_bytes());
-    part(srdf.unwrap_or("").as_bytes());
-    for (uri, data) in meshes {
-        part(uri.as_bytes());
-        part(data);
+    let parts = [urdf.as_bytes(), srdf.unwrap_or("").as_bytes()]
+        .into_iter()
+        .chain(meshes.flat_map(|(uri, data)| [uri.as_bytes(), data]));
+    for part in parts {
+        h.update((part.len() as u64).to_le_bytes());
+        hash_yielding(&mut h, part).await;
     }
     h.finalize().into()
+}
+
+/// Bytes hashed between two yields to the runtime (about a tenth of a
+/// millisecond of SHA-256).
+const HASH_SLICE: usize = 128 << 10;
+
+/// `h ← h · bytes`, yielding to the runtime after every [`HASH_SLICE`].
+async fn hash_yielding(h: &mut Sha256, bytes: &[u8]) {
+    for slice in bytes.chunks(HASH_SLICE) {
+        h.update(slice);
+        if slice.len() == HASH_SLICE {
+            tokio::task::yield_now().await;
+        }
+    }
 }
 
 /// Most mesh files one model may carry.
@@ -148,17 +163,23 @@ struct Inline<'a> {
 }
 
 impl Inline<'_> {
-    fn id(&self) -> ModelId {
+    async fn id(&self) -> ModelId {
         model_id(
             self.urdf,
             self.srdf,
             self.meshes.iter().map(|f| (f.uri.as_str(), f.data.as_slice())),
         )
+        .await
     }
 
-    /// The model's owned source, its SRDF read (refused here when bad): built
-    /// only when the model is not held already.
-    fn source(&self, limits: &UrdfLimits) -> Result<ModelSource, Status> {
+    /// The model's owned source, its SRDF read on the CPU pool (refused here
+    /// when bad): built only when the model is not held already.
+    async fn source(
+        &self,
+        limits: UrdfLimits,
+        compute: &Compute,
+        budget: &Budget,
+    ) -> Result<ModelSource, Status> {
         let meshes: Vec<(String, Vec<u8>)> = self
             .meshes
             .iter()
@@ -166,10 +187,17 @@ impl Inline<'_> {
             .collect();
         let srdf = match self.srdf {
             None => None,
-            Some(text) => Some(Arc::new(SrdfSource {
-                text: text.to_string(),
-                parsed: parse_srdf(text, limits).map_err(|e| robot_error(e, ""))?,
-            })),
+            Some(text) => {
+                let text = text.to_string();
+                let read = compute
+                    .run(budget, move |_| {
+                        let parsed = parse_srdf(&text, &limits)?;
+                        Ok(SrdfSource { text, parsed })
+                    })
+                    .await?
+                    .map_err(|e| robot_error(e, ""))?;
+                Some(Arc::new(read))
+            }
         };
         Ok(ModelSource {
             urdf: Arc::from(self.urdf),
@@ -381,7 +409,7 @@ impl ModelStore {
                 }
                 // Another chain of a built-in: parsed once, then cached like any URDF.
                 let source = builtin_source(name)?;
-                (source.id(), Some(source))
+                (source.id().await, Some(source))
             }
             Some(Source::Urdf(text)) => {
                 for (field, len) in [("robot.urdf", text.len()), ("robot.srdf", robot.srdf.len())] {
@@ -397,7 +425,7 @@ impl ModelStore {
                     srdf: Some(robot.srdf.as_str()).filter(|s| !s.is_empty()),
                     meshes: meshes_in(&robot.meshes)?,
                 };
-                let id = sent.id();
+                let id = sent.id().await;
                 inline = Some(sent);
                 (id, None)
             }
@@ -416,19 +444,20 @@ impl ModelStore {
         // The source behind the id: held already, or read from the request
         // (its files copied, its SRDF parsed, so a bad one is refused on the
         // call that sends it); a model this replica holds is not read again.
-        let held_or_sent = || match self.texts.lock().expect("cache lock").get(&id) {
-            Some(held) => Ok(held),
-            None => match &inline {
-                Some(sent) => sent.source(&self.limits),
-                None => Err(not_found(
+        let held_or_sent = async || {
+            let held = self.texts.lock().expect("cache lock").get(&id);
+            match (held, &inline) {
+                (Some(held), _) => Ok(held),
+                (None, Some(sent)) => sent.source(self.limits, compute, budget).await,
+                (None, None) => Err(not_found(
                     "robot.model_id",
                     "this server does not hold that model; send the URDF again",
                 )),
-            },
+            }
         };
         let text = match text {
             Some(t) => Some(t),
-            None if !robot.group.is_empty() => Some(held_or_sent()?),
+            None if !robot.group.is_empty() => Some(held_or_sent().await?),
             None => None,
         };
         if !robot.group.is_empty() {
@@ -446,7 +475,7 @@ impl ModelStore {
         }
         let text = match text {
             Some(t) => t,
-            None => held_or_sent()?,
+            None => held_or_sent().await?,
         };
         let chain = self.parse(text.urdf.clone(), spec, compute, budget).await?;
         let text_bytes = text.bytes();
@@ -553,7 +582,8 @@ mod tests {
         assert!(store.bytes() > max / 4, "the cache still holds models");
     }
 
-    /// An inline model with mesh files and an SRDF: its id is SHA-256 over
+    /// An inline model with mesh files (one of several hashing slices) and an
+    /// SRDF: its id is SHA-256 over
     /// the documented layout (written out here byte by byte), whatever order
     /// the files come in; sent again it is the model held (the same chain
     /// and source, not read again); the same URDF with a broken SRDF is
@@ -575,10 +605,11 @@ mod tests {
             meshes: files,
             ..Default::default()
         };
-        let (a, b) = (
-            file("package://m/b.stl", b"bee"),
-            file("package://m/a.stl", b"ay"),
-        );
+        // a file of several hashing slices, not a whole number of them
+        let big: Vec<u8> = (0..2 * HASH_SLICE + 12_345)
+            .map(|i| (i * 7 % 251) as u8)
+            .collect();
+        let (a, b) = (file("package://m/b.stl", &big), file("package://m/a.stl", b"ay"));
         let first = store
             .resolve(Some(&sent(srdf, vec![a.clone(), b.clone()])), &compute, &budget)
             .await
@@ -591,7 +622,7 @@ mod tests {
             b"package://m/a.stl",
             b"ay",
             b"package://m/b.stl",
-            b"bee",
+            &big,
         ] {
             bytes.extend_from_slice(&(part.len() as u64).to_le_bytes());
             bytes.extend_from_slice(part);
