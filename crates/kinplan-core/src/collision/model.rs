@@ -27,6 +27,7 @@ use super::{CollisionError, Geometry};
 use crate::robot::{Chain, CollisionShape, JointKind, Shape};
 use crate::{Deadline, Stop};
 use rayon::prelude::*;
+use std::collections::{HashMap, HashSet};
 
 /// Most collision bodies (links with geometry) a model may have: one bit
 /// each in a `u64` of the padded check, whose top bit is its self pairs.
@@ -243,18 +244,33 @@ impl RobotModel {
         // Body carried by each link, for attached bodies' parents.
         let mut last_body_at_link: Vec<Option<usize>> = vec![None; chain.links().len()];
         let mut last: Option<usize> = None;
-        // Each body's shapes are built on their own (a mesh's hull and fitted
-        // polytope are the costly part), so side by side; the first error in
-        // body order is the one reported.
+        // A mesh's hull and fitted polytope are the costly part: built once
+        // per file and scale however many elements name them, side by side;
+        // then each body's shapes. The first error in body order is the one
+        // reported.
+        let link_fields: Vec<String> = chain
+            .collision()
+            .iter()
+            .map(|lc| format!("links[{}]", lc.link))
+            .collect();
+        let attached_fields: Vec<String> = (0..attached.len()).map(|k| format!("attached[{k}]")).collect();
+        let elements = chain
+            .collision()
+            .iter()
+            .map(|lc| &lc.shapes[..])
+            .zip(&link_fields)
+            .chain(attached.iter().map(|a| &a.shapes[..]).zip(&attached_fields));
+        let hulls = mesh_hulls(elements, meshes, deadline);
         let link_shapes: Vec<_> = chain
             .collision()
-            .par_iter()
-            .map(|lc| body_shapes(&lc.shapes, meshes, &format!("links[{}]", lc.link), deadline))
+            .iter()
+            .zip(&link_fields)
+            .map(|(lc, field)| body_shapes(&lc.shapes, &hulls, field))
             .collect();
         let attached_shapes: Vec<_> = attached
-            .par_iter()
-            .enumerate()
-            .map(|(k, a)| body_shapes(&a.shapes, meshes, &format!("attached[{k}]"), deadline))
+            .iter()
+            .zip(&attached_fields)
+            .map(|(a, field)| body_shapes(&a.shapes, &hulls, field))
             .collect();
         for ((li, lc), shapes) in chain.collision().iter().enumerate().zip(link_shapes) {
             let shapes = shapes?;
@@ -595,13 +611,115 @@ fn named_mesh<'a>(meshes: &'a [InlineMesh], filename: &str) -> Option<&'a Inline
         .or_else(|| builtin_mesh(filename))
 }
 
-/// parry shapes of URDF collision elements; zero-size primitives (a URDF
-/// may declare them) are skipped.
-fn body_shapes(
-    shapes: &[CollisionShape],
-    meshes: &[InlineMesh],
+/// A mesh file at one scale (the bits of its three factors).
+type MeshKey<'a> = (&'a str, [u64; 3]);
+
+fn mesh_key<'a>(filename: &'a str, scale: &Vector3<f64>) -> MeshKey<'a> {
+    (
+        filename,
+        [scale.x.to_bits(), scale.y.to_bits(), scale.z.to_bits()],
+    )
+}
+
+/// The costly part of a mesh body, mesh frame, shared by every collision
+/// element that names the same file at the same scale.
+struct MeshHull {
+    /// The mesh's vertices, scaled.
+    points: Vec<parry3d_f64::math::Vector>,
+    shape: MeshShape,
+}
+
+/// What collides for a mesh (each contains every vertex).
+enum MeshShape {
+    /// A polytope of few faces fitted around the hull ([`fewer_faced`]).
+    Fitted(SharedShape),
+    /// The hull itself, grown where parry's hull left vertices outside.
+    Hull(SharedShape),
+    /// Too many vertices to check against the hull: the closed-form bound
+    /// of the element's vertices is the shape.
+    Bound,
+}
+
+/// The [`MeshHull`] of every distinct mesh file and scale that `elements`
+/// (the collision shapes of each body, with the body's field) name, built
+/// side by side; a build that fails carries the error of the first element,
+/// in body order, that names its mesh. Files neither sent nor built in are
+/// left out (the element reports them).
+fn mesh_hulls<'a>(
+    elements: impl Iterator<Item = (&'a [CollisionShape], &'a String)>,
+    meshes: &'a [InlineMesh],
+    deadline: Deadline<'_>,
+) -> HashMap<MeshKey<'a>, Result<MeshHull, CollisionError>> {
+    let mut first: Vec<(MeshKey<'a>, &'a InlineMesh, String)> = Vec::new();
+    let mut seen = HashSet::new();
+    for (shapes, field) in elements {
+        for (k, cs) in shapes.iter().enumerate() {
+            if let Shape::MeshReference { filename, scale } = &cs.shape {
+                let key = mesh_key(filename, scale);
+                if let Some(mesh) = named_mesh(meshes, filename)
+                    && seen.insert(key)
+                {
+                    first.push((key, mesh, format!("{field}.collision[{k}]")));
+                }
+            }
+        }
+    }
+    first
+        .par_iter()
+        .map(|(key, mesh, field)| {
+            let scale = Vector3::from(key.1.map(f64::from_bits));
+            (*key, mesh_hull(mesh, &scale, field, deadline))
+        })
+        .collect()
+}
+
+/// A mesh's hull at `scale` and the shape that collides for it
+/// ([`MeshShape`]); errors name `field`.
+fn mesh_hull(
+    mesh: &InlineMesh,
+    scale: &Vector3<f64>,
     field: &str,
     deadline: Deadline<'_>,
+) -> Result<MeshHull, CollisionError> {
+    if let Some(stop) = deadline.stop() {
+        return Err(CollisionError::Stopped {
+            what: "building the robot's collision bodies (mesh hulls)".into(),
+            stop,
+        });
+    }
+    validate_mesh_points(&mesh.vertices, &mesh.indices, field, &SceneLimits::default())?;
+    let points: Vec<_> = mesh
+        .vertices
+        .iter()
+        .map(|p| vec_to_parry(&p.coords.component_mul(scale)))
+        .collect();
+    let hull = SharedShape::convex_hull(&points).ok_or_else(|| CollisionError::Degenerate {
+        field: field.to_string(),
+        reason: format!("mesh `{}` has no 3-D convex hull", mesh.filename),
+    })?;
+    // a polytope of few faces, itself checked to hold every point
+    let shape = if let Some(polytope) = fewer_faced(&hull, &points) {
+        MeshShape::Fitted(polytope)
+    } else {
+        match farthest_outside(&hull, &points) {
+            Some(0.0) => MeshShape::Hull(hull),
+            // parry's hull left points outside: grow it by the farthest
+            Some(d) => MeshShape::Hull(
+                SharedShape::round_convex_hull(&points, d * (1.0 + 1e-9) + 1e-12).expect("the hull exists"),
+            ),
+            None => MeshShape::Bound,
+        }
+    };
+    Ok(MeshHull { points, shape })
+}
+
+/// parry shapes of URDF collision elements, meshes from `hulls`
+/// ([`mesh_hulls`]); zero-size primitives (a URDF may declare them) are
+/// skipped.
+fn body_shapes(
+    shapes: &[CollisionShape],
+    hulls: &HashMap<MeshKey<'_>, Result<MeshHull, CollisionError>>,
+    field: &str,
 ) -> Result<Vec<BodyShape>, CollisionError> {
     let mut out = Vec::with_capacity(shapes.len());
     for (k, cs) in shapes.iter().enumerate() {
@@ -620,66 +738,43 @@ fn body_shapes(
                 length: *length,
             },
             Shape::MeshReference { filename, scale } => {
-                if let Some(stop) = deadline.stop() {
-                    return Err(CollisionError::Stopped {
-                        what: "building the robot's collision bodies (mesh hulls)".into(),
-                        stop,
-                    });
-                }
-                let mesh = named_mesh(meshes, filename).ok_or_else(|| CollisionError::MeshNotInline {
-                    field: field.clone(),
-                    filename: filename.clone(),
-                })?;
-                validate_mesh_points(&mesh.vertices, &mesh.indices, &field, &SceneLimits::default())?;
-                let points: Vec<_> = mesh
-                    .vertices
-                    .iter()
-                    .map(|p| vec_to_parry(&p.coords.component_mul(scale)))
-                    .collect();
-                let hull = SharedShape::convex_hull(&points).ok_or_else(|| CollisionError::Degenerate {
-                    field: field.clone(),
-                    reason: format!("mesh `{filename}` has no 3-D convex hull"),
-                })?;
-                // a polytope of few faces, itself checked to hold every point
-                if let Some(polytope) = fewer_faced(&hull, &points) {
-                    let corners = polytope.as_convex_polyhedron().expect("a polytope").points();
-                    let corners: Vec<Point3<f64>> =
-                        corners.iter().map(|p| cs.origin * point_from_parry(*p)).collect();
-                    out.push(BodyShape {
+                let mesh = match hulls.get(&mesh_key(filename, scale)) {
+                    Some(built) => built.as_ref().map_err(Clone::clone)?,
+                    None => {
+                        return Err(CollisionError::MeshNotInline {
+                            field: field.clone(),
+                            filename: filename.clone(),
+                        });
+                    }
+                };
+                let placed = |p: &parry3d_f64::math::Vector| cs.origin * point_from_parry(*p);
+                out.push(match &mesh.shape {
+                    MeshShape::Fitted(polytope) => {
+                        let corners = polytope.as_convex_polyhedron().expect("a polytope").points();
+                        BodyShape {
+                            offset: cs.origin,
+                            shape: polytope.clone(),
+                            fast: RobotFast::None,
+                            bound: enclosing(&corners.iter().map(placed).collect::<Vec<_>>()),
+                            faces: None,
+                        }
+                    }
+                    MeshShape::Hull(hull) => BodyShape {
                         offset: cs.origin,
-                        shape: polytope,
+                        shape: hull.clone(),
                         fast: RobotFast::None,
-                        bound: enclosing(&corners),
+                        bound: enclosing(&mesh.points.iter().map(placed).collect::<Vec<_>>()),
                         faces: None,
-                    });
-                    continue;
-                }
-                let every: Vec<Point3<f64>> =
-                    points.iter().map(|p| cs.origin * point_from_parry(*p)).collect();
-                let bound = enclosing(&every);
-                match farthest_outside(&hull, &points) {
-                    Some(0.0) => out.push(BodyShape {
-                        offset: cs.origin,
-                        shape: hull,
-                        fast: RobotFast::None,
-                        bound,
-                        faces: None,
-                    }),
-                    // parry's hull left points outside: grow it by the farthest
-                    Some(d) => out.push(BodyShape {
-                        offset: cs.origin,
-                        shape: SharedShape::round_convex_hull(&points, d * (1.0 + 1e-9) + 1e-12)
-                            .expect("the hull exists"),
-                        fast: RobotFast::None,
-                        bound,
-                        faces: None,
-                    }),
+                    },
                     // too many points to check: the closed-form bound is the shape
-                    None => out.push(bound_shape(bound).ok_or_else(|| CollisionError::Degenerate {
-                        field: field.clone(),
-                        reason: format!("mesh `{filename}` has no finite bound"),
-                    })?),
-                }
+                    MeshShape::Bound => {
+                        bound_shape(enclosing(&mesh.points.iter().map(placed).collect::<Vec<_>>()))
+                            .ok_or_else(|| CollisionError::Degenerate {
+                                field: field.clone(),
+                                reason: format!("mesh `{filename}` has no finite bound"),
+                            })?
+                    }
+                });
                 continue;
             }
         };

@@ -1316,6 +1316,70 @@ fn naming_n_times(filename: &str, n: usize) -> String {
     probe_urdf(&elements)
 }
 
+/// Collision elements naming one mesh file at one scale share one hull,
+/// each placed at its own origin; the same file at another scale is
+/// another hull. Each shape holds its element's vertices (parry's point
+/// test, 0.1 mm inside), and its closed-form bound holds its corners.
+#[test]
+fn a_mesh_named_twice_is_built_once_and_placed_twice() {
+    use super::super::convert::{point_from_parry, pose_to_parry, vec_to_parry};
+    let mesh = uv_sphere("package://probe/ball.stl", 12, 24);
+    let name = &mesh.filename;
+    let geometry = format!(
+        r#"<mesh filename="{name}"/></geometry></collision>
+           <collision><origin xyz="0.3 0 0" rpy="0 0 1"/><geometry><mesh filename="{name}"/></geometry></collision>
+           <collision><origin xyz="0 0.3 0"/><geometry><mesh filename="{name}" scale="2 1 2"/>"#
+    );
+    let chain = Arc::new(
+        parse_chain(
+            &probe_urdf(&geometry),
+            &ChainSpec::default(),
+            UrdfLimits::default(),
+        )
+        .unwrap(),
+    );
+    let model = RobotModel::with_parts(chain, &[], std::slice::from_ref(&mesh)).unwrap();
+    let shapes = &model.bodies[0].shapes;
+    assert_eq!(shapes.len(), 3);
+    assert!(
+        Arc::ptr_eq(&shapes[0].shape.0, &shapes[1].shape.0),
+        "one hull for one file and scale"
+    );
+    assert!(
+        !Arc::ptr_eq(&shapes[0].shape.0, &shapes[2].shape.0),
+        "another scale, another hull"
+    );
+    let origins = [
+        Isometry3::identity(),
+        Isometry3::new(Vector3::new(0.3, 0.0, 0.0), Vector3::new(0.0, 0.0, 1.0)),
+        Isometry3::translation(0.0, 0.3, 0.0),
+    ];
+    let scales = [
+        Vector3::repeat(1.0),
+        Vector3::repeat(1.0),
+        Vector3::new(2.0, 1.0, 2.0),
+    ];
+    for (k, shape) in shapes.iter().enumerate() {
+        let pose = pose_to_parry(&shape.offset);
+        for v in &mesh.vertices {
+            let at = origins[k] * Point3::from(v.coords.component_mul(&scales[k]));
+            // 0.1 mm towards the element's centre: strictly inside the hull
+            let inner = at + (origins[k].translation.vector - at.coords).normalize() * 1e-4;
+            assert!(
+                shape.shape.contains_point(&pose, vec_to_parry(&inner.coords)),
+                "element {k}: {at:?} outside"
+            );
+        }
+        for p in shape.shape.as_convex_polyhedron().expect("a polytope").points() {
+            let corner = shape.offset * point_from_parry(*p);
+            assert!(
+                super::super::bound::tests::outside(&shape.bound, &corner) <= 1e-12,
+                "{corner:?}"
+            );
+        }
+    }
+}
+
 #[test]
 fn a_mesh_named_beyond_the_vertex_budget_is_refused_before_any_hull() {
     let mesh = uv_sphere("package://r/m.stl", 100, 200);
