@@ -246,7 +246,8 @@ impl RobotModel {
         let mut last: Option<usize> = None;
         // A mesh's hull and fitted polytope are the costly part: built once
         // per file and scale however many elements name them, side by side;
-        // then each body's shapes. The first error in body order is the one
+        // then each body's shapes (placing a mesh's vertices for its bound),
+        // side by side too. The first error in body order is the one
         // reported.
         let link_fields: Vec<String> = chain
             .collision()
@@ -263,12 +264,12 @@ impl RobotModel {
         let hulls = mesh_hulls(elements, meshes, deadline);
         let link_shapes: Vec<_> = chain
             .collision()
-            .iter()
+            .par_iter()
             .zip(&link_fields)
             .map(|(lc, field)| body_shapes(&lc.shapes, &hulls, field))
             .collect();
         let attached_shapes: Vec<_> = attached
-            .iter()
+            .par_iter()
             .zip(&attached_fields)
             .map(|(a, field)| body_shapes(&a.shapes, &hulls, field))
             .collect();

@@ -583,11 +583,10 @@ mod tests {
     }
 
     /// An inline model with mesh files (one of several hashing slices) and an
-    /// SRDF: its id is SHA-256 over
-    /// the documented layout (written out here byte by byte), whatever order
-    /// the files come in; sent again it is the model held (the same chain
-    /// and source, not read again); the same URDF with a broken SRDF is
-    /// another model, refused on the call that sends it.
+    /// SRDF: its id is SHA-256 over the documented layout (written out here
+    /// byte by byte), whatever order the files come in; sent again it is the
+    /// model held (the same chain and source, not read again); the same URDF
+    /// with a broken SRDF is another model, refused on the call that sends it.
     #[tokio::test]
     async fn an_inline_model_is_named_by_its_content_and_read_once() {
         let store = ModelStore::new(UrdfLimits::default(), 8, 64 << 20);
