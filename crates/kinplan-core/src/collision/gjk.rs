@@ -175,6 +175,9 @@ pub(crate) struct Corners {
     x: Vec<f64>,
     y: Vec<f64>,
     z: Vec<f64>,
+    /// A hash of the corners' coordinates: names the shape in the warm
+    /// start's table ([`pair_key`]) the same way in every run.
+    key: u64,
 }
 
 impl Corners {
@@ -186,11 +189,24 @@ impl Corners {
             c.resize(padded, points[0][k]);
             c
         };
+        // FNV-1a over the coordinates' bits
+        let key = points
+            .iter()
+            .flat_map(|p| p.coords.iter())
+            .fold(0xcbf2_9ce4_8422_2325_u64, |h, v| {
+                (h ^ v.to_bits()).wrapping_mul(0x0000_0100_0000_01b3)
+            });
         Corners {
             x: column(0),
             y: column(1),
             z: column(2),
+            key,
         }
+    }
+
+    /// The hash of the corners' coordinates (for [`pair_key`]).
+    pub(crate) fn key(&self) -> u64 {
+        self.key
     }
 
     /// The first corner.
@@ -328,7 +344,7 @@ struct Hints {
     /// Which opening of the outermost [`WarmChecks`] a slot was filled in.
     generation: u64,
     /// Per slot: the pair's key, the generation, the direction.
-    slots: [(usize, u64, [f64; 3]); HINT_SLOTS],
+    slots: [(u64, u64, [f64; 3]); HINT_SLOTS],
 }
 
 thread_local! {
@@ -375,18 +391,20 @@ impl Drop for WarmChecks {
     }
 }
 
-/// A key naming the pair of shapes held at `a` and `b` for
-/// [`within_keyed`]: their addresses, which stay put while the model and
-/// scene holding them live.
-pub(crate) fn pair_key<A, B>(a: &A, b: &B) -> usize {
-    (a as *const A as usize) ^ (b as *const B as usize).rotate_left(29)
+/// A key naming a pair of shapes for [`within_keyed`] from the keys of the
+/// two (a polytope's [`Corners::key`], a scene leaf's place among the
+/// leaves): made of the inputs alone, not of where they sit in memory, so
+/// which hint a test finds is the same in every run.
+pub(crate) fn pair_key(a: u64, b: u64) -> u64 {
+    a ^ b.rotate_left(29).wrapping_mul(0x9e37_79b9_7f4a_7c15)
 }
 
 /// [`within`] for the pair of shapes named by `key`, started from the
 /// direction that last proved them apart within the current
 /// [`WarmChecks`] on this thread (a cold start outside one).
-pub(crate) fn within_keyed(corners: &Corners, other: &Convex, margin: f64, key: usize) -> bool {
-    let slot = key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (usize::BITS - HINT_SLOTS.trailing_zeros());
+pub(crate) fn within_keyed(corners: &Corners, other: &Convex, margin: f64, key: u64) -> bool {
+    let slot =
+        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (u64::BITS - HINT_SLOTS.trailing_zeros())) as usize;
     let (warm, hint) = HINTS.with_borrow(|h| {
         let (k, generation, d) = h.slots[slot];
         let hint = (h.depth > 0 && k == key && generation == h.generation).then(|| Vector3::from(d));

@@ -206,7 +206,7 @@ pub(crate) fn shapes_intersect_leaf(a: &Body, pa: &Isometry3<f64>, leaf: &Leaf) 
         Some(hit) => hit,
         None => {
             bound_meets_leaf(sa, pa, leaf, 0.0)
-                && gjk_leaf_within(sa, pa, &leaf.fast, 0.0).unwrap_or_else(|| {
+                && gjk_leaf_within(sa, pa, leaf, 0.0).unwrap_or_else(|| {
                     intersect(
                         &pose_to_parry(&(pa * sa.offset)),
                         &sa.shape,
@@ -337,11 +337,11 @@ fn posed(fast: &RobotFast, pose: &Isometry3<f64>) -> Option<LeafFast> {
 /// leaf's closed form; `None` when the shape is no polytope with corners
 /// or the leaf has no closed form.
 #[inline]
-fn gjk_leaf_within(sa: &BodyShape, pa: &Isometry3<f64>, leaf: &LeafFast, margin: f64) -> Option<bool> {
+fn gjk_leaf_within(sa: &BodyShape, pa: &Isometry3<f64>, leaf: &Leaf, margin: f64) -> Option<bool> {
     let faces = sa.faces.as_ref()?;
     let pose = pa * sa.offset;
-    let (other, radius) = Convex::of_leaf(&pose, leaf)?;
-    let key = gjk::pair_key(faces.corners(), leaf);
+    let (other, radius) = Convex::of_leaf(&pose, &leaf.fast)?;
+    let key = gjk::pair_key(faces.corners().key(), leaf.key);
     Some(gjk::within_keyed(faces.corners(), &other, margin + radius, key))
 }
 
@@ -365,7 +365,7 @@ fn gjk_robot_within(
     let pose = pp * poly.offset;
     if let Some(other_faces) = other.faces.as_ref() {
         let shape = Convex::of_corners(&pose, other_faces.corners(), &(po * other.offset));
-        let key = gjk::pair_key(faces.corners(), other_faces.corners());
+        let key = gjk::pair_key(faces.corners().key(), other_faces.corners().key());
         return Some(gjk::within_keyed(faces.corners(), &shape, margin, key));
     }
     let (shape, radius) = Convex::of_leaf(&pose, &posed(&other.fast, po)?)?;
@@ -419,7 +419,7 @@ pub(crate) fn body_leaf_within(
             Some(hit) => hit,
             None => {
                 bound_meets_leaf(sa, pa, leaf, margin)
-                    && gjk_leaf_within(sa, pa, &leaf.fast, margin).unwrap_or_else(|| {
+                    && gjk_leaf_within(sa, pa, leaf, margin).unwrap_or_else(|| {
                         parry_within(
                             sa,
                             &pose_to_parry(&(pa * sa.offset)),

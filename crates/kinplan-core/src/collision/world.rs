@@ -22,6 +22,9 @@ pub(crate) struct Leaf {
     pub aabb: Aabb,
     /// The closed-form description (spheres, capsules, boxes, cells).
     pub fast: LeafFast,
+    /// Its place among the scene's leaves (names it in the GJK warm
+    /// start's table).
+    pub key: u64,
 }
 
 /// The scene ready for queries (see the module doc).
@@ -84,6 +87,7 @@ impl SceneGeometry {
                     shape,
                     aabb,
                     fast,
+                    key: leaves.len() as u64,
                 });
             };
             match &o.geometry {
