@@ -107,8 +107,7 @@ async fn model_id<'a>(
     h.finalize().into()
 }
 
-/// Bytes hashed between two yields to the runtime (about a tenth of a
-/// millisecond of SHA-256).
+/// Bytes hashed between two yields to the runtime.
 const HASH_SLICE: usize = 128 << 10;
 
 /// `h ← h · bytes`, yielding to the runtime after every [`HASH_SLICE`].
